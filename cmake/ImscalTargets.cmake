@@ -1,0 +1,33 @@
+# Shared build settings for every imscal target.
+
+# Compile options every imscal target gets: warnings (as errors in CI) and sanitizers.
+add_library(imscal_build_options INTERFACE)
+target_compile_options(imscal_build_options INTERFACE -Wall -Wextra)
+if(IMSCAL_WERROR)
+  target_compile_options(imscal_build_options INTERFACE -Werror)
+endif()
+if(IMSCAL_SANITIZE)
+  target_compile_options(imscal_build_options INTERFACE
+    -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+  target_link_options(imscal_build_options INTERFACE -fsanitize=address,undefined)
+endif()
+
+# One library per folder: every .cpp directly in the folder (a folder of headers only makes an
+# INTERFACE target). Headers are included from the repository root: #include "ims/strapdown.hpp".
+# Usage: imscal_folder_library(imscal_ims DEPENDS imscal_core Eigen3::Eigen ...)
+function(imscal_folder_library name)
+  cmake_parse_arguments(ARG "" "" "DEPENDS" ${ARGN})
+  file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
+  if(sources)
+    add_library(${name} STATIC ${sources})
+    target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/generated)
+    target_link_libraries(${name} PUBLIC ${ARG_DEPENDS} PRIVATE imscal_build_options)
+    if(IMSCAL_SANITIZE)
+      target_link_libraries(${name} PUBLIC imscal_build_options)
+    endif()
+  else()
+    add_library(${name} INTERFACE)
+    target_include_directories(${name} INTERFACE ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/generated)
+    target_link_libraries(${name} INTERFACE ${ARG_DEPENDS})
+  endif()
+endfunction()

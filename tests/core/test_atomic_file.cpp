@@ -1,0 +1,55 @@
+// AtomicFile: the target appears only on commit, an abandoned write leaves nothing behind, and an
+// existing output is refused unless overwriting is allowed.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/atomic_file.hpp"
+
+namespace fs = std::filesystem;
+using imscal::AtomicFile;
+using imscal::Overwrite;
+
+namespace {
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("imscal_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+}  // namespace
+
+TEST(AtomicFile, TargetAppearsOnlyOnCommit) {
+  const fs::path dir = fresh_dir("atomic_commit");
+  const fs::path target = dir / "out.csv";
+  {
+    AtomicFile file(target);
+    file.stream() << "a,b\n1,2\n";
+    EXPECT_FALSE(fs::exists(target));
+    file.commit();
+  }
+  EXPECT_EQ(slurp(target), "a,b\n1,2\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1);
+}
+
+TEST(AtomicFile, AbandonedWriteLeavesNothing) {
+  const fs::path dir = fresh_dir("atomic_abandon");
+  { AtomicFile file(dir / "out.csv"); file.stream() << "partial"; }
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 0);
+}
+
+TEST(AtomicFile, RefusesToOverwriteWithoutPermission) {
+  const fs::path dir = fresh_dir("atomic_refuse");
+  imscal::write_file_atomically(dir / "out.txt", "first");
+  EXPECT_THROW(AtomicFile(dir / "out.txt", Overwrite::kRefuse), std::runtime_error);
+  imscal::write_file_atomically(dir / "out.txt", "second", Overwrite::kAllow);
+  EXPECT_EQ(slurp(dir / "out.txt"), "second");
+}
