@@ -1,8 +1,13 @@
 #pragma once
 // Raw IMS samples in memory, as read from a file or synthesised.
 #include <Eigen/Core>
+#include <cstddef>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "ims/earth_model.hpp"
 
 namespace imscal::ims {
 
@@ -25,6 +30,11 @@ struct ImuSeries {
   double nominal_dt_s = 0.0;  // nominal sample interval
   std::vector<ImuSample> samples;
   std::string source;  // file the data came from (for messages); empty if synthesised
+  // Line of the file that holds samples[0] (1-based), so that sample i is on line
+  // first_data_line + i in text files; 0 for binary files and synthesised data.
+  std::size_t first_data_line = 0;
+  std::optional<Site> site;  // where the record was taken, if the file says
+  std::vector<std::pair<std::string, std::string>> metadata;  // other header fields, in order
 };
 
 }  // namespace imscal::ims
