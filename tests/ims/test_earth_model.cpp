@@ -59,8 +59,8 @@ TEST(EarthModel, GravityGradientIsFreeAirAndLinearisationHolds) {
   // Horizontal gradients are half as large and negative (convergence towards the centre).
   EXPECT_NEAR(earth.gravity_gradient_W()(0, 0), -1.54e-6, 0.05e-6);
   // Linearised field vs GeographicLib at the point, over a robot's workspace (2 m): < 1e-11.
-  for (const Eigen::Vector3d& p : {Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(-1, 1.5, 0.7),
-                                  Eigen::Vector3d(0, 0, -2)}) {
+  for (const Eigen::Vector3d& p :
+       {Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(-1, 1.5, 0.7), Eigen::Vector3d(0, 0, -2)}) {
     EXPECT_LT((earth.gravity_W(p) - earth.gravity_exact_W(p)).norm(), 1e-11);
   }
 }

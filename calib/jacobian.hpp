@@ -1,0 +1,17 @@
+#pragma once
+// Geometric Jacobian of the flange: the twist of H in the base R from the joint rates,
+//   [v; w] = J(q) * q_dot,
+// rows 0..2 the linear velocity [m/s] of the flange origin, rows 3..5 the angular velocity
+// [rad/s], both in R coordinates (the same reference point and axes as KDL's
+// ChainJntToJacSolver on a chain ending at H).
+#include <Eigen/Core>
+
+#include "calib/robot_description.hpp"
+
+namespace imscal::calib {
+
+using Jacobian = Eigen::Matrix<double, 6, kJointCount>;
+
+Jacobian geometric_jacobian(const KinematicModel& model, const JointVector& q);
+
+}  // namespace imscal::calib

@@ -1,0 +1,279 @@
+#include "ident/arx_fit.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Householder>
+#include <Eigen/QR>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace imscal::ident {
+namespace {
+
+using ConstMap = Eigen::Map<const Eigen::VectorXd>;
+
+// Rows per block of the blocked passes: small enough that the block and its lagged copies stay
+// in the L1/L2 cache, large enough that the dot products run at full vector speed.
+constexpr std::size_t kChunkRows = 2048;
+// Rows per block of the streamed QR (the block plus the running R are factored together).
+constexpr int kQrBlockRows = 512;
+
+void check_segment(const IoSegment& segment) {
+  if (segment.input.size() != segment.output.size())
+    throw std::invalid_argument("ARX data segment: input has " +
+                                std::to_string(segment.input.size()) + " samples, output has " +
+                                std::to_string(segment.output.size()));
+}
+
+double dot_lagged(const double* a, const double* b, std::size_t length) {
+  return ConstMap(a, static_cast<Eigen::Index>(length))
+      .dot(ConstMap(b, static_cast<Eigen::Index>(length)));
+}
+
+// Adds one segment's contribution to `gram` (see build_lagged_gram).
+void add_segment_gram(const IoSegment& segment, const LagSet& lags, int first_row,
+                      Eigen::MatrixXd& local, Eigen::MatrixXd& gram) {
+  const double* y = segment.output.data();
+  const double* u = segment.input.data();
+  const std::size_t n = segment.output.size();
+  const std::size_t f = static_cast<std::size_t>(first_row);
+  const int ny = lags.output_columns();
+  const int nu = lags.input_columns();
+  const int lu0 = lags.input_lag_min;
+  local.setZero();
+
+  // Base sums (one pass over the data, blocked): row y-lag 0 against every column, and row
+  // u-lag lu0 against every input column and every output lag >= 1.
+  for (std::size_t c = f; c < n; c += kChunkRows) {
+    const std::size_t len = std::min(kChunkRows, n - c);
+    for (int j = 0; j < ny; ++j)
+      local(0, lags.output_column(j)) += dot_lagged(y + c, y + c - j, len);
+    for (int l = 0; l < nu; ++l) {
+      const int lag = lu0 + l;
+      local(0, lags.input_column(lag)) += dot_lagged(y + c, u + c - lag, len);
+      local(lags.input_column(lu0), lags.input_column(lag)) +=
+          dot_lagged(u + c - lu0, u + c - lag, len);
+    }
+    for (int i = 1; i < ny; ++i)
+      local(lags.output_column(i), lags.input_column(lu0)) +=
+          dot_lagged(y + c - i, u + c - lu0, len);
+  }
+
+  // Sliding update: moving both lags by one shifts the summation window by one sample, which
+  // adds the sample before the window start and drops the last one.
+  auto shifted = [&](const double* s1, int l1, const double* s2, int l2, double previous) {
+    return previous + s1[f - l1] * s2[f - l2] - s1[n - l1] * s2[n - l2];
+  };
+  for (int i = 1; i < ny; ++i)
+    for (int j = i; j < ny; ++j) local(i, j) = shifted(y, i, y, j, local(i - 1, j - 1));
+  for (int la = lu0 + 1; la <= lags.input_lag_max; ++la)
+    for (int lb = la; lb <= lags.input_lag_max; ++lb)
+      local(lags.input_column(la), lags.input_column(lb)) =
+          shifted(u, la, u, lb, local(lags.input_column(la - 1), lags.input_column(lb - 1)));
+  for (int i = 1; i < ny; ++i)
+    for (int lb = lu0 + 1; lb <= lags.input_lag_max; ++lb)
+      local(i, lags.input_column(lb)) =
+          shifted(y, i, u, lb, local(i - 1, lags.input_column(lb - 1)));
+
+  gram.triangularView<Eigen::Upper>() += local;  // only the upper triangle of local is filled
+}
+
+// Streamed Householder QR of the column-scaled [Φ y]: returns the (p+1)-square R factor.
+Eigen::MatrixXd streamed_qr_factor(std::span<const IoSegment> segments,
+                                   const ArxStructure& structure, const Eigen::VectorXd& scale) {
+  const int na = structure.na;
+  const int nb = structure.nb;
+  const int p = na + nb;
+  const int q = p + 1;
+  const std::size_t first = static_cast<std::size_t>(structure.max_lag());
+  const std::size_t d = static_cast<std::size_t>(structure.dead_time);
+  Eigen::MatrixXd stack = Eigen::MatrixXd::Zero(q + kQrBlockRows, q);
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr;
+  int rows = 0;
+  auto flush = [&]() {
+    qr.compute(stack.topRows(q + rows));
+    stack.topRows(q) = qr.matrixQR().topRows(q).triangularView<Eigen::Upper>();
+    rows = 0;
+  };
+  for (const IoSegment& segment : segments) {
+    const auto& y = segment.output;
+    const auto& u = segment.input;
+    for (std::size_t k = first; k < y.size(); ++k) {
+      auto row = stack.row(q + rows);
+      for (int i = 0; i < na; ++i) row(i) = -y[k - 1 - i] * scale(i);
+      for (int j = 0; j < nb; ++j) row(na + j) = u[k - d - j] * scale(na + j);
+      row(p) = y[k];
+      if (++rows == kQrBlockRows) flush();
+    }
+  }
+  if (rows > 0) flush();
+  return stack.topRows(q);
+}
+
+// One blocked pass over the data: the residual r(k) = y(k) - φ(k)ᵀθ of every regression row;
+// returns Σ r² and, when wanted, accumulates Φᵀr (θ order) into *phi_t_r.
+double residual_pass(std::span<const IoSegment> segments, const ArxStructure& structure,
+                     const Eigen::VectorXd& theta, Eigen::VectorXd* phi_t_r) {
+  structure.validate();
+  if (theta.size() != structure.parameter_count())
+    throw std::invalid_argument("residual pass: θ size does not match the structure");
+  const std::size_t first = static_cast<std::size_t>(structure.max_lag());
+  const std::size_t d = static_cast<std::size_t>(structure.dead_time);
+  const int na = structure.na;
+  std::array<double, kChunkRows> residual_buffer;
+  if (phi_t_r != nullptr) phi_t_r->setZero(theta.size());
+  double sum = 0.0;
+  for (const IoSegment& segment : segments) {
+    check_segment(segment);
+    const double* y = segment.output.data();
+    const double* u = segment.input.data();
+    const std::size_t n = segment.output.size();
+    for (std::size_t c = first; c < n; c += kChunkRows) {
+      const Eigen::Index len = static_cast<Eigen::Index>(std::min(kChunkRows, n - c));
+      Eigen::Map<Eigen::VectorXd> e(residual_buffer.data(), len);
+      e = ConstMap(y + c, len);
+      for (int i = 0; i < na; ++i) e += theta(i) * ConstMap(y + c - 1 - i, len);
+      for (int j = 0; j < structure.nb; ++j) e -= theta(na + j) * ConstMap(u + c - d - j, len);
+      sum += e.squaredNorm();
+      if (phi_t_r == nullptr) continue;
+      for (int i = 0; i < na; ++i) (*phi_t_r)(i) -= e.dot(ConstMap(y + c - 1 - i, len));
+      for (int j = 0; j < structure.nb; ++j)
+        (*phi_t_r)(na + j) += e.dot(ConstMap(u + c - d - j, len));
+    }
+  }
+  return sum;
+}
+
+}  // namespace
+
+LaggedGram build_lagged_gram(std::span<const IoSegment> segments, const LagSet& lags,
+                             int first_row) {
+  if (lags.output_lag_max < 0 || lags.input_lag_min < 0 || lags.input_lag_max < lags.input_lag_min)
+    throw std::invalid_argument("build_lagged_gram: invalid lag set");
+  if (first_row < lags.max_lag())
+    throw std::invalid_argument("build_lagged_gram: first_row " + std::to_string(first_row) +
+                                " is below the largest lag " + std::to_string(lags.max_lag()));
+  LaggedGram result;
+  result.lags = lags;
+  result.first_row = first_row;
+  const int columns = lags.columns();
+  result.gram = Eigen::MatrixXd::Zero(columns, columns);
+  Eigen::MatrixXd local(columns, columns);
+  for (const IoSegment& segment : segments) {
+    check_segment(segment);
+    if (segment.output.size() <= static_cast<std::size_t>(first_row)) continue;
+    result.row_count += segment.output.size() - static_cast<std::size_t>(first_row);
+    add_segment_gram(segment, lags, first_row, local, result.gram);
+  }
+  result.gram.triangularView<Eigen::StrictlyLower>() = result.gram.transpose();
+  return result;
+}
+
+double residual_sum_of_squares(std::span<const IoSegment> segments, const ArxStructure& structure,
+                               const Eigen::VectorXd& theta) {
+  return residual_pass(segments, structure, theta, nullptr);
+}
+
+ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& structure,
+                     const ArxFitOptions& options) {
+  structure.validate();
+  const int na = structure.na;
+  const int nb = structure.nb;
+  const int p = na + nb;
+  const LagSet lags{na, structure.dead_time, structure.dead_time + nb - 1};
+  const LaggedGram lagged = build_lagged_gram(segments, lags, structure.max_lag());
+  if (lagged.row_count <= static_cast<std::size_t>(p))
+    throw std::invalid_argument("fit_arx: " + std::to_string(lagged.row_count) +
+                                " regression rows for " + std::to_string(p) + " parameters (" +
+                                to_string(structure) + ")");
+
+  // ΦᵀΦ and Φᵀy in θ order; output regressors enter as -y, hence the signs.
+  std::vector<int> column(p);
+  Eigen::VectorXd sign(p);
+  for (int i = 0; i < na; ++i) column[i] = lags.output_column(i + 1), sign(i) = -1.0;
+  for (int j = 0; j < nb; ++j)
+    column[na + j] = lags.input_column(structure.dead_time + j), sign(na + j) = 1.0;
+  Eigen::MatrixXd normal(p, p);
+  Eigen::VectorXd rhs(p);
+  for (int r = 0; r < p; ++r) {
+    rhs(r) = sign(r) * lagged.gram(column[r], 0);
+    for (int c = 0; c < p; ++c)
+      normal(r, c) = sign(r) * sign(c) * lagged.gram(column[r], column[c]);
+  }
+  Eigen::VectorXd scale(p);
+  for (int r = 0; r < p; ++r) {
+    if (!(normal(r, r) > 0.0))
+      throw std::runtime_error("fit_arx: regressor " + std::to_string(r) +
+                               " is zero over all rows (no excitation)");
+    scale(r) = 1.0 / std::sqrt(normal(r, r));
+  }
+  const Eigen::MatrixXd scaled = scale.asDiagonal() * normal * scale.asDiagonal();
+  const Eigen::VectorXd scaled_rhs = scale.cwiseProduct(rhs);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled, Eigen::EigenvaluesOnly);
+  const double lambda_min = eigen.eigenvalues().minCoeff();
+  const double condition = lambda_min > 0.0 ? eigen.eigenvalues().maxCoeff() / lambda_min
+                                            : std::numeric_limits<double>::infinity();
+
+  bool use_normal = options.method == LeastSquaresMethod::kNormalEquations ||
+                    (options.method == LeastSquaresMethod::kAuto &&
+                     condition <= options.max_condition_normal_equations);
+  Eigen::VectorXd scaled_theta;
+  Eigen::MatrixXd scaled_inverse;
+  double reported_condition = condition;
+  if (use_normal) {
+    Eigen::LLT<Eigen::MatrixXd> llt(scaled);
+    if (llt.info() == Eigen::Success) {
+      scaled_theta = llt.solve(scaled_rhs);
+      scaled_inverse = llt.solve(Eigen::MatrixXd::Identity(p, p));
+    } else if (options.method == LeastSquaresMethod::kNormalEquations) {
+      throw std::runtime_error("fit_arx: normal equations not positive definite (" +
+                               to_string(structure) + ")");
+    } else {
+      use_normal = false;
+    }
+  }
+  if (!use_normal) {
+    const Eigen::MatrixXd r_aug = streamed_qr_factor(segments, structure, scale);
+    const auto r = r_aug.topLeftCorner(p, p).triangularView<Eigen::Upper>();
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(r_aug.topLeftCorner(p, p));
+    const double s_min = svd.singularValues().minCoeff();
+    if (!(s_min > 0.0))
+      throw std::runtime_error("fit_arx: regressors are rank deficient (" + to_string(structure) +
+                               ")");
+    reported_condition = std::pow(svd.singularValues().maxCoeff() / s_min, 2);
+    scaled_theta = r.solve(r_aug.topRightCorner(p, 1));
+    const Eigen::MatrixXd r_inverse = r.solve(Eigen::MatrixXd::Identity(p, p));
+    scaled_inverse = r_inverse * r_inverse.transpose();
+  }
+
+  Eigen::VectorXd theta = scale.cwiseProduct(scaled_theta);
+  if (use_normal) {
+    // Iterative refinement with residuals computed from the data: the normal equations' error
+    // (≈ condition × ε of yᵀy-sized sums) shrinks to that of Φᵀr, r being the small residual.
+    Eigen::VectorXd phi_t_r;
+    for (int step = 0; step < options.refinement_steps; ++step) {
+      residual_pass(segments, structure, theta, &phi_t_r);
+      theta += scale.cwiseProduct(scaled_inverse * scale.cwiseProduct(phi_t_r));
+    }
+  }
+  const double rss = residual_pass(segments, structure, theta, nullptr);
+  const double variance = rss / static_cast<double>(lagged.row_count - static_cast<std::size_t>(p));
+  Eigen::MatrixXd covariance = variance * scale.asDiagonal() * scaled_inverse * scale.asDiagonal();
+  Eigen::VectorXd std_dev = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  return ArxFitResult{ArxModel(structure, theta.head(na), theta.tail(nb), options.sample_time_s),
+                      std::move(std_dev),
+                      std::move(covariance),
+                      rss,
+                      variance,
+                      lagged.row_count,
+                      reported_condition,
+                      use_normal ? LeastSquaresMethod::kNormalEquations : LeastSquaresMethod::kQr};
+}
+
+}  // namespace imscal::ident

@@ -1,0 +1,98 @@
+#include "ident/arx_model.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace imscal::ident {
+
+ArxModel::ArxModel(ArxStructure structure, Eigen::VectorXd a, Eigen::VectorXd b,
+                   double sample_time_s)
+    : structure_(structure), a_(std::move(a)), b_(std::move(b)), sample_time_s_(sample_time_s) {
+  structure_.validate();
+  if (a_.size() != structure_.na || b_.size() != structure_.nb)
+    throw std::invalid_argument("ArxModel: coefficient counts (" + std::to_string(a_.size()) +
+                                ", " + std::to_string(b_.size()) + ") do not match " +
+                                to_string(structure_));
+  if (!(sample_time_s_ > 0.0)) throw std::invalid_argument("ArxModel: sample time must be > 0");
+}
+
+Eigen::VectorXd ArxModel::parameters() const {
+  Eigen::VectorXd theta(a_.size() + b_.size());
+  theta << a_, b_;
+  return theta;
+}
+
+void ArxModel::predict_one_step(const IoSegment& segment, std::span<double> predicted) const {
+  const std::size_t n = segment.output.size();
+  if (segment.input.size() != n || predicted.size() != n)
+    throw std::invalid_argument("ArxModel::predict_one_step: sizes differ");
+  const std::size_t first = static_cast<std::size_t>(structure_.max_lag());
+  const auto& u = segment.input;
+  const auto& y = segment.output;
+  for (std::size_t k = 0; k < std::min(first, n); ++k) predicted[k] = y[k];
+  for (std::size_t k = first; k < n; ++k) {
+    double sum = 0.0;
+    for (int i = 0; i < structure_.na; ++i) sum -= a_[i] * y[k - 1 - i];
+    const std::size_t u_first = k - static_cast<std::size_t>(structure_.dead_time);
+    for (int j = 0; j < structure_.nb; ++j) sum += b_[j] * u[u_first - j];
+    predicted[k] = sum;
+  }
+}
+
+void ArxModel::simulate(std::span<const double> input, std::span<const double> initial_output,
+                        std::span<double> simulated) const {
+  const std::size_t n = input.size();
+  const std::size_t first = static_cast<std::size_t>(structure_.max_lag());
+  if (simulated.size() != n) throw std::invalid_argument("ArxModel::simulate: sizes differ");
+  if (initial_output.size() < std::min(first, n))
+    throw std::invalid_argument("ArxModel::simulate: need max_lag initial outputs");
+  for (std::size_t k = 0; k < std::min(first, n); ++k) simulated[k] = initial_output[k];
+  for (std::size_t k = first; k < n; ++k) {
+    double sum = 0.0;
+    for (int i = 0; i < structure_.na; ++i) sum -= a_[i] * simulated[k - 1 - i];
+    const std::size_t u_first = k - static_cast<std::size_t>(structure_.dead_time);
+    for (int j = 0; j < structure_.nb; ++j) sum += b_[j] * input[u_first - j];
+    simulated[k] = sum;
+  }
+}
+
+void ArxModel::predict_joint_error(std::span<const double> input,
+                                   std::span<const double> initial_output,
+                                   std::span<double> joint_error) const {
+  simulate(input, initial_output, joint_error);
+  const std::size_t first = static_cast<std::size_t>(structure_.max_lag());
+  const std::size_t d = static_cast<std::size_t>(structure_.dead_time);
+  for (std::size_t k = 0; k < joint_error.size(); ++k)
+    joint_error[k] = k < first ? 0.0 : input[k - d] - joint_error[k];
+}
+
+Eigen::VectorXcd ArxModel::poles() const {
+  const int na = structure_.na;
+  if (na == 0) return Eigen::VectorXcd(0);
+  // Companion matrix of z^na + a_1 z^(na-1) + ... + a_na: first row -a, ones on the
+  // sub-diagonal; its characteristic polynomial is A(z).
+  Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(na, na);
+  companion.row(0) = -a_.transpose();
+  for (int i = 1; i < na; ++i) companion(i, i - 1) = 1.0;
+  Eigen::EigenSolver<Eigen::MatrixXd> solver(companion, /*computeEigenvectors=*/false);
+  if (solver.info() != Eigen::Success)
+    throw std::runtime_error("ArxModel::poles: eigenvalue iteration did not converge");
+  return solver.eigenvalues();
+}
+
+double ArxModel::spectral_radius() const {
+  const Eigen::VectorXcd p = poles();
+  return p.size() == 0 ? 0.0 : p.cwiseAbs().maxCoeff();
+}
+
+double ArxModel::static_gain() const {
+  const double a_at_one = 1.0 + a_.sum();
+  if (a_at_one == 0.0) return std::numeric_limits<double>::infinity();
+  return b_.sum() / a_at_one;
+}
+
+}  // namespace imscal::ident

@@ -1,0 +1,59 @@
+#include "ims/imu_conversion.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace imscal::ims {
+namespace {
+
+// Interval ending at sample i [s]; the first is one nominal interval (ims/imu_data.hpp).
+double interval_before(const ImuSeries& series, std::size_t i) {
+  const double dt =
+      i == 0 ? series.nominal_dt_s : series.samples[i].t_s - series.samples[i - 1].t_s;
+  if (!(dt > 0.0 && std::isfinite(dt))) {
+    throw std::invalid_argument(fmt::format(
+        "{}: sample {}: interval {} s is not positive; validate the series before converting",
+        series.source, i, dt));
+  }
+  return dt;
+}
+
+}  // namespace
+
+ImuSeries rates_to_increments(const ImuSeries& rates) {
+  if (rates.quantity != ImuQuantity::kRates) {
+    throw std::invalid_argument("rates_to_increments: the series holds increments already");
+  }
+  ImuSeries out = rates;
+  out.quantity = ImuQuantity::kIncrements;
+  for (std::size_t i = 0; i < out.samples.size(); ++i) {
+    const double dt = interval_before(rates, i);
+    out.samples[i].gyro = rates.samples[i].gyro * dt;
+    out.samples[i].acc = rates.samples[i].acc * dt;
+  }
+  return out;
+}
+
+ImuSeries increments_to_rates(const ImuSeries& increments) {
+  if (increments.quantity != ImuQuantity::kIncrements) {
+    throw std::invalid_argument("increments_to_rates: the series holds rates already");
+  }
+  ImuSeries out = increments;
+  out.quantity = ImuQuantity::kRates;
+  for (std::size_t i = 0; i < out.samples.size(); ++i) {
+    const double dt = interval_before(increments, i);
+    out.samples[i].gyro = increments.samples[i].gyro / dt;
+    out.samples[i].acc = increments.samples[i].acc / dt;
+  }
+  return out;
+}
+
+ImuSeries to_quantity(const ImuSeries& series, ImuQuantity quantity) {
+  if (series.quantity == quantity) return series;
+  return quantity == ImuQuantity::kIncrements ? rates_to_increments(series)
+                                              : increments_to_rates(series);
+}
+
+}  // namespace imscal::ims

@@ -1,0 +1,387 @@
+#include "ims/zupt_smoother.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/input_error.hpp"
+#include "ims/error_state_model.hpp"
+#include "ims/sensor_error_model.hpp"
+#include "ims/so3.hpp"
+#include "ims/strapdown.hpp"
+
+namespace imscal::ims {
+using namespace error_state;
+
+namespace {
+
+constexpr double kChi2Dof3Quantile95 = 7.8147;  // chi-square(3) 95% quantile
+
+using Matrix3x15 = Eigen::Matrix<double, 3, kSize>;
+
+ErrorProcessNoise process_noise_of(const ZuptOptions& o) {
+  ErrorProcessNoise noise;
+  noise.gyro_white_psd.setConstant(o.gyro_noise_density_rad_per_sqrt_s *
+                                   o.gyro_noise_density_rad_per_sqrt_s);
+  noise.acc_white_psd.setConstant(o.acc_noise_density_m_s_per_sqrt_s *
+                                  o.acc_noise_density_m_s_per_sqrt_s);
+  // The bias state holds the turn-on bias (constant) plus the in-run Gauss-Markov part, so it
+  // does not decay: it is modelled as a random walk driven by the Gauss-Markov noise, 2 sigma^2
+  // / tau. That is exact for spans << tau and overstates the drift for longer ones.
+  noise.gyro_bias_correlation_time_s = std::numeric_limits<double>::infinity();
+  noise.acc_bias_correlation_time_s = std::numeric_limits<double>::infinity();
+  const auto drive = [](double sigma, double tau) {
+    return std::isfinite(tau) && tau > 0.0 ? 2.0 * sigma * sigma / tau : 0.0;
+  };
+  noise.gyro_bias_drive_psd.setConstant(
+      drive(o.gyro_bias_instability_rad_s, o.gyro_bias_correlation_time_s));
+  noise.acc_bias_drive_psd.setConstant(
+      drive(o.acc_bias_instability_m_s2, o.acc_bias_correlation_time_s));
+  return noise;
+}
+
+void check_options(const ImuSeries& imu, const ZuptOptions& o) {
+  auto refuse = [&](const char* field, const char* problem) {
+    throw InputError(imu.source, 0, field, problem);
+  };
+  if (imu.quantity != ImuQuantity::kIncrements) {
+    refuse("quantity", "zero-velocity smoothing needs increments");
+  }
+  if (imu.samples.empty()) refuse("samples", "empty record");
+  if (!(imu.nominal_dt_s > 0.0)) refuse("nominal_dt_s", "must be positive");
+  if (!(o.gyro_noise_density_rad_per_sqrt_s > 0.0) || !(o.acc_noise_density_m_s_per_sqrt_s > 0.0)) {
+    refuse("noise density", "gyro and accelerometer noise densities must be positive");
+  }
+  if (!(o.zero_velocity_sigma_m_s > 0.0)) refuse("zero_velocity_sigma_m_s", "must be positive");
+  if (!(o.propagation_interval_s > 0.0)) refuse("propagation_interval_s", "must be positive");
+  if (!(o.innovation_gate_chi2 > 0.0)) refuse("innovation_gate_chi2", "must be positive");
+}
+
+// What the forward pass keeps per propagation instant k (k = 0: the initial state).
+struct Epoch {
+  std::size_t last_sample = 0;  // sample index ending the interval (k - 1, k]; unused for k = 0
+  double t_s = 0.0;
+  ErrorMatrix transition;                               // from k - 1 to k
+  ErrorMatrix predicted_cov;                            // at k before the updates
+  ErrorMatrix filtered_cov;                             // at k after the updates
+  ErrorVector correction = ErrorVector::Zero();         // error estimate fed back at k
+  Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();  // estimates after the updates at k
+  Eigen::Vector3d acc_bias = Eigen::Vector3d::Zero();
+};
+
+struct UpdateTally {
+  std::size_t accepted = 0, rejected = 0, above95 = 0;
+  double nis_sum = 0.0;
+  InnovationStatistics statistics() const {
+    InnovationStatistics s;
+    s.accepted = accepted;
+    s.rejected = rejected;
+    s.mean_nis = accepted ? nis_sum / double(accepted) : 0.0;
+    s.fraction_above_95 = accepted ? double(above95) / double(accepted) : 0.0;
+    return s;
+  }
+};
+
+// Kalman update with a 3-component measurement z = H x + noise(R); Joseph form. Returns false
+// (and changes nothing) when the innovation fails the gate.
+bool update(ErrorVector& x, ErrorMatrix& P, const Eigen::Vector3d& z, const Matrix3x15& H,
+            const Eigen::Matrix3d& R, double gate, UpdateTally& tally) {
+  const Eigen::Vector3d innovation = z - H * x;
+  const Eigen::Matrix3d S = H * P * H.transpose() + R;
+  const Eigen::LDLT<Eigen::Matrix3d> S_ldlt(S);
+  const double nis = innovation.dot(S_ldlt.solve(innovation));
+  if (!(nis <= gate)) {
+    ++tally.rejected;
+    return false;
+  }
+  ++tally.accepted;
+  tally.nis_sum += nis;
+  if (nis > kChi2Dof3Quantile95) ++tally.above95;
+  const Eigen::Matrix<double, kSize, 3> K = S_ldlt.solve(H * P).transpose();  // P H^T S^-1
+  x += K * innovation;
+  const ErrorMatrix I_KH = ErrorMatrix::Identity() - K * H;
+  P = I_KH * P * I_KH.transpose() + K * R * K.transpose();
+  P = 0.5 * (P + P.transpose());
+  return true;
+}
+
+NavState apply_error(const NavState& nominal, const ErrorVector& e) {
+  NavState corrected = nominal;
+  corrected.q_W_S =
+      (quat_exp(Eigen::Vector3d(e.segment<3>(kAttitude))) * nominal.q_W_S).normalized();
+  corrected.v_W += e.segment<3>(kVelocity);
+  corrected.p_W += e.segment<3>(kPosition);
+  return corrected;
+}
+
+// Smoother gain C = P_f Phi^T P_p^-1, solved on the equilibrated P_p (its diagonal spans ~20
+// orders of magnitude between positions and gyro biases).
+ErrorMatrix smoother_gain(const ErrorMatrix& filtered_cov, const ErrorMatrix& transition,
+                          const ErrorMatrix& predicted_cov) {
+  // States without uncertainty (e.g. a bias declared exactly known) keep the scale 1; the LDLT
+  // then treats their zero pivots as such.
+  const ErrorVector scale = predicted_cov.diagonal().unaryExpr(
+      [](double variance) { return variance > 0.0 ? 1.0 / std::sqrt(variance) : 1.0; });
+  const ErrorMatrix scaled_pred = scale.asDiagonal() * predicted_cov * scale.asDiagonal();
+  const ErrorMatrix rhs = scale.asDiagonal() * (transition * filtered_cov);  // D Phi P_f
+  // (D P_p D) y = D Phi P_f  =>  P_p^-1 Phi P_f = D y  =>  C = (D y)^T.
+  const ErrorMatrix y = scaled_pred.ldlt().solve(rhs);
+  return (scale.asDiagonal() * y).transpose();
+}
+
+RestDetectorOptions rest_options_of(const ZuptOptions& o) {
+  RestDetectorOptions r = o.rest;
+  if (r.gyro_noise_density_rad_per_sqrt_s == 0.0) {
+    r.gyro_noise_density_rad_per_sqrt_s = o.gyro_noise_density_rad_per_sqrt_s;
+    r.gyro_quantization_lsb_rad = o.gyro_quantization_lsb_rad;
+  }
+  if (r.acc_noise_density_m_s_per_sqrt_s == 0.0) {
+    r.acc_noise_density_m_s_per_sqrt_s = o.acc_noise_density_m_s_per_sqrt_s;
+    r.acc_quantization_lsb_m_s = o.acc_quantization_lsb_m_s;
+  }
+  // A bias of 3 sigma still passes the magnitude tests.
+  if (r.gyro_bias_bound_rad_s == 0.0)
+    r.gyro_bias_bound_rad_s = 3.0 * o.initial_gyro_bias_sigma_rad_s;
+  if (r.acc_bias_bound_m_s2 == 0.0) r.acc_bias_bound_m_s2 = 3.0 * o.initial_acc_bias_sigma_m_s2;
+  return r;
+}
+
+Epoch initial_epoch(const NavState& initial, const Eigen::Matrix<double, 9, 1>& initial_sigma,
+                    const ZuptOptions& options) {
+  Epoch first;
+  first.t_s = initial.t_s;
+  first.filtered_cov.setZero();
+  first.filtered_cov.diagonal().head<9>() = initial_sigma.cwiseAbs2();
+  first.filtered_cov.diagonal().segment<3>(kGyroBias).setConstant(
+      options.initial_gyro_bias_sigma_rad_s * options.initial_gyro_bias_sigma_rad_s);
+  first.filtered_cov.diagonal().segment<3>(kAccBias).setConstant(
+      options.initial_acc_bias_sigma_m_s2 * options.initial_acc_bias_sigma_m_s2);
+  first.predicted_cov = first.filtered_cov;
+  first.transition.setIdentity();
+  first.gyro_bias = options.initial_gyro_bias_rad_s;
+  first.acc_bias = options.initial_acc_bias_m_s2;
+  return first;
+}
+
+struct SmoothedErrors {
+  // after[k]: smoothed error relative to the fed-back (post-update) nominal at k;
+  // before[k] = after[k] + correction[k]: relative to the nominal before the updates at k,
+  // i.e. the end of the mechanised interval (k - 1, k].
+  std::vector<ErrorVector> after, before;
+  std::vector<ErrorVector> variance;  // diagonal of the smoothed covariance
+};
+
+// Rauch-Tung-Striebel on the error state. With the estimates fed back, the filtered error is
+// zero after every update and so is its prediction: x_s(k) = C_k x_s^before(k + 1).
+SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs) {
+  const std::size_t last = epochs.size() - 1;
+  SmoothedErrors s;
+  s.after.resize(epochs.size());
+  s.before.resize(epochs.size());
+  s.variance.resize(epochs.size());
+  s.after[last].setZero();
+  ErrorMatrix smoothed_cov = epochs[last].filtered_cov;
+  s.variance[last] = smoothed_cov.diagonal();
+  s.before[last] = epochs[last].correction;
+  for (std::size_t k = last; k-- > 0;) {
+    const Epoch& next = epochs[k + 1];
+    const ErrorMatrix C =
+        smoother_gain(epochs[k].filtered_cov, next.transition, next.predicted_cov);
+    s.after[k] = C * s.before[k + 1];
+    smoothed_cov = epochs[k].filtered_cov + C * (smoothed_cov - next.predicted_cov) * C.transpose();
+    smoothed_cov = 0.5 * (smoothed_cov + smoothed_cov.transpose());
+    s.variance[k] = smoothed_cov.diagonal().cwiseMax(0.0);
+    s.before[k] = s.after[k] + epochs[k].correction;
+  }
+  return s;
+}
+
+// The nominal state of every sample corrected by the smoothed error, interpolated linearly in
+// time between the propagation instants that enclose the sample.
+std::vector<SmoothedState> apply_smoothed_errors(const std::vector<NavState>& nominal,
+                                                 const std::vector<Epoch>& epochs,
+                                                 const SmoothedErrors& smoothed) {
+  std::vector<SmoothedState> states(nominal.size());
+  std::size_t i = 0;
+  for (std::size_t k = 1; k < epochs.size(); ++k) {
+    const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
+    for (; i <= epochs[k].last_sample; ++i) {
+      const double alpha = (nominal[i].t_s - t0) / (t1 - t0);
+      const ErrorVector e = (1.0 - alpha) * smoothed.after[k - 1] + alpha * smoothed.before[k];
+      const ErrorVector var =
+          (1.0 - alpha) * smoothed.variance[k - 1] + alpha * smoothed.variance[k];
+      states[i].state = apply_error(nominal[i], e);
+      states[i].sigma = var.head<9>().cwiseSqrt();
+    }
+  }
+  return states;
+}
+
+}  // namespace
+
+ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& earth,
+                                    const NavState& initial,
+                                    const Eigen::Matrix<double, 9, 1>& initial_sigma,
+                                    const ZuptOptions& options) {
+  check_options(imu, options);
+  const std::size_t n = imu.samples.size();
+  ZuptSmootherResult result;
+
+  const RestDetection rest = detect_rest(imu, earth, rest_options_of(options));
+  result.summary.rest_intervals = rest.intervals;
+
+  const ErrorProcessNoise noise = process_noise_of(options);
+  const std::size_t samples_per_epoch = std::max<std::size_t>(
+      1, std::size_t(std::lround(options.propagation_interval_s / imu.nominal_dt_s)));
+  const std::size_t epoch_count = (n + samples_per_epoch - 1) / samples_per_epoch;
+  // Epoch k (1-based) mechanises samples [(k-1) M, min(n, k M)); at rest if all of them are.
+  std::vector<bool> epoch_at_rest(epoch_count + 2, false);
+  for (std::size_t k = 1; k <= epoch_count; ++k) {
+    const std::size_t begin = (k - 1) * samples_per_epoch;
+    const std::size_t end = std::min(n, begin + samples_per_epoch);
+    epoch_at_rest[k] =
+        std::all_of(rest.at_rest.begin() + std::ptrdiff_t(begin),
+                    rest.at_rest.begin() + std::ptrdiff_t(end), [](bool b) { return b; });
+  }
+  // Epochs at least `margin_s` inside a rest.
+  const auto rest_interior = [&](double margin_s) {
+    const std::size_t margin =
+        std::size_t(std::ceil(margin_s / (double(samples_per_epoch) * imu.nominal_dt_s)));
+    std::vector<bool> interior(epoch_count + 2, false);
+    for (std::size_t k = 1 + margin; k + margin <= epoch_count; ++k) {
+      bool inside = true;
+      for (std::size_t j = k - margin; j <= k + margin && inside; ++j) inside = epoch_at_rest[j];
+      interior[k] = inside;
+    }
+    return interior;
+  };
+  const std::vector<bool> epoch_in_rest_interior = rest_interior(options.zero_rate_edge_margin_s);
+  const std::vector<bool> epoch_zero_velocity = rest_interior(options.zero_velocity_edge_margin_s);
+
+  // ---- forward pass ----
+  std::vector<NavState> nominal(n);  // per sample, mechanised from the last fed-back state
+  std::vector<Epoch> epochs;
+  epochs.reserve(epoch_count + 1);
+  epochs.push_back(initial_epoch(initial, initial_sigma, options));
+  Strapdown strapdown(earth, initial);
+  ErrorLinearisation point;
+  point.earth_rate_W = earth.earth_rate_W();
+  point.gravity_gradient_W = earth.gravity_gradient_W();
+  UpdateTally zupt_tally, zaru_tally;
+  // Zero angular rate over a whole rest: sums of the raw gyro increments, time and attitude.
+  Eigen::Vector3d rest_raw_dtheta = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rest_sum_R = Eigen::Matrix3d::Zero();
+  double rest_time = 0.0;
+  const double zero_velocity_variance =
+      options.zero_velocity_sigma_m_s * options.zero_velocity_sigma_m_s +
+      // the nominal velocity carries the quantisation residual of the summed increments
+      options.acc_quantization_lsb_m_s * options.acc_quantization_lsb_m_s / 12.0;
+
+  for (std::size_t k = 1; k <= epoch_count; ++k) {
+    const std::size_t begin = (k - 1) * samples_per_epoch;
+    const std::size_t end = std::min(n, begin + samples_per_epoch);
+    const Epoch& previous = epochs.back();
+    Eigen::Matrix3d sum_R = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d sum_dv_W = Eigen::Vector3d::Zero();
+    Eigen::Vector3d sum_raw_dtheta = Eigen::Vector3d::Zero();
+    const double t_begin = strapdown.state().t_s;
+    for (std::size_t i = begin; i < end; ++i) {
+      const ImuSample& raw = imu.samples[i];
+      const double dt = sample_interval(imu, i);
+      ImuSample corrected = raw;
+      corrected.gyro -= previous.gyro_bias * dt;
+      corrected.acc -= previous.acc_bias * dt;
+      const Eigen::Matrix3d R_before = strapdown.state().q_W_S.toRotationMatrix();
+      strapdown.step(corrected);
+      const Eigen::Matrix3d R_mid = 0.5 * (R_before + strapdown.state().q_W_S.toRotationMatrix());
+      sum_R += R_mid * dt;
+      sum_dv_W += R_mid * corrected.acc;
+      sum_raw_dtheta += raw.gyro;
+      nominal[i] = strapdown.state();
+    }
+    const double interval = strapdown.state().t_s - t_begin;
+    point.mean_R_W_S = sum_R / interval;
+    point.mean_specific_force_W = sum_dv_W / interval;
+    const DiscreteErrorModel model = discretize_error_model(
+        continuous_error_dynamics(point, noise), continuous_error_noise(point, noise), interval);
+
+    Epoch epoch;
+    epoch.last_sample = end - 1;
+    epoch.t_s = strapdown.state().t_s;
+    epoch.transition = model.transition;
+    epoch.predicted_cov = model.transition * previous.filtered_cov * model.transition.transpose() +
+                          model.noise_covariance;
+    epoch.predicted_cov = 0.5 * (epoch.predicted_cov + epoch.predicted_cov.transpose());
+    epoch.gyro_bias = previous.gyro_bias;
+    epoch.acc_bias = previous.acc_bias;
+    ErrorMatrix P = epoch.predicted_cov;
+    ErrorVector x = ErrorVector::Zero();
+    if (epoch_zero_velocity[k]) {
+      const NavState& state = strapdown.state();
+      // Zero velocity: z = -v_estimate = dv + noise.
+      Matrix3x15 H = Matrix3x15::Zero();
+      H.block<3, 3>(0, kVelocity).setIdentity();
+      const double gate = state.v_W.norm() > options.gate_min_speed_m_s
+                              ? options.innovation_gate_chi2
+                              : std::numeric_limits<double>::infinity();
+      update(x, P, -state.v_W, H, zero_velocity_variance * Eigen::Matrix3d::Identity(), gate,
+             zupt_tally);
+    }
+    if (epoch_in_rest_interior[k]) {
+      rest_raw_dtheta += sum_raw_dtheta;
+      rest_sum_R += sum_R;
+      rest_time += interval;
+      if (!epoch_in_rest_interior[k + 1]) {
+        // Zero angular rate, once per rest over its whole length (the quantisation residuals
+        // of the summed gyro increments then enter only once):
+        //   z = mean gyro - b_g - R_S_W omega_ie = dbg + R_S_W [omega_ie]x phi + noise.
+        const Eigen::Matrix3d R_S_W = (rest_sum_R / rest_time).transpose();
+        const Eigen::Vector3d z =
+            rest_raw_dtheta / rest_time - epoch.gyro_bias - R_S_W * point.earth_rate_W;
+        Matrix3x15 H = Matrix3x15::Zero();
+        H.block<3, 3>(0, kAttitude) = R_S_W * skew(point.earth_rate_W);
+        H.block<3, 3>(0, kGyroBias).setIdentity();
+        const double lsb = options.gyro_quantization_lsb_rad;
+        const double rate_variance =
+            options.gyro_noise_density_rad_per_sqrt_s * options.gyro_noise_density_rad_per_sqrt_s /
+                rest_time +
+            lsb * lsb / (6.0 * rest_time * rest_time) +
+            options.zero_angular_rate_sigma_rad_s * options.zero_angular_rate_sigma_rad_s;
+        update(x, P, z, H, rate_variance * Eigen::Matrix3d::Identity(),
+               options.innovation_gate_chi2, zaru_tally);
+      }
+    }
+    if (!x.isZero(0.0)) {
+      strapdown.reset(apply_error(strapdown.state(), x));
+      epoch.gyro_bias += x.segment<3>(kGyroBias);
+      epoch.acc_bias += x.segment<3>(kAccBias);
+    }
+    if (!epoch_in_rest_interior[k] || !epoch_in_rest_interior[k + 1]) {
+      rest_raw_dtheta.setZero();
+      rest_sum_R.setZero();
+      rest_time = 0.0;
+    }
+    epoch.filtered_cov = P;
+    epoch.correction = x;
+    epochs.push_back(std::move(epoch));
+  }
+  result.summary.zero_velocity = zupt_tally.statistics();
+  result.summary.zero_angular_rate = zaru_tally.statistics();
+  result.summary.propagation_steps = epoch_count;
+
+  const SmoothedErrors smoothed = rts_backward_pass(epochs);
+  result.states = apply_smoothed_errors(nominal, epochs, smoothed);
+  result.biases.resize(epochs.size());
+  for (std::size_t k = 0; k < epochs.size(); ++k) {
+    SmoothedBias& b = result.biases[k];
+    b.t_s = epochs[k].t_s;
+    b.gyro_rad_s = epochs[k].gyro_bias + smoothed.after[k].segment<3>(kGyroBias);
+    b.acc_m_s2 = epochs[k].acc_bias + smoothed.after[k].segment<3>(kAccBias);
+    b.gyro_sigma_rad_s = smoothed.variance[k].segment<3>(kGyroBias).cwiseSqrt();
+    b.acc_sigma_m_s2 = smoothed.variance[k].segment<3>(kAccBias).cwiseSqrt();
+  }
+  return result;
+}
+
+}  // namespace imscal::ims
