@@ -30,6 +30,7 @@
 #include "ims/nav_trajectory_io.hpp"
 #include "ims/sensor_spec.hpp"
 #include "ims/strapdown.hpp"
+#include "ims/sensor_error_model.hpp"
 #include "ims/zupt_smoother.hpp"
 #include "tools/command_registry.hpp"
 
@@ -47,6 +48,11 @@ struct MechanizeArgs {
   std::optional<double> align_s;
   std::string site;
   std::string smooth_spec;  // sensor spec YAML: zero-velocity smoothing (ims/zupt_smoother.hpp)
+  std::string sensor_errors;  // sensor error model YAML applied on read (ims/sensor_error_model)
+  // Heading from an external reference, replacing the gyrocompassed one: a few seconds of
+  // gyrocompassing give degrees (sigma ~ gyro noise / horizontal Earth rate).
+  std::optional<double> heading_deg;
+  double heading_sigma_deg = 0.001;
   bool force = false;
 };
 
@@ -117,6 +123,11 @@ Prepared prepare(const MechanizeArgs& args) {
         args.input);
     series = ims::rates_to_increments(series);
   }
+  if (!args.sensor_errors.empty()) {
+    // Error correction on read: the unit's calibration (bias, scale factor, misalignment).
+    series = ims::correct(series, ims::load_sensor_error_model(args.sensor_errors));
+    spdlog::info("corrected {} with the sensor error model {}", args.input, args.sensor_errors);
+  }
   try {
     p.earth = std::make_unique<ims::EarthModel>(choose_site(args, series));
   } catch (const std::invalid_argument& e) {
@@ -155,15 +166,23 @@ Prepared prepare(const MechanizeArgs& args) {
     p.initial.q_W_S = alignment.q_W_S;
     const double level_sigma = std::max(alignment.sigma_roll_rad, alignment.sigma_pitch_rad);
     p.attitude_sigma_rad = {level_sigma, level_sigma, alignment.sigma_heading_rad};
+    if (args.heading_deg) {
+      alignment.angles.heading_rad = *args.heading_deg * kDeg;
+      alignment.sigma_heading_rad = args.heading_sigma_deg * kDeg;
+      p.initial.q_W_S = Eigen::Quaterniond(ims::R_W_S_from_angles(
+          alignment.angles.roll_rad, alignment.angles.pitch_rad, -alignment.angles.heading_rad));
+      p.attitude_sigma_rad.z() = alignment.sigma_heading_rad;
+    }
     while (first_sample < samples.size() && samples[first_sample].t_s <= alignment.t_ref_s) {
       ++first_sample;
     }
     p.attitude_source = fmt::format(
         "coarse alignment over the first {} s (roll {:.4f} +- {:.4f}, pitch {:.4f} +- {:.4f}, "
-        "heading {:.4f} +- {:.4f} deg)",
+        "heading {:.4f} +- {:.4f} deg{})",
         *args.align_s, alignment.angles.roll_rad / kDeg, alignment.sigma_roll_rad / kDeg,
         alignment.angles.pitch_rad / kDeg, alignment.sigma_pitch_rad / kDeg,
-        alignment.angles.heading_rad / kDeg, alignment.sigma_heading_rad / kDeg);
+        alignment.angles.heading_rad / kDeg, alignment.sigma_heading_rad / kDeg,
+        args.heading_deg ? " from --heading-deg" : " by gyrocompassing");
   }
   p.increments = std::move(series);
   p.increments.samples.erase(p.increments.samples.begin(),
@@ -207,10 +226,15 @@ void smooth(const MechanizeArgs& args, const Outputs& outputs, const Prepared& p
     throw imscal::InputError(kCommandLine, 0, "--smooth",
                              "needs --align-s (the initial attitude and its 1-sigma)");
   }
-  const ims::ZuptOptions options =
-      ims::zupt_options_from_spec(ims::load_sensor_spec(args.smooth_spec));
+  const ims::SensorSpec spec = ims::load_sensor_spec(args.smooth_spec);
+  const ims::ZuptOptions options = ims::zupt_options_from_spec(spec);
+  // Levelling at rest cannot tell tilt from a horizontal accelerometer bias: the tilt sigma is
+  // at least the turn-on bias over g, whatever the noise of the alignment says.
+  Eigen::Vector3d attitude_sigma = p.attitude_sigma_rad;
+  const double bias_tilt_rad = spec.acc.turn_on_bias_sigma / p.earth->normal_gravity_magnitude();
+  for (int i = 0; i < 2; ++i) attitude_sigma[i] = std::hypot(attitude_sigma[i], bias_tilt_rad);
   ims::NavSigma initial_sigma;
-  initial_sigma << p.attitude_sigma_rad, Eigen::Vector3d::Constant(options.zero_velocity_sigma_m_s),
+  initial_sigma << attitude_sigma, Eigen::Vector3d::Constant(options.zero_velocity_sigma_m_s),
       Eigen::Vector3d::Zero();
   const ims::ZuptSmootherResult result =
       ims::smooth_with_zupt(p.increments, *p.earth, p.initial, initial_sigma, options);
@@ -273,6 +297,15 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--smooth", args->smooth_spec,
                      "Sensor spec YAML: zero-velocity-aided smoothing with 1-sigma columns "
                      "(needs --align-s)");
+      sub.add_option("--sensor-errors", args->sensor_errors,
+                     "Sensor error model YAML (bias, scale factor, misalignment) to correct the "
+                     "raw data with on read (datasets/FORMAT.md)");
+      sub.add_option("--heading-deg", args->heading_deg,
+                     "Initial heading from an external reference (deg clockwise from North of "
+                     "the sensor's +Y axis), replacing gyrocompassing; with --align-s");
+      sub.add_option("--heading-sigma-deg", args->heading_sigma_deg,
+                     "1-sigma of --heading-deg (deg)")
+          ->capture_default_str();
       sub.add_flag("--force", args->force, "Overwrite existing outputs");
       sub.callback([args] { run(*args); });
     }};

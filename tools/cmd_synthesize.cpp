@@ -1,6 +1,7 @@
 // `imscal synthesize`: raw IMS data of a known motion, as a given kind of sensor would record
 // it, with the truth beside it:
-//   DIR/imu.csv                  increments with drawn sensor errors and noise (ims/imu_csv.hpp)
+//   DIR/imu.csv                  increments with drawn sensor errors and noise (ims/imu_csv.hpp;
+//                                --imu-format imsb writes the binary DIR/imu.imsb instead)
 //   DIR/truth/trajectory.csv     the motion at begin_s and at the sample times
 //                                (ims/nav_trajectory_io.hpp)
 //   DIR/truth/sensor_errors.yaml the drawn deterministic errors (ims/sensor_error_model.hpp)
@@ -37,6 +38,7 @@ struct SynthesizeArgs {
   double rate_hz = 1000.0;
   std::uint64_t seed = 1;
   std::string out;
+  std::string imu_format = "csv";  // csv or imsb (ims/imu_file.hpp)
   bool force = false;
 };
 
@@ -85,7 +87,7 @@ void run(const SynthesizeArgs& args) {
     throw InputError("<command line>", 0, "--rate-hz", "expected a positive rate");
   }
   const fs::path out(args.out);
-  const fs::path imu_file = out / "imu.csv";
+  const fs::path imu_file = out / ("imu." + args.imu_format);
   const fs::path trajectory_file = out / "truth" / "trajectory.csv";
   const fs::path errors_file = out / "truth" / "sensor_errors.yaml";
   const Overwrite overwrite = args.force ? Overwrite::kAllow : Overwrite::kRefuse;
@@ -134,6 +136,9 @@ tools::CommandRegistration registration{
       sub.add_option("--seed", args->seed, "Seed of the sensor errors and noise")
           ->capture_default_str();
       sub.add_option("--out", args->out, "Output directory")->required();
+      sub.add_option("--imu-format", args->imu_format, "Raw IMS file format: csv or imsb (binary)")
+          ->check(CLI::IsMember({"csv", "imsb"}))
+          ->capture_default_str();
       sub.add_flag("--force", args->force, "Replace existing outputs");
       sub.callback([args] { run(*args); });
     }};
