@@ -13,8 +13,9 @@ namespace {
 void check_site(const Site& site) {
   if (!(std::abs(site.latitude_deg) <= 90.0) || !(std::abs(site.longitude_deg) <= 540.0) ||
       !std::isfinite(site.height_m) || std::abs(site.height_m) > 1e5) {
-    throw std::invalid_argument("site: latitude must be in [-90, 90] deg, longitude finite, "
-                                "height within +-100 km");
+    throw std::invalid_argument(
+        "site: latitude must be in [-90, 90] deg, longitude finite, "
+        "height within +-100 km");
   }
 }
 }  // namespace
@@ -22,9 +23,8 @@ void check_site(const Site& site) {
 EarthModel::EarthModel(const Site& site) : site_(site) {
   check_site(site);
   std::vector<double> rotation(9);  // row-major M: geocentric = M * local ENU at the site
-  GeographicLib::Geocentric::WGS84().Forward(site.latitude_deg, site.longitude_deg,
-                                             site.height_m, origin_E_.x(), origin_E_.y(),
-                                             origin_E_.z(), rotation);
+  GeographicLib::Geocentric::WGS84().Forward(site.latitude_deg, site.longitude_deg, site.height_m,
+                                             origin_E_.x(), origin_E_.y(), origin_E_.z(), rotation);
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) R_E_W_(r, c) = rotation[3 * r + c];
 
@@ -46,7 +46,9 @@ EarthModel::EarthModel(const Site& site) : site_(site) {
   transverse_radius_m_ = ellipsoid.TransverseCurvatureRadius(site.latitude_deg);
 }
 
-double EarthModel::earth_rate_magnitude() { return GeographicLib::Constants::WGS84_omega(); }
+double EarthModel::earth_rate_magnitude() {
+  return GeographicLib::Constants::WGS84_omega();
+}
 
 Eigen::Vector3d EarthModel::ecef_from_W(const Eigen::Vector3d& p_W) const {
   return origin_E_ + R_E_W_ * p_W;

@@ -47,8 +47,7 @@ class EarthModel {
   // Geometry between W and the Earth-centred Earth-fixed frame E.
   const Eigen::Matrix3d& R_E_W() const { return R_E_W_; }
   Eigen::Vector3d ecef_from_W(const Eigen::Vector3d& p_W) const;
-  Eigen::Vector3d W_from_geodetic(double latitude_deg, double longitude_deg,
-                                  double height_m) const;
+  Eigen::Vector3d W_from_geodetic(double latitude_deg, double longitude_deg, double height_m) const;
 
  private:
   Site site_;

@@ -9,8 +9,7 @@
 namespace imscal::ims {
 
 TrajectoryComparison compare_trajectories(const NavTrajectory& estimate,
-                                          const NavTrajectory& reference,
-                                          double time_tolerance_s) {
+                                          const NavTrajectory& reference, double time_tolerance_s) {
   TrajectoryComparison result;
   const bool has_sigma = estimate.sigmas.size() == estimate.states.size();
   double position_sq = 0.0, attitude_sq = 0.0;

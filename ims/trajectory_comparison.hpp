@@ -10,7 +10,7 @@ namespace imscal::ims {
 
 struct TrajectoryComparison {
   std::size_t matched_states = 0;
-  double position_rms_m = 0.0;   // 3-D RMS over the matched states
+  double position_rms_m = 0.0;  // 3-D RMS over the matched states
   double position_max_m = 0.0;
   double attitude_rms_rad = 0.0;  // RMS of the rotation angle between estimate and reference
   double attitude_max_rad = 0.0;

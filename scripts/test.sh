@@ -6,6 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 jobs=$(nproc)
+bash scripts/check-format.sh
 
 echo "== Release build, warnings as errors =="
 bash scripts/build.sh build-ci -DIMSCAL_WERROR=ON

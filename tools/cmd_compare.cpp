@@ -34,8 +34,8 @@ void run(const CompareArgs& args) {
   std::cout << fmt::format(
       "{} states matched\nposition error: RMS {:.4f} mm, max {:.4f} mm\nattitude error: RMS "
       "{:.6f} deg, max {:.6f} deg\n",
-      c.matched_states, 1e3 * c.position_rms_m, 1e3 * c.position_max_m,
-      kDeg * c.attitude_rms_rad, kDeg * c.attitude_max_rad);
+      c.matched_states, 1e3 * c.position_rms_m, 1e3 * c.position_max_m, kDeg * c.attitude_rms_rad,
+      kDeg * c.attitude_max_rad);
   nlohmann::json j = {{"estimate", args.estimate},
                       {"reference", args.reference},
                       {"matched_states", c.matched_states},

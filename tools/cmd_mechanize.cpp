@@ -28,9 +28,9 @@
 #include "ims/imu_conversion.hpp"
 #include "ims/imu_file.hpp"
 #include "ims/nav_trajectory_io.hpp"
+#include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
 #include "ims/strapdown.hpp"
-#include "ims/sensor_error_model.hpp"
 #include "ims/zupt_smoother.hpp"
 #include "tools/command_registry.hpp"
 
@@ -47,7 +47,7 @@ struct MechanizeArgs {
   std::string initial_attitude;  // "ROLL,PITCH,HEADING" [deg]
   std::optional<double> align_s;
   std::string site;
-  std::string smooth_spec;  // sensor spec YAML: zero-velocity smoothing (ims/zupt_smoother.hpp)
+  std::string smooth_spec;    // sensor spec YAML: zero-velocity smoothing (ims/zupt_smoother.hpp)
   std::string sensor_errors;  // sensor error model YAML applied on read (ims/sensor_error_model)
   // Heading from an external reference, replacing the gyrocompassed one: a few seconds of
   // gyrocompassing give degrees (sigma ~ gyro noise / horizontal Earth rate).

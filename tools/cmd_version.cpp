@@ -13,10 +13,10 @@ namespace {
 imscal::tools::CommandRegistration registration{
     "version", "Print the version of imscal and of the libraries it uses", [](CLI::App& sub) {
       sub.callback([] {
-        std::cout << fmt::format(
-            "imscal {}\nEigen {}.{}.{}\nCeres {}\nGeographicLib {}\n", imscal::kVersion,
-            EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, CERES_VERSION_STRING,
-            GEOGRAPHICLIB_VERSION_STRING);
+        std::cout << fmt::format("imscal {}\nEigen {}.{}.{}\nCeres {}\nGeographicLib {}\n",
+                                 imscal::kVersion, EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION,
+                                 EIGEN_MINOR_VERSION, CERES_VERSION_STRING,
+                                 GEOGRAPHICLIB_VERSION_STRING);
       });
     }};
 }  // namespace

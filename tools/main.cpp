@@ -19,8 +19,9 @@ std::vector<CommandSpec>& command_registry() {
 
 int main(int argc, char** argv) {
   using namespace imscal;
-  CLI::App app{"imscal: dynamic calibration of industrial robots with an inertial measurement "
-               "system (IMS)"};
+  CLI::App app{
+      "imscal: dynamic calibration of industrial robots with an inertial measurement "
+      "system (IMS)"};
   app.set_version_flag("--version", std::string("imscal ") + kVersion);
   app.require_subcommand(1);
   app.add_flag_callback(

@@ -42,7 +42,10 @@ TEST(AtomicFile, TargetAppearsOnlyOnCommit) {
 
 TEST(AtomicFile, AbandonedWriteLeavesNothing) {
   const fs::path dir = fresh_dir("atomic_abandon");
-  { AtomicFile file(dir / "out.csv"); file.stream() << "partial"; }
+  {
+    AtomicFile file(dir / "out.csv");
+    file.stream() << "partial";
+  }
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 0);
 }
 

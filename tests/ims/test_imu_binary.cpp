@@ -19,6 +19,7 @@
 #include "core/input_error.hpp"
 #include "ims/imu_binary.hpp"
 #include "ims/imu_csv.hpp"
+#include "tests/support/scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 using imscal::InputError;
@@ -33,18 +34,7 @@ using imscal::ims::write_imu_binary;
 
 namespace {
 
-class ImuBinary : public testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           fmt::format("imscal-test-imu-binary-{}-{}", ::getpid(),
-                       testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-};
+class ImuBinary : public imscal::test_support::ScratchDirTest {};
 
 // Rest for 1 s, then motion; random noise fills all digits.
 ImuSeries make_series(std::size_t n, double dt, ImuQuantity quantity, unsigned seed) {

@@ -19,6 +19,7 @@
 
 #include "core/input_error.hpp"
 #include "ims/imu_csv.hpp"
+#include "tests/support/scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 using imscal::InputError;
@@ -34,18 +35,7 @@ using imscal::ims::write_imu_csv;
 
 namespace {
 
-class ImuCsv : public testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           fmt::format("imscal-test-imu-csv-{}-{}", ::getpid(),
-                       testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-};
+class ImuCsv : public imscal::test_support::ScratchDirTest {};
 
 // A record of n samples: 1 s at rest, then a turning and accelerating motion, with random
 // noise so that every value needs all 17 significant digits.

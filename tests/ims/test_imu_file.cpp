@@ -16,6 +16,7 @@
 #include "ims/imu_csv.hpp"
 #include "ims/imu_file.hpp"
 #include "ims/psins_reader.hpp"
+#include "tests/support/scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 using imscal::InputError;
@@ -29,18 +30,7 @@ using imscal::ims::ImuSeries;
 
 namespace {
 
-class ImuFile : public testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           fmt::format("imscal-test-imu-file-{}-{}", ::getpid(),
-                       testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-};
+class ImuFile : public imscal::test_support::ScratchDirTest {};
 
 // 1.5 s at rest (gravity on z), with a slow turn about z.
 ImuSeries rest_series(ImuQuantity quantity) {

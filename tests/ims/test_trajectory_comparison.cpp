@@ -34,8 +34,8 @@ TEST(TrajectoryComparison, KnownOffsetAndRotation) {
   for (auto& s : estimate.states) {
     s.p_W += offset;
     s.q_W_S = ims::quat_exp(Eigen::Vector3d(-tilt)) * s.q_W_S;  // error = truth * est^-1 = tilt
-    estimate.sigmas.push_back((Eigen::Matrix<double, 9, 1>() << 1e-5, 1, 1, 1, 1, 1, 1e-4, 2e-4,
-                               1).finished());
+    estimate.sigmas.push_back(
+        (Eigen::Matrix<double, 9, 1>() << 1e-5, 1, 1, 1, 1, 1, 1e-4, 2e-4, 1).finished());
   }
   const ims::TrajectoryComparison c = ims::compare_trajectories(estimate, truth);
   EXPECT_EQ(c.matched_states, 200u);
@@ -79,9 +79,9 @@ TEST(TrajectoryComparison, CliFailsTheAcceptanceCheckWithExitCodeOne) {
   EXPECT_EQ(WEXITSTATUS(pass), 0);
   const int fail = std::system((base + " --max-position-rms-mm 0.5 > /dev/null 2>&1").c_str());
   EXPECT_EQ(WEXITSTATUS(fail), 1);
-  const int missing = std::system(
-      (std::string(IMSCAL_BINARY) + " compare --estimate /nonexistent.csv --reference " +
-       (dir / "truth.csv").string() + " > /dev/null 2>&1")
-          .c_str());
+  const int missing = std::system((std::string(IMSCAL_BINARY) +
+                                   " compare --estimate /nonexistent.csv --reference " +
+                                   (dir / "truth.csv").string() + " > /dev/null 2>&1")
+                                      .c_str());
   EXPECT_EQ(WEXITSTATUS(missing), 2);
 }
