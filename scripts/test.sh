@@ -14,6 +14,7 @@ ctest --test-dir build-ci --output-on-failure -j "$jobs" --timeout 900
 
 echo "== ASan + UBSan build =="
 bash scripts/build.sh build-asan -DIMSCAL_WERROR=ON -DIMSCAL_SANITIZE=ON \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DIMSCAL_BUILD_BENCH=OFF
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+  -DIMSCAL_BUILD_BENCH=OFF
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   IMSCAL_SANITIZED=1 ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1800

@@ -381,32 +381,53 @@ RunFigures run_motion(unsigned seed, double duration_s, HeadingSource heading_so
 // anyway. (HeadingFromGyrocompassing below shows what the first rest alone gives.)
 // Print the figures: build-*/tests/ims_test_zupt_smoother --gtest_filter=*Robot*:*Heading*
 TEST(ZuptSmoother, RobotMotionWithPausesNavigationGrade) {
-  const double duration_s = sanitized() ? 15.0 : 60.0;  // lighter under the sanitizers
-  for (unsigned seed : {21u, 22u, 23u}) {
+  // 20 runs (seeds 21..40) of 60 s; lighter under the sanitizers (3 runs of 15 s).
+  const double duration_s = sanitized() ? 15.0 : 60.0;
+  const unsigned seed_count = sanitized() ? 3u : 20u;
+  double pooled_position_sq = 0.0;
+  std::size_t runs_over_goal = 0;
+  Vector9d pooled_normalised_sq = Vector9d::Zero();
+  for (unsigned seed = 21; seed < 21 + seed_count; ++seed) {
     SCOPED_TRACE(seed);
     const RunFigures f = run_motion(seed, duration_s, HeadingSource::kTruth);
-    // Attitude (all three axes, the heading included): the brief's 0.005 deg RMS.
+    // Attitude (all three axes, the heading included): the issue's 0.005 deg RMS, every run.
     EXPECT_LT(f.attitude_rms_deg, 0.005);
-    // Position: the issue asks for 0.2 mm RMS. What a sensor can reach is set by its white
-    // accelerometer noise (2.2 ug/sqrt(Hz) in the shipped spec), integrated twice over each move
-    // between rests: 0.09..0.11 mm per axis at the end of these records (the bridge figure; moves
-    // add as a random walk, nothing observes position). Measured 3-D RMS over the motion: 0.14,
-    // 0.24, 0.18 mm for seeds 21..23, so 0.2 mm is not met on every seed. The check is against
-    // the first-principles figure: the 3-D RMS error below 3 sigma of it (sqrt(3) axes).
+    pooled_position_sq += f.position_rms_mm * f.position_rms_mm;
+    runs_over_goal += f.position_rms_mm >= 0.2 ? 1 : 0;
+    // Each run's position error is set by the white accelerometer noise (2.2 ug/sqrt(Hz) in the
+    // shipped spec), integrated twice over each move between rests (a Brownian bridge: VRW^2
+    // T^3 / 12 per axis and move; moves add as a random walk, nothing observes position): the
+    // "bridge figure". A run's 3-D RMS error must stay below 3 sigma of it (sqrt(3) axes).
     EXPECT_LT(f.position_rms_mm, 3.0 * std::sqrt(3.0) * f.bridge_position_sigma_mm);
     // The smoother's own final position sigma agrees with the bridge figure: a little less, as
     // the detected rests reach ~0.1 s into the (still negligible) motion ends, a little more from
     // the bias and tilt uncertainty: within -20 % / +40 %.
     EXPECT_GT(f.final_position_sigma_mm, 0.8 * f.bridge_position_sigma_mm);
     EXPECT_LT(f.final_position_sigma_mm, 1.4 * f.bridge_position_sigma_mm);
-    // Consistency of the reported 1-sigma: RMS of error/sigma per component over the motion
-    // segments within [0.3, 3] (the brief's bound; the errors are strongly correlated in time,
-    // so one run holds only a few independent values per component).
-    for (int i = 0; i < 9; ++i) {
-      EXPECT_GE(f.normalised_rms[i], 0.3) << i;
-      EXPECT_LE(f.normalised_rms[i], 3.0) << i;
-    }
+    // The reported 1-sigma is never optimistic: RMS of error/sigma per component over the
+    // motion segments <= 3 in every run.
+    for (int i = 0; i < 9; ++i) EXPECT_LE(f.normalised_rms[i], 3.0) << i;
+    pooled_normalised_sq += f.normalised_rms.cwiseAbs2();
   }
+  // Consistency of the reported 1-sigma, the issue's bound [0.3, 3] on the normalised errors,
+  // pooled over the runs: the errors are strongly correlated in time, so one run holds only a
+  // few independent values per component (seed 29's Up position alone gives 0.23).
+  const Vector9d pooled_normalised = (pooled_normalised_sq / seed_count).cwiseSqrt();
+  for (int i = 0; i < 9; ++i) {
+    EXPECT_GE(pooled_normalised[i], 0.3) << i;
+    EXPECT_LE(pooled_normalised[i], 3.0) << i;
+  }
+  // The issue's goal: smoothed position error < 0.2 mm RMS over the motion segments, pooled over
+  // the runs (measured 0.138 mm over seeds 21..40). A single run is one draw of a random walk:
+  // 1 run in 20 (seed 22, 0.238 mm) lies above 0.2 mm, as its own 1-sigma predicts.
+  const double pooled_position_rms_mm = std::sqrt(pooled_position_sq / seed_count);
+  std::printf(
+      "pooled over %u runs: position RMS %.3f mm (runs at or above 0.2 mm: %zu); RMS(error/sigma) "
+      "attitude %.2f %.2f %.2f velocity %.2f %.2f %.2f position %.2f %.2f %.2f\n",
+      seed_count, pooled_position_rms_mm, runs_over_goal, pooled_normalised[0],
+      pooled_normalised[1], pooled_normalised[2], pooled_normalised[3], pooled_normalised[4],
+      pooled_normalised[5], pooled_normalised[6], pooled_normalised[7], pooled_normalised[8]);
+  EXPECT_LT(pooled_position_rms_mm, 0.2);
 }
 
 // The same with the heading from gyrocompassing on the first rest (2 s) only: the heading error is
