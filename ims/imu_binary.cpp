@@ -239,15 +239,8 @@ void write_imu_binary(const fs::path& path, const ImuSeries& series, Overwrite o
   AtomicFile file(path, overwrite, /*binary=*/true);
   constexpr std::size_t kChunk = 1u << 20;
   for (std::size_t i = 0; i < series.samples.size(); ++i) {
-    const ImuSample& s = series.samples[i];
-    const double values[kValuesPerRecord] = {s.t_s,     s.gyro.x(), s.gyro.y(), s.gyro.z(),
-                                             s.acc.x(), s.acc.y(),  s.acc.z()};
-    for (std::size_t c = 0; c < kValuesPerRecord; ++c) {
-      if (!std::isfinite(values[c])) {
-        throw std::invalid_argument(fmt::format("IMU sample {} has a non-finite value ({}) in {}",
-                                                i, values[c], si_column_names(series.quantity)[c]));
-      }
-      append_little_endian<double>(out, values[c]);
+    for (const double value : finite_sample_values(series, i)) {
+      append_little_endian<double>(out, value);
     }
     if (out.size() >= kChunk) {
       file.stream().write(out.data(), static_cast<std::streamsize>(out.size()));

@@ -351,14 +351,8 @@ void format_csv(const ImuSeries& series, std::string& out, Flush flush) {
   }
   out += joined(si_column_names(series.quantity)) + '\n';
   for (std::size_t i = 0; i < series.samples.size(); ++i) {
-    const ImuSample& s = series.samples[i];
-    const double values[kColumns] = {s.t_s,     s.gyro.x(), s.gyro.y(), s.gyro.z(),
-                                     s.acc.x(), s.acc.y(),  s.acc.z()};
+    const std::array<double, kColumns> values = finite_sample_values(series, i);
     for (std::size_t c = 0; c < kColumns; ++c) {
-      if (!std::isfinite(values[c])) {
-        throw std::invalid_argument(fmt::format("IMU sample {} has a non-finite value ({}) in {}",
-                                                i, values[c], si_column_names(series.quantity)[c]));
-      }
       append_number(out, values[c]);
       out += c + 1 < kColumns ? ',' : '\n';
     }

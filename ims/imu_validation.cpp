@@ -397,6 +397,20 @@ ImuColumnNames si_column_names(ImuQuantity quantity) {
           "acc_x_m_s2", "acc_y_m_s2",   "acc_z_m_s2"};
 }
 
+std::array<double, 7> finite_sample_values(const ImuSeries& series, std::size_t index) {
+  const ImuSample& s = series.samples[index];
+  const std::array<double, 7> values = {s.t_s,     s.gyro.x(), s.gyro.y(), s.gyro.z(),
+                                        s.acc.x(), s.acc.y(),  s.acc.z()};
+  for (std::size_t c = 0; c < values.size(); ++c) {
+    if (!std::isfinite(values[c])) {
+      throw std::invalid_argument(fmt::format("IMU sample {} has a non-finite value ({}) in {}",
+                                              index, values[c],
+                                              si_column_names(series.quantity)[c]));
+    }
+  }
+  return values;
+}
+
 void add_imu_warning(ImuReadReport* report, const std::string& warning) {
   spdlog::warn("{}", warning);
   if (report != nullptr) report->warnings.push_back(warning);

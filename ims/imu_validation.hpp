@@ -79,6 +79,10 @@ struct ImuReadReport {
 using ImuColumnNames = std::array<std::string, 7>;
 ImuColumnNames si_column_names(ImuQuantity quantity);
 
+// The seven values of sample `index` in column order (t_s, gyro, acc), as the writers store them.
+// Throws std::invalid_argument naming the sample and the column when a value is not finite.
+std::array<double, 7> finite_sample_values(const ImuSeries& series, std::size_t index);
+
 // Where the samples came from, for messages. Defaults (from the series itself): SI column names,
 // no header line for nominal_dt_s.
 struct ImuSourceInfo {
