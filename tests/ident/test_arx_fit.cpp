@@ -14,6 +14,7 @@
 
 #include "ident/arx_fit.hpp"
 #include "ident/arx_model.hpp"
+#include "tests/support/arx_systems.hpp"
 
 using imscal::ident::ArxFitOptions;
 using imscal::ident::ArxModel;
@@ -30,68 +31,21 @@ bool sanitized() {
   return std::getenv("IMSCAL_SANITIZED") != nullptr;
 }
 
-// Monic polynomial coefficients a_1..a_n of Π (z - p_i) for the given (conjugate-closed) poles.
-Eigen::VectorXd polynomial_from_poles(const std::vector<std::complex<double>>& poles) {
-  std::vector<std::complex<double>> c{1.0};
-  for (const auto& p : poles) {
-    c.push_back(0.0);
-    for (std::size_t i = c.size() - 1; i > 0; --i) c[i] -= p * c[i - 1];
-  }
-  Eigen::VectorXd a(static_cast<Eigen::Index>(poles.size()));
-  for (std::size_t i = 1; i < c.size(); ++i) a(static_cast<Eigen::Index>(i - 1)) = c[i].real();
-  return a;
-}
+using imscal::test_support::polynomial_from_poles;
+using imscal::test_support::random_b;
+using imscal::test_support::random_poles;
+using imscal::test_support::view;
+using Record = imscal::test_support::ArxRecord;
 
-// Random stable poles: conjugate pairs (and one real pole for odd na), modulus in [0.3, 0.9].
-std::vector<std::complex<double>> random_poles(int na, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> modulus(0.3, 0.9), angle(0.1, 3.0), sign(-1.0, 1.0);
-  std::vector<std::complex<double>> poles;
-  for (int i = 0; i + 1 < na; i += 2) {
-    const auto p = std::polar(modulus(rng), angle(rng));
-    poles.push_back(p);
-    poles.push_back(std::conj(p));
-  }
-  if (na % 2 == 1) poles.emplace_back(modulus(rng) * (sign(rng) < 0 ? -1.0 : 1.0), 0.0);
-  return poles;
-}
-
-Eigen::VectorXd random_b(int nb, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> magnitude(0.5, 1.5), sign(-1.0, 1.0);
-  Eigen::VectorXd b(nb);
-  for (int j = 0; j < nb; ++j) b(j) = magnitude(rng) * (sign(rng) < 0 ? -1.0 : 1.0);
-  return b;
-}
-
-struct Record {
-  std::vector<double> u, y, e;
-};
-
-// y(k) = -Σ a_i y(k-i) + Σ b_j u(k-d-j) + e(k), samples before k = 0 taken as y0 (not 0, so
-// that two runs start from different states).
+// White input (offset, std) and white equation noise, both from one normal stream; samples
+// before k = 0 taken as y0 and the input offset.
 Record simulate(const ArxModel& m, std::size_t n, double noise_std, std::mt19937_64& rng,
                 double input_offset = 0.0, double input_std = 1.0, double y0 = 0.0) {
   std::normal_distribution<double> normal(0.0, 1.0);
-  Record r;
-  r.u.resize(n);
-  r.y.resize(n);
-  r.e.resize(n);
-  for (auto& v : r.u) v = input_offset + input_std * normal(rng);
-  for (auto& v : r.e) v = noise_std * normal(rng);
-  const auto& s = m.structure();
-  for (std::size_t k = 0; k < n; ++k) {
-    double sum = r.e[k];
-    for (int i = 1; i <= s.na; ++i) sum -= m.a()(i - 1) * (k >= std::size_t(i) ? r.y[k - i] : y0);
-    for (int j = 0; j < s.nb; ++j) {
-      const long idx = long(k) - s.dead_time - j;
-      sum += m.b()(j) * (idx >= 0 ? r.u[std::size_t(idx)] : input_offset);
-    }
-    r.y[k] = sum;
-  }
-  return r;
-}
-
-IoSegment view(const Record& r) {
-  return {r.u, r.y};
+  std::vector<double> u(n), e(n);
+  for (auto& v : u) v = input_offset + input_std * normal(rng);
+  for (auto& v : e) v = noise_std * normal(rng);
+  return imscal::test_support::simulate_arx(m, std::move(u), std::move(e), y0, input_offset);
 }
 
 double relative_error(const Eigen::VectorXd& estimate, const Eigen::VectorXd& truth) {

@@ -13,6 +13,7 @@
 
 #include "ident/arx_fit.hpp"
 #include "ident/model_validation.hpp"
+#include "tests/support/arx_systems.hpp"
 
 using imscal::ident::ArxModel;
 using imscal::ident::ArxStructure;
@@ -30,9 +31,8 @@ bool sanitized() {
   return std::getenv("IMSCAL_SANITIZED") != nullptr;
 }
 
-struct Record {
-  std::vector<double> u, y, e;
-};
+using imscal::test_support::view;
+using Record = imscal::test_support::ArxRecord;
 
 // A fixed stable system: poles 0.8 ± 0.3i and 0.5, input lags 3..4 (d = 3, nb = 2).
 ArxModel reference_system() {
@@ -47,28 +47,11 @@ ArxModel reference_system() {
 Record simulate(const ArxModel& m, std::size_t n, double noise_std, std::mt19937_64& rng,
                 double input_pole = 0.0) {
   std::normal_distribution<double> normal(0.0, 1.0);
-  Record r;
-  r.u.resize(n);
-  r.y.resize(n);
-  r.e.resize(n);
+  std::vector<double> u(n), e(n);
   double previous = 0.0;
-  for (auto& v : r.u) v = previous = input_pole * previous + normal(rng);
-  const auto& s = m.structure();
-  for (std::size_t k = 0; k < n; ++k) {
-    r.e[k] = noise_std * normal(rng);
-    double sum = r.e[k];
-    for (int i = 1; i <= s.na && std::size_t(i) <= k; ++i) sum -= m.a()(i - 1) * r.y[k - i];
-    for (int j = 0; j < s.nb; ++j) {
-      const long idx = long(k) - s.dead_time - j;
-      if (idx >= 0) sum += m.b()(j) * r.u[std::size_t(idx)];
-    }
-    r.y[k] = sum;
-  }
-  return r;
-}
-
-IoSegment view(const Record& r) {
-  return {r.u, r.y};
+  for (auto& v : u) v = previous = input_pole * previous + normal(rng);
+  for (auto& v : e) v = noise_std * normal(rng);
+  return imscal::test_support::simulate_arx(m, std::move(u), std::move(e));
 }
 
 }  // namespace

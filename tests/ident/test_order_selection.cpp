@@ -11,6 +11,7 @@
 
 #include "ident/arx_fit.hpp"
 #include "ident/order_selection.hpp"
+#include "tests/support/arx_systems.hpp"
 
 using imscal::ident::ArxModel;
 using imscal::ident::ArxStructure;
@@ -24,61 +25,17 @@ using imscal::ident::select_arx_order;
 
 namespace {
 
-// Monic polynomial coefficients a_1..a_n of Π (z - p_i) for conjugate-closed poles.
-Eigen::VectorXd polynomial_from_poles(const std::vector<std::complex<double>>& poles) {
-  std::vector<std::complex<double>> c{1.0};
-  for (const auto& p : poles) {
-    c.push_back(0.0);
-    for (std::size_t i = c.size() - 1; i > 0; --i) c[i] -= p * c[i - 1];
-  }
-  Eigen::VectorXd a(static_cast<Eigen::Index>(poles.size()));
-  for (std::size_t i = 1; i < c.size(); ++i) a(static_cast<Eigen::Index>(i - 1)) = c[i].real();
-  return a;
-}
-
-// Random stable system: poles with modulus in [0.3, 0.9] (conjugate pairs, one real pole for
-// odd na), input coefficients of magnitude [0.5, 1.5] and random sign.
-ArxModel random_system(const ArxStructure& s, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> modulus(0.3, 0.9), angle(0.1, 3.0), unit(-1.0, 1.0),
-      magnitude(0.5, 1.5);
-  std::vector<std::complex<double>> poles;
-  for (int i = 0; i + 1 < s.na; i += 2) {
-    const auto p = std::polar(modulus(rng), angle(rng));
-    poles.push_back(p);
-    poles.push_back(std::conj(p));
-  }
-  if (s.na % 2 == 1) poles.emplace_back(modulus(rng) * (unit(rng) < 0 ? -1.0 : 1.0), 0.0);
-  Eigen::VectorXd b(s.nb);
-  for (int j = 0; j < s.nb; ++j) b(j) = magnitude(rng) * (unit(rng) < 0 ? -1.0 : 1.0);
-  return ArxModel(s, polynomial_from_poles(poles), b);
-}
-
-struct Record {
-  std::vector<double> u, y;
-};
+using imscal::test_support::random_system;
+using imscal::test_support::view;
+using Record = imscal::test_support::ArxRecord;
 
 // White Gaussian input (persistently exciting of every order) and white equation noise.
 Record simulate(const ArxModel& m, std::size_t n, double noise_std, std::mt19937_64& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
-  Record r;
-  r.u.resize(n);
-  r.y.resize(n);
-  for (auto& v : r.u) v = normal(rng);
-  const auto& s = m.structure();
-  for (std::size_t k = 0; k < n; ++k) {
-    double sum = noise_std * normal(rng);
-    for (int i = 1; i <= s.na && std::size_t(i) <= k; ++i) sum -= m.a()(i - 1) * r.y[k - i];
-    for (int j = 0; j < s.nb; ++j) {
-      const long idx = long(k) - s.dead_time - j;
-      if (idx >= 0) sum += m.b()(j) * r.u[std::size_t(idx)];
-    }
-    r.y[k] = sum;
-  }
-  return r;
-}
-
-IoSegment view(const Record& r) {
-  return {r.u, r.y};
+  std::vector<double> u(n), e(n);
+  for (auto& v : u) v = normal(rng);
+  for (auto& v : e) v = noise_std * normal(rng);
+  return imscal::test_support::simulate_arx(m, std::move(u), std::move(e));
 }
 
 }  // namespace

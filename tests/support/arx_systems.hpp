@@ -1,0 +1,88 @@
+#pragma once
+// Known ARX systems and their simulated data, shared by the ident tests: the truth that
+// identification results are checked against.
+#include <Eigen/Core>
+#include <complex>
+#include <cstddef>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "ident/arx_model.hpp"
+#include "ident/arx_structure.hpp"
+
+namespace imscal::test_support {
+
+// Monic polynomial coefficients a_1..a_n of Π (z - p_i) for conjugate-closed poles.
+inline Eigen::VectorXd polynomial_from_poles(const std::vector<std::complex<double>>& poles) {
+  std::vector<std::complex<double>> c{1.0};
+  for (const auto& p : poles) {
+    c.push_back(0.0);
+    for (std::size_t i = c.size() - 1; i > 0; --i) c[i] -= p * c[i - 1];
+  }
+  Eigen::VectorXd a(static_cast<Eigen::Index>(poles.size()));
+  for (std::size_t i = 1; i < c.size(); ++i) a(static_cast<Eigen::Index>(i - 1)) = c[i].real();
+  return a;
+}
+
+// Random stable poles: conjugate pairs (and one real pole for odd na), modulus in [0.3, 0.9].
+inline std::vector<std::complex<double>> random_poles(int na, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> modulus(0.3, 0.9), angle(0.1, 3.0), sign(-1.0, 1.0);
+  std::vector<std::complex<double>> poles;
+  for (int i = 0; i + 1 < na; i += 2) {
+    const auto p = std::polar(modulus(rng), angle(rng));
+    poles.push_back(p);
+    poles.push_back(std::conj(p));
+  }
+  if (na % 2 == 1) poles.emplace_back(modulus(rng) * (sign(rng) < 0 ? -1.0 : 1.0), 0.0);
+  return poles;
+}
+
+// Input coefficients of magnitude [0.5, 1.5] and random sign.
+inline Eigen::VectorXd random_b(int nb, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> magnitude(0.5, 1.5), sign(-1.0, 1.0);
+  Eigen::VectorXd b(nb);
+  for (int j = 0; j < nb; ++j) b(j) = magnitude(rng) * (sign(rng) < 0 ? -1.0 : 1.0);
+  return b;
+}
+
+// A random stable system of the given structure (poles first, then b, from the same stream).
+inline ident::ArxModel random_system(const ident::ArxStructure& s, std::mt19937_64& rng) {
+  const Eigen::VectorXd a = polynomial_from_poles(random_poles(s.na, rng));
+  return ident::ArxModel(s, a, random_b(s.nb, rng));
+}
+
+struct ArxRecord {
+  std::vector<double> u, y, e;
+};
+
+// y(k) = -Σ a_i y(k-i) + Σ b_j u(k-d-j) + e(k) for the given input u and equation noise e
+// (same length); samples before k = 0 are taken as y_before and u_before (non-zero values let
+// two runs start from different states).
+inline ArxRecord simulate_arx(const ident::ArxModel& m, std::vector<double> u,
+                              std::vector<double> e, double y_before = 0.0, double u_before = 0.0) {
+  ArxRecord r;
+  r.u = std::move(u);
+  r.e = std::move(e);
+  const std::size_t n = r.u.size();
+  r.y.resize(n);
+  const auto& s = m.structure();
+  for (std::size_t k = 0; k < n; ++k) {
+    double sum = r.e[k];
+    for (int i = 1; i <= s.na; ++i) {
+      sum -= m.a()(i - 1) * (k >= std::size_t(i) ? r.y[k - i] : y_before);
+    }
+    for (int j = 0; j < s.nb; ++j) {
+      const long idx = long(k) - s.dead_time - j;
+      sum += m.b()(j) * (idx >= 0 ? r.u[std::size_t(idx)] : u_before);
+    }
+    r.y[k] = sum;
+  }
+  return r;
+}
+
+inline ident::IoSegment view(const ArxRecord& r) {
+  return {r.u, r.y};
+}
+
+}  // namespace imscal::test_support
