@@ -49,9 +49,9 @@ const char* to_string(OrderCriterion criterion) {
   return "?";
 }
 
-OrderSelectionResult select_arx_order(std::span<const IoSegment> segments,
-                                      const OrderSelectionOptions& options,
-                                      std::span<const IoSegment> validation) {
+OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
+                                  const OrderSelectionOptions& options,
+                                  std::span<const IoSegment> validation) {
   const OrderGrid& grid = options.grid;
   validate_grid(grid);
   if (!(options.validation_fraction >= 0.0 && options.validation_fraction < 1.0))
@@ -178,12 +178,19 @@ OrderSelectionResult select_arx_order(std::span<const IoSegment> segments,
   if (best == nullptr)
     throw std::runtime_error("select_arx_order: every candidate is rank deficient");
   const ArxStructure chosen = best->structure;
+  return OrderSweepResult{chosen, options.criterion, std::move(candidates), n_rows, val.row_count};
+}
 
+OrderSelectionResult select_arx_order(std::span<const IoSegment> segments,
+                                      const OrderSelectionOptions& options,
+                                      std::span<const IoSegment> validation) {
+  OrderSweepResult sweep = sweep_arx_orders(segments, options, validation);
   std::vector<IoSegment> all(segments.begin(), segments.end());
   all.insert(all.end(), validation.begin(), validation.end());
-  ArxFitResult final_fit = fit_arx(all, chosen, options.final_fit);
-  return OrderSelectionResult{chosen, options.criterion, std::move(candidates),
-                              n_rows, val.row_count,     std::move(final_fit)};
+  ArxFitResult final_fit = fit_arx(all, sweep.chosen, options.final_fit);
+  return OrderSelectionResult{
+      sweep.chosen,          sweep.criterion,       std::move(sweep.candidates),
+      sweep.estimation_rows, sweep.validation_rows, std::move(final_fit)};
 }
 
 }  // namespace imscal::ident

@@ -73,6 +73,19 @@ struct OrderSelectionResult {
   ArxFitResult final_fit;  // the chosen structure fitted on all the data
 };
 
+// The sweep alone, without the final fit (for callers that fit the chosen structure on other
+// rows, e.g. ident/joint_identification.hpp, which fits each operating-point cell on its own rows).
+struct OrderSweepResult {
+  ArxStructure chosen;
+  OrderCriterion criterion = OrderCriterion::kBic;
+  std::vector<OrderCandidate> candidates;  // as OrderSelectionResult::candidates
+  std::size_t estimation_rows = 0;
+  std::size_t validation_rows = 0;
+};
+OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
+                                  const OrderSelectionOptions& options = {},
+                                  std::span<const IoSegment> validation = {});
+
 // validation: separate validation runs; when empty, validation_fraction of every segment is
 // held out instead. Throws std::invalid_argument for a bad grid or too little data.
 OrderSelectionResult select_arx_order(std::span<const IoSegment> segments,

@@ -19,6 +19,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/csv_text.hpp"
 #include "core/input_error.hpp"
 
 namespace imscal::ims {
@@ -91,19 +92,8 @@ std::string joined(const ImuColumnNames& names) {
   return text;
 }
 
-std::string_view trim(std::string_view text) {
-  const auto first = text.find_first_not_of(" \t\r");
-  if (first == std::string_view::npos) return {};
-  const auto last = text.find_last_not_of(" \t\r");
-  return text.substr(first, last - first + 1);
-}
-
-bool parse_number(std::string_view text, double& value) {
-  text = trim(text);
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  return ec == std::errc() && ptr == text.data() + text.size() && !text.empty();
-}
+using csv::parse_number;
+using csv::trim;
 
 // Matches a column name against the expected one; returns the factor to SI.
 double column_factor(const std::string& file, std::size_t line, std::size_t column,
@@ -311,12 +301,6 @@ std::size_t count_fields(std::string_view line) {
 // ---------------------------------------------------------------------------------------------
 // Writing.
 
-void append_number(std::string& out, double value) {
-  char buffer[32];
-  const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
-  out.append(buffer, ptr);
-}
-
 void check_header_text(std::string_view text, const char* what) {
   if (text.find_first_of("\r\n") != std::string_view::npos || trim(text) != text) {
     throw std::invalid_argument(
@@ -329,15 +313,15 @@ void format_csv(const ImuSeries& series, std::string& out, Flush flush) {
   out += "# imscal-imu: 1\n# quantity: ";
   out += quantity_name(series.quantity);
   out += "\n# nominal_dt_s: ";
-  append_number(out, series.nominal_dt_s);
+  csv::append_shortest(out, series.nominal_dt_s);
   out += '\n';
   if (series.site) {
     out += "# site_latitude_deg: ";
-    append_number(out, series.site->latitude_deg);
+    csv::append_shortest(out, series.site->latitude_deg);
     out += "\n# site_longitude_deg: ";
-    append_number(out, series.site->longitude_deg);
+    csv::append_shortest(out, series.site->longitude_deg);
     out += "\n# site_height_m: ";
-    append_number(out, series.site->height_m);
+    csv::append_shortest(out, series.site->height_m);
     out += '\n';
   }
   for (const auto& [key, value] : series.metadata) {
@@ -353,7 +337,7 @@ void format_csv(const ImuSeries& series, std::string& out, Flush flush) {
   for (std::size_t i = 0; i < series.samples.size(); ++i) {
     const std::array<double, kColumns> values = finite_sample_values(series, i);
     for (std::size_t c = 0; c < kColumns; ++c) {
-      append_number(out, values[c]);
+      csv::append_shortest(out, values[c]);
       out += c + 1 < kColumns ? ',' : '\n';
     }
     flush(out);

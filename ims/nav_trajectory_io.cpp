@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 
+#include "core/csv_text.hpp"
 #include "core/input_error.hpp"
 
 namespace imscal::ims {
@@ -44,25 +45,8 @@ void flush_chunk(AtomicFile& file, std::string& text) {
   text.clear();
 }
 
-std::vector<std::string_view> split(std::string_view line, char separator) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t end = line.find(separator, start);
-    fields.push_back(line.substr(start, end == std::string_view::npos ? end : end - start));
-    if (end == std::string_view::npos) break;
-    start = end + 1;
-  }
-  return fields;
-}
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) {
-    s.remove_suffix(1);
-  }
-  return s;
-}
+using csv::split;
+using csv::trim;
 
 }  // namespace
 

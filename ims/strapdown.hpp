@@ -30,8 +30,10 @@
 //    mid-interval position.
 //  - Position: trapezoid of the velocity with the end correction -(h/12)(dv_k - dv_{k-1})
 //    (O(h^5) per step; the error sum telescopes), Coriolis to second order.
-// No heap allocation and no trigonometric call while |rotation per step| < 0.01 rad; about
-// 60-70 ns per sample (bench/bench_strapdown.cpp).
+// No heap allocation and no trigonometric call while |rotation per step| < 0.01 rad. The
+// per-sample code works on 3-vectors padded to 4 doubles (one AVX register) and is arranged for
+// short dependency chains; about 45 ns per sample on one core of the development machine
+// (bench/bench_strapdown.cpp, which also times the previous implementation in the same run).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <vector>
@@ -66,23 +68,41 @@ class Strapdown {
   void reset(const NavState& state);
 
  private:
+  // A three-vector padded with a zero to four doubles and aligned to 32 bytes: one AVX register
+  // in the per-sample code (ims/strapdown.cpp), loaded and stored whole.
+  struct alignas(32) Vec3 {
+    double x = 0.0, y = 0.0, z = 0.0, zero = 0.0;
+  };
   static constexpr int kEarthRateSyncSteps = 1024;
   void sync_earth_rate();
+  void update_increment_maps(double h, double trapezoid_fraction);
 
-  Eigen::Vector3d earth_rate_W_;  // omega_ie in W [rad/s]; zero when options.earth_rate is off
-  Eigen::Vector3d earth_rate_S_;  // the same in S at state_.t_s [rad/s]
+  Vec3 earth_rate_W_;  // omega_ie in W [rad/s]; zero when options.earth_rate is off
+  Vec3 earth_rate_S_;  // the same in S at state_.t_s [rad/s]
   int steps_since_sync_ = 0;
-  Eigen::Vector3d coriolis_rate_W_;  // omega_ie used in the Coriolis term [rad/s] (or zero)
-  Eigen::Vector3d gravity_origin_W_;
-  Eigen::Matrix3d gravity_gradient_W_;
+  Vec3 coriolis_rate_W_;  // omega_ie used in the Coriolis term [rad/s] (or zero)
+  Vec3 gravity_origin_W_;
+  Vec3 gravity_gradient_W_[3];  // columns of the gravity gradient [1/s^2]
   StrapdownOptions options_;
+  // state_ is the output; the per-sample code works on the copies below (same values).
   NavState state_;
-  // The two previous increments (oldest first) and how many of them are valid (0..2).
-  Eigen::Vector3d gyro_history_[2];
-  Eigen::Vector3d acc_history_[2];
+  Vec3 q_vec_;  // vector part of state_.q_W_S
+  double q_w_ = 1.0;
+  Vec3 v_W_, p_W_;
+  // The two previous increments, the latest at index newest_, and how many of them are valid
+  // (0..2).
+  Vec3 gyro_history_[2];
+  Vec3 acc_history_[2];
+  int newest_ = 0;
   int history_count_ = 0;
-  Eigen::Vector3d previous_dv_0_W_ = Eigen::Vector3d::Zero();  // last dv without Coriolis [m/s]
+  Vec3 previous_dv_0_W_;  // last dv without Coriolis [m/s]
   double previous_dt_s_ = 0.0;
+  // Constant 3x3 matrices (columns) that take R_W_S times the sum of the two Gauss-node
+  // values of the rotated specific force to the velocity, position and Coriolis-free velocity
+  // increments (ims/strapdown.cpp), made for the interval maps_h_s_ and the trapezoid weight
+  // maps_trapezoid_fraction_ * h.
+  Vec3 velocity_map_[3], position_map_[3], dv_0_map_[3];
+  double maps_h_s_ = -1.0, maps_trapezoid_fraction_ = -1.0;
 };
 
 // Mechanizes a whole series of increments. Returns samples.size() + 1 states: element 0 is

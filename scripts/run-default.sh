@@ -28,4 +28,6 @@ echo "== 3. Error correction, alignment, mechanization, zero-velocity smoothing"
 echo "== 4. Smoothed trajectory against the truth"
 "$imscal" compare --estimate "$out/nav/trajectory.csv" \
   --reference "$out/regenerated/truth/trajectory.csv" --json "$out/nav/errors.json"
-echo "Results in $out/: align-rlg.json, nav/trajectory.csv (with 1-sigma), nav/trajectory.tum, nav/errors.json"
+echo "== 5. The paper's test on the simulated robot: seed-line (robot log, raw IMS file, truth)"
+"$imscal" simulate --scenario seed-line --out "$out/seed-line" --force
+echo "Results in $out/: align-rlg.json, nav/ (trajectory with 1-sigma, errors.json), seed-line/"

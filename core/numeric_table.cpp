@@ -1,0 +1,98 @@
+#include "core/numeric_table.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+
+#include "core/csv_text.hpp"
+#include "core/input_error.hpp"
+
+namespace imscal {
+
+std::size_t NumericTable::column(const std::string& name) const {
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    if (columns[c] == name) return c;
+  }
+  throw InputError(file, header_line, name, "missing column '" + name + "'");
+}
+
+const std::string& NumericTable::meta(const std::string& key) const {
+  const auto it = metadata.find(key);
+  if (it == metadata.end()) {
+    throw InputError(file, 0, key, "missing header line '# " + key + ": ...'");
+  }
+  return it->second;
+}
+
+NumericTable read_numeric_table(const std::filesystem::path& path) {
+  NumericTable table;
+  table.file = path.string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(table.file, 0, "", "cannot open the file");
+  std::string line;
+  std::size_t line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    const std::string_view text = csv::trim(line);
+    if (text.empty()) {
+      if (table.columns.empty()) continue;
+      throw InputError(table.file, line_number, "", "empty line among the data rows");
+    }
+    if (table.columns.empty()) {
+      if (text.front() == '#') {
+        const std::string_view body = csv::trim(text.substr(1));
+        const auto colon = body.find(':');
+        if (colon != std::string_view::npos) {
+          table.metadata[std::string(csv::trim(body.substr(0, colon)))] =
+              std::string(csv::trim(body.substr(colon + 1)));
+        }
+        continue;
+      }
+      std::set<std::string> seen;
+      for (const std::string_view name : csv::split(text, ',')) {
+        std::string column(csv::trim(name));
+        if (column.empty() || !seen.insert(column).second) {
+          throw InputError(table.file, line_number, column,
+                           column.empty() ? "empty column name in the header"
+                                          : "column '" + column + "' appears twice");
+        }
+        table.columns.push_back(std::move(column));
+      }
+      table.header_line = line_number;
+      continue;
+    }
+    const std::vector<std::string_view> fields = csv::split(text, ',');
+    if (fields.size() != table.columns.size()) {
+      const bool semicolons = fields.size() == 1 && text.find(';') != std::string_view::npos;
+      throw InputError(
+          table.file, line_number, "",
+          fmt::format("{} fields, the header has {}{}", fields.size(), table.columns.size(),
+                      semicolons ? " (';' is not a separator here: use ',')" : ""));
+    }
+    for (std::size_t c = 0; c < fields.size(); ++c) {
+      double value = 0.0;
+      if (!csv::parse_number(fields[c], value)) {
+        throw InputError(table.file, line_number, table.columns[c],
+                         fmt::format("'{}' is not a number", csv::trim(fields[c])));
+      }
+      if (!std::isfinite(value)) {
+        throw InputError(table.file, line_number, table.columns[c],
+                         fmt::format("'{}' is not a finite number", csv::trim(fields[c])));
+      }
+      table.values.push_back(value);
+    }
+    table.lines.push_back(line_number);
+  }
+  if (table.columns.empty()) {
+    throw InputError(table.file, line_number, "",
+                     line_number == 0 ? "the file is empty" : "no header line with column names");
+  }
+  if (table.lines.empty()) {
+    throw InputError(table.file, table.header_line, "", "no data rows after the header");
+  }
+  return table;
+}
+
+}  // namespace imscal

@@ -1,0 +1,61 @@
+#include "core/output_folder.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <system_error>
+
+#include "core/input_error.hpp"
+
+namespace imscal {
+
+namespace fs = std::filesystem;
+
+OutputFolder::OutputFolder(fs::path folder, std::vector<fs::path> outputs, Overwrite overwrite)
+    : folder_(std::move(folder)), outputs_(std::move(outputs)) {
+  for (const fs::path& relative : outputs_) {
+    if (relative.is_absolute() || relative.empty()) {
+      throw std::invalid_argument("OutputFolder: outputs must be relative paths");
+    }
+    const fs::path target = folder_ / relative;
+    if (overwrite == Overwrite::kRefuse && fs::exists(target)) {
+      throw InputError(target.string(), 0, "", "exists already (use --force to replace it)");
+    }
+  }
+  fs::create_directories(folder_);
+  staging_ = folder_ / (".imscal-staging-" + std::to_string(::getpid()));
+  fs::remove_all(staging_);
+  fs::create_directories(staging_);
+}
+
+OutputFolder::~OutputFolder() {
+  std::error_code ignored;
+  fs::remove_all(staging_, ignored);
+}
+
+fs::path OutputFolder::staged(const fs::path& relative) const {
+  if (std::find(outputs_.begin(), outputs_.end(), relative) == outputs_.end()) {
+    throw std::logic_error("OutputFolder: '" + relative.string() + "' was not declared");
+  }
+  const fs::path path = staging_ / relative;
+  fs::create_directories(path.parent_path());
+  return path;
+}
+
+void OutputFolder::commit() {
+  for (const fs::path& relative : outputs_) {
+    if (!fs::is_regular_file(staging_ / relative)) {
+      throw std::logic_error("OutputFolder: '" + relative.string() + "' was not written");
+    }
+  }
+  // Renames within one file system are atomic per file; the set is complete before the first.
+  for (const fs::path& relative : outputs_) {
+    const fs::path target = folder_ / relative;
+    fs::create_directories(target.parent_path());
+    fs::rename(staging_ / relative, target);
+  }
+  committed_ = true;
+}
+
+}  // namespace imscal

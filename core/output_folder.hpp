@@ -1,0 +1,38 @@
+#pragma once
+// A command's set of output files, written all or nothing: every file is first written into a
+// hidden staging folder inside the output folder, and only when all of them are complete are they
+// renamed into place. An error or an interruption before commit() leaves the output folder as it
+// was (the staging folder is removed; a crash leaves only the hidden `.imscal-staging-*`).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/atomic_file.hpp"
+
+namespace imscal {
+
+class OutputFolder {
+ public:
+  // `outputs`: the files this command will write, relative to `folder`. With Overwrite::kRefuse
+  // an InputError naming the first existing one is thrown here, before any work is done.
+  OutputFolder(std::filesystem::path folder, std::vector<std::filesystem::path> outputs,
+               Overwrite overwrite);
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+  ~OutputFolder();
+
+  // Where to write `relative` (one of the declared outputs) now; its parent folder exists.
+  std::filesystem::path staged(const std::filesystem::path& relative) const;
+  // Moves every declared output into place; throws if one was not written.
+  void commit();
+
+  const std::filesystem::path& folder() const { return folder_; }
+
+ private:
+  std::filesystem::path folder_;
+  std::filesystem::path staging_;
+  std::vector<std::filesystem::path> outputs_;
+  bool committed_ = false;
+};
+
+}  // namespace imscal

@@ -1,0 +1,8 @@
+// Fuzz target "imu_csv": see fuzz/fuzz_readers.hpp for the reader it exercises.
+#include "fuzz/fuzz_input_file.hpp"
+#include "fuzz/fuzz_readers.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  imscal::fuzz::read_with("imu_csv", imscal::fuzz::write_input("imu_csv", ".csv", data, size));
+  return 0;
+}

@@ -1,0 +1,8 @@
+// Fuzz target "psins": see fuzz/fuzz_readers.hpp for the reader it exercises.
+#include "fuzz/fuzz_input_file.hpp"
+#include "fuzz/fuzz_readers.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  imscal::fuzz::read_with("psins", imscal::fuzz::write_input("psins", ".imu", data, size));
+  return 0;
+}

@@ -1,0 +1,63 @@
+#pragma once
+// What each fuzz target feeds its input to, shared by the fuzz targets (fuzz/fuzz_*.cpp) and the
+// regression test that replays the inputs fuzzing once found (tests/core/test_fuzz_regressions).
+// A reader may accept the input or refuse it with an InputError; anything else is a bug.
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "calib/robot_description.hpp"
+#include "calib/robot_log.hpp"
+#include "core/config_node.hpp"
+#include "core/input_error.hpp"
+#include "ims/imu_binary.hpp"
+#include "ims/imu_csv.hpp"
+#include "ims/nav_trajectory_io.hpp"
+#include "ims/psins_reader.hpp"
+#include "ims/sensor_error_model.hpp"
+#include "ims/sensor_spec.hpp"
+
+namespace imscal::fuzz {
+
+// Every config parser on one YAML text; each may refuse it on its own.
+inline void parse_yaml_configs(const std::string& text) {
+  const ConfigNode root = ConfigNode::load_string(text, "fuzz.yaml");
+  try {
+    calib::parse_robot_description(root);
+  } catch (const InputError&) {
+  }
+  try {
+    ims::parse_sensor_spec(root);
+  } catch (const InputError&) {
+  }
+  ims::parse_sensor_error_model(root);
+}
+
+// Reads `file` with the reader of `target` (the fuzz target's name without "fuzz_"); returns
+// quietly when the reader accepts or refuses the input with an InputError.
+inline void read_with(std::string_view target, const std::filesystem::path& file) {
+  try {
+    if (target == "imu_csv") {
+      ims::read_imu_csv(file);
+    } else if (target == "imu_binary") {
+      ims::read_imu_binary(file);
+    } else if (target == "psins") {
+      ims::read_psins(file);
+    } else if (target == "robot_log") {
+      calib::read_robot_log_csv(file);
+    } else if (target == "nav_trajectory") {
+      ims::read_trajectory_csv(file);
+    } else if (target == "yaml_configs") {
+      std::ifstream in(file, std::ios::binary);
+      parse_yaml_configs(std::string(std::istreambuf_iterator<char>(in), {}));
+    } else {
+      throw std::logic_error("no fuzz target '" + std::string(target) + "'");
+    }
+  } catch (const InputError&) {
+  }
+}
+
+}  // namespace imscal::fuzz

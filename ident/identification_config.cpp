@@ -1,0 +1,164 @@
+#include "ident/identification_config.hpp"
+
+#include <fmt/format.h>
+
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+
+namespace imscal::ident {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+std::vector<double> scaled(const std::vector<double>& v, double factor) {
+  std::vector<double> out;
+  for (double x : v) out.push_back(x * factor);
+  return out;
+}
+
+void check_increasing(const ConfigNode& node, const std::vector<double>& v) {
+  if (v.size() < 2) node.fail("at least 2 bounds needed");
+  for (std::size_t i = 1; i < v.size(); ++i)
+    if (!(v[i] > v[i - 1])) node.fail("bounds must be strictly increasing");
+}
+
+std::pair<int, int> range(const ConfigNode& node, int lowest) {
+  const std::vector<double> v = node.as_doubles();
+  if (v.size() != 2 || v[0] != double(long(v[0])) || v[1] != double(long(v[1])) || v[0] < lowest ||
+      v[1] < v[0])
+    node.fail(fmt::format("expected [min, max], integers, {} <= min <= max", lowest));
+  return {int(v[0]), int(v[1])};
+}
+
+}  // namespace
+
+CellGrid IdentificationConfig::joint_grid(std::size_t joint) const {
+  if (joint >= max_speed_rad_s.size())
+    throw std::invalid_argument(fmt::format(
+        "identification config: no maximum speed for joint {} (joints.max_speed_deg_s has {})",
+        joint + 1, max_speed_rad_s.size()));
+  std::vector<CellDimension> dims;
+  dims.push_back(
+      {OperatingQuantity::kSpeed, scaled(speed_fraction_bounds, max_speed_rad_s[joint])});
+  dims.push_back(
+      {OperatingQuantity::kPayload, scaled(payload_fraction_bounds, nominal_payload_kg)});
+  for (const auto& e : extra_dimensions) dims.push_back({e.quantity, e.bounds_si});
+  return CellGrid(std::move(dims));
+}
+
+IdentificationConfig load_identification_config(const ConfigNode& root) {
+  root.require_only_keys({"imscal-identification-config", "joints", "cells", "order", "validation",
+                          "stability_margin", "backlash"});
+  if (root.child("imscal-identification-config").as_int() != 1)
+    root.child("imscal-identification-config").fail("unknown config version; expected 1");
+  IdentificationConfig c;
+  auto& o = c.options;
+
+  const ConfigNode joints = root.child("joints");
+  joints.require_only_keys({"max_speed_deg_s", "nominal_payload_kg"});
+  c.max_speed_rad_s = scaled(joints.child("max_speed_deg_s").as_doubles(), kDeg);
+  for (double v : c.max_speed_rad_s)
+    if (!(v > 0.0)) joints.child("max_speed_deg_s").fail("every maximum speed must be > 0");
+  c.nominal_payload_kg = joints.child("nominal_payload_kg").as_double();
+  if (!(c.nominal_payload_kg > 0.0))
+    joints.child("nominal_payload_kg").fail("nominal payload must be > 0");
+
+  if (auto cells = root.optional_child("cells")) {
+    cells->require_only_keys({"speed_fraction_bounds", "payload_fraction_bounds", "extra",
+                              "min_rows", "min_rms_speed_deg_s"});
+    if (auto n = cells->optional_child("speed_fraction_bounds")) {
+      c.speed_fraction_bounds = n->as_doubles();
+      check_increasing(*n, c.speed_fraction_bounds);
+    }
+    if (auto n = cells->optional_child("payload_fraction_bounds")) {
+      c.payload_fraction_bounds = n->as_doubles();
+      check_increasing(*n, c.payload_fraction_bounds);
+    }
+    if (auto extra = cells->optional_child("extra")) {
+      for (const ConfigNode& e : extra->as_sequence()) {
+        e.require_only_keys({"quantity", "bounds_deg", "bounds_deg_s2"});
+        const std::string q = e.child("quantity").as_string();
+        ExtraDimension d;
+        if (q == "position") {
+          d.quantity = OperatingQuantity::kPosition;
+          if (e.has("bounds_deg_s2")) e.child("bounds_deg_s2").fail("position bounds: bounds_deg");
+          d.bounds_si = scaled(e.child("bounds_deg").as_doubles(), kDeg);
+          check_increasing(e.child("bounds_deg"), d.bounds_si);
+        } else if (q == "acceleration") {
+          d.quantity = OperatingQuantity::kAcceleration;
+          if (e.has("bounds_deg")) e.child("bounds_deg").fail("acceleration bounds: bounds_deg_s2");
+          d.bounds_si = scaled(e.child("bounds_deg_s2").as_doubles(), kDeg);
+          check_increasing(e.child("bounds_deg_s2"), d.bounds_si);
+        } else {
+          e.child("quantity").fail("extra dimension must be 'position' or 'acceleration'");
+        }
+        c.extra_dimensions.push_back(std::move(d));
+      }
+    }
+    const long min_rows = cells->get_int("min_rows", long(o.min_rows_per_cell));
+    if (min_rows < 1) cells->child("min_rows").fail("must be >= 1");
+    o.min_rows_per_cell = std::size_t(min_rows);
+    o.min_rms_speed_rad_s =
+        cells->get_double("min_rms_speed_deg_s", o.min_rms_speed_rad_s / kDeg) * kDeg;
+  }
+  if (auto order = root.optional_child("order")) {
+    order->require_only_keys({"na", "nb", "dead_time", "criterion"});
+    if (auto n = order->optional_child("na")) std::tie(o.grid.na_min, o.grid.na_max) = range(*n, 0);
+    if (auto n = order->optional_child("nb")) std::tie(o.grid.nb_min, o.grid.nb_max) = range(*n, 1);
+    if (auto n = order->optional_child("dead_time"))
+      std::tie(o.grid.dead_time_min, o.grid.dead_time_max) = range(*n, 0);
+    if (auto n = order->optional_child("criterion")) {
+      const std::string name = n->as_string();
+      if (name == "aic")
+        o.criterion = OrderCriterion::kAic;
+      else if (name == "bic")
+        o.criterion = OrderCriterion::kBic;
+      else if (name == "validation")
+        o.criterion = OrderCriterion::kValidation;
+      else
+        n->fail("criterion must be aic, bic or validation");
+    }
+  }
+  if (auto v = root.optional_child("validation")) {
+    v->require_only_keys({"fraction", "max_lag", "band_z"});
+    o.validation_fraction = v->get_double("fraction", o.validation_fraction);
+    if (!(o.validation_fraction > 0.0 && o.validation_fraction < 1.0))
+      v->child("fraction").fail("held-out fraction must be in (0, 1)");
+    o.validation.max_lag = int(v->get_int("max_lag", o.validation.max_lag));
+    if (o.validation.max_lag < 1) v->child("max_lag").fail("must be >= 1");
+    o.validation.band_z = v->get_double("band_z", o.validation.band_z);
+    if (!(o.validation.band_z > 0.0)) v->child("band_z").fail("must be > 0");
+  }
+  o.stability_margin = root.get_double("stability_margin", o.stability_margin);
+  if (!(o.stability_margin >= 0.0 && o.stability_margin < 1.0))
+    root.child("stability_margin").fail("must be in [0, 1)");
+  if (auto b = root.optional_child("backlash")) {
+    b->require_only_keys(
+        {"enabled", "min_speed_deg_s", "max_lag_s", "settle_s", "window_s", "min_reversals"});
+    o.identify_backlash = b->get_bool("enabled", o.identify_backlash);
+    auto& bl = o.backlash;
+    bl.min_speed_rad_s = b->get_double("min_speed_deg_s", bl.min_speed_rad_s / kDeg) * kDeg;
+    bl.max_lag_s = b->get_double("max_lag_s", bl.max_lag_s);
+    bl.settle_s = b->get_double("settle_s", bl.settle_s);
+    bl.window_s = b->get_double("window_s", bl.window_s);
+    bl.min_reversals = int(b->get_int("min_reversals", bl.min_reversals));
+    if (!(bl.min_speed_rad_s >= 0.0)) b->child("min_speed_deg_s").fail("must be >= 0");
+    if (!(bl.max_lag_s >= 0.0)) b->child("max_lag_s").fail("must be >= 0");
+    if (!(bl.settle_s >= 0.0)) b->child("settle_s").fail("must be >= 0");
+    if (!(bl.window_s > 0.0)) b->child("window_s").fail("must be > 0");
+    if (bl.min_reversals < 2) b->child("min_reversals").fail("must be >= 2");
+  }
+  // The grid of every joint must be valid (bounds, dimension count).
+  for (std::size_t j = 0; j < c.max_speed_rad_s.size(); ++j) {
+    try {
+      (void)c.joint_grid(j);
+    } catch (const std::invalid_argument& e) {
+      root.child("cells").fail(e.what());
+    }
+  }
+  return c;
+}
+
+}  // namespace imscal::ident

@@ -1,0 +1,36 @@
+#pragma once
+// The identification config (YAML, read by `imscal identify --config`): the operating-point
+// grid and the options of ident/joint_identification.hpp. Degrees appear only here, in the key
+// names; everything is converted to SI on loading. Shipped default with every key explained:
+// datasets/identification/ident-default.yaml.
+#include <cstddef>
+#include <vector>
+
+#include "core/config_node.hpp"
+#include "ident/joint_identification.hpp"
+#include "ident/operating_point.hpp"
+
+namespace imscal::ident {
+
+struct ExtraDimension {
+  OperatingQuantity quantity = OperatingQuantity::kPosition;
+  std::vector<double> bounds_si;  // the same for every joint
+};
+
+struct IdentificationConfig {
+  std::vector<double> max_speed_rad_s;  // per joint, in the joint order of the data
+  double nominal_payload_kg = 16.0;
+  std::vector<double> speed_fraction_bounds{0.0, 0.2, 0.8, 1.0};  // of max speed (paper, Table 2)
+  std::vector<double> payload_fraction_bounds{0.0, 0.5, 1.0};     // of nominal payload
+  std::vector<ExtraDimension> extra_dimensions;
+  JointIdentificationOptions options;
+
+  // Speed × payload (× extra dimensions) of one joint, in SI. Throws std::invalid_argument for
+  // a joint without a maximum speed.
+  CellGrid joint_grid(std::size_t joint) const;
+};
+
+// InputError (file, line, key) on unknown keys, bad values or an inconsistent grid.
+IdentificationConfig load_identification_config(const ConfigNode& root);
+
+}  // namespace imscal::ident

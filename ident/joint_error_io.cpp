@@ -1,0 +1,317 @@
+#include "ident/joint_error_io.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <map>
+#include <stdexcept>
+#include <string_view>
+
+#include "core/csv_text.hpp"
+#include "core/input_error.hpp"
+
+namespace imscal::ident {
+namespace {
+
+constexpr int kFormatVersion = 1;
+// A step longer than this many cycles is a gap between two runs (a dropped sample or a pause in
+// the recording): no regressor may reach across it.
+constexpr double kGapCycles = 1.5;
+
+using csv::parse_number;
+using csv::trim;
+
+std::vector<std::string> expected_columns(const std::vector<std::string>& joints) {
+  std::vector<std::string> names{"t_s", "payload_kg"};
+  for (const char* family : {"q_desired", "q_measured", "q_internal"})
+    for (const auto& j : joints) names.push_back(fmt::format("{}_{}_rad", family, j));
+  return names;
+}
+
+// Joint names from the q_desired_<J>_rad columns of the header.
+std::vector<std::string> joints_from_header(const std::string& file, std::size_t line,
+                                            const std::vector<std::string>& columns) {
+  std::vector<std::string> joints;
+  for (std::size_t c = 2; c < columns.size(); ++c) {
+    const std::string& name = columns[c];
+    if (!name.starts_with("q_desired_")) break;
+    if (!name.ends_with("_rad") || name.size() <= 14)
+      throw InputError(file, line, name,
+                       "desired joint angles must be named q_desired_<joint>_rad (radians)");
+    joints.push_back(name.substr(10, name.size() - 14));
+  }
+  if (joints.empty())
+    throw InputError(file, line, columns.size() > 2 ? columns[2] : "",
+                     "expected the columns t_s,payload_kg,q_desired_<joint>_rad...");
+  return joints;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::size_t, std::size_t>> JointErrorLog::segments() const {
+  std::vector<std::pair<std::size_t, std::size_t>> out;
+  for (std::size_t s = 0; s < segment_starts.size(); ++s) {
+    const std::size_t end = s + 1 < segment_starts.size() ? segment_starts[s + 1] : sample_count();
+    if (end > segment_starts[s]) out.emplace_back(segment_starts[s], end);
+  }
+  return out;
+}
+
+void split_at_gaps(JointErrorLog& log) {
+  log.segment_starts = {0};
+  for (std::size_t k = 1; k < log.time_s.size(); ++k)
+    if (log.time_s[k] - log.time_s[k - 1] > kGapCycles * log.cycle_s)
+      log.segment_starts.push_back(k);
+}
+
+JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::ifstream in(path);
+  if (!in) throw InputError(file, 0, "", "cannot open the file");
+  JointErrorLog log;
+  std::map<std::string, std::size_t, std::less<>> seen;
+  std::string text;
+  std::size_t line = 0;
+  std::vector<std::string> columns;
+  // Header comments, then the column line.
+  while (std::getline(in, text)) {
+    ++line;
+    const std::string_view t = trim(text);
+    if (t.empty()) continue;
+    if (t.front() != '#') {
+      std::size_t start = 0;
+      const std::string_view all = t;
+      while (true) {
+        const auto comma = all.find(',', start);
+        columns.emplace_back(trim(all.substr(start, comma - start)));
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+      }
+      break;
+    }
+    const std::string_view body = trim(t.substr(1));
+    const auto colon = body.find(':');
+    if (colon == std::string_view::npos) continue;  // a free comment
+    const std::string key(trim(body.substr(0, colon)));
+    const std::string value(trim(body.substr(colon + 1)));
+    if (seen.contains(key))
+      throw InputError(file, line, key,
+                       fmt::format("header key given twice (first on line {})", seen[key]));
+    seen[key] = line;
+    if (key == "imscal-joint-errors") {
+      if (value != std::to_string(kFormatVersion))
+        throw InputError(file, line, key,
+                         fmt::format("unknown format version '{}'; this imscal reads version {}",
+                                     value, kFormatVersion));
+    } else if (key == "robot") {
+      log.robot = value;
+    } else if (key == "cycle_s") {
+      if (!parse_number(value, log.cycle_s) || !std::isfinite(log.cycle_s) || log.cycle_s <= 0.0)
+        throw InputError(file, line, key,
+                         fmt::format("expected a positive cycle time in seconds, got '{}'", value));
+    } else if (key == "source") {
+      log.source = value;
+    } else {
+      log.metadata.emplace_back(key, value);
+    }
+  }
+  if (!seen.contains("imscal-joint-errors"))
+    throw InputError(
+        file, 1, "imscal-joint-errors",
+        "not a joint_errors.csv: the header line '# imscal-joint-errors: 1' is missing");
+  if (!seen.contains("robot")) throw InputError(file, 1, "robot", "header '# robot: NAME' missing");
+  if (!seen.contains("cycle_s"))
+    throw InputError(file, 1, "cycle_s", "header '# cycle_s: SECONDS' missing");
+  if (columns.empty()) throw InputError(file, line, "", "no column header line");
+  const std::size_t header_line = line;
+  log.joint_names = joints_from_header(file, header_line, columns);
+  const std::vector<std::string> expected = expected_columns(log.joint_names);
+  for (std::size_t c = 0; c < std::max(expected.size(), columns.size()); ++c) {
+    if (c >= columns.size())
+      throw InputError(file, header_line, expected[c], "column missing from the header");
+    if (c >= expected.size() || columns[c] != expected[c])
+      throw InputError(file, header_line, columns[c],
+                       fmt::format("unexpected column {} '{}'; expected '{}'", c + 1, columns[c],
+                                   c < expected.size() ? expected[c] : "(no further column)"));
+  }
+  const std::size_t joints = log.joint_names.size();
+  log.q_desired_rad.assign(joints, {});
+  log.q_measured_rad.assign(joints, {});
+  log.q_internal_rad.assign(joints, {});
+  std::vector<double> row(expected.size());
+  while (std::getline(in, text)) {
+    ++line;
+    const std::string_view t = trim(text);
+    if (t.empty() || t.front() == '#') continue;
+    if (log.first_data_line == 0) log.first_data_line = line;
+    std::size_t start = 0, c = 0;
+    while (true) {
+      const auto comma = t.find(',', start);
+      if (c >= row.size())
+        throw InputError(file, line, "",
+                         fmt::format("more than the {} columns of the header", row.size()));
+      const std::string_view cell = t.substr(start, comma - start);
+      if (!parse_number(cell, row[c]))
+        throw InputError(file, line, expected[c],
+                         fmt::format("'{}' is not a number", std::string(trim(cell))));
+      if (!std::isfinite(row[c]))
+        throw InputError(file, line, expected[c], "value is not finite (NaN or infinite)");
+      ++c;
+      if (comma == std::string_view::npos) break;
+      start = comma + 1;
+    }
+    if (c != row.size())
+      throw InputError(file, line, expected[c],
+                       fmt::format("{} columns, the header has {}", c, row.size()));
+    if (!log.time_s.empty() && !(row[0] > log.time_s.back()))
+      throw InputError(file, line, "t_s",
+                       fmt::format("time {} s does not increase (previous sample {} s)", row[0],
+                                   log.time_s.back()));
+    if (row[1] < 0.0) throw InputError(file, line, "payload_kg", "negative payload");
+    log.time_s.push_back(row[0]);
+    log.payload_kg.push_back(row[1]);
+    for (std::size_t j = 0; j < joints; ++j) {
+      log.q_desired_rad[j].push_back(row[2 + j]);
+      log.q_measured_rad[j].push_back(row[2 + joints + j]);
+      log.q_internal_rad[j].push_back(row[2 + 2 * joints + j]);
+    }
+  }
+  if (log.time_s.empty()) throw InputError(file, line, "", "no samples after the header");
+  split_at_gaps(log);
+  if (log.segment_starts.size() > 1)
+    spdlog::warn("{}: {} time gaps longer than {} cycles; the data are used as {} separate runs",
+                 file, log.segment_starts.size() - 1, kGapCycles, log.segment_starts.size());
+  return log;
+}
+
+void write_joint_errors_csv(const std::filesystem::path& file, const JointErrorLog& log,
+                            Overwrite overwrite) {
+  const std::size_t n = log.sample_count();
+  const std::size_t joints = log.joint_count();
+  if (joints == 0) throw std::invalid_argument("write_joint_errors_csv: no joints");
+  if (log.payload_kg.size() != n || log.q_desired_rad.size() != joints ||
+      log.q_measured_rad.size() != joints || log.q_internal_rad.size() != joints)
+    throw std::invalid_argument("write_joint_errors_csv: inconsistent sizes");
+  for (std::size_t j = 0; j < joints; ++j)
+    if (log.q_desired_rad[j].size() != n || log.q_measured_rad[j].size() != n ||
+        log.q_internal_rad[j].size() != n)
+      throw std::invalid_argument("write_joint_errors_csv: inconsistent sizes of joint " +
+                                  log.joint_names[j]);
+  if (!(log.cycle_s > 0.0)) throw std::invalid_argument("write_joint_errors_csv: cycle_s <= 0");
+  for (const auto& name : log.joint_names)
+    if (name.empty() || name.find_first_of(",# \t\n") != std::string::npos)
+      throw std::invalid_argument("write_joint_errors_csv: bad joint name '" + name + "'");
+  AtomicFile out(file, overwrite);
+  auto& s = out.stream();
+  s << fmt::format("# imscal-joint-errors: {}\n# robot: {}\n# cycle_s: {}\n", kFormatVersion,
+                   log.robot, log.cycle_s);
+  if (!log.source.empty()) s << "# source: " << log.source << '\n';
+  for (const auto& [key, value] : log.metadata) s << "# " << key << ": " << value << '\n';
+  const auto names = expected_columns(log.joint_names);
+  for (std::size_t c = 0; c < names.size(); ++c) s << (c ? "," : "") << names[c];
+  s << '\n';
+  std::string line;
+  for (std::size_t k = 0; k < n; ++k) {
+    line = fmt::format("{:.17g},{:.17g}", log.time_s[k], log.payload_kg[k]);
+    for (const auto* family : {&log.q_desired_rad, &log.q_measured_rad, &log.q_internal_rad})
+      for (std::size_t j = 0; j < joints; ++j) {
+        const double v = (*family)[j][k];
+        if (!std::isfinite(v))
+          throw std::invalid_argument(
+              fmt::format("write_joint_errors_csv: non-finite value at sample {}", k));
+        fmt::format_to(std::back_inserter(line), ",{:.17g}", v);
+      }
+    line += '\n';
+    s << line;
+  }
+  out.commit();
+}
+
+// ---------------------------------------------------------------------------------------------
+// SHA-256 (FIPS 180-4).
+
+namespace {
+
+constexpr std::array<std::uint32_t, 64> kSha256Round = {
+    0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4, 0xab1c5ed5,
+    0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3, 0x72be5d74, 0x80deb1fe, 0x9bdc06a7, 0xc19bf174,
+    0xe49b69c1, 0xefbe4786, 0x0fc19dc6, 0x240ca1cc, 0x2de92c6f, 0x4a7484aa, 0x5cb0a9dc, 0x76f988da,
+    0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7, 0xc6e00bf3, 0xd5a79147, 0x06ca6351, 0x14292967,
+    0x27b70a85, 0x2e1b2138, 0x4d2c6dfc, 0x53380d13, 0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85,
+    0xa2bfe8a1, 0xa81a664b, 0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070,
+    0x19a4c116, 0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a, 0x5b9cca4f, 0x682e6ff3,
+    0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2};
+
+std::uint32_t rotr(std::uint32_t x, int n) {
+  return (x >> n) | (x << (32 - n));
+}
+
+void sha256_block(std::array<std::uint32_t, 8>& h, const unsigned char* block) {
+  std::array<std::uint32_t, 64> w{};
+  for (int i = 0; i < 16; ++i)
+    w[i] = std::uint32_t(block[4 * i]) << 24 | std::uint32_t(block[4 * i + 1]) << 16 |
+           std::uint32_t(block[4 * i + 2]) << 8 | std::uint32_t(block[4 * i + 3]);
+  for (int i = 16; i < 64; ++i) {
+    const std::uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
+    const std::uint32_t s1 = rotr(w[i - 2], 17) ^ rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
+    w[i] = w[i - 16] + s0 + w[i - 7] + s1;
+  }
+  auto v = h;
+  for (int i = 0; i < 64; ++i) {
+    const std::uint32_t s1 = rotr(v[4], 6) ^ rotr(v[4], 11) ^ rotr(v[4], 25);
+    const std::uint32_t ch = (v[4] & v[5]) ^ (~v[4] & v[6]);
+    const std::uint32_t t1 = v[7] + s1 + ch + kSha256Round[i] + w[i];
+    const std::uint32_t s0 = rotr(v[0], 2) ^ rotr(v[0], 13) ^ rotr(v[0], 22);
+    const std::uint32_t maj = (v[0] & v[1]) ^ (v[0] & v[2]) ^ (v[1] & v[2]);
+    const std::uint32_t t2 = s0 + maj;
+    v = {t1 + t2, v[0], v[1], v[2], v[3] + t1, v[4], v[5], v[6]};
+  }
+  for (int i = 0; i < 8; ++i) h[i] += v[i];
+}
+
+}  // namespace
+
+std::string file_sha256_hex(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string(), 0, "", "cannot open the file for its checksum");
+  std::array<std::uint32_t, 8> h = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
+                                    0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+  std::vector<unsigned char> buffer(1 << 16);
+  std::uint64_t total = 0;
+  std::array<unsigned char, 128> tail{};
+  std::size_t tail_size = 0;
+  while (in) {
+    in.read(reinterpret_cast<char*>(buffer.data()), std::streamsize(buffer.size()));
+    const std::size_t got = static_cast<std::size_t>(in.gcount());
+    total += got;
+    std::size_t i = 0;
+    if (tail_size > 0) {
+      while (tail_size < 64 && i < got) tail[tail_size++] = buffer[i++];
+      if (tail_size < 64) continue;
+      sha256_block(h, tail.data());
+      tail_size = 0;
+    }
+    for (; i + 64 <= got; i += 64) sha256_block(h, buffer.data() + i);
+    while (i < got) tail[tail_size++] = buffer[i++];
+  }
+  tail[tail_size++] = 0x80;
+  if (tail_size > 56) {
+    while (tail_size < 64) tail[tail_size++] = 0;
+    sha256_block(h, tail.data());
+    tail_size = 0;
+  }
+  while (tail_size < 56) tail[tail_size++] = 0;
+  const std::uint64_t bits = total * 8;
+  for (int i = 0; i < 8; ++i) tail[56 + i] = static_cast<unsigned char>(bits >> (56 - 8 * i));
+  sha256_block(h, tail.data());
+  std::string hex;
+  for (auto word : h) hex += fmt::format("{:08x}", word);
+  return hex;
+}
+
+}  // namespace imscal::ident

@@ -1,0 +1,62 @@
+#pragma once
+// joint_errors.csv: the joint angles of one or more robot runs, sampled every controller cycle,
+// from which the ARX error models are identified (written by `imscal calibrate`, read by
+// `imscal identify`; format in datasets/FORMAT.md, section "joint_errors.csv").
+//
+//   # imscal-joint-errors: 1
+//   # robot: kr16
+//   # cycle_s: 0.002
+//   # source: ...                      (optional; further "# key: value" lines are kept)
+//   t_s,payload_kg,q_desired_A1_rad,..,q_measured_A1_rad,..,q_internal_A1_rad,..
+//
+// q_desired: the robot's desired joint angle; q_measured: the joint angle reached, from the IMS
+// chain (inverse kinematics of the measured flange pose); q_internal: the robot's motor encoders
+// (joint side). The joint error of the paper is Δq = q_desired - q_measured.
+// Time gaps longer than 1.5 cycles split the data into segments (separate runs; a warning, not
+// an error); a time that does not increase is an error.
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/atomic_file.hpp"
+
+namespace imscal::ident {
+
+struct JointErrorLog {
+  std::string robot;
+  double cycle_s = 0.002;  // nominal sample time [s]
+  std::string source;      // where the data came from (free text)
+  std::vector<std::pair<std::string, std::string>> metadata;  // further header keys, in order
+  std::vector<std::string> joint_names;                       // "A1".."A6"
+  std::vector<double> time_s;
+  std::vector<double> payload_kg;
+  // [joint][sample], SI (rad)
+  std::vector<std::vector<double>> q_desired_rad, q_measured_rad, q_internal_rad;
+  // First sample of every segment (a run without gaps); segment_starts[0] == 0.
+  std::vector<std::size_t> segment_starts{0};
+  std::size_t first_data_line = 0;  // 1-based line of the first sample (0: not read from a file)
+
+  std::size_t sample_count() const { return time_s.size(); }
+  std::size_t joint_count() const { return joint_names.size(); }
+  // [begin, end) sample ranges of the segments.
+  std::vector<std::pair<std::size_t, std::size_t>> segments() const;
+};
+
+// Reads and validates a joint_errors.csv; InputError(file, line, field, problem) on bad input.
+JointErrorLog read_joint_errors_csv(const std::filesystem::path& file);
+
+// Writes the log (17 significant digits, so a round trip is exact), atomically. Throws
+// std::invalid_argument for an inconsistent log (sizes, non-finite values, names).
+void write_joint_errors_csv(const std::filesystem::path& file, const JointErrorLog& log,
+                            Overwrite overwrite = Overwrite::kAllow);
+
+// Re-derives segment_starts from the time stamps (gap > 1.5 cycle_s starts a segment).
+void split_at_gaps(JointErrorLog& log);
+
+// SHA-256 of a file's bytes as 64 lower-case hex digits (the data source checksum of
+// parameters.json). Throws InputError when the file cannot be read.
+std::string file_sha256_hex(const std::filesystem::path& file);
+
+}  // namespace imscal::ident

@@ -1,0 +1,238 @@
+#include "ident/joint_identification.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace imscal::ident {
+namespace {
+
+using Ranges = std::vector<std::pair<std::size_t, std::size_t>>;
+
+std::size_t rows_of(std::span<const IoSegment> views, std::size_t first_row) {
+  std::size_t rows = 0;
+  for (const auto& v : views)
+    if (v.output.size() > first_row) rows += v.output.size() - first_row;
+  return rows;
+}
+
+// NRMSE fit [%] of the free-run joint error on the views: Δq = q_d - q_m against
+// Δq̂ = q_d - (ŷ - l s); Δq - Δq̂ = ŷ - y with y = q_m + l s the fitted output, so only the
+// reference spread differs from the simulation fit. NaN when the joint error is constant.
+double joint_error_fit(const ArxModel& model, std::span<const IoSegment> views,
+                       std::span<const double> output, std::span<const double> q_desired,
+                       std::span<const double> q_measured) {
+  const auto first = std::size_t(model.structure().max_lag());
+  std::vector<double> simulated;
+  double misfit = 0.0, sum = 0.0, sum_sq = 0.0;
+  std::size_t count = 0;
+  for (const IoSegment& v : views) {
+    const std::size_t offset = std::size_t(v.output.data() - output.data());
+    simulated.resize(v.output.size());
+    model.simulate(v.input, v.output, simulated);
+    for (std::size_t k = first; k < v.output.size(); ++k) {
+      const double r = simulated[k] - v.output[k];
+      const double error = q_desired[offset + k] - q_measured[offset + k];
+      misfit += r * r;
+      sum += error;
+      sum_sq += error * error;
+      ++count;
+    }
+  }
+  const double spread = count ? sum_sq - sum * sum / double(count) : 0.0;
+  if (!(spread > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return 100.0 * (1.0 - std::sqrt(misfit / spread));
+}
+
+// Fills `cell` from its nearest identified cell (band steps, then the lower number).
+void fill_from_nearest(const CellGrid& grid, std::vector<CellIdentification>& reports,
+                       std::vector<CellParameters>& cells, int cell) {
+  int best = -1, best_distance = std::numeric_limits<int>::max();
+  for (int other = 0; other < grid.cell_count(); ++other) {
+    if (reports[std::size_t(other)].status != CellStatus::kIdentified) continue;
+    const int distance = grid.band_distance(cell, other);
+    if (distance < best_distance) best = other, best_distance = distance;
+  }
+  auto& report = reports[std::size_t(cell)];
+  auto& target = cells[std::size_t(cell)];
+  const auto& source = cells[std::size_t(best)];
+  target.status = report.status = CellStatus::kFilled;
+  target.filled_from = report.filled_from = best;
+  target.reason = report.reason;
+  target.structure = source.structure;
+  target.a = source.a;
+  target.b = source.b;
+  target.figures = source.figures;
+  target.figures.estimation_rows = report.estimation_rows;
+  target.figures.validation_rows = report.validation_rows;
+}
+
+}  // namespace
+
+JointIdentification identify_joint(const std::string& name, std::span<const double> q_desired,
+                                   std::span<const double> q_measured,
+                                   std::span<const double> payload,
+                                   std::span<const std::pair<std::size_t, std::size_t>> segments,
+                                   double cycle_s, const CellGrid& grid,
+                                   const JointIdentificationOptions& options) {
+  const std::size_t n = q_desired.size();
+  if (q_measured.size() != n || payload.size() != n)
+    throw std::invalid_argument("identify_joint: signal lengths differ");
+  if (!(options.validation_fraction >= 0.0 && options.validation_fraction < 1.0))
+    throw std::invalid_argument("identify_joint: validation_fraction must be in [0, 1)");
+  JointIdentification out;
+  out.parameters.name = name;
+  out.parameters.dimensions = grid.dimensions();
+
+  // 1. Backlash and the output without it: y = q_m + l s (the joint lags by l in the direction
+  // of motion, so adding l s restores the play-free angle).
+  std::vector<double> output(q_measured.begin(), q_measured.end());
+  if (options.identify_backlash) {
+    out.backlash = identify_backlash(q_desired, q_measured, segments, cycle_s, options.backlash);
+    if (out.backlash.identified) {
+      const std::vector<double> s = motion_direction(
+          q_desired, segments, cycle_s, options.backlash.min_speed_rad_s, out.backlash.lag_samples);
+      for (std::size_t k = 0; k < n; ++k) output[k] += out.backlash.l_rad * s[k];
+      out.parameters.backlash_identified = true;
+      // A negative estimate (noise around a play-free joint) is kept in the report but the
+      // table holds l >= 0: equation 3 has no meaning for l < 0.
+      out.parameters.backlash_l_rad = std::max(out.backlash.l_rad, 0.0);
+      out.parameters.backlash_l_sigma_rad = out.backlash.l_sigma_rad;
+      out.parameters.backlash_lag_samples = out.backlash.lag_samples;
+      if (out.backlash.l_rad < 0.0) {
+        for (std::size_t k = 0; k < n; ++k) output[k] = q_measured[k];
+        out.parameters.backlash_identified = false;
+        out.backlash.reason =
+            fmt::format("estimate {:.3g} rad is negative: no backlash", out.backlash.l_rad);
+      }
+    }
+  } else {
+    out.backlash.reason = "backlash identification disabled";
+  }
+
+  // 2. Estimation and held-out parts of every segment.
+  Ranges estimation, held_out;
+  for (const auto& [begin, end] : segments) {
+    const std::size_t len = end - begin;
+    const auto cut = end - std::size_t(std::llround(options.validation_fraction * double(len)));
+    if (cut > begin) estimation.emplace_back(begin, cut);
+    if (end > cut) held_out.emplace_back(cut, end);
+  }
+
+  // 3. Cells and their runs (one pass each).
+  const OperatingSignals signals = operating_signals(q_desired, segments, cycle_s);
+  const std::vector<int> cell_of = assign_cells(grid, q_desired, payload, signals);
+  const auto est_runs = cell_runs(cell_of, grid.cell_count(), estimation);
+  const auto val_runs = cell_runs(cell_of, grid.cell_count(), held_out);
+
+  OrderSelectionOptions sweep_options;
+  sweep_options.grid = options.grid;
+  sweep_options.criterion = options.criterion;
+  sweep_options.min_relative_pivot = options.min_relative_pivot;
+  sweep_options.final_fit = options.fit;
+  sweep_options.validation_fraction = 0.0;  // the held-out runs are passed explicitly
+  const OrderGrid& g = options.grid;
+  const auto history = std::size_t(std::max(g.na_max, g.dead_time_max + g.nb_max - 1));
+
+  out.cells.resize(std::size_t(grid.cell_count()));
+  out.parameters.cells.resize(std::size_t(grid.cell_count()));
+  for (int cell = 0; cell < grid.cell_count(); ++cell) {
+    auto& report = out.cells[std::size_t(cell)];
+    auto& params = out.parameters.cells[std::size_t(cell)];
+    report.cell = cell;
+    report.label = grid.label(cell);
+    params.bands = grid.bands_of(cell);
+    const auto& runs = est_runs[std::size_t(cell)];
+    double speed_sq = 0.0;
+    std::size_t samples = 0;
+    for (const CellRun& r : runs)
+      for (std::size_t k = r.begin; k < r.end; ++k, ++samples)
+        speed_sq += signals.speed_rad_s[k] * signals.speed_rad_s[k];
+    report.rms_speed_rad_s = samples ? std::sqrt(speed_sq / double(samples)) : 0.0;
+    const auto sweep_est = run_views(runs, q_desired, output, history);
+    const auto sweep_val = run_views(val_runs[std::size_t(cell)], q_desired, output, history);
+    report.estimation_rows = rows_of(sweep_est, history);
+    report.validation_rows = rows_of(sweep_val, history);
+    auto reject = [&](std::string reason) {
+      report.status = CellStatus::kFilled;
+      report.reason = std::move(reason);
+    };
+    if (report.estimation_rows < options.min_rows_per_cell) {
+      reject(fmt::format("{} estimation rows, fewer than min_rows_per_cell = {}",
+                         report.estimation_rows, options.min_rows_per_cell));
+      continue;
+    }
+    if (report.rms_speed_rad_s < options.min_rms_speed_rad_s) {
+      reject(fmt::format("too little excitation: RMS desired speed {:.3g} rad/s < {:.3g} rad/s",
+                         report.rms_speed_rad_s, options.min_rms_speed_rad_s));
+      continue;
+    }
+    try {
+      report.sweep = sweep_arx_orders(sweep_est, sweep_options, sweep_val);
+      const ArxStructure chosen = report.sweep->chosen;
+      // The final fit on the cell's own rows: views with exactly the chosen model's history.
+      const auto lag = std::size_t(chosen.max_lag());
+      const auto fit_est = run_views(runs, q_desired, output, lag);
+      report.fit = fit_arx(fit_est, chosen, options.fit);
+    } catch (const std::exception& e) {
+      reject(fmt::format("fit failed: {}", e.what()));
+      continue;
+    }
+    const ArxModel& model = report.fit->model;
+    report.stability = check_stability(model, options.stability_margin);
+    if (!report.stability->stable) {
+      reject(report.stability->reason);
+      continue;
+    }
+    params.structure = model.structure();
+    params.a.assign(model.a().data(), model.a().data() + model.a().size());
+    params.b.assign(model.b().data(), model.b().data() + model.b().size());
+    CellFitFigures& f = params.figures;
+    f.estimation_rows = report.fit->row_count;
+    f.spectral_radius = report.stability->spectral_radius;
+    f.one_step_fit_percent = f.simulation_fit_percent = f.joint_error_fit_percent =
+        f.residual_rms_rad = std::numeric_limits<double>::quiet_NaN();
+    const auto val_views = run_views(val_runs[std::size_t(cell)], q_desired, output,
+                                     std::size_t(model.structure().max_lag()));
+    try {
+      if (!val_views.empty()) {
+        report.validation = validate_arx(model, val_views, options.validation);
+        f.validation_rows = report.validation->sample_count;
+        f.one_step_fit_percent = report.validation->one_step_fit_percent;
+        f.simulation_fit_percent = report.validation->simulation_fit_percent;
+        f.residual_rms_rad = report.validation->residual_rms;
+        f.joint_error_fit_percent =
+            joint_error_fit(model, val_views, output, q_desired, q_measured);
+        f.whiteness_passed = report.validation->residual_whiteness.passed;
+        f.input_residual_passed = report.validation->input_residual.passed;
+      }
+    } catch (const std::invalid_argument& e) {
+      spdlog::warn("joint {} cell {}: no validation figures ({})", name, report.label, e.what());
+    }
+  }
+
+  // 5. Fill the cells that failed from their nearest identified neighbour, with the reason.
+  bool any = false;
+  std::string reasons;
+  for (const auto& r : out.cells) {
+    any = any || r.status == CellStatus::kIdentified;
+    reasons += fmt::format("\n  cell {} ({}): {}", r.cell, r.label,
+                           r.reason.empty() ? "identified" : r.reason);
+  }
+  if (!any)
+    throw std::runtime_error(
+        fmt::format("joint {}: no cell could be identified:{}", name, reasons));
+  for (int cell = 0; cell < grid.cell_count(); ++cell) {
+    if (out.cells[std::size_t(cell)].status == CellStatus::kIdentified) continue;
+    fill_from_nearest(grid, out.cells, out.parameters.cells, cell);
+    const auto& r = out.cells[std::size_t(cell)];
+    spdlog::warn("joint {} cell {} ({}) filled from cell {}: {}", name, cell, r.label,
+                 r.filled_from, r.reason);
+  }
+  return out;
+}
+
+}  // namespace imscal::ident

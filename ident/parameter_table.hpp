@@ -1,0 +1,98 @@
+#pragma once
+// The identified error model of a robot, as exported to parameters.json / parameters.csv and
+// loaded by the precontrol: per joint, the operating-point cell grid, the ARX model of every cell
+// (paper, equation 2 and Table 2), the backlash l of equation 3, and how well each model fits.
+// Every cell of the grid has a model: cells that could not be identified are filled from the
+// nearest identified cell, and say so (status "filled", filled_from, reason).
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "ident/arx_model.hpp"
+#include "ident/operating_point.hpp"
+
+namespace imscal::ident {
+
+inline constexpr int kParameterTableSchemaVersion = 1;
+
+enum class CellStatus {
+  kIdentified,  // fitted from this cell's own rows
+  kFilled,      // copied from the cell `filled_from` (reason says why)
+};
+const char* to_string(CellStatus status);
+
+struct CellFitFigures {
+  std::size_t estimation_rows = 0;
+  std::size_t validation_rows = 0;
+  double one_step_fit_percent = 0.0;  // NRMSE fit on held-out data (NaN: no held-out data)
+  double simulation_fit_percent = 0.0;
+  // NRMSE fit of the free-run joint error Δq̂ against Δq = q_d - q_m: the same misfit as
+  // simulation_fit_percent, but relative to the spread of the joint error instead of the joint
+  // angle (which is ~100 % for any model that follows the command).
+  double joint_error_fit_percent = 0.0;
+  double residual_rms_rad = 0.0;
+  bool whiteness_passed = false;
+  bool input_residual_passed = false;
+  double spectral_radius = 0.0;
+
+  friend bool operator==(const CellFitFigures&, const CellFitFigures&) = default;
+};
+
+struct CellParameters {
+  std::vector<int> bands;  // band index per dimension of the joint's grid
+  CellStatus status = CellStatus::kIdentified;
+  int filled_from = -1;  // flat index of the source cell when filled
+  std::string reason;    // why filled (empty when identified)
+  ArxStructure structure;
+  std::vector<double> a;  // a_1..a_na
+  std::vector<double> b;  // b_0..b_{nb-1}
+  CellFitFigures figures;
+
+  ArxModel model(double sample_time_s) const;
+  friend bool operator==(const CellParameters&, const CellParameters&) = default;
+};
+
+struct JointParameters {
+  std::string name;
+  std::vector<CellDimension> dimensions;  // grid of this joint (SI bounds)
+  double backlash_l_rad = 0.0;            // paper's l_i: error +l moving +, -l moving -
+  double backlash_l_sigma_rad = 0.0;
+  bool backlash_identified = false;
+  std::size_t backlash_lag_samples = 0;  // lag used for the direction of motion
+  std::vector<CellParameters> cells;     // flat (row-major) order of the grid
+
+  CellGrid grid() const { return CellGrid(dimensions); }
+  friend bool operator==(const JointParameters& x, const JointParameters& y) {
+    if (x.dimensions.size() != y.dimensions.size()) return false;
+    for (std::size_t d = 0; d < x.dimensions.size(); ++d)
+      if (x.dimensions[d].quantity != y.dimensions[d].quantity ||
+          x.dimensions[d].bounds != y.dimensions[d].bounds)
+        return false;
+    return x.name == y.name && x.backlash_l_rad == y.backlash_l_rad &&
+           x.backlash_l_sigma_rad == y.backlash_l_sigma_rad &&
+           x.backlash_identified == y.backlash_identified &&
+           x.backlash_lag_samples == y.backlash_lag_samples && x.cells == y.cells;
+  }
+};
+
+struct DataSource {
+  std::string file;    // as given on the command line
+  std::string sha256;  // of the file's bytes
+  std::size_t samples = 0;
+  std::string description;  // the file's "# source:" header
+
+  friend bool operator==(const DataSource&, const DataSource&) = default;
+};
+
+struct ParameterTable {
+  int schema_version = kParameterTableSchemaVersion;
+  std::string robot;
+  double sample_time_s = 0.002;
+  std::string created_by;  // "imscal <version>"
+  DataSource source;
+  std::vector<JointParameters> joints;
+
+  friend bool operator==(const ParameterTable&, const ParameterTable&) = default;
+};
+
+}  // namespace imscal::ident

@@ -1,0 +1,402 @@
+#include "ident/parameter_table_io.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string_view>
+
+#include "core/input_error.hpp"
+#include "ident/model_stability.hpp"
+
+namespace imscal::ident {
+
+const char* to_string(CellStatus status) {
+  return status == CellStatus::kIdentified ? "identified" : "filled";
+}
+
+ArxModel CellParameters::model(double sample_time_s) const {
+  return ArxModel(structure, Eigen::Map<const Eigen::VectorXd>(a.data(), Eigen::Index(a.size())),
+                  Eigen::Map<const Eigen::VectorXd>(b.data(), Eigen::Index(b.size())),
+                  sample_time_s);
+}
+
+namespace {
+
+using nlohmann::json;
+constexpr std::string_view kSchemaName = "imscal-parameter-table";
+// Loaded models must be stable with at least this margin; the identification uses its own
+// (configurable, normally larger) margin, this only refuses tables that are plainly unusable.
+constexpr double kLoadStabilityMargin = 0.0;
+
+json units() {
+  return {{"angle", "rad"},  {"time", "s"},       {"speed", "rad/s"},
+          {"payload", "kg"}, {"position", "rad"}, {"acceleration", "rad/s^2"}};
+}
+
+// NaN/inf figures (e.g. no held-out data) are written as null.
+json number_or_null(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
+
+json cell_json(const CellParameters& c) {
+  json j = {{"bands", c.bands},
+            {"status", to_string(c.status)},
+            {"na", c.structure.na},
+            {"nb", c.structure.nb},
+            {"dead_time", c.structure.dead_time},
+            {"a", c.a},
+            {"b", c.b},
+            {"fit",
+             {{"estimation_rows", c.figures.estimation_rows},
+              {"validation_rows", c.figures.validation_rows},
+              {"one_step_fit_percent", number_or_null(c.figures.one_step_fit_percent)},
+              {"simulation_fit_percent", number_or_null(c.figures.simulation_fit_percent)},
+              {"joint_error_fit_percent", number_or_null(c.figures.joint_error_fit_percent)},
+              {"residual_rms_rad", number_or_null(c.figures.residual_rms_rad)},
+              {"whiteness_passed", c.figures.whiteness_passed},
+              {"input_residual_passed", c.figures.input_residual_passed},
+              {"spectral_radius", number_or_null(c.figures.spectral_radius)}}}};
+  if (c.status == CellStatus::kFilled) {
+    j["filled_from"] = c.filled_from;
+    j["reason"] = c.reason;
+  }
+  return j;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading: a JSON value with its path, every error an InputError naming the file and the path.
+
+class Node {
+ public:
+  Node(const json& value, std::string path, const std::string& file)
+      : value_(value), path_(std::move(path)), file_(file) {}
+
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw InputError(file_, 0, path_.empty() ? "/" : path_, problem);
+  }
+  Node child(const std::string& key) const {
+    if (!value_.is_object()) fail("expected an object");
+    const auto it = value_.find(key);
+    if (it == value_.end()) Node(value_, path_ + "/" + key, file_).fail("missing key");
+    return Node(*it, path_ + "/" + key, file_);
+  }
+  bool has(const std::string& key) const { return value_.is_object() && value_.contains(key); }
+  void only_keys(std::initializer_list<std::string_view> allowed) const {
+    if (!value_.is_object()) fail("expected an object");
+    for (const auto& [key, v] : value_.items()) {
+      bool known = false;
+      for (auto a : allowed) known = known || a == key;
+      if (!known) Node(v, path_ + "/" + key, file_).fail("unknown key");
+    }
+  }
+  std::vector<Node> items() const {
+    if (!value_.is_array()) fail("expected an array");
+    std::vector<Node> out;
+    for (std::size_t i = 0; i < value_.size(); ++i)
+      out.emplace_back(value_[i], path_ + "/" + std::to_string(i), file_);
+    return out;
+  }
+  double number() const {
+    if (!value_.is_number())
+      fail(value_.is_null() ? "not a finite number (null/NaN)" : "expected a number");
+    const double v = value_.get<double>();
+    if (!std::isfinite(v)) fail("not a finite number");
+    return v;
+  }
+  // A figure: null stands for "not available" (NaN).
+  double number_or_nan() const {
+    return value_.is_null() ? std::numeric_limits<double>::quiet_NaN() : number();
+  }
+  long integer() const {
+    if (!value_.is_number_integer()) fail("expected an integer");
+    return value_.get<long>();
+  }
+  std::size_t count() const {
+    const long v = integer();
+    if (v < 0) fail("expected a count >= 0");
+    return std::size_t(v);
+  }
+  bool boolean() const {
+    if (!value_.is_boolean()) fail("expected true or false");
+    return value_.get<bool>();
+  }
+  std::string string() const {
+    if (!value_.is_string()) fail("expected a string");
+    return value_.get<std::string>();
+  }
+  std::vector<double> numbers() const {
+    std::vector<double> out;
+    for (const Node& n : items()) out.push_back(n.number());
+    return out;
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  const json& value_;
+  std::string path_;
+  const std::string& file_;
+};
+
+CellDimension read_dimension(const Node& n) {
+  n.only_keys({"quantity", "unit", "bounds"});
+  CellDimension d;
+  try {
+    d.quantity = operating_quantity_from_string(n.child("quantity").string());
+  } catch (const std::invalid_argument& e) {
+    n.child("quantity").fail(e.what());
+  }
+  const std::string unit = n.child("unit").string();
+  if (unit != si_unit(d.quantity))
+    n.child("unit").fail(fmt::format("unit '{}' for {}; expected '{}'", unit, to_string(d.quantity),
+                                     si_unit(d.quantity)));
+  d.bounds = n.child("bounds").numbers();
+  if (d.bounds.size() < 2) n.child("bounds").fail("at least 2 bounds needed");
+  for (std::size_t i = 1; i < d.bounds.size(); ++i)
+    if (!(d.bounds[i] > d.bounds[i - 1]))
+      n.child("bounds").fail("bounds must be strictly increasing");
+  return d;
+}
+
+CellFitFigures read_figures(const Node& n) {
+  n.only_keys({"estimation_rows", "validation_rows", "one_step_fit_percent",
+               "simulation_fit_percent", "joint_error_fit_percent", "residual_rms_rad",
+               "whiteness_passed", "input_residual_passed", "spectral_radius"});
+  CellFitFigures f;
+  f.estimation_rows = n.child("estimation_rows").count();
+  f.validation_rows = n.child("validation_rows").count();
+  f.one_step_fit_percent = n.child("one_step_fit_percent").number_or_nan();
+  f.simulation_fit_percent = n.child("simulation_fit_percent").number_or_nan();
+  f.joint_error_fit_percent = n.child("joint_error_fit_percent").number_or_nan();
+  f.residual_rms_rad = n.child("residual_rms_rad").number_or_nan();
+  f.whiteness_passed = n.child("whiteness_passed").boolean();
+  f.input_residual_passed = n.child("input_residual_passed").boolean();
+  f.spectral_radius = n.child("spectral_radius").number_or_nan();
+  return f;
+}
+
+CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time_s) {
+  n.only_keys(
+      {"bands", "status", "filled_from", "reason", "na", "nb", "dead_time", "a", "b", "fit"});
+  CellParameters c;
+  const Node bands = n.child("bands");
+  for (const Node& b : bands.items()) c.bands.push_back(int(b.integer()));
+  if (c.bands.size() != grid.dimensions().size())
+    bands.fail(
+        fmt::format("{} band indices for {} dimensions", c.bands.size(), grid.dimensions().size()));
+  for (std::size_t d = 0; d < c.bands.size(); ++d)
+    if (c.bands[d] < 0 || c.bands[d] >= grid.dimensions()[d].cell_count())
+      bands.fail(fmt::format("band {} of dimension {} is outside 0..{}", c.bands[d], d,
+                             grid.dimensions()[d].cell_count() - 1));
+  const std::string status = n.child("status").string();
+  if (status == "identified") {
+    c.status = CellStatus::kIdentified;
+    if (n.has("filled_from")) n.child("filled_from").fail("only a filled cell has filled_from");
+  } else if (status == "filled") {
+    c.status = CellStatus::kFilled;
+    c.filled_from = int(n.child("filled_from").integer());
+    if (c.filled_from < 0 || c.filled_from >= grid.cell_count())
+      n.child("filled_from").fail("not a cell of this joint");
+    c.reason = n.child("reason").string();
+  } else {
+    n.child("status").fail("expected 'identified' or 'filled', got '" + status + "'");
+  }
+  if (c.status == CellStatus::kIdentified && n.has("reason")) c.reason = n.child("reason").string();
+  c.structure.na = int(n.child("na").integer());
+  c.structure.nb = int(n.child("nb").integer());
+  c.structure.dead_time = int(n.child("dead_time").integer());
+  try {
+    c.structure.validate();
+  } catch (const std::invalid_argument& e) {
+    n.fail(e.what());
+  }
+  c.a = n.child("a").numbers();
+  c.b = n.child("b").numbers();
+  if (c.a.size() != std::size_t(c.structure.na))
+    n.child("a").fail(fmt::format("{} coefficients, na = {}", c.a.size(), c.structure.na));
+  if (c.b.size() != std::size_t(c.structure.nb))
+    n.child("b").fail(fmt::format("{} coefficients, nb = {}", c.b.size(), c.structure.nb));
+  c.figures = read_figures(n.child("fit"));
+  const StabilityCheck stability = check_stability(c.model(sample_time_s), kLoadStabilityMargin);
+  if (!stability.stable) n.child("a").fail("model rejected: " + stability.reason);
+  return c;
+}
+
+JointParameters read_joint(const Node& n, double sample_time_s) {
+  n.only_keys({"name", "backlash", "dimensions", "cells"});
+  JointParameters j;
+  j.name = n.child("name").string();
+  if (j.name.empty()) n.child("name").fail("empty joint name");
+  const Node bl = n.child("backlash");
+  bl.only_keys({"l_rad", "l_sigma_rad", "identified", "lag_samples"});
+  j.backlash_l_rad = bl.child("l_rad").number();
+  j.backlash_l_sigma_rad = bl.child("l_sigma_rad").number();
+  if (j.backlash_l_rad < 0.0) bl.child("l_rad").fail("negative backlash");
+  if (j.backlash_l_sigma_rad < 0.0) bl.child("l_sigma_rad").fail("negative standard deviation");
+  j.backlash_identified = bl.child("identified").boolean();
+  j.backlash_lag_samples = bl.child("lag_samples").count();
+  const Node dims = n.child("dimensions");
+  for (const Node& d : dims.items()) j.dimensions.push_back(read_dimension(d));
+  CellGrid grid;
+  try {
+    grid = CellGrid(j.dimensions);
+  } catch (const std::invalid_argument& e) {
+    dims.fail(e.what());
+  }
+  const Node cells = n.child("cells");
+  std::vector<std::optional<CellParameters>> by_flat(std::size_t(grid.cell_count()));
+  for (const Node& c : cells.items()) {
+    CellParameters cell = read_cell(c, grid, sample_time_s);
+    const int flat = grid.flat_index(cell.bands);
+    if (by_flat[std::size_t(flat)]) c.child("bands").fail("cell given twice: " + grid.label(flat));
+    by_flat[std::size_t(flat)] = std::move(cell);
+  }
+  for (int flat = 0; flat < grid.cell_count(); ++flat) {
+    if (!by_flat[std::size_t(flat)])
+      cells.fail(fmt::format("missing cell {} ({}) of the {} cells of the grid", flat,
+                             grid.label(flat), grid.cell_count()));
+    j.cells.push_back(std::move(*by_flat[std::size_t(flat)]));
+  }
+  return j;
+}
+
+}  // namespace
+
+std::string parameters_json_text(const ParameterTable& t) {
+  json joints = json::array();
+  for (const JointParameters& j : t.joints) {
+    json dims = json::array();
+    for (const auto& d : j.dimensions)
+      dims.push_back({{"quantity", to_string(d.quantity)},
+                      {"unit", si_unit(d.quantity)},
+                      {"bounds", d.bounds}});
+    json cells = json::array();
+    for (const auto& c : j.cells) cells.push_back(cell_json(c));
+    joints.push_back({{"name", j.name},
+                      {"backlash",
+                       {{"l_rad", j.backlash_l_rad},
+                        {"l_sigma_rad", j.backlash_l_sigma_rad},
+                        {"identified", j.backlash_identified},
+                        {"lag_samples", j.backlash_lag_samples}}},
+                      {"dimensions", dims},
+                      {"cells", cells}});
+  }
+  const json root = {{"schema", kSchemaName},
+                     {"schema_version", t.schema_version},
+                     {"robot", t.robot},
+                     {"sample_time_s", t.sample_time_s},
+                     {"created_by", t.created_by},
+                     {"units", units()},
+                     {"source",
+                      {{"file", t.source.file},
+                       {"sha256", t.source.sha256},
+                       {"samples", t.source.samples},
+                       {"description", t.source.description}}},
+                     {"joints", joints}};
+  return root.dump(1) + "\n";
+}
+
+std::string parameters_csv_text(const ParameterTable& t) {
+  std::ostringstream s;
+  s << "joint,cell,bands,bounds_si,status,filled_from,na,nb,dead_time,backlash_l_rad,"
+       "backlash_l_sigma_rad,estimation_rows,validation_rows,one_step_fit_percent,"
+       "simulation_fit_percent,joint_error_fit_percent,residual_rms_rad,whiteness_passed,input_"
+       "residual_passed,"
+       "spectral_radius,a,b\n";
+  auto join = [](const std::vector<double>& v) {
+    std::string out;
+    for (double x : v) out += fmt::format("{}{:.17g}", out.empty() ? "" : " ", x);
+    return out;
+  };
+  for (const JointParameters& j : t.joints) {
+    const CellGrid grid = j.grid();
+    for (std::size_t flat = 0; flat < j.cells.size(); ++flat) {
+      const CellParameters& c = j.cells[flat];
+      std::string bands;
+      for (int b : c.bands) bands += fmt::format("{}{}", bands.empty() ? "" : " ", b);
+      const auto& f = c.figures;
+      s << fmt::format(
+          "{},{},{},\"{}\",{},{},{},{},{},{:.17g},{:.17g},{},{},{},{},{},{},{},{},{},{},{}\n",
+          j.name, flat, bands, grid.label(int(flat)), to_string(c.status), c.filled_from,
+          c.structure.na, c.structure.nb, c.structure.dead_time, j.backlash_l_rad,
+          j.backlash_l_sigma_rad, f.estimation_rows, f.validation_rows, f.one_step_fit_percent,
+          f.simulation_fit_percent, f.joint_error_fit_percent, f.residual_rms_rad,
+          f.whiteness_passed ? 1 : 0, f.input_residual_passed ? 1 : 0, f.spectral_radius, join(c.a),
+          join(c.b));
+    }
+  }
+  return s.str();
+}
+
+void write_parameters_json(const std::filesystem::path& file, const ParameterTable& table,
+                           Overwrite overwrite) {
+  write_file_atomically(file, parameters_json_text(table), overwrite);
+}
+
+void write_parameters_csv(const std::filesystem::path& file, const ParameterTable& table,
+                          Overwrite overwrite) {
+  write_file_atomically(file, parameters_csv_text(table), overwrite);
+}
+
+ParameterTable parse_parameters_json(const std::string& text, const std::string& origin) {
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw InputError(origin, 0, "/", fmt::format("not valid JSON: {}", e.what()));
+  }
+  const Node r(root, "", origin);
+  r.only_keys({"schema", "schema_version", "robot", "sample_time_s", "created_by", "units",
+               "source", "joints"});
+  if (r.child("schema").string() != kSchemaName)
+    r.child("schema").fail(
+        fmt::format("not an imscal parameter table (expected '{}')", kSchemaName));
+  ParameterTable t;
+  t.schema_version = int(r.child("schema_version").integer());
+  if (t.schema_version != kParameterTableSchemaVersion)
+    r.child("schema_version")
+        .fail(fmt::format("unknown schema version {}; this imscal reads version {}",
+                          t.schema_version, kParameterTableSchemaVersion));
+  t.robot = r.child("robot").string();
+  t.sample_time_s = r.child("sample_time_s").number();
+  if (!(t.sample_time_s > 0.0)) r.child("sample_time_s").fail("sample time must be > 0");
+  t.created_by = r.child("created_by").string();
+  const Node u = r.child("units");
+  const json expected = units();
+  u.only_keys({"angle", "time", "speed", "payload", "position", "acceleration"});
+  for (const auto& [key, value] : expected.items())
+    if (u.child(key).string() != value.get<std::string>())
+      u.child(key).fail(fmt::format("unit '{}', expected '{}' (SI)", u.child(key).string(),
+                                    value.get<std::string>()));
+  const Node src = r.child("source");
+  src.only_keys({"file", "sha256", "samples", "description"});
+  t.source.file = src.child("file").string();
+  t.source.sha256 = src.child("sha256").string();
+  t.source.samples = src.child("samples").count();
+  t.source.description = src.child("description").string();
+  const Node joints = r.child("joints");
+  std::set<std::string> names;
+  for (const Node& j : joints.items()) {
+    t.joints.push_back(read_joint(j, t.sample_time_s));
+    if (!names.insert(t.joints.back().name).second)
+      j.child("name").fail("joint '" + t.joints.back().name + "' given twice");
+  }
+  if (t.joints.empty()) joints.fail("no joint");
+  return t;
+}
+
+ParameterTable read_parameters_json(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string(), 0, "", "cannot open the file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return parse_parameters_json(s.str(), file.string());
+}
+
+}  // namespace imscal::ident

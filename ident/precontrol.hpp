@@ -1,0 +1,165 @@
+#pragma once
+// The online error compensation (paper, section 3.4): linked by a controller integrator,
+// constructed once from a parameter table (ident/parameter_table.hpp), then called once per
+// control cycle with the desired joint angles and the payload. It returns per joint the offset
+// Δq to add to the desired angle, and a status.
+//
+// Per joint and cycle:
+//   1. every cell's ARX model (paper eq. 2) runs in parallel on the desired angle (free run: its
+//      own past outputs), giving Δq̂_c(k) = q_d(k-d) - q̂_c(k) (as ArxModel::predict_joint_error);
+//   2. the cells are blended by the operating point (ident/cell_blending.hpp): continuous across
+//      cell boundaries; outside the table the outermost cells are used and an event is logged;
+//   3. the backlash term of eq. 3, l · tanh(q̇_d(k - lag) / v_b) with the table's lag: ±l when
+//      moving, a smooth transition through zero velocity instead of a jump at reversals (no
+//      chattering);
+//   4. a critically damped second-order smoother (time constant τ) makes offset and its rate
+//      continuous; the output change per cycle is also limited to rate_limit · cycle;
+//   5. the supervisor compares |raw offset| and |rate of the smoothed offset| with per-joint
+//      tolerances: when one is exceeded, or the input is NaN/Inf, or cycles were lost, the
+//      compensation is deactivated and faded out over fade_out_s with a raised-cosine ramp (no
+//      step), and the event is logged with its cause. Re-activation is explicit (reactivate()).
+//
+// Real-time rules inside cycle(): no heap allocation, no exception, no lock, bounded work; the
+// state has a fixed size (kMax* below). Events go to a fixed ring buffer the caller reads
+// between cycles. Cycle times: the table's model runs at its own sample time T; a caller cycle
+// of m·T (m = 1..8, e.g. 4 ms for KUKA RSI / ABB EGM with a 2 ms table) runs the model m times
+// per call on linearly interpolated desired values; a caller cycle of T/m (e.g. 1 ms) runs the
+// model every m-th call and interpolates its output. Other ratios are refused at construction.
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "ident/parameter_table.hpp"
+
+namespace imscal::ident {
+
+inline constexpr int kPrecontrolJoints = 6;
+inline constexpr int kMaxPrecontrolOrder = 64;     // na, nb
+inline constexpr int kMaxPrecontrolDeadTime = 64;  // d [samples]
+inline constexpr int kMaxPrecontrolCells = 16;     // cells per joint
+inline constexpr int kPrecontrolEventCapacity = 256;
+
+struct PrecontrolOptions {
+  double caller_cycle_s = 0.002;
+  std::array<double, kPrecontrolJoints> offset_tolerance_rad{};  // 0: 5 mrad default
+  std::array<double, kPrecontrolJoints> rate_tolerance_rad_s{};  // 0: 0.5 rad/s default
+  std::array<double, kPrecontrolJoints> rate_limit_rad_s{};      // 0: 0.2 rad/s default
+  double smoothing_time_constant_s = 0.004;      // τ of the critically damped smoother
+  double fade_out_s = 0.2;                       // deactivation ramp
+  double backlash_velocity_scale_rad_s = 0.002;  // v_b of the tanh transition
+  int max_lost_cycles = 0;  // lost cycles bridged by holding the last input (more: deactivate)
+};
+
+enum class PrecontrolState : std::uint8_t { kActive, kFadingOut, kInactive };
+
+enum class PrecontrolCause : std::uint8_t {
+  kNone,
+  kOffsetTolerance,  // |raw offset| > tolerance
+  kRateTolerance,    // |offset rate| > tolerance
+  kInvalidInput,     // NaN / Inf desired angle or payload
+  kLostCycles,       // the cycle counter jumped by more than max_lost_cycles + 1
+  kOutsideTable,     // operating point outside the identified grid (not a deactivation)
+  kReactivated,
+};
+const char* to_string(PrecontrolCause cause);
+
+struct PrecontrolEvent {
+  std::uint64_t cycle = 0;
+  std::int8_t joint = -1;  // -1: all joints
+  PrecontrolCause cause = PrecontrolCause::kNone;
+  double value = 0.0;  // the offending value (rad, rad/s, lost cycles, ...)
+};
+
+struct PrecontrolOutput {
+  std::array<double, kPrecontrolJoints> offset_rad{};
+  PrecontrolState state = PrecontrolState::kActive;
+  bool outside_table = false;
+};
+
+class Precontrol {
+ public:
+  // Refuses (returns false with the reason in *why) a table for another robot, with another
+  // joint count, sizes beyond the fixed capacity, non-finite parameters, or a caller cycle that
+  // is not m·T or T/m. On success *out is ready (the only allocation-free object afterwards).
+  static bool create(const ParameterTable& table, const std::string& robot,
+                     const PrecontrolOptions& options, Precontrol* out, std::string* why);
+
+  // One control cycle. cycle_counter: the caller's cycle number (consecutive normally).
+  PrecontrolOutput cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
+                         double payload_kg, std::uint64_t cycle_counter) noexcept;
+
+  // Explicit re-activation after a deactivation: the models restart from the current desired
+  // values (at rest: zero error) and the offsets rise smoothly from zero.
+  void reactivate() noexcept;
+
+  PrecontrolState state() const noexcept { return state_; }
+  // Events since the last call (oldest first), copied out; the ring keeps the newest
+  // kPrecontrolEventCapacity and counts what it dropped.
+  int read_events(PrecontrolEvent* out, int capacity) noexcept;
+  std::uint64_t dropped_events() const noexcept { return dropped_events_; }
+
+ private:
+  // Histories are rings stored twice (each value written at i and i + ring): the newest-first
+  // window of any length up to the ring size is then contiguous, so the model's dot products
+  // run over plain arrays (vectorised) without index wrapping.
+  static constexpr int kInputRing = 128;  // power of two >= nb + d
+  static_assert(kInputRing >= kMaxPrecontrolOrder + kMaxPrecontrolDeadTime);
+  static constexpr int kSpeedRing = 128;  // > the largest backlash lag accepted [cycles]
+  struct CellModel {
+    int na = 0, nb = 0, d = 0;
+    std::array<double, kMaxPrecontrolOrder> a{};
+    std::array<double, kMaxPrecontrolOrder> b{};
+    std::array<double, 2 * kMaxPrecontrolOrder> y{};  // q̂ history, newest at y[y_pos]
+    int y_pos = 0;
+  };
+  struct JointModel {
+    int cells = 0;
+    std::array<CellModel, kMaxPrecontrolCells> cell{};
+    // Blending grid: per dimension the quantity and cell centres.
+    int dims = 0;
+    std::array<OperatingQuantity, 4> quantity{};
+    std::array<std::array<double, kMaxPrecontrolCells>, 4> centres{};
+    std::array<int, 4> centre_count{};
+    std::array<double, 4> lower{}, upper{};  // grid bounds (outside: event)
+    double backlash_l_rad = 0.0;
+    // The identification's direction of motion is the desired velocity `backlash_lag` cycles
+    // earlier (ident/backlash_identification.hpp): a ring of past speeds [rad/s].
+    int backlash_lag = 0;
+    std::array<double, kSpeedRing> speed_history{};
+    int speed_pos = 0;
+    // Input history q_d(k), q_d(k-1), ... (ring), newest at u_head.
+    std::array<double, 2 * kInputRing> u{};  // q_d history, newest at u[u_pos]
+    int u_pos = 0;
+    double last_error = 0.0;      // blended Δq̂ of the last model step
+    double previous_error = 0.0;  // the one before (for output interpolation at T/m cycles)
+    double smooth = 0.0, smooth_rate = 0.0;  // smoother state
+    double output = 0.0;                     // last offset handed out
+  };
+
+  void model_step(JointModel& joint, double q_desired, double speed, double acceleration,
+                  double payload, bool& outside) noexcept;
+  void restart_models(const std::array<double, kPrecontrolJoints>& q_desired) noexcept;
+  void deactivate(std::uint64_t cycle, int joint, PrecontrolCause cause, double value) noexcept;
+  void log(std::uint64_t cycle, int joint, PrecontrolCause cause, double value) noexcept;
+
+  PrecontrolOptions options_;
+  double model_sample_s_ = 0.002;
+  int steps_per_call_ = 1;  // caller cycle = steps · T
+  int calls_per_step_ = 1;  // caller cycle = T / calls
+  int call_phase_ = 0;
+  std::array<JointModel, kPrecontrolJoints> joints_{};
+  std::array<double, kPrecontrolJoints> last_q_{};
+  std::array<double, kPrecontrolJoints> last_speed_{};
+  double last_payload_ = 0.0;
+  bool started_ = false;
+  std::uint64_t last_cycle_ = 0;
+  PrecontrolState state_ = PrecontrolState::kActive;
+  double fade_elapsed_s_ = 0.0;
+  std::array<double, kPrecontrolJoints> fade_from_{};
+  bool was_outside_ = false;
+  std::array<PrecontrolEvent, kPrecontrolEventCapacity> events_{};
+  int event_head_ = 0, event_count_ = 0;
+  std::uint64_t dropped_events_ = 0;
+};
+
+}  // namespace imscal::ident

@@ -1,0 +1,131 @@
+#include "sim/simulation.hpp"
+
+#include <cmath>
+#include <random>
+
+#include "calib/forward_kinematics.hpp"
+#include "ims/earth_model.hpp"
+#include "ims/imu_noise.hpp"
+#include "ims/imu_synthesis.hpp"
+#include "ims/spline_trajectory.hpp"
+#include "sim/motion_planner.hpp"
+#include "sim/motion_program.hpp"
+#include "sim/plant_config.hpp"
+
+namespace imscal::sim {
+namespace {
+
+// Random draws of the scenario, in a fixed order from one generator (same seed, same draws):
+// base yaw, mount perturbation (rotation vector, translation), then the sensor errors and the
+// seed of the sensor noise (in run_simulation).
+Eigen::Isometry3d draw_base(const Scenario& s, std::mt19937_64& rng) {
+  Eigen::Isometry3d T_W_R = s.T_W_R;
+  if (s.random_base_yaw) {
+    std::uniform_real_distribution<double> yaw(-M_PI, M_PI);
+    T_W_R.linear() = Eigen::AngleAxisd(yaw(rng), Eigen::Vector3d::UnitZ()) * T_W_R.linear();
+  }
+  return T_W_R;
+}
+
+Eigen::Isometry3d draw_mount(const Scenario& s, const calib::RobotDescription& robot,
+                             std::mt19937_64& rng) {
+  Eigen::Isometry3d T_H_S = robot.tool.T_H_T * s.mount_offset;
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::Vector3d rotation, translation;
+  for (int i = 0; i < 3; ++i) rotation[i] = normal(rng) * s.mount_random_rotation_sigma_rad;
+  for (int i = 0; i < 3; ++i) translation[i] = normal(rng) * s.mount_random_position_sigma_m;
+  Eigen::Isometry3d perturbation = Eigen::Isometry3d::Identity();
+  if (rotation.norm() > 0.0) {
+    perturbation.linear() = Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).matrix();
+  }
+  perturbation.translation() = translation;
+  return T_H_S * perturbation;
+}
+
+void truncate(DesiredJointPath& path, double max_duration_s) {
+  if (path.samples.empty() || path.samples.back().t_s <= max_duration_s) return;
+  while (!path.samples.empty() && path.samples.back().t_s > max_duration_s) path.samples.pop_back();
+  while (!path.segments.empty() && path.segments.back().begin_s >= max_duration_s) {
+    path.segments.pop_back();
+  }
+  if (!path.segments.empty()) path.segments.back().end_s = path.samples.back().t_s;
+}
+
+}  // namespace
+
+std::vector<Eigen::Isometry3d> flange_poses(const calib::RobotDescription& robot,
+                                            const PlantLog& plant) {
+  std::vector<Eigen::Isometry3d> poses;
+  poses.reserve(plant.samples.size());
+  for (const PlantSample& s : plant.samples) {
+    poses.push_back(calib::forward_kinematics<double>(robot.kinematics, s.q_link_rad));
+  }
+  return poses;
+}
+
+SimulationResult run_simulation(const Scenario& scenario, std::uint64_t seed,
+                                const SimulationProgress& progress, double max_duration_s) {
+  auto report = [&](const char* stage, double fraction) {
+    if (progress) progress(stage, fraction);
+  };
+  SimulationResult result;
+  result.robot = calib::load_robot_description(scenario.robot_file);
+  result.sensor_spec = ims::load_sensor_spec(scenario.sensor_file);
+  const MotionProgram program = load_motion_program(scenario.program_file);
+  report("plan", 0.0);
+  result.path = plan_motion(result.robot, program);
+  truncate(result.path, max_duration_s);
+  report("plan", 1.0);
+
+  std::mt19937_64 rng(seed);
+  result.T_W_R = draw_base(scenario, rng);
+  result.T_H_S = draw_mount(scenario, result.robot, rng);
+  result.imu_clock_offset_s = scenario.imu_clock_offset_s;
+
+  PlantConfig config =
+      make_plant_config(result.robot, scenario.effects ? &*scenario.effects : nullptr,
+                        scenario.integration_step ? &*scenario.integration_step : nullptr);
+  // The arm feels the site's gravity (GeographicLib normal gravity at the base), in R.
+  const ims::EarthModel earth(scenario.site);
+  config.gravity_in_base_m_s2 =
+      result.T_W_R.linear().transpose() * earth.gravity_W(result.T_W_R.translation());
+  result.plant = simulate_plant(config, result.path, scenario.plant_output_interval_s,
+                                [&](double fraction) { report("plant", fraction); });
+
+  // The IMS frame S in W at every plant sample, interpolated by a spline for the synthesis.
+  report("ims", 0.0);
+  const std::vector<Eigen::Isometry3d> T_R_H = flange_poses(result.robot, result.plant);
+  std::vector<ims::PoseSample> poses(T_R_H.size());
+  for (std::size_t k = 0; k < T_R_H.size(); ++k) {
+    const Eigen::Isometry3d T_W_S = result.T_W_R * T_R_H[k] * result.T_H_S;
+    poses[k] = {result.plant.samples[k].t_s, T_W_S.translation(),
+                Eigen::Quaterniond(T_W_S.linear()).normalized()};
+  }
+  const ims::SplineTrajectory trajectory(poses);
+  const ims::ImuSeries ideal =
+      ims::synthesize_ideal_increments(trajectory, earth, scenario.imu_rate_hz);
+  report("ims", 0.7);
+
+  result.sensor_errors = ims::draw_sensor_errors(result.sensor_spec, rng);
+  result.imu_raw = ims::corrupt(ideal, result.sensor_errors, result.sensor_spec, rng());
+  // Truth at the start of the first interval and at every sample, then both on the IMS clock.
+  auto truth_at = [&](double t_robot) {
+    const ims::KinematicState state = trajectory.at(t_robot);
+    return ims::NavState{t_robot + result.imu_clock_offset_s, state.q_W_S, state.v_W, state.p_W};
+  };
+  result.sensor_truth.reserve(ideal.samples.size() + 1);
+  result.sensor_truth.push_back(truth_at(trajectory.begin_s()));
+  for (const ims::ImuSample& sample : ideal.samples) {
+    result.sensor_truth.push_back(truth_at(sample.t_s));
+  }
+  for (ims::ImuSample& sample : result.imu_raw.samples) sample.t_s += result.imu_clock_offset_s;
+  result.imu_raw.site = scenario.site;
+  result.imu_raw.metadata = {{"sensor", result.sensor_spec.name},
+                             {"scenario", scenario.name},
+                             {"seed", std::to_string(seed)},
+                             {"generator", "imscal simulate"}};
+  report("ims", 1.0);
+  return result;
+}
+
+}  // namespace imscal::sim

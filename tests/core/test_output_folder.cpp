@@ -1,0 +1,76 @@
+// All-or-nothing output folders: nothing appears before commit, an exception leaves the folder as
+// it was, existing outputs are refused without overwrite.
+#include "core/output_folder.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "core/input_error.hpp"
+#include "tests/support/scratch_dir.hpp"
+
+namespace imscal {
+namespace {
+
+namespace fs = std::filesystem;
+using OutputFolderTest = test_support::ScratchDirTest;
+
+void write(const fs::path& file, const std::string& text) {
+  std::ofstream(file) << text;
+}
+
+std::string read(const fs::path& file) {
+  std::ifstream in(file);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST_F(OutputFolderTest, FilesAppearOnlyAtCommit) {
+  OutputFolder out(dir_ / "run", {"a.txt", "truth/b.txt"}, Overwrite::kRefuse);
+  write(out.staged("a.txt"), "A");
+  write(out.staged("truth/b.txt"), "B");
+  EXPECT_FALSE(fs::exists(dir_ / "run" / "a.txt"));
+  out.commit();
+  EXPECT_EQ(read(dir_ / "run" / "a.txt"), "A");
+  EXPECT_EQ(read(dir_ / "run" / "truth" / "b.txt"), "B");
+}
+
+TEST_F(OutputFolderTest, AnErrorBeforeCommitLeavesTheFolderAsItWas) {
+  write(dir_ / "a.txt", "old");
+  try {
+    OutputFolder out(dir_, {"a.txt", "b.txt"}, Overwrite::kAllow);
+    write(out.staged("a.txt"), "new");
+    throw std::runtime_error("stage failed");
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_EQ(read(dir_ / "a.txt"), "old");
+  EXPECT_FALSE(fs::exists(dir_ / "b.txt"));
+  // No staging folder is left behind.
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_FALSE(entry.path().filename().string().starts_with(".imscal-staging"));
+  }
+}
+
+TEST_F(OutputFolderTest, ExistingOutputsAreRefusedUnlessAllowed) {
+  write(dir_ / "a.txt", "old");
+  try {
+    OutputFolder out(dir_, {"b.txt", "a.txt"}, Overwrite::kRefuse);
+    ADD_FAILURE() << "accepted an existing output";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), (dir_ / "a.txt").string());
+  }
+  OutputFolder out(dir_, {"a.txt"}, Overwrite::kAllow);
+  write(out.staged("a.txt"), "new");
+  out.commit();
+  EXPECT_EQ(read(dir_ / "a.txt"), "new");
+}
+
+TEST_F(OutputFolderTest, CommitRefusesAMissingOutputAndUndeclaredFiles) {
+  OutputFolder out(dir_, {"a.txt", "b.txt"}, Overwrite::kRefuse);
+  write(out.staged("a.txt"), "A");
+  EXPECT_THROW(out.staged("c.txt"), std::logic_error);
+  EXPECT_THROW(out.commit(), std::logic_error);
+  EXPECT_FALSE(fs::exists(dir_ / "a.txt"));  // nothing moved: the set was incomplete
+}
+
+}  // namespace
+}  // namespace imscal

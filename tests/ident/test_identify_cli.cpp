@@ -1,0 +1,165 @@
+// `imscal identify` end to end on a generated joint_errors.csv: two simulated joints with known
+// backlash, a time gap (two runs); the outputs must load, hold the backlash within 10 % and fit
+// the held-out data; existing outputs are refused without --force; a bad config is refused.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "ident/joint_error_io.hpp"
+#include "ident/parameter_table_io.hpp"
+#include "tests/ident/joint_simulation.hpp"
+#include "tests/support/scratch_dir.hpp"
+
+namespace {
+namespace ident = imscal::ident;
+using imscal::test_support::SimulatedJoint;
+
+constexpr double kDt = 0.002;
+const double kTrueL[] = {0.8e-3, 1.5e-3};
+
+class IdentifyCli : public imscal::test_support::ScratchDirTest {
+ protected:
+  void SetUp() override {
+    ScratchDirTest::SetUp();
+    // Lighter under the sanitizers (IMSCAL_SANITIZED): fewer samples, still > 40 reversals.
+    const std::size_t samples = std::getenv("IMSCAL_SANITIZED") ? 30000 : 50000;
+    ident::JointErrorLog log;
+    log.robot = "kr16";
+    log.cycle_s = kDt;
+    log.source = "test_identify_cli simulation";
+    log.joint_names = {"A1", "A2"};
+    log.q_desired_rad.resize(2);
+    log.q_measured_rad.resize(2);
+    log.q_internal_rad.resize(2);
+    for (std::size_t j = 0; j < 2; ++j) {
+      SimulatedJoint joint;
+      joint.backlash_l_rad = kTrueL[j];
+      joint.pole_modulus = j == 0 ? 0.92 : 0.9;
+      joint.dead_time = j == 0 ? 2 : 1;
+      joint.measurement_noise_rad = 1e-5;
+      joint.offset_rad = j == 0 ? 0.3 : -0.6;
+      // Two runs of the same motion, 1 s apart (a gap in the time stamps).
+      for (int run = 0; run < 2; ++run) {
+        const auto r = imscal::test_support::simulate_joint(joint, samples / 2, kDt, 10 * j + run,
+                                                            run * (samples / 2 * kDt + 1.0));
+        if (j == 0) {
+          log.time_s.insert(log.time_s.end(), r.t_s.begin(), r.t_s.end());
+          log.payload_kg.insert(log.payload_kg.end(), r.t_s.size(), 5.0);
+        }
+        log.q_desired_rad[j].insert(log.q_desired_rad[j].end(), r.q_desired.begin(),
+                                    r.q_desired.end());
+        log.q_measured_rad[j].insert(log.q_measured_rad[j].end(), r.q_measured.begin(),
+                                     r.q_measured.end());
+        log.q_internal_rad[j].insert(log.q_internal_rad[j].end(), r.q_linear.begin(),
+                                     r.q_linear.end());
+      }
+    }
+    ident::write_joint_errors_csv(dir_ / "joint_errors.csv", log);
+    // The shipped default with a smaller sweep (the test's joints are of order 2).
+    std::ifstream in(std::string(IMSCAL_SOURCE_DIR) +
+                     "/datasets/identification/ident-default.yaml");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string config = text.str();
+    const auto replace = [&](const std::string& from, const std::string& to) {
+      const auto at = config.find(from);
+      ASSERT_NE(at, std::string::npos) << from;
+      config.replace(at, from.size(), to);
+    };
+    replace("max_speed_deg_s: [156, 156, 156, 330, 330, 615]", "max_speed_deg_s: [60, 60]");
+    replace("na: [1, 32]", "na: [1, 4]");
+    replace("nb: [1, 32]", "nb: [1, 4]");
+    replace("settle_s: 0.05", "settle_s: 0.08");
+    std::ofstream(dir_ / "ident.yaml") << config;
+  }
+
+  int identify(const std::string& extra = "", const std::string& config = "ident.yaml") {
+    const std::string command = std::string(IMSCAL_BINARY) + " identify --joint-errors " +
+                                (dir_ / "joint_errors.csv").string() + " --config " +
+                                (dir_ / config).string() + " --out " + (dir_ / "out").string() +
+                                " " + extra + " > " + (dir_ / "log.txt").string() + " 2>&1";
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  std::string log_text() {
+    std::ifstream in(dir_ / "log.txt");
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+};
+
+TEST_F(IdentifyCli, WritesALoadableTableThatFitsHeldOutData) {
+  ASSERT_EQ(identify(), 0) << log_text();
+  const ident::ParameterTable table = ident::read_parameters_json(dir_ / "out" / "parameters.json");
+  EXPECT_EQ(table.robot, "kr16");
+  EXPECT_EQ(table.sample_time_s, kDt);
+  EXPECT_EQ(table.source.sha256, ident::file_sha256_hex(dir_ / "joint_errors.csv"));
+  ASSERT_EQ(table.joints.size(), 2u);
+  for (std::size_t j = 0; j < 2; ++j) {
+    const auto& joint = table.joints[j];
+    EXPECT_TRUE(joint.backlash_identified);
+    // The brief's goal for backlash: within 10 %.
+    EXPECT_NEAR(joint.backlash_l_rad, kTrueL[j], 0.1 * kTrueL[j]) << joint.name;
+    ASSERT_EQ(joint.cells.size(), 6u);  // 3 speed bands x 2 payload bands
+    int identified = 0;
+    for (const auto& cell : joint.cells) {
+      if (cell.status != ident::CellStatus::kIdentified) {
+        EXPECT_FALSE(cell.reason.empty());
+        continue;
+      }
+      ++identified;
+      // The goal for held-out simulation fit of a joint: >= 90 %.
+      EXPECT_GE(cell.figures.simulation_fit_percent, 90.0) << joint.name << " cell";
+      EXPECT_LT(cell.figures.spectral_radius, 1.0);
+    }
+    // Payload 5 kg of 16: payload band 1 is empty; the motion (60 deg/s max) reaches speed bands
+    // 0 and 1 at least.
+    EXPECT_GE(identified, 2);
+    EXPECT_EQ(joint.cells[1].status, ident::CellStatus::kFilled);
+  }
+  // The report: chosen structures with criterion curves, validation tests, backlash.
+  std::ifstream in(dir_ / "out" / "identification_report.json");
+  const auto report = nlohmann::json::parse(in);
+  ASSERT_EQ(report["joints"].size(), 2u);
+  const auto& cell0 = report["joints"][0]["cells"][0];
+  EXPECT_TRUE(cell0.contains("criterion_curves"));
+  EXPECT_EQ(cell0["criterion_curves"]["over_na"].size(), 4u);
+  EXPECT_TRUE(cell0["validation"]["residual_whiteness"].contains("band"));
+  EXPECT_TRUE(report["joints"][1]["cells"][1].contains("reason"));
+  EXPECT_EQ(report["segments"], 2);
+  // CSV: header + 2 joints x 6 cells.
+  std::ifstream csv(dir_ / "out" / "parameters.csv");
+  std::string line;
+  int lines = 0;
+  while (std::getline(csv, line)) ++lines;
+  EXPECT_EQ(lines, 13);
+
+  // Outputs exist: refused without --force (exit 2, files untouched), accepted with it.
+  const auto before = std::filesystem::last_write_time(dir_ / "out" / "parameters.json");
+  EXPECT_EQ(identify(), 2) << log_text();
+  EXPECT_NE(log_text().find("--force"), std::string::npos);
+  EXPECT_EQ(std::filesystem::last_write_time(dir_ / "out" / "parameters.json"), before);
+  EXPECT_EQ(identify("--force"), 0) << log_text();
+}
+
+TEST_F(IdentifyCli, BadConfigRefusedWithoutOutput) {
+  std::ofstream(dir_ / "bad.yaml")
+      << "imscal-identification-config: 1\n"
+         "joints: {max_speed_deg_s: [60, 60], nominal_payload_kg: 16}\n"
+         "order: {na: [1, 4], nb: [1, 4], dead_tme: [0, 2]}\n";
+  EXPECT_EQ(identify("", "bad.yaml"), 2);
+  EXPECT_NE(log_text().find("dead_tme"), std::string::npos) << log_text();
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "out" / "parameters.json"));
+  // A config for the wrong number of joints.
+  std::ofstream(dir_ / "three.yaml")
+      << "imscal-identification-config: 1\n"
+         "joints: {max_speed_deg_s: [60, 60, 60], nominal_payload_kg: 16}\n";
+  EXPECT_EQ(identify("", "three.yaml"), 2);
+  EXPECT_NE(log_text().find("3 maximum speeds"), std::string::npos) << log_text();
+}
+
+}  // namespace

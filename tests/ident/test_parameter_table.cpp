@@ -1,0 +1,169 @@
+// parameters.json: exact round trip, and the loader's refusals of inconsistent tables, each with
+// the file and the JSON path of the offending value.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <string>
+
+#include "core/input_error.hpp"
+#include "ident/parameter_table_io.hpp"
+#include "tests/support/arx_systems.hpp"
+#include "tests/support/scratch_dir.hpp"
+
+namespace {
+namespace ident = imscal::ident;
+using nlohmann::json;
+
+// A two-joint table with random stable models, irregular numbers (to exercise the exact
+// round trip of doubles) and one filled cell.
+ident::ParameterTable sample_table() {
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  ident::ParameterTable t;
+  t.robot = "kr16";
+  t.sample_time_s = 0.002;
+  t.created_by = "imscal test";
+  t.source = {"/tmp/joint_errors.csv", std::string(64, 'a'), 123456, "simulated"};
+  for (const char* name : {"A1", "A2"}) {
+    ident::JointParameters j;
+    j.name = name;
+    j.dimensions = {{ident::OperatingQuantity::kSpeed, {0.0, 0.1 * M_PI / 3, 2.7227136331111539}},
+                    {ident::OperatingQuantity::kPayload, {0.0, 8.0, 16.0}}};
+    j.backlash_l_rad = 1e-3 * uniform(rng);
+    j.backlash_l_sigma_rad = 1e-5 * uniform(rng);
+    j.backlash_identified = true;
+    j.backlash_lag_samples = 17;
+    const ident::CellGrid grid(j.dimensions);
+    for (int flat = 0; flat < grid.cell_count(); ++flat) {
+      ident::CellParameters c;
+      c.bands = grid.bands_of(flat);
+      c.structure = {2 + flat % 3, 1 + flat % 2, flat % 4};
+      const auto model = imscal::test_support::random_system(c.structure, rng);
+      c.a.assign(model.a().data(), model.a().data() + model.a().size());
+      c.b.assign(model.b().data(), model.b().data() + model.b().size());
+      c.figures.estimation_rows = 5000u + unsigned(flat);
+      c.figures.validation_rows = 2000;
+      c.figures.one_step_fit_percent = 99.1 * uniform(rng);
+      c.figures.simulation_fit_percent = 95.3 * uniform(rng);
+      c.figures.joint_error_fit_percent = 91.7 * uniform(rng);
+      c.figures.residual_rms_rad = 1e-6 * uniform(rng);
+      c.figures.whiteness_passed = flat % 2 == 0;
+      c.figures.input_residual_passed = true;
+      c.figures.spectral_radius = model.spectral_radius();
+      if (flat == 3) {
+        c.status = ident::CellStatus::kFilled;
+        c.filled_from = 2;
+        c.reason = "12 estimation rows, fewer than min_rows_per_cell = 2000";
+      }
+      j.cells.push_back(c);
+    }
+    t.joints.push_back(j);
+  }
+  return t;
+}
+
+class ParameterTableFiles : public imscal::test_support::ScratchDirTest {};
+
+TEST_F(ParameterTableFiles, RoundTripIsExact) {
+  const ident::ParameterTable table = sample_table();
+  const auto file = dir_ / "parameters.json";
+  ident::write_parameters_json(file, table);
+  const ident::ParameterTable back = ident::read_parameters_json(file);
+  // Every double bit for bit (operator== compares the values exactly), every string and count.
+  EXPECT_TRUE(back == table);
+  EXPECT_EQ(ident::parameters_json_text(back), ident::parameters_json_text(table));
+  // The CSV has the header and one row per joint and cell.
+  ident::write_parameters_csv(dir_ / "parameters.csv", table);
+  const std::string csv = ident::parameters_csv_text(table);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 2 * 4);
+}
+
+TEST(ParameterTable, NotAvailableFiguresRoundTripAsNull) {
+  ident::ParameterTable table = sample_table();
+  table.joints[0].cells[0].figures.simulation_fit_percent = std::nan("");
+  const std::string text = ident::parameters_json_text(table);
+  const auto back = ident::parse_parameters_json(text, "mem");
+  EXPECT_TRUE(std::isnan(back.joints[0].cells[0].figures.simulation_fit_percent));
+}
+
+struct Refusal {
+  std::string name;
+  std::function<void(json&)> corrupt;
+  std::string path;     // expected InputError::field
+  std::string message;  // expected part of the problem
+};
+
+class LoaderRefuses : public ::testing::TestWithParam<Refusal> {};
+
+TEST_P(LoaderRefuses, WithPathAndMessage) {
+  json j = json::parse(ident::parameters_json_text(sample_table()));
+  GetParam().corrupt(j);
+  try {
+    ident::parse_parameters_json(j.dump(), "parameters.json");
+    FAIL() << "accepted a bad table";
+  } catch (const imscal::InputError& e) {
+    EXPECT_EQ(e.file(), "parameters.json");
+    EXPECT_EQ(e.field(), GetParam().path) << e.what();
+    EXPECT_NE(e.problem().find(GetParam().message), std::string::npos) << e.what();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BadTables, LoaderRefuses,
+    ::testing::Values(
+        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 2; }, "/schema_version",
+                "unknown schema version 2"},
+        Refusal{"WrongSchema", [](json& j) { j["schema"] = "something"; }, "/schema",
+                "not an imscal parameter table"},
+        Refusal{"ALengthWrong", [](json& j) { j["joints"][0]["cells"][1]["a"].push_back(0.1); },
+                "/joints/0/cells/1/a", "coefficients, na ="},
+        Refusal{"BLengthWrong", [](json& j) { j["joints"][1]["cells"][2]["b"] = json::array(); },
+                "/joints/1/cells/2/b", "0 coefficients, nb ="},
+        Refusal{"MissingCell", [](json& j) { j["joints"][0]["cells"].erase(2); }, "/joints/0/cells",
+                "missing cell 2"},
+        Refusal{"RepeatedCell",
+                [](json& j) {
+                  j["joints"][0]["cells"][1]["bands"] = j["joints"][0]["cells"][0]["bands"];
+                },
+                "/joints/0/cells/1/bands", "cell given twice"},
+        Refusal{"NaNCoefficient", [](json& j) { j["joints"][0]["cells"][0]["a"][0] = nullptr; },
+                "/joints/0/cells/0/a/0", "not a finite number"},
+        Refusal{"BandOutOfRange", [](json& j) { j["joints"][0]["cells"][0]["bands"][1] = 2; },
+                "/joints/0/cells/0/bands", "outside 0..1"},
+        Refusal{"BandCountWrong", [](json& j) { j["joints"][0]["cells"][0]["bands"] = {0}; },
+                "/joints/0/cells/0/bands", "1 band indices for 2 dimensions"},
+        Refusal{"BoundsNotIncreasing",
+                [](json& j) {
+                  j["joints"][1]["dimensions"][1]["bounds"] = {0.0, 8.0, 8.0};
+                },
+                "/joints/1/dimensions/1/bounds", "strictly increasing"},
+        Refusal{"UnstableModel",
+                [](json& j) {
+                  auto& c = j["joints"][0]["cells"][0];
+                  c["na"] = 1;
+                  c["a"] = {-1.5};  // pole at z = 1.5
+                },
+                "/joints/0/cells/0/a", "unstable"},
+        Refusal{"MissingKey", [](json& j) { j["joints"][0].erase("backlash"); },
+                "/joints/0/backlash", "missing key"},
+        Refusal{"UnknownKey", [](json& j) { j["joints"][0]["cells"][0]["c"] = 1; },
+                "/joints/0/cells/0/c", "unknown key"},
+        Refusal{"WrongUnit", [](json& j) { j["units"]["angle"] = "deg"; }, "/units/angle",
+                "expected 'rad'"},
+        Refusal{"NegativeBacklash", [](json& j) { j["joints"][1]["backlash"]["l_rad"] = -1e-4; },
+                "/joints/1/backlash/l_rad", "negative backlash"},
+        Refusal{"BadSampleTime", [](json& j) { j["sample_time_s"] = 0.0; }, "/sample_time_s",
+                "sample time must be > 0"},
+        Refusal{"DuplicateJoint", [](json& j) { j["joints"][1]["name"] = "A1"; }, "/joints/1/name",
+                "given twice"},
+        Refusal{"WrongType", [](json& j) { j["joints"][0]["cells"][0]["na"] = "two"; },
+                "/joints/0/cells/0/na", "expected an integer"}),
+    [](const ::testing::TestParamInfo<Refusal>& info) { return info.param.name; });
+
+TEST(ParameterTable, NotJsonRefused) {
+  EXPECT_THROW(ident::parse_parameters_json("{\"schema\": ", "p.json"), imscal::InputError);
+}
+
+}  // namespace

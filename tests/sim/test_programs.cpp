@@ -1,0 +1,324 @@
+// The shipped motion programs (datasets/programs/*.yaml) plan on the default robot and do what
+// their comments promise: seed-line is the paper's test path; identification, mounting and
+// iso9283 have the moves, rests, payloads and geometry their briefs ask for. Positions are
+// checked through forward kinematics (independent of the IK the planner used).
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "calib/forward_kinematics.hpp"
+#include "calib/jacobian.hpp"
+#include "calib/robot_description.hpp"
+#include "sim/motion_planner.hpp"
+#include "sim/motion_program.hpp"
+
+namespace imscal::sim {
+namespace {
+
+using calib::JointVector;
+namespace fs = std::filesystem;
+
+const calib::RobotDescription& robot() {
+  static const calib::RobotDescription r =
+      calib::load_robot_description(std::string(IMSCAL_SOURCE_DIR) + "/datasets/robots/kr16.yaml");
+  return r;
+}
+
+fs::path programs_dir() {
+  return fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "programs";
+}
+
+struct Planned {
+  MotionProgram program;
+  DesiredJointPath path;
+};
+
+// Each program is planned once for all tests.
+const Planned& planned(const std::string& name) {
+  static std::map<std::string, Planned> cache;
+  auto it = cache.find(name);
+  if (it == cache.end()) {
+    Planned p;
+    p.program = load_motion_program(programs_dir() / (name + ".yaml"));
+    p.path = plan_motion(robot(), p.program);
+    it = cache.emplace(name, std::move(p)).first;
+  }
+  return it->second;
+}
+
+std::pair<std::size_t, std::size_t> range(const DesiredJointPath& path, const PathSegment& s) {
+  return {static_cast<std::size_t>(std::lround(s.begin_s / path.cycle_s)),
+          static_cast<std::size_t>(std::lround(s.end_s / path.cycle_s))};
+}
+
+const PathSegment& segment(const DesiredJointPath& path, const std::string& label) {
+  for (const auto& s : path.segments) {
+    if (s.label == label) return s;
+  }
+  throw std::runtime_error("no segment " + label);
+}
+
+Eigen::Isometry3d fk(const JointVector& q) {
+  return calib::forward_kinematics<double>(robot().kinematics, q);
+}
+
+double path_speed(const JointVector& q, const JointVector& qd) {
+  return (calib::geometric_jacobian(robot().kinematics, q) * qd).head<3>().norm();
+}
+
+TEST(ShippedPrograms, EveryProgramPlansWithinTheLimits) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(programs_dir())) {
+    if (entry.path().extension() != ".yaml") continue;
+    ++count;
+    const std::string name = entry.path().stem().string();
+    SCOPED_TRACE(name);
+    const Planned& p = planned(name);
+    const DesiredJointPath& path = p.path;
+    const auto& k = robot().kinematics;
+    ASSERT_GT(path.samples.size(), 1u);
+    EXPECT_EQ(path.cycle_s, robot().controller_cycle_s);
+    EXPECT_EQ(path.segments.front().begin_s, 0.0);
+    EXPECT_EQ(path.segments.back().end_s, path.samples.back().t_s);
+    for (std::size_t i = 1; i < path.segments.size(); ++i) {
+      EXPECT_EQ(path.segments[i].begin_s, path.segments[i - 1].end_s);
+    }
+    EXPECT_EQ(path.segments.front().kind, SegmentKind::kRest);  // the IMS needs rest first
+    EXPECT_EQ(path.segments.back().kind, SegmentKind::kRest);
+    // Counted with plain code and asserted once per program: a per-sample gtest assertion would
+    // dominate the run time (200 000 samples), above all under the sanitizers.
+    int bad_time = 0, bad_payload = 0, outside_limits = 0, too_fast = 0;
+    for (std::size_t n = 0; n < path.samples.size(); ++n) {
+      const DesiredJointSample& s = path.samples[n];
+      bad_time += s.t_s != static_cast<double>(n) * path.cycle_s;
+      bad_payload +=
+          s.payload_index < 0 || s.payload_index >= static_cast<int>(path.payloads.size());
+      for (int i = 0; i < 6; ++i) {
+        outside_limits += s.q_rad(i) < k.lower_limit_rad(i) || s.q_rad(i) > k.upper_limit_rad(i);
+        // Rounding slack only: the planner checks the same limit.
+        too_fast += std::abs(s.qd_rad_s(i)) > robot().joints[i].max_velocity_rad_s * (1 + 1e-9);
+      }
+    }
+    EXPECT_EQ(bad_time, 0);
+    EXPECT_EQ(bad_payload, 0);
+    EXPECT_EQ(outside_limits, 0);
+    EXPECT_EQ(too_fast, 0);
+    int rest_moving = 0, ptp_too_hard = 0;
+    for (const PathSegment& seg : path.segments) {
+      const auto [first, last] = range(path, seg);
+      for (std::size_t n = first; n <= last; ++n) {
+        const DesiredJointSample& s = path.samples[n];
+        if (seg.kind == SegmentKind::kRest) {
+          rest_moving += s.q_rad != path.samples[first].q_rad || s.qd_rad_s.norm() > 1e-12;
+        }
+        if (seg.kind == SegmentKind::kPtp) {
+          for (int i = 0; i < 6; ++i) {
+            ptp_too_hard +=
+                std::abs(s.qdd_rad_s2(i)) > p.program.max_acceleration_rad_s2(i) * (1 + 1e-9);
+          }
+        }
+      }
+    }
+    EXPECT_EQ(rest_moving, 0);
+    EXPECT_EQ(ptp_too_hard, 0);
+  }
+  EXPECT_EQ(count, 4);  // seed-line, identification, mounting, iso9283
+}
+
+TEST(ShippedPrograms, SeedLineIsThePapersTestPath) {
+  const Planned& p = planned("seed-line");
+  const DesiredJointPath& path = p.path;
+  // Rest >= 5 s at the start (IMS alignment).
+  EXPECT_EQ(path.segments.front().kind, SegmentKind::kRest);
+  EXPECT_GE(path.segments.front().end_s, 5.0);
+  // Payload 5 kg throughout.
+  for (const auto& s : path.samples) ASSERT_EQ(path.payloads[s.payload_index].body.mass_kg, 5.0);
+
+  const PathSegment& out = segment(path, "line -y");
+  const PathSegment& pause = segment(path, "pause");
+  const PathSegment& back = segment(path, "line +y");
+  EXPECT_EQ(out.kind, SegmentKind::kLinear);
+  EXPECT_EQ(pause.begin_s, out.end_s);
+  EXPECT_NEAR(pause.end_s - pause.begin_s, 1.0, 1e-12);  // 1 s pause (500 cycles)
+  EXPECT_EQ(back.begin_s, pause.end_s);
+
+  const auto [o0, o1] = range(path, out);
+  const auto [b0, b1] = range(path, back);
+  const Eigen::Isometry3d start = fk(path.samples[o0].q_rad);
+  const Eigen::Vector3d p0 = start.translation();
+  // 800 mm in -y; back at the start. FK of IK solutions: 1e-9 m (IK refines to 1e-12 m).
+  EXPECT_LT((fk(path.samples[o1].q_rad).translation() - (p0 - Eigen::Vector3d(0, 0.8, 0))).norm(),
+            1e-9);
+  EXPECT_LT((fk(path.samples[b1].q_rad).translation() - p0).norm(), 1e-9);
+  // On the line, constant orientation, peak path speed 0.4 m/s.
+  double peak = 0.0;
+  for (auto [a, b] : {std::pair{o0, o1}, std::pair{b0, b1}}) {
+    for (std::size_t n = a; n <= b; ++n) {
+      const Eigen::Isometry3d pose = fk(path.samples[n].q_rad);
+      const Eigen::Vector3d d = pose.translation() - p0;
+      EXPECT_LT(std::hypot(d.x(), d.z()), 1e-9);
+      EXPECT_LT(Eigen::AngleAxisd(start.linear().transpose() * pose.linear()).angle(), 1e-9);
+      peak = std::max(peak, path_speed(path.samples[n].q_rad, path.samples[n].qd_rad_s));
+    }
+  }
+  // Cruise at 0.4 m/s, slowed at most by the stretch to whole cycles (< 0.1 % of ~2.3 s).
+  EXPECT_NEAR(peak, 0.4, 1e-3 * 0.4);
+  EXPECT_LE(peak, 0.4 * (1 + 1e-9));
+  // At the outer limits of the workspace: the wrist centre (origin of DH frame 4) is 90-97 % of
+  // the stretched arm's distance from axis 2 (origin of DH frame 1) somewhere on the line.
+  auto arm_extension = [](const JointVector& q) {
+    const auto chain = calib::chain_poses<double>(robot().kinematics, q);
+    return (chain.T_R_link[4].translation() - chain.T_R_link[1].translation()).norm();
+  };
+  const double stretched = arm_extension(JointVector::Zero());  // q = 0: arm stretched
+  double max_extension = 0.0;
+  for (std::size_t n = o0; n <= o1; ++n) {
+    max_extension = std::max(max_extension, arm_extension(path.samples[n].q_rad) / stretched);
+  }
+  EXPECT_GT(max_extension, 0.90);
+  EXPECT_LT(max_extension, 0.97);
+}
+
+TEST(ShippedPrograms, IdentificationHasSingleJointAndMixedMovesWithTwoPayloads) {
+  const Planned& p = planned("identification");
+  const DesiredJointPath& path = p.path;
+  const double total = path.samples.back().t_s;
+  EXPECT_GE(total, 120.0);  // brief: 2-3 minutes
+  EXPECT_LE(total, 180.0);
+  EXPECT_GE(path.segments.front().end_s, 5.0);
+  ASSERT_EQ(path.payloads.size(), 2u);
+  EXPECT_NE(path.payloads[0].body.mass_kg, path.payloads[1].body.mass_kg);
+  std::array<int, 6> plus{}, minus{};
+  std::array<double, 6> peak_acceleration{};
+  std::vector<double> mixed_speed_fractions;
+  for (const PathSegment& seg : path.segments) {
+    if (seg.kind != SegmentKind::kPtp) continue;
+    const auto [a, b] = range(path, seg);
+    const JointVector delta = path.samples[b].q_rad - path.samples[a].q_rad;
+    int moving = 0, joint = -1;
+    for (int i = 0; i < 6; ++i) {
+      if (std::abs(delta(i)) > 1e-9) {
+        ++moving;
+        joint = i;
+      }
+    }
+    double speed_fraction = 0.0;
+    for (std::size_t n = a; n <= b; ++n) {
+      for (int i = 0; i < 6; ++i) {
+        speed_fraction = std::max(speed_fraction, std::abs(path.samples[n].qd_rad_s(i)) /
+                                                      robot().joints[i].max_velocity_rad_s);
+        if (moving == 1 && i == joint) {
+          peak_acceleration[i] =
+              std::max(peak_acceleration[i], std::abs(path.samples[n].qdd_rad_s2(i)));
+        }
+      }
+    }
+    if (moving == 1) {
+      (delta(joint) > 0 ? plus : minus)[joint]++;
+    } else {
+      mixed_speed_fractions.push_back(speed_fraction);
+    }
+  }
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_GE(plus[i], 1) << "joint " << i;
+    EXPECT_GE(minus[i], 1) << "joint " << i;
+    // At the highest acceleration: the trapezoid's plateau is the program's max (exactly, up
+    // to the stretch to whole cycles: < 1 % for moves > 0.4 s).
+    EXPECT_GT(peak_acceleration[i], 0.99 * p.program.max_acceleration_rad_s2(i)) << i;
+  }
+  // Mixed moves at low, medium and high joint speed (fraction of the fastest joint's limit).
+  auto has = [&](double lo, double hi) {
+    return std::any_of(mixed_speed_fractions.begin(), mixed_speed_fractions.end(),
+                       [&](double f) { return f >= lo && f <= hi; });
+  };
+  EXPECT_TRUE(has(0.1, 0.3));
+  EXPECT_TRUE(has(0.4, 0.6));
+  EXPECT_TRUE(has(0.9, 1.0 + 1e-9));
+}
+
+TEST(ShippedPrograms, MountingHasManyRestPosesTurnedAboutAllFlangeAxes) {
+  const Planned& p = planned("mounting");
+  const DesiredJointPath& path = p.path;
+  EXPECT_GE(path.segments.front().end_s - path.segments.front().begin_s, 10.0);
+  std::vector<Eigen::Matrix3d> rotations;
+  for (const PathSegment& seg : path.segments) {
+    if (seg.kind != SegmentKind::kRest) continue;
+    EXPECT_GE(seg.end_s - seg.begin_s, 5.0 - 1e-9) << seg.label;
+    rotations.push_back(fk(path.samples[range(path, seg).first].q_rad).linear());
+  }
+  EXPECT_GE(rotations.size(), 12u);
+  // Rotation of each pose relative to the first, as a rotation vector in the flange axes H:
+  // some pose turns by >= 60 deg about each of x_H, y_H, z_H.
+  Eigen::Vector3d largest = Eigen::Vector3d::Zero();
+  // Gravity (-z of R) seen in H: must point along +-x_H, +-y_H, +-z_H in some pose (>= 0.7).
+  Eigen::Vector3d most_positive = Eigen::Vector3d::Constant(-1),
+                  most_negative = Eigen::Vector3d::Constant(1);
+  for (const Eigen::Matrix3d& R : rotations) {
+    const Eigen::AngleAxisd turn(rotations.front().transpose() * R);
+    largest = largest.cwiseMax((turn.angle() * turn.axis()).cwiseAbs());
+    const Eigen::Vector3d g = R.transpose() * Eigen::Vector3d(0, 0, -1);
+    most_positive = most_positive.cwiseMax(g);
+    most_negative = most_negative.cwiseMin(g);
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_GE(largest(axis), 60.0 * M_PI / 180.0) << "axis " << axis;
+    EXPECT_GE(most_positive(axis), 0.7) << "axis " << axis;
+    EXPECT_LE(most_negative(axis), -0.7) << "axis " << axis;
+  }
+}
+
+TEST(ShippedPrograms, Iso9283PathSetLiesOnTheCubesDiagonalPlane) {
+  const Planned& p = planned("iso9283");
+  const DesiredJointPath& path = p.path;
+  // Cube: edge 500 mm, centre (1100, 0, 800) mm; plane through the centre with normal
+  // (-1, 0, 1)/sqrt2 (from the comment at the top of iso9283.yaml).
+  const Eigen::Vector3d centre(1.1, 0.0, 0.8);
+  const Eigen::Vector3d normal = Eigen::Vector3d(-1, 0, 1).normalized();
+  const double edge = 0.5;
+  std::map<std::string, double> peak_speed;
+  for (const char* pct : {"100%", "50%", "10%"}) {
+    for (const std::string kind : {"line ", "large circle ", "small circle "}) {
+      const PathSegment& seg = segment(path, kind + pct);
+      const auto [a, b] = range(path, seg);
+      // Largest departures over the segment (one assertion each, see above): off the plane,
+      // off the circle's radius or off the diagonal. FK of IK solutions: 1e-9 m.
+      double peak = 0.0, off_plane = 0.0, off_path = 0.0;
+      const Eigen::Vector3d diagonal = Eigen::Vector3d(1, 1, 1).normalized();
+      for (std::size_t n = a; n <= b; ++n) {
+        const Eigen::Vector3d r = fk(path.samples[n].q_rad).translation() - centre;
+        off_plane = std::max(off_plane, std::abs(r.dot(normal)));
+        if (kind == "large circle ") {
+          off_path = std::max(off_path, std::abs(r.norm() - 0.8 * edge / 2));  // D = 80 % edge
+        } else if (kind == "small circle ") {
+          off_path = std::max(off_path, std::abs(r.norm() - 0.1 * 0.8 * edge / 2));  // 10 %
+        } else {
+          // On the diagonal of the plane's rectangle, through the cube centre.
+          off_path = std::max(off_path, (r - r.dot(diagonal) * diagonal).norm());
+        }
+        peak = std::max(peak, path_speed(path.samples[n].q_rad, path.samples[n].qd_rad_s));
+      }
+      EXPECT_LT(off_plane, 1e-9) << seg.label;
+      EXPECT_LT(off_path, 1e-9) << seg.label;
+      peak_speed[kind + pct] = peak;
+      if (kind == "line ") {
+        // Length 80 % of the diagonal (866 mm): P2 and P4 at 10 % from the corners.
+        const Eigen::Vector3d d =
+            fk(path.samples[b].q_rad).translation() - fk(path.samples[a].q_rad).translation();
+        EXPECT_NEAR(d.norm(), 0.8 * std::sqrt(3.0) * edge, 1e-9);
+      }
+    }
+  }
+  // 100 %, 50 %, 10 % of the rated 0.5 m/s; reached on every path (cruise; stretch < 0.5 %).
+  for (const std::string kind : {"line ", "large circle ", "small circle "}) {
+    EXPECT_NEAR(peak_speed[kind + "100%"], 0.5, 5e-3 * 0.5) << kind;
+    EXPECT_NEAR(peak_speed[kind + "50%"], 0.25, 5e-3 * 0.25) << kind;
+    EXPECT_NEAR(peak_speed[kind + "10%"], 0.05, 5e-3 * 0.05) << kind;
+  }
+}
+
+}  // namespace
+}  // namespace imscal::sim

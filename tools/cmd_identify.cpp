@@ -1,0 +1,231 @@
+// `imscal identify`: the per-joint ARX error models of the paper (equation 2, Table 2) with
+// backlash (equation 3), from a joint_errors.csv, written as parameters.json (the table the
+// precontrol loads), parameters.csv and identification_report.json (chosen orders, criterion
+// curves, validation figures, backlash, filled cells with reasons).
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.hpp"
+#include "core/config_node.hpp"
+#include "core/input_error.hpp"
+#include "core/version.hpp"
+#include "ident/identification_config.hpp"
+#include "ident/joint_error_io.hpp"
+#include "ident/joint_identification.hpp"
+#include "ident/parameter_table_io.hpp"
+#include "tools/command_registry.hpp"
+
+namespace {
+namespace fs = std::filesystem;
+namespace ident = imscal::ident;
+using nlohmann::json;
+
+struct IdentifyArgs {
+  std::string joint_errors;
+  std::string config;
+  std::string out;
+  bool force = false;
+};
+
+json number_or_null(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
+
+json correlation_json(const ident::CorrelationTest& t) {
+  json c = json::array();
+  for (double v : t.correlation) c.push_back(v);
+  return {{"lags", t.lags},
+          {"correlation", c},
+          {"band", t.band},
+          {"family_band", t.family_band},
+          {"max_abs_correlation", t.max_abs_correlation},
+          {"outside_count", t.outside_count},
+          {"allowed_outside", t.allowed_outside},
+          {"passed", t.passed}};
+}
+
+// Criterion curves through the chosen structure: over na (chosen nb, d), over nb (chosen na, d)
+// and over d (chosen na, nb) — the whole grid would be thousands of points per cell.
+json curves_json(const ident::OrderSweepResult& sweep) {
+  json curves = {{"over_na", json::array()}, {"over_nb", json::array()}, {"over_d", json::array()}};
+  const auto& c = sweep.chosen;
+  for (const auto& cand : sweep.candidates) {
+    const auto& s = cand.structure;
+    const json point = {{"na", s.na},
+                        {"nb", s.nb},
+                        {"dead_time", s.dead_time},
+                        {"valid", cand.valid},
+                        {"loss", number_or_null(cand.loss)},
+                        {"aic", number_or_null(cand.aic)},
+                        {"bic", number_or_null(cand.bic)},
+                        {"validation_loss", number_or_null(cand.validation_loss)}};
+    if (s.nb == c.nb && s.dead_time == c.dead_time) curves["over_na"].push_back(point);
+    if (s.na == c.na && s.dead_time == c.dead_time) curves["over_nb"].push_back(point);
+    if (s.na == c.na && s.nb == c.nb) curves["over_d"].push_back(point);
+  }
+  return curves;
+}
+
+json joint_report(const ident::JointIdentification& r, double seconds) {
+  const auto& b = r.backlash;
+  json cells = json::array();
+  for (const auto& c : r.cells) {
+    json cell = {{"cell", c.cell},
+                 {"label", c.label},
+                 {"status", ident::to_string(c.status)},
+                 {"estimation_rows", c.estimation_rows},
+                 {"validation_rows", c.validation_rows},
+                 {"rms_desired_speed_rad_s", c.rms_speed_rad_s}};
+    if (c.status == ident::CellStatus::kFilled) {
+      cell["filled_from"] = c.filled_from;
+      cell["reason"] = c.reason;
+    }
+    if (c.sweep) {
+      cell["criterion"] = ident::to_string(c.sweep->criterion);
+      cell["chosen"] = {{"na", c.sweep->chosen.na},
+                        {"nb", c.sweep->chosen.nb},
+                        {"dead_time", c.sweep->chosen.dead_time}};
+      cell["criterion_curves"] = curves_json(*c.sweep);
+    }
+    if (c.fit) {
+      cell["fit"] = {
+          {"rows", c.fit->row_count},
+          {"residual_variance_rad2", c.fit->residual_variance},
+          {"scaled_condition", c.fit->scaled_condition},
+          {"method", c.fit->method_used == ident::LeastSquaresMethod::kQr ? "qr" : "normal"},
+          {"parameter_std",
+           std::vector<double>(c.fit->parameter_std.data(),
+                               c.fit->parameter_std.data() + c.fit->parameter_std.size())}};
+    }
+    if (c.stability) {
+      cell["stability"] = {{"stable", c.stability->stable},
+                           {"spectral_radius", c.stability->spectral_radius},
+                           {"margin", c.stability->margin},
+                           {"reason", c.stability->reason}};
+    }
+    if (c.validation) {
+      const auto& v = *c.validation;
+      cell["validation"] = {
+          {"samples", v.sample_count},
+          {"one_step_fit_percent", v.one_step_fit_percent},
+          {"simulation_fit_percent", v.simulation_fit_percent},
+          {"joint_error_fit_percent",
+           number_or_null(r.parameters.cells[std::size_t(c.cell)].figures.joint_error_fit_percent)},
+          {"residual_rms_rad", v.residual_rms},
+          {"residual_whiteness", correlation_json(v.residual_whiteness)},
+          {"input_residual", correlation_json(v.input_residual)}};
+    }
+    cells.push_back(cell);
+  }
+  return {{"joint", r.parameters.name},
+          {"seconds", seconds},
+          {"backlash",
+           {{"identified", r.parameters.backlash_identified},
+            {"l_rad", b.l_rad},
+            {"l_sigma_rad", b.l_sigma_rad},
+            {"full_play_rad", 2.0 * r.parameters.backlash_l_rad},
+            {"reversals_found", b.reversals_found},
+            {"reversals_used", b.reversals_used},
+            {"lag_samples", b.lag_samples},
+            {"per_reversal_l_rad", b.per_reversal_rad},
+            {"reason", b.reason}}},
+          {"cells", cells}};
+}
+
+void run(const IdentifyArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  const ident::JointErrorLog log = ident::read_joint_errors_csv(args.joint_errors);
+  const imscal::ConfigNode config_node = imscal::ConfigNode::load_file(args.config);
+  const ident::IdentificationConfig config = ident::load_identification_config(config_node);
+  if (config.max_speed_rad_s.size() != log.joint_count())
+    throw imscal::InputError(
+        args.config, config_node.child("joints").child("max_speed_deg_s").line(),
+        "joints.max_speed_deg_s",
+        fmt::format("{} maximum speeds, but {} has {} joints ({})", config.max_speed_rad_s.size(),
+                    args.joint_errors, log.joint_count(), fmt::join(log.joint_names, ", ")));
+  const fs::path out_dir(args.out);
+  const fs::path json_path = out_dir / "parameters.json", csv_path = out_dir / "parameters.csv",
+                 report_path = out_dir / "identification_report.json";
+  const auto overwrite = args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse;
+  if (!args.force)
+    for (const auto& p : {json_path, csv_path, report_path})
+      if (fs::exists(p))
+        throw imscal::InputError(p.string(), 0, "", "output exists; use --force to overwrite it");
+  fs::create_directories(out_dir);
+
+  const auto segments = log.segments();
+  ident::ParameterTable table;
+  table.robot = log.robot;
+  table.sample_time_s = log.cycle_s;
+  table.created_by = std::string("imscal ") + imscal::kVersion;
+  table.source = {args.joint_errors, ident::file_sha256_hex(args.joint_errors), log.sample_count(),
+                  log.source};
+  json joints_report = json::array();
+  spdlog::info("identify: {} joints, {} samples in {} segments, cycle {} s", log.joint_count(),
+               log.sample_count(), segments.size(), log.cycle_s);
+  for (std::size_t j = 0; j < log.joint_count(); ++j) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const ident::CellGrid grid = config.joint_grid(j);
+    spdlog::info("joint {} ({}/{}): {} cells, order sweep na {}..{} nb {}..{} d {}..{}",
+                 log.joint_names[j], j + 1, log.joint_count(), grid.cell_count(),
+                 config.options.grid.na_min, config.options.grid.na_max, config.options.grid.nb_min,
+                 config.options.grid.nb_max, config.options.grid.dead_time_min,
+                 config.options.grid.dead_time_max);
+    const ident::JointIdentification r =
+        ident::identify_joint(log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j],
+                              log.payload_kg, segments, log.cycle_s, grid, config.options);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    int identified = 0;
+    for (const auto& c : r.cells) identified += c.status == ident::CellStatus::kIdentified;
+    spdlog::info("joint {}: {}/{} cells identified, backlash l = {:.3g} ± {:.2g} rad, {:.2f} s",
+                 log.joint_names[j], identified, r.cells.size(), r.parameters.backlash_l_rad,
+                 r.parameters.backlash_l_sigma_rad, seconds);
+    for (const auto& c : r.cells)
+      std::cout << fmt::format(
+          "{:>4} cell {:>2} {:<40} {:<10} {:>14} sim fit {:>7.2f} %  joint error fit {:>7.2f} %\n",
+          log.joint_names[j], c.cell, c.label, ident::to_string(c.status),
+          c.sweep ? ident::to_string(c.sweep->chosen) : "-",
+          r.parameters.cells[std::size_t(c.cell)].figures.simulation_fit_percent,
+          r.parameters.cells[std::size_t(c.cell)].figures.joint_error_fit_percent);
+    joints_report.push_back(joint_report(r, seconds));
+    table.joints.push_back(r.parameters);
+  }
+  const json report = {
+      {"created_by", table.created_by},
+      {"joint_errors", args.joint_errors},
+      {"joint_errors_sha256", table.source.sha256},
+      {"config", args.config},
+      {"samples", log.sample_count()},
+      {"segments", segments.size()},
+      {"sample_time_s", log.cycle_s},
+      {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
+      {"joints", joints_report}};
+  // The table last: a reader that sees parameters.json sees a finished run.
+  imscal::write_file_atomically(report_path, report.dump(1) + "\n", overwrite);
+  ident::write_parameters_csv(csv_path, table, overwrite);
+  ident::write_parameters_json(json_path, table, overwrite);
+  spdlog::info("wrote {}, {}, {}", json_path.string(), csv_path.string(), report_path.string());
+}
+
+imscal::tools::CommandRegistration registration{
+    "identify",
+    "Identify the per-joint ARX error models (operating-point cells, backlash) from joint errors",
+    [](CLI::App& sub) {
+      auto args = std::make_shared<IdentifyArgs>();
+      sub.add_option("--joint-errors", args->joint_errors, "joint_errors.csv (imscal calibrate)")
+          ->required();
+      sub.add_option("--config", args->config,
+                     "Identification config (datasets/identification/ident-default.yaml)")
+          ->required();
+      sub.add_option("--out", args->out, "Output folder")->required();
+      sub.add_flag("--force", args->force, "Overwrite existing outputs");
+      sub.callback([args] { run(*args); });
+    }};
+}  // namespace
