@@ -13,6 +13,8 @@
 #include "calib/robot_log.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "ident/joint_error_io.hpp"
+#include "ident/parameter_table_io.hpp"
 #include "ims/imu_binary.hpp"
 #include "ims/imu_csv.hpp"
 #include "ims/nav_trajectory_io.hpp"
@@ -50,6 +52,10 @@ inline void read_with(std::string_view target, const std::filesystem::path& file
       calib::read_robot_log_csv(file);
     } else if (target == "nav_trajectory") {
       ims::read_trajectory_csv(file);
+    } else if (target == "joint_errors") {
+      ident::read_joint_errors_csv(file);
+    } else if (target == "parameter_table") {
+      ident::read_parameters_json(file);
     } else if (target == "yaml_configs") {
       std::ifstream in(file, std::ios::binary);
       parse_yaml_configs(std::string(std::istreambuf_iterator<char>(in), {}));

@@ -348,7 +348,7 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
   json root;
   try {
     root = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax errors, and numbers beyond double (1e648)
     throw InputError(origin, 0, "/", fmt::format("not valid JSON: {}", e.what()));
   }
   const Node r(root, "", origin);

@@ -19,5 +19,5 @@ bash scripts/build.sh build-asan -DIMSCAL_WERROR=ON -DIMSCAL_SANITIZE=ON \
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   IMSCAL_SANITIZED=1 ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1800
 
-echo "== Fuzzing (libFuzzer, ASan + UBSan), ${FUZZ_SECONDS:-40} s per reader =="
-FUZZ_SECONDS=${FUZZ_SECONDS:-40} bash scripts/fuzz.sh
+echo "== Fuzzing (libFuzzer, ASan + UBSan), ${FUZZ_SECONDS:-30} s per reader =="
+FUZZ_SECONDS=${FUZZ_SECONDS:-30} bash scripts/fuzz.sh
