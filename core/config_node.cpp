@@ -67,10 +67,20 @@ ConfigNode ConfigNode::child(std::string_view key) const {
   return *c;
 }
 
+// A map key as text; keys that are not plain scalars (YAML allows `? [a, b]: 1`) are refused.
+std::string ConfigNode::key_text(const YAML::Node& key) const {
+  if (!key.IsScalar()) {
+    const auto mark = key.Mark();
+    throw InputError(file_, mark.line >= 0 ? static_cast<std::size_t>(mark.line + 1) : 0, path_,
+                     "a key must be a plain name, not a list or map");
+  }
+  return key.Scalar();
+}
+
 void ConfigNode::require_only_keys(std::initializer_list<std::string_view> allowed) const {
   if (!node_.IsMap()) fail("expected a map of keys");
   for (const auto& kv : node_) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = key_text(kv.first);
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
       std::string list;
       for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
@@ -139,7 +149,7 @@ Eigen::Vector3d ConfigNode::as_vector3() const {
 std::vector<std::string> ConfigNode::keys() const {
   if (!node_.IsMap()) fail("expected a map of keys");
   std::vector<std::string> out;
-  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  for (const auto& kv : node_) out.push_back(key_text(kv.first));
   return out;
 }
 

@@ -52,6 +52,7 @@ class ConfigNode {
 
  private:
   ConfigNode(YAML::Node node, std::string file, std::string path);
+  std::string key_text(const YAML::Node& key) const;
   YAML::Node node_;
   std::string file_;
   std::string path_;
