@@ -27,6 +27,17 @@ Eigen::Matrix3d right_jacobian(const Eigen::Vector3d& phi) {
          (angle - std::sin(angle)) / (angle_sq * angle) * k * k;
 }
 
+// d(-E v)/d vec(E): column 3 c + r holds -v_c e_r.
+ImuPreintegration::Matrix39 sensitivity_derivative(const Eigen::Vector3d& v) {
+  ImuPreintegration::Matrix39 d = ImuPreintegration::Matrix39::Zero();
+  for (int c = 0; c < 3; ++c) d.block<3, 3>(0, 3 * c) = -v[c] * Eigen::Matrix3d::Identity();
+  return d;
+}
+
+Eigen::Matrix<double, 9, 1> vec(const Eigen::Matrix3d& e) {
+  return Eigen::Map<const Eigen::Matrix<double, 9, 1>>(e.data());
+}
+
 }  // namespace
 
 ImuPreintegration::ImuPreintegration(const ims::ImuSeries& imu, double t_begin_s, double t_end_s,
@@ -39,6 +50,8 @@ ImuPreintegration::ImuPreintegration(const ims::ImuSeries& imu, double t_begin_s
   for (auto& m : moments_) m.setZero();
   for (auto& j : moment_gyro_jacobian_) j.setZero();
   for (auto& j : moment_acc_jacobian_) j.setZero();
+  for (auto& j : moment_gyro_sensitivity_) j.setZero();
+  for (auto& j : moment_acc_sensitivity_) j.setZero();
   Eigen::Vector3d previous_rotation_vector = Eigen::Vector3d::Zero();
   Eigen::Vector3d previous_dv = Eigen::Vector3d::Zero();
   bool first = true;
@@ -78,17 +91,28 @@ ImuPreintegration::ImuPreintegration(const ims::ImuSeries& imu, double t_begin_s
     }
     const Eigen::Vector3d rotated_dv = rotation_mid * (dv + within);
     const Eigen::Matrix3d dv_gyro = -rotation_mid * ims::skew(dv) * jacobian_mid;
+    // Sensitivity errors: the interval's increments move by -E_g dtheta, -E_a dv.
+    const Matrix39 dtheta_sensitivity = sensitivity_derivative(dtheta);
+    const Matrix39 sensitivity_mid =
+        half_step.transpose() * rotation_gyro_sensitivity_ +
+        right_jacobian(0.5 * rotation_vector) * (0.5 * dtheta_sensitivity);
+    const Matrix39 dv_gyro_sensitivity = -rotation_mid * ims::skew(dv) * sensitivity_mid;
+    const Matrix39 dv_acc_sensitivity = rotation_mid * sensitivity_derivative(dv);
     double weight = 1.0;  // tau_mid^m
     for (int m = 0; m < kMomentCount; ++m) {
       moments_[m] += weight * rotated_dv;
       moment_gyro_jacobian_[m] += weight * dv_gyro;
       moment_acc_jacobian_[m] += -weight * h * rotation_mid;
+      moment_gyro_sensitivity_[m] += weight * dv_gyro_sensitivity;
+      moment_acc_sensitivity_[m] += weight * dv_acc_sensitivity;
       weight *= tau_mid;
     }
     // Advance the rotation and its gyro-bias Jacobian over the whole interval.
     const Eigen::Matrix3d step = exp_rotation(rotation_vector);
-    rotation_gyro_jacobian_ =
-        step.transpose() * rotation_gyro_jacobian_ - right_jacobian(rotation_vector) * h;
+    const Eigen::Matrix3d step_jacobian = right_jacobian(rotation_vector);
+    rotation_gyro_jacobian_ = step.transpose() * rotation_gyro_jacobian_ - step_jacobian * h;
+    rotation_gyro_sensitivity_ =
+        step.transpose() * rotation_gyro_sensitivity_ + step_jacobian * dtheta_sensitivity;
     delta_rotation_ = delta_rotation_ * step;
     previous_rotation_vector = dtheta;
     previous_dv = dv;
@@ -110,6 +134,19 @@ Eigen::Matrix3d ImuPreintegration::delta_rotation(const ImuBiases& b) const {
 Eigen::Vector3d ImuPreintegration::moment(int m, const ImuBiases& b) const {
   return moments_[m] + moment_gyro_jacobian_[m] * (b.gyro_rad_s - linearisation_.gyro_rad_s) +
          moment_acc_jacobian_[m] * (b.acc_m_s2 - linearisation_.acc_m_s2);
+}
+
+Eigen::Matrix3d ImuPreintegration::delta_rotation(const ImuBiases& b,
+                                                  const ImuSensitivityErrors& e) const {
+  return delta_rotation_ *
+         exp_rotation(rotation_gyro_jacobian_ * (b.gyro_rad_s - linearisation_.gyro_rad_s) +
+                      rotation_gyro_sensitivity_ * vec(e.gyro));
+}
+
+Eigen::Vector3d ImuPreintegration::moment(int m, const ImuBiases& b,
+                                          const ImuSensitivityErrors& e) const {
+  return moment(m, b) + moment_gyro_sensitivity_[m] * vec(e.gyro) +
+         moment_acc_sensitivity_[m] * vec(e.acc);
 }
 
 ims::NavState ImuPreintegration::predict(const ims::NavState& start, const ims::EarthModel& earth,

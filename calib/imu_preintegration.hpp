@@ -24,6 +24,17 @@
 // increments); tau^m taken at the middle. Second order in h: on a 10 s robot-like motion at
 // 1 kHz the end state errs by ~1e-13 rad, 3e-7 m/s and 4e-6 m (tests). The bias Jacobians leave
 // out the small within-interval terms (relative effect ~ |dtheta| ~ 1e-3).
+//
+// Sensitivity errors (scale factors and misalignments, the model of ims/sensor_error_model.hpp:
+// raw = (I + E) true + b dt, E = diag(scale) + misalignment, |E| ~ 1e-4): corrected increments
+// are (I + E)^-1 (raw - b dt) = (I - E)(raw - b dt) + O(E^2) (E^2 ~ 1e-8 relative: 1e-8 of a
+// 180 deg turn is 3e-8 rad, below the gyro noise). The rotation and moments are linearised in
+// the 9 entries of E_g and E_a at E = 0 (the raw increments are integrated as if exact): each
+// interval's increment moves by -E dtheta_k, a bias-like perturbation with a per-interval
+// direction, propagated by the same recursions as the bias Jacobians. The Jacobians are 3x9 in
+// vec(E), column-major (entry (r, c) of E at index 3 c + r, as Eigen::Map<Matrix3d> reads it).
+// Which of the 18 entries the data can separate from the frames is the bundle's business
+// (calib/frame_calibration.hpp: the gyro triad defines S, its antisymmetric part is R_S_H's).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
@@ -37,6 +48,12 @@ namespace imscal::calib {
 struct ImuBiases {
   Eigen::Vector3d gyro_rad_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d acc_m_s2 = Eigen::Vector3d::Zero();
+};
+
+// Sensitivity errors E of both triads (raw = (I + E) true + bias dt) [1, rad].
+struct ImuSensitivityErrors {
+  Eigen::Matrix3d gyro = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d acc = Eigen::Matrix3d::Zero();
 };
 
 class ImuPreintegration {
@@ -63,6 +80,20 @@ class ImuPreintegration {
   const Eigen::Matrix3d& moment_gyro_jacobian(int m) const { return moment_gyro_jacobian_[m]; }
   const Eigen::Matrix3d& moment_acc_jacobian(int m) const { return moment_acc_jacobian_[m]; }
 
+  // Jacobians in vec(E) at E = 0 (see above): DR(b, E) = DR(b) exp(J_rot_Eg vec(E_g)),
+  // M_m(b, E) = M_m(b) + J_m_Eg vec(E_g) + J_m_Ea vec(E_a).
+  using Matrix39 = Eigen::Matrix<double, 3, 9>;
+  const Matrix39& rotation_gyro_sensitivity_jacobian() const { return rotation_gyro_sensitivity_; }
+  const Matrix39& moment_gyro_sensitivity_jacobian(int m) const {
+    return moment_gyro_sensitivity_[m];
+  }
+  const Matrix39& moment_acc_sensitivity_jacobian(int m) const {
+    return moment_acc_sensitivity_[m];
+  }
+  // The rotation and moments with biases b and sensitivity errors e (first order in both).
+  Eigen::Matrix3d delta_rotation(const ImuBiases& b, const ImuSensitivityErrors& e) const;
+  Eigen::Vector3d moment(int m, const ImuBiases& b, const ImuSensitivityErrors& e) const;
+
   // The state at t_end_s from `start` (at t_begin_s) with biases b.
   ims::NavState predict(const ims::NavState& start, const ims::EarthModel& earth,
                         const ImuBiases& b) const;
@@ -76,6 +107,9 @@ class ImuPreintegration {
   Eigen::Matrix3d rotation_gyro_jacobian_ = Eigen::Matrix3d::Zero();
   std::array<Eigen::Matrix3d, kMomentCount> moment_gyro_jacobian_{};
   std::array<Eigen::Matrix3d, kMomentCount> moment_acc_jacobian_{};
+  Matrix39 rotation_gyro_sensitivity_ = Matrix39::Zero();
+  std::array<Matrix39, kMomentCount> moment_gyro_sensitivity_{};
+  std::array<Matrix39, kMomentCount> moment_acc_sensitivity_{};
 };
 
 }  // namespace imscal::calib

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <functional>
 #include <random>
+#include <string>
 
 #include "calib/forward_kinematics.hpp"
 #include "calib/robot_description.hpp"
@@ -210,33 +211,32 @@ TEST(TimeOffset, RecoversNegativeOffsetFromIncrements) {
   EXPECT_NEAR(result.offset_s, true_offset_s, 0.2e-3);  // the brief's 0.2 ms
 }
 
-TEST(TimeOffset, ShortOverlapIsRefused) {
-  const JointMotion m = random_motion(7);
-  const Records r = simulate(m, 0.02, 4.0, imscal::ims::ImuQuantity::kRates, 0.0, 0.0, 2);
+// Simulates `motion` for `duration_s` and expects estimate_time_offset to refuse it with an
+// InputError on `field` whose message contains `text`.
+void expect_refused(const JointMotion& motion, double duration_s, double gyro_noise,
+                    double robot_noise, const std::string& field, const std::string& text) {
+  const Records r = simulate(motion, 0.02, duration_s, imscal::ims::ImuQuantity::kRates, gyro_noise,
+                             robot_noise, 2);
   const auto robot = imscal::calib::flange_rate_magnitude(kr16(), r.robot_t_s, r.robot_q);
   const auto ims = imscal::calib::ims_rate_magnitude(r.imu, r.earth_rate_S);
   try {
-    imscal::calib::estimate_time_offset(robot, ims);  // 4 s - 2 x 0.5 s = 3 s < 5 s
-    FAIL();
+    imscal::calib::estimate_time_offset(robot, ims);
+    FAIL() << "expected a refusal on " << field;
   } catch (const imscal::InputError& e) {
-    EXPECT_EQ(e.field(), "overlap");
-    EXPECT_THAT(e.what(), testing::HasSubstr("at least 5.000 s"));
+    EXPECT_EQ(e.field(), field);
+    EXPECT_THAT(e.what(), testing::HasSubstr(text));
   }
+}
+
+TEST(TimeOffset, ShortOverlapIsRefused) {
+  // 4 s - 2 x 0.5 s search range = 3 s of overlap < 5 s.
+  expect_refused(random_motion(7), 4.0, 0.0, 0.0, "overlap", "at least 5.000 s");
 }
 
 TEST(TimeOffset, RobotAtRestIsRefused) {
   JointMotion still;  // no terms: the robot stands still
   still.q0 << 0.3, -1.2, 1.9, 0.4, 0.8, -0.5;
-  const Records r = simulate(still, 0.02, 20.0, imscal::ims::ImuQuantity::kRates, 1e-5, 2e-3, 2);
-  const auto robot = imscal::calib::flange_rate_magnitude(kr16(), r.robot_t_s, r.robot_q);
-  const auto ims = imscal::calib::ims_rate_magnitude(r.imu, r.earth_rate_S);
-  try {
-    imscal::calib::estimate_time_offset(robot, ims);
-    FAIL();
-  } catch (const imscal::InputError& e) {
-    EXPECT_EQ(e.field(), "motion");
-    EXPECT_THAT(e.what(), testing::HasSubstr("too poor"));
-  }
+  expect_refused(still, 20.0, 1e-5, 2e-3, "motion", "too poor");
 }
 
 TEST(TimeOffset, PeriodicMotionIsRefusedAsAmbiguous) {
@@ -244,16 +244,7 @@ TEST(TimeOffset, PeriodicMotionIsRefusedAsAmbiguous) {
   JointMotion periodic;
   periodic.q0 << 0.3, -1.2, 1.9, 0.4, 0.8, -0.5;
   periodic.terms[5].push_back({0.5, 2.0 * M_PI * 1.5, 0.0});
-  const Records r = simulate(periodic, 0.02, 20.0, imscal::ims::ImuQuantity::kRates, 1e-5, 2e-3, 2);
-  const auto robot = imscal::calib::flange_rate_magnitude(kr16(), r.robot_t_s, r.robot_q);
-  const auto ims = imscal::calib::ims_rate_magnitude(r.imu, r.earth_rate_S);
-  try {
-    imscal::calib::estimate_time_offset(robot, ims);
-    FAIL();
-  } catch (const imscal::InputError& e) {
-    EXPECT_EQ(e.field(), "offset");
-    EXPECT_THAT(e.what(), testing::HasSubstr("ambiguous"));
-  }
+  expect_refused(periodic, 20.0, 1e-5, 2e-3, "offset", "ambiguous");
 }
 
 TEST(TimeOffset, MalformedSeriesAreRefused) {

@@ -1,0 +1,100 @@
+#pragma once
+// Joint-space errors from the IMS (the paper's Fig. 2): with the calibrated frames,
+//   W_T_S(t)   the sensor's trajectory by zero-velocity-aided smoothing (ims/zupt_smoother.hpp),
+//              started at the first rest pose with R_W_S0 = R_W_R R_R_H(q_0) R_H_S and
+//              p_W_S0 = T_W_R T_R_H(q_0) p_H_S (whatever the origin of W in T_R_W is: with the
+//              convention of calib/frame_calibration.hpp it is 0), biases from the frames;
+//   T_R_H(t)   = T_R_W W_T_S(t + dt) T_S_H at every robot sample (t robot clock, t + dt IMS clock;
+//              the smoothed poses interpolated between IMS samples: linear position, slerp);
+//   q_measured inverse kinematics (calib/inverse_kinematics.hpp) in the configuration of the
+//              robot's own reading at that sample, the 2*pi branch nearest to it;
+//   dq         = q_desired - q_measured per joint (the robot's internal reading beside it).
+//
+// The result holds the columns of joint_errors.csv (ident/joint_error_io.hpp, datasets/FORMAT.md
+// section 10: t_s, payload_kg, q_desired, q_measured, q_internal); calib may not use ident, so
+// the tools layer copies it into an ident::JointErrorLog and writes it there. Robot samples
+// outside the smoothed IMS record or whose inverse kinematics fails are left out (counted): the
+// identification treats the time gap as a split between runs.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "calib/frame_calibration.hpp"
+#include "calib/imu_preintegration.hpp"
+#include "calib/robot_description.hpp"
+#include "calib/robot_log.hpp"
+#include "ims/imu_data.hpp"
+#include "ims/zupt_options.hpp"
+#include "ims/zupt_smoother.hpp"
+
+namespace imscal::calib {
+
+// What the joint-space step needs of the calibration's result.
+struct CalibratedFrames {
+  Eigen::Isometry3d T_R_W = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_S_H = Eigen::Isometry3d::Identity();
+  ImuBiases biases;            // constant part, initial value of the smoother's bias states
+  double time_offset_s = 0.0;  // t_ims = t_robot + time_offset_s
+};
+
+struct JointSpaceInput {
+  // Increments, already corrected for the unit's scale factors and misalignments (biases stay:
+  // the frames' biases seed the smoother); IMS clock.
+  const ims::ImuSeries* imu = nullptr;
+  const RobotLog* log = nullptr;  // robot clock
+  ims::Site site;
+  KinematicModel kinematics;
+  CalibratedFrames frames;
+  // The first rest pose: the smoothing starts at its begin (the IMS record is cut there) from
+  // the attitude and position of the forward kinematics of its link-side angles (for a
+  // calibrated run: RestObservation::q_link_rad + FrameCalibrationResult::joint_deviation_rad).
+  RestObservation first_rest;
+  ims::ZuptOptions zupt;  // sensor part from ims::zupt_options_from_spec
+  std::string source;     // for messages
+};
+
+struct JointSpaceOptions {
+  // 1-sigma of the initial state handed to the smoother: attitude [rad] (the first rest's
+  // joint-angle uncertainty through the kinematics, plus the frames'), velocity [m/s] (at rest),
+  // position [m] (defines W_T_S's origin: small).
+  double initial_attitude_sigma_rad = 2e-5;
+  double initial_velocity_sigma_m_s = 1e-5;
+  double initial_position_sigma_m = 1e-6;
+};
+
+// One row per kept robot sample (the joint_errors.csv columns) [robot clock, SI].
+struct JointSpaceErrors {
+  std::string robot;
+  double cycle_s = 0.002;
+  std::vector<double> t_s;
+  std::vector<double> payload_kg;
+  std::vector<JointVector> q_desired_rad;
+  std::vector<JointVector> q_measured_rad;  // from the IMS chain
+  std::vector<JointVector> q_internal_rad;
+  std::size_t outside_record = 0;  // robot samples without IMS data (before/after the record)
+  std::size_t ik_failures = 0;     // robot samples whose inverse kinematics failed
+  std::string first_ik_failure;    // reason of the first failure, in words
+  ims::ZuptSummary smoother;       // rests, innovation statistics
+  // The smoothed trajectory (IMS clock), for reports and checks.
+  std::vector<ims::SmoothedState> trajectory;
+};
+
+// Throws InputError when the inputs cannot be used (null pointers, no increments, the first rest
+// outside the record, inverse kinematics impossible for the first rest).
+JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
+                                    const JointSpaceOptions& options = {});
+
+// Steps 2-3 alone: the flange poses and inverse kinematics at the robot samples from a given
+// sensor trajectory W_T_S (IMS clock, sorted by time), e.g. the smoother's or a reference's.
+// Fills everything but `smoother` and `trajectory`.
+JointSpaceErrors joint_errors_along(const std::vector<ims::SmoothedState>& trajectory,
+                                    const RobotLog& log, const KinematicModel& kinematics,
+                                    const CalibratedFrames& frames);
+
+// The sensor pose W_T_S at IMS time t from the smoothed states (sorted by time): linear in
+// position, slerp in attitude between the two samples around t; false outside their span.
+bool interpolate_sensor_pose(const std::vector<ims::SmoothedState>& states, double t_ims_s,
+                             Eigen::Isometry3d& T_W_S);
+
+}  // namespace imscal::calib

@@ -1,0 +1,162 @@
+#include "calib/rest_poses.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/input_error.hpp"
+#include "ims/earth_model.hpp"
+#include "ims/zupt_options.hpp"
+
+namespace imscal::calib {
+namespace {
+
+// The rest detector's options from the data sheet, as the zero-velocity smoother fills them.
+ims::RestDetectorOptions detector_options(const ims::SensorSpec& spec) {
+  const ims::ZuptOptions zupt = ims::zupt_options_from_spec(spec);
+  ims::RestDetectorOptions r = zupt.rest;
+  r.gyro_noise_density_rad_per_sqrt_s = zupt.gyro_noise_density_rad_per_sqrt_s;
+  r.gyro_quantization_lsb_rad = zupt.gyro_quantization_lsb_rad;
+  r.acc_noise_density_m_s_per_sqrt_s = zupt.acc_noise_density_m_s_per_sqrt_s;
+  r.acc_quantization_lsb_m_s = zupt.acc_quantization_lsb_m_s;
+  // A bias of 3 sigma still passes the magnitude tests.
+  r.gyro_bias_bound_rad_s = 3.0 * zupt.initial_gyro_bias_sigma_rad_s;
+  r.acc_bias_bound_m_s2 = 3.0 * zupt.initial_acc_bias_sigma_m_s2;
+  return r;
+}
+
+std::string seconds(double t) {
+  return fmt::format("{:.3f} s", t);
+}
+
+}  // namespace
+
+RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions& options) {
+  const std::string source = input.source.empty() ? "rest poses" : input.source;
+  if (input.imu == nullptr || input.log == nullptr || input.robot == nullptr) {
+    throw InputError(source, 0, "", "the IMS record, the robot log and the robot are required");
+  }
+  const std::vector<RobotLogSample>& samples = input.log->samples;
+  if (samples.size() < 2) throw InputError(source, 0, "robot log", "fewer than 2 samples");
+
+  RestPoseResult result;
+  const ims::EarthModel earth(input.site);
+  result.detection = ims::detect_rest(*input.imu, earth, detector_options(input.sensor));
+
+  for (const ims::RestInterval& interval : result.detection.intervals) {
+    const double begin = interval.begin_s + options.edge_trim_s;
+    const double end = interval.end_s - options.edge_trim_s;
+    const std::string where = fmt::format("rest at {} .. {} (IMS clock)", seconds(interval.begin_s),
+                                          seconds(interval.end_s));
+    if (interval.duration_s() < options.min_duration_s || end <= begin) {
+      result.rejected.push_back(
+          fmt::format("{}: shorter than {} s", where, options.min_duration_s));
+      continue;
+    }
+    // The same interval on the robot clock.
+    const double robot_begin = begin - input.time_offset_s;
+    const double robot_end = end - input.time_offset_s;
+    if (robot_begin < samples.front().t_s || robot_end > samples.back().t_s) {
+      result.rejected.push_back(fmt::format("{}: the robot log ({} .. {}) does not cover it", where,
+                                            seconds(samples.front().t_s),
+                                            seconds(samples.back().t_s)));
+      continue;
+    }
+    const auto first =
+        std::lower_bound(samples.begin(), samples.end(), robot_begin,
+                         [](const RobotLogSample& s, double t) { return s.t_s < t; });
+    const auto last = std::upper_bound(samples.begin(), samples.end(), robot_end,
+                                       [](double t, const RobotLogSample& s) { return t < s.t_s; });
+    if (last - first < 2) {
+      result.rejected.push_back(fmt::format("{}: fewer than 2 robot samples", where));
+      continue;
+    }
+    RestPoseDetail detail;
+    JointVector low = first->q_internal_rad, high = first->q_internal_rad;
+    JointVector sum = JointVector::Zero();
+    double payload_low = first->payload_kg, payload_high = first->payload_kg;
+    for (auto it = first; it != last; ++it) {
+      low = low.cwiseMin(it->q_internal_rad);
+      high = high.cwiseMax(it->q_internal_rad);
+      sum += it->q_internal_rad;
+      payload_low = std::min(payload_low, it->payload_kg);
+      payload_high = std::max(payload_high, it->payload_kg);
+    }
+    detail.robot_samples = static_cast<std::size_t>(last - first);
+    detail.q_internal_mean_rad = sum / static_cast<double>(detail.robot_samples);
+    detail.q_internal_spread_rad = high - low;
+    int moving = -1;
+    detail.q_internal_spread_rad.maxCoeff(&moving);
+    if (detail.q_internal_spread_rad(moving) > options.max_joint_spread_rad) {
+      result.rejected.push_back(fmt::format(
+          "{}: the robot is not still there: joint {} moves by {:.3g} rad (> {:.3g} rad)", where,
+          input.robot->joints[moving].name, detail.q_internal_spread_rad(moving),
+          options.max_joint_spread_rad));
+      continue;
+    }
+    if (payload_high != payload_low) {
+      result.rejected.push_back(fmt::format("{}: the payload changes during it", where));
+      continue;
+    }
+    detail.payload_kg = payload_low;
+    RigidBodyParameters payload = input.payload;
+    payload.mass_kg = detail.payload_kg;
+    detail.deflection =
+        correct_static_deflection(*input.robot, payload.mass_kg > 0.0 ? &payload : nullptr,
+                                  detail.q_internal_mean_rad, options.deflection);
+
+    RestObservation rest;
+    rest.label = fmt::format("rest {} at {:.1f} s", result.rests.size() + 1, begin);
+    rest.begin_ims_s = begin;
+    rest.end_ims_s = end;
+    rest.q_link_rad = detail.deflection.q_link_rad;
+    rest.q_link_sigma_rad = detail.deflection.q_link_sigma_rad;
+    result.rests.push_back(rest);
+    result.details.push_back(detail);
+  }
+  return result;
+}
+
+RobotJointSeries robot_joint_series(const RobotLog& log) {
+  RobotJointSeries series;
+  series.t_robot_s.reserve(log.samples.size());
+  series.q_rad.reserve(log.samples.size());
+  for (const RobotLogSample& s : log.samples) {
+    series.t_robot_s.push_back(s.t_s);
+    series.q_rad.push_back(s.q_internal_rad);
+  }
+  return series;
+}
+
+TimeOffsetResult estimate_initial_time_offset(const ims::ImuSeries& imu, const RobotLog& log,
+                                              const KinematicModel& kinematics,
+                                              const ims::RestInterval& initial_rest,
+                                              const TimeOffsetOptions& options) {
+  if (initial_rest.last_sample >= imu.samples.size() ||
+      initial_rest.last_sample <= initial_rest.first_sample) {
+    throw InputError(imu.source, 0, "", "the initial rest lies outside the IMS record");
+  }
+  // Mean gyro rate over the rest: the Earth rate in S plus the gyro bias [rad/s].
+  Eigen::Vector3d earth_rate_S = Eigen::Vector3d::Zero();
+  if (imu.quantity == ims::ImuQuantity::kIncrements) {
+    Eigen::Vector3d angle = Eigen::Vector3d::Zero();
+    for (std::size_t i = initial_rest.first_sample + 1; i <= initial_rest.last_sample; ++i) {
+      angle += imu.samples[i].gyro;
+    }
+    earth_rate_S = angle / (imu.samples[initial_rest.last_sample].t_s -
+                            imu.samples[initial_rest.first_sample].t_s);
+  } else {
+    for (std::size_t i = initial_rest.first_sample; i <= initial_rest.last_sample; ++i) {
+      earth_rate_S += imu.samples[i].gyro;
+    }
+    earth_rate_S /= static_cast<double>(initial_rest.last_sample - initial_rest.first_sample + 1);
+  }
+  const RobotJointSeries joints = robot_joint_series(log);
+  const RateMagnitudeSeries robot_rate =
+      flange_rate_magnitude(kinematics, joints.t_robot_s, joints.q_rad, "robot log");
+  const RateMagnitudeSeries ims_rate = ims_rate_magnitude(imu, earth_rate_S);
+  return estimate_time_offset(robot_rate, ims_rate, options);
+}
+
+}  // namespace imscal::calib

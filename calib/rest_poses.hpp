@@ -1,0 +1,84 @@
+#pragma once
+// From the raw records to the rest poses of the frame calibration (calib/frame_calibration.hpp):
+//
+// 1. Rest intervals on the IMS clock from the IMS alone (ims::detect_rest with the sensor's
+//    noise model, ims::zupt_options_from_spec); those shorter than min_duration_s are dropped,
+//    the others trimmed by edge_trim_s at both ends (the slow ends of smooth motions).
+// 2. The robot must be still over the same interval on its own clock (t_robot = t_ims - dt):
+//    every joint's internal reading may spread (max - min) by at most max_joint_spread_rad, and
+//    the log must cover the interval; otherwise the rest is rejected with the reason.
+// 3. The internal readings are averaged and corrected for the static deflection
+//    (calib/static_deflection.hpp) with the payload the robot carries then: its mass from the
+//    log's payload_kg, its centre of mass from the given payload body (in the tool frame T).
+//
+// Also: the log as a RobotJointSeries (calib/frame_calibration.hpp) and the initial time offset
+// by cross-correlation of the angular-rate magnitudes (calib/time_offset.hpp).
+#include <string>
+#include <vector>
+
+#include "calib/frame_calibration.hpp"
+#include "calib/robot_description.hpp"
+#include "calib/robot_log.hpp"
+#include "calib/static_deflection.hpp"
+#include "calib/time_offset.hpp"
+#include "ims/imu_data.hpp"
+#include "ims/rest_detector.hpp"
+#include "ims/sensor_spec.hpp"
+
+namespace imscal::calib {
+
+struct RestPoseOptions {
+  double min_duration_s = 2.0;  // detected rests shorter than this are not used
+  double edge_trim_s = 0.5;     // taken off both ends of every rest
+  // Largest spread (max - min) of a joint's internal reading over a rest [rad]: a still robot's
+  // encoders move by a few counts at most (1e-5 rad = 2 arcsec).
+  double max_joint_spread_rad = 1e-5;
+  StaticDeflectionOptions deflection;
+};
+
+struct RestPoseInput {
+  const ims::ImuSeries* imu = nullptr;  // IMS clock
+  const RobotLog* log = nullptr;        // robot clock
+  const RobotDescription* robot = nullptr;
+  ims::SensorSpec sensor;  // noise model of the rest detection
+  ims::Site site;          // where the record was taken (Earth rate, gravity of the detector)
+  // The payload's centre of mass (and shape) in the tool frame T; its mass is taken from the
+  // log. Ignored while the log says 0 kg.
+  RigidBodyParameters payload;
+  double time_offset_s = 0.0;  // t_ims = t_robot + time_offset_s (initial value is fine)
+  std::string source;          // for messages
+};
+
+// What was found at one accepted rest, beside its RestObservation.
+struct RestPoseDetail {
+  JointVector q_internal_mean_rad = JointVector::Zero();
+  JointVector q_internal_spread_rad = JointVector::Zero();  // max - min over the rest
+  double payload_kg = 0.0;
+  std::size_t robot_samples = 0;
+  StaticDeflection deflection;
+};
+
+struct RestPoseResult {
+  std::vector<RestObservation> rests;   // accepted, in time order
+  std::vector<RestPoseDetail> details;  // parallel to rests
+  std::vector<std::string> rejected;    // rests not used, each with the reason in words
+  ims::RestDetection detection;         // the IMS-only detection (all intervals)
+};
+
+// Throws InputError for missing inputs (null pointers, an empty log) and when the detector
+// does (no increments, too short a record).
+RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions& options = {});
+
+// The log's internal joint readings as the frame calibration's joint series (robot clock).
+RobotJointSeries robot_joint_series(const RobotLog& log);
+
+// The initial time offset t_ims = t_robot + dt by cross-correlating the flange's angular-rate
+// magnitude from the joint readings with that from the gyros; the Earth rate (plus gyro bias)
+// in S is taken as the mean gyro rate over the first `initial_rest` (the record must start at
+// rest; e.g. RestPoseResult::detection.intervals.front()).
+TimeOffsetResult estimate_initial_time_offset(const ims::ImuSeries& imu, const RobotLog& log,
+                                              const KinematicModel& kinematics,
+                                              const ims::RestInterval& initial_rest,
+                                              const TimeOffsetOptions& options = {});
+
+}  // namespace imscal::calib

@@ -1,0 +1,244 @@
+#include "calib/rotation_calibration.hpp"
+
+#include <ceres/ceres.h>
+#include <fmt/format.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/input_error.hpp"
+#include "ims/so3.hpp"
+
+namespace imscal::calib {
+namespace {
+
+// The gyro-integrated rotation over samples [first, last] of the sensor clock, corrected by
+// bias and scale, in S: product of exp(omega_mid * dt) over the sample intervals (trapezoidal
+// rate per interval; the rates are ~100 Hz samples of a motion well below 10 Hz).
+template <typename Bias, typename Scale>
+Eigen::Quaterniond integrate_gyro(const ToolImuRecord& record, std::size_t first, std::size_t last,
+                                  const Bias& bias, const Scale& scale) {
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  for (std::size_t k = first; k < last; ++k) {
+    const Eigen::Vector3d mean_reading = 0.5 * (record.gyro_rad_s[k] + record.gyro_rad_s[k + 1]);
+    const Eigen::Vector3d omega_S = (mean_reading - bias).cwiseQuotient(scale);
+    q = q * ims::quat_exp<double>(omega_S * (record.t_s[k + 1] - record.t_s[k]));
+  }
+  return q;
+}
+
+struct WindowCost {
+  const ToolImuRecord* record;
+  std::size_t first;
+  std::size_t last;
+
+  bool operator()(const double* q_coeffs, const double* bias_p, const double* scale_p,
+                  const double* offset_p, double* residual) const {
+    const Eigen::Quaterniond q_T_S =
+        Eigen::Quaterniond(q_coeffs[3], q_coeffs[0], q_coeffs[1], q_coeffs[2]).normalized();
+    const Eigen::Map<const Eigen::Vector3d> bias(bias_p);
+    const Eigen::Map<const Eigen::Vector3d> scale(scale_p);
+    const Eigen::Quaterniond dq_S = integrate_gyro(*record, first, last, bias, scale);
+    Eigen::Quaterniond q_a, q_b;
+    if (!robot_orientation_at(*record, record->t_s[first] - offset_p[0], q_a) ||
+        !robot_orientation_at(*record, record->t_s[last] - offset_p[0], q_b)) {
+      return false;
+    }
+    const Eigen::Quaterniond dq_T_robot = q_a.conjugate() * q_b;
+    const Eigen::Quaterniond dq_T_gyro = q_T_S * dq_S * q_T_S.conjugate();
+    const Eigen::Vector3d r = ims::quat_log(Eigen::Quaterniond(dq_T_robot.conjugate() * dq_T_gyro));
+    residual[0] = r.x();
+    residual[1] = r.y();
+    residual[2] = r.z();
+    return true;
+  }
+};
+
+}  // namespace
+
+bool gyro_bias_at_rest(const ToolImuRecord& record, double time_offset_s, double rest_rate_rad_s,
+                       Eigen::Vector3d& bias_rad_s, double max_time_s) {
+  const RobotRateSeries robot = robot_tool_rate(record);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < record.t_s.size() && record.t_s[k] <= max_time_s; ++k) {
+    // Still over +-0.1 s around the sample: the robot is not just passing through zero rate.
+    bool still = true;
+    for (double dt : {-0.1, 0.0, 0.1}) {
+      Eigen::Vector3d w;
+      if (!robot_rate_at(robot, record.t_s[k] - time_offset_s + dt, w) ||
+          w.norm() > rest_rate_rad_s) {
+        still = false;
+      }
+    }
+    // The first samples of a record may be zero placeholders (the files' first row is all zero).
+    if (!still || record.gyro_rad_s[k].isZero(0.0)) continue;
+    sum += record.gyro_rad_s[k];
+    ++count;
+  }
+  if (count < 10) return false;
+  bias_rad_s = sum / static_cast<double>(count);
+  return true;
+}
+
+RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolImuAnalysis& analysis,
+                                       const RotationCalibrationOptions& options) {
+  if (!record.has_raw_imu) {
+    throw InputError(record.file, 0, "gyro_x_dps", "rotation calibration needs raw gyro columns");
+  }
+  RotationCalibration result;
+  double offset = analysis.time_offset_s;
+  Eigen::Quaterniond q_T_S(analysis.R_T_S);
+  Eigen::Vector3d bias = Eigen::Vector3d::Zero();
+  gyro_bias_at_rest(record, offset, options.rest_rate_rad_s, bias);
+  Eigen::Vector3d scale = Eigen::Vector3d::Constant(analysis.gyro_scale_ratio);
+
+  // Windows of samples, skipping gaps, rails and spans without valid robot poses (with a margin
+  // of 0.15 s for the offset to move).
+  std::vector<std::pair<std::size_t, std::size_t>> windows;
+  const auto& t = record.t_s;
+  std::size_t first = 0;
+  while (first < t.size()) {
+    std::size_t last = first;
+    bool usable = true;
+    while (last + 1 < t.size() && t[last] - t[first] < options.window_s) {
+      if (t[last + 1] - t[last] > options.max_sample_step_s) usable = false;
+      ++last;
+    }
+    if (t[last] - t[first] < 0.5 * options.window_s) break;
+    for (const auto& [begin_s, end_s] : analysis.missed_motion_spans_s) {
+      if (t[last] >= begin_s && t[first] <= end_s) usable = false;  // motion the sensor lost
+    }
+    for (std::size_t k = first; k <= last && usable; ++k) {
+      if (record.gyro_rad_s[k].isZero(0.0)) usable = false;  // placeholder rows
+      for (std::size_t i = 0; i < analysis.clipped_axes.size(); ++i) {
+        const int axis = analysis.clipped_axes[i];
+        if (std::abs(record.gyro_rad_s[k][axis]) >= 0.99 * analysis.clipped_axis_rail_rad_s[i]) {
+          usable = false;
+        }
+      }
+    }
+    Eigen::Quaterniond q;
+    for (double margin : {-0.15, 0.15}) {
+      if (!robot_orientation_at(record, t[first] - offset + margin, q) ||
+          !robot_orientation_at(record, t[last] - offset + margin, q)) {
+        usable = false;
+      }
+    }
+    if (usable) {
+      windows.emplace_back(first, last);
+    } else {
+      ++result.skipped_window_count;
+    }
+    // Next window start: stride later.
+    std::size_t next = first + 1;
+    while (next < t.size() && t[next] - t[first] < options.window_stride_s) ++next;
+    first = next;
+  }
+  if (windows.size() < 10) {
+    throw InputError(record.file, 0, "t_s",
+                     fmt::format("only {} usable windows of {:.2f} s for the rotation calibration",
+                                 windows.size(), options.window_s));
+  }
+
+  double q_param[4] = {q_T_S.x(), q_T_S.y(), q_T_S.z(), q_T_S.w()};
+  double bias_param[3] = {bias.x(), bias.y(), bias.z()};
+  double scale_param[3] = {scale.x(), scale.y(), scale.z()};
+  double offset_param[1] = {offset};
+
+  ceres::Problem problem;
+  std::vector<ceres::ResidualBlockId> ids;
+  for (const auto& [a, b] : windows) {
+    auto* cost = new ceres::NumericDiffCostFunction<WindowCost, ceres::CENTRAL, 3, 4, 3, 3, 1>(
+        new WindowCost{&record, a, b});
+    ids.push_back(problem.AddResidualBlock(cost, new ceres::CauchyLoss(options.cauchy_scale_rad),
+                                           q_param, bias_param, scale_param, offset_param));
+  }
+  problem.SetManifold(q_param, new ceres::EigenQuaternionManifold);
+  if (!options.estimate_scale) problem.SetParameterBlockConstant(scale_param);
+
+  auto rms_of_windows = [&]() {
+    double sum = 0.0;
+    for (const auto& [a, b] : windows) {
+      double r[3];
+      WindowCost{&record, a, b}(q_param, bias_param, scale_param, offset_param, r);
+      sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    }
+    return std::sqrt(sum / (3.0 * windows.size()));
+  };
+  result.initial_rms_residual_rad = rms_of_windows();
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  result.summary = summary.BriefReport();
+  result.iterations = static_cast<int>(summary.iterations.size());
+
+  result.q_T_S = Eigen::Quaterniond(q_param[3], q_param[0], q_param[1], q_param[2]).normalized();
+  result.gyro_bias_rad_s = Eigen::Vector3d(bias_param);
+  result.gyro_scale = Eigen::Vector3d(scale_param);
+  result.time_offset_s = offset_param[0];
+  result.window_count = windows.size();
+
+  double sum = 0.0;
+  for (const auto& [a, b] : windows) {
+    double r[3];
+    WindowCost{&record, a, b}(q_param, bias_param, scale_param, offset_param, r);
+    const double norm_sq = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    sum += norm_sq;
+    if (std::sqrt(norm_sq) > 3.0 * options.cauchy_scale_rad) ++result.outlier_window_count;
+  }
+  result.rms_residual_rad = std::sqrt(sum / (3.0 * windows.size()));
+
+  // Covariance, scaled by the residual variance per component (the windows' residuals are not
+  // in units of their sigma).
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.null_space_rank = -1;  // pseudo-inverse when rank deficient
+  ceres::Covariance covariance(covariance_options);
+  std::vector<std::pair<const double*, const double*>> blocks = {
+      {q_param, q_param}, {bias_param, bias_param}, {offset_param, offset_param}};
+  if (options.estimate_scale) blocks.emplace_back(scale_param, scale_param);
+  if (covariance.Compute(blocks, &problem)) {
+    const std::size_t parameter_count = options.estimate_scale ? 10 : 7;
+    const double dof = std::max(1.0, 3.0 * windows.size() - parameter_count);
+    const double variance = sum / dof;
+    double c3[9];
+    covariance.GetCovarianceMatrixInTangentSpace({q_param, q_param}, c3);
+    for (int i = 0; i < 3; ++i) result.sigma_rotation_rad[i] = std::sqrt(c3[4 * i] * variance);
+    // A negative variance means a numerically rank-deficient problem: no usable sigma.
+    result.covariance_ok = result.sigma_rotation_rad.allFinite();
+    covariance.GetCovarianceBlock(bias_param, bias_param, c3);
+    for (int i = 0; i < 3; ++i) result.sigma_bias_rad_s[i] = std::sqrt(c3[4 * i] * variance);
+    if (options.estimate_scale) {
+      covariance.GetCovarianceBlock(scale_param, scale_param, c3);
+      for (int i = 0; i < 3; ++i) result.sigma_scale[i] = std::sqrt(c3[4 * i] * variance);
+    }
+    double c1 = 0.0;
+    covariance.GetCovarianceBlock(offset_param, offset_param, &c1);
+    result.sigma_time_offset_s = std::sqrt(c1 * variance);
+    result.covariance_ok = result.covariance_ok && result.sigma_bias_rad_s.allFinite() &&
+                           result.sigma_scale.allFinite() &&
+                           std::isfinite(result.sigma_time_offset_s);
+  }
+
+  // Gravity's direction in B from the still samples.
+  const RobotRateSeries robot = robot_tool_rate(record);
+  Eigen::Vector3d up_sum = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    Eigen::Vector3d w;
+    Eigen::Quaterniond q_B_T;
+    if (record.acc_m_s2[k].isZero(0.0)) continue;
+    if (!robot_rate_at(robot, t[k] - result.time_offset_s, w) || w.norm() > options.rest_rate_rad_s)
+      continue;
+    if (!robot_orientation_at(record, t[k] - result.time_offset_s, q_B_T)) continue;
+    up_sum += q_B_T * (result.q_T_S * record.acc_m_s2[k]).normalized();
+  }
+  if (up_sum.norm() > 0.0) result.up_B = up_sum.normalized();
+  return result;
+}
+
+}  // namespace imscal::calib

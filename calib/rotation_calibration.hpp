@@ -1,0 +1,74 @@
+#pragma once
+// The rotation part of a tool-IMU calibration: R_T_S (the sensor frame S in the robot's tool
+// frame T), the gyro bias, optionally the gyro scale factors, and the time offset between the
+// sensor clock and the robot pose's clock, from a tool-IMU record (calib/tool_imu_record.hpp).
+//
+// Measurement model (per gyro sample, S axes):
+//   gyro_S = diag(k) * omega_S + b,    omega_T = R_T_S * omega_S,
+// and an instant stamped t by the robot is stamped t + offset_s by the sensor.
+// Residuals: over short windows [t_a, t_b] of sensor samples, the gyro-integrated rotation
+// (corrected for b and k, mapped through R_T_S) against the robot's relative tool rotation
+// between t_a - offset and t_b - offset; the residual is the rotation vector of their difference
+// [rad]. Robust loss (Cauchy), Ceres with the quaternion manifold for R_T_S, numeric derivatives
+// (the robot pose is interpolated in time, and the offset moves the interpolation).
+// Initial values without user guesses: the offset by cross-correlation of |omega|, R_T_S by the
+// Kabsch fit of rate vectors, the scale from |gyro| / |robot rate| (all from
+// check_tool_imu_record), the bias from the samples where the robot stands still.
+// Uncertainty: ceres::Covariance scaled by the residual variance (1 sigma).
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <string>
+
+#include "calib/tool_imu_record.hpp"
+
+namespace imscal::calib {
+
+struct RotationCalibrationOptions {
+  double window_s = 0.5;          // length of a residual window [s]
+  double window_stride_s = 0.25;  // start-to-start spacing of the windows [s]
+  // Windows whose sensor time steps exceed this are skipped (a gap cannot be integrated) [s];
+  // so are windows overlapping ToolImuAnalysis::missed_motion_spans_s.
+  double max_sample_step_s = 0.1;
+  // Windows where the robot turns less than this are still used (they fix the bias); windows
+  // with any sample at a confirmed gyro rail (ToolImuAnalysis::clipped_axes) are skipped.
+  bool estimate_scale = true;  // per-axis scale factors k (else k fixed at the initial)
+  double cauchy_scale_rad = 0.5 * M_PI / 180.0;  // robust loss scale on the residual [rad]
+  // Robot angular rate below which a sample counts as "at rest" for the initial bias [rad/s].
+  double rest_rate_rad_s = 0.01;
+  int max_iterations = 100;
+};
+
+struct RotationCalibration {
+  Eigen::Quaterniond q_T_S = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();  // b, in S, as labelled units->SI
+  Eigen::Vector3d gyro_scale = Eigen::Vector3d::Ones();       // k per S axis
+  double time_offset_s = 0.0;                                 // t_sensor = t_robot + offset
+  // 1 sigma: rotation about the T axes [rad], bias [rad/s], scale [-], offset [s].
+  Eigen::Vector3d sigma_rotation_rad = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_bias_rad_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_scale = Eigen::Vector3d::Zero();
+  double sigma_time_offset_s = 0.0;
+  bool covariance_ok = false;
+  // Gravity's specific force direction in the robot base B (unit, "up" as the accelerometer
+  // sees it), averaged over rest samples: the attitude filter's aiding reference.
+  Eigen::Vector3d up_B = Eigen::Vector3d::UnitZ();
+  std::size_t window_count = 0;
+  std::size_t skipped_window_count = 0;
+  double rms_residual_rad = 0.0;  // after the fit, over all windows
+  double initial_rms_residual_rad = 0.0;
+  std::size_t outlier_window_count = 0;  // residual above 3 Cauchy scales
+  int iterations = 0;
+  std::string summary;  // Ceres' brief report
+};
+
+RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolImuAnalysis& analysis,
+                                       const RotationCalibrationOptions& options = {});
+
+// The gyro bias [rad/s, S] from the samples where the robot stands still (robot rate below
+// rest_rate_rad_s at t - time_offset_s), with a known scale: mean of gyro - k * 0. Returns false
+// when fewer than 10 such samples exist (then bias is left unchanged).
+bool gyro_bias_at_rest(const ToolImuRecord& record, double time_offset_s, double rest_rate_rad_s,
+                       Eigen::Vector3d& bias_rad_s, double max_time_s = 1e300);
+
+}  // namespace imscal::calib

@@ -1,0 +1,308 @@
+// Issue 4's campaign figure with the plant effects on: simulation -> rest poses
+// (calib/rest_poses.hpp, from the raw IMS record and the robot log, as `imscal calibrate` does)
+// -> calibrate_frames, over N seeds (50 in Release, 2 under IMSCAL_SANITIZED), each with a random
+// base heading, a random IMS mount and a newly drawn IMS unit (biases, scale factors,
+// misalignments, noise). The plant's motion does not depend on these draws (the base turns about
+// the vertical only), so it is simulated once per scenario and the IMS record re-synthesised per
+// seed from the same link-side motion.
+//
+// Reported per scenario: rests found, seeds calibrated or refused, the worst rotation/translation
+// errors of T_S_H, the worst tilt (roll/pitch) and translation of T_R_W, and the heading,
+// biases and time offset in units of their reported sigma. Goal of issue 4: 0.005 deg / 0.05 mm,
+// the rest within 3 sigma. Asserted is what the chain meets (see the comments at the asserts);
+// the figures are printed for the report.
+//
+// Two scenarios: `mounting` as shipped (every plant effect) and the same with the backlash off
+// (a scratch copy), which shows what the other effects leave.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <numbers>
+#include <random>
+#include <thread>
+
+#include "calib/calibration_config.hpp"
+#include "calib/frame_calibration.hpp"
+#include "calib/rest_poses.hpp"
+#include "core/input_error.hpp"
+#include "ims/imu_noise.hpp"
+#include "ims/imu_synthesis.hpp"
+#include "ims/so3.hpp"
+#include "ims/spline_trajectory.hpp"
+#include "sim/scenario.hpp"
+#include "sim/simulation.hpp"
+#include "sim/simulation_output.hpp"
+#include "tests/support/scratch_dir.hpp"
+
+namespace imscal::calib {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+bool sanitized() {
+  return std::getenv("IMSCAL_SANITIZED") != nullptr;
+}
+
+struct SeedOutcome {
+  std::uint64_t seed = 0;
+  std::size_t rests = 0;
+  bool calibrated = false;
+  bool converged = false;
+  std::string refusal;
+  double initial_dt_error_s = 0.0;
+  double S_H_rotation_deg = 0.0, S_H_translation_mm = 0.0;
+  double R_W_tilt_deg = 0.0, R_W_translation_mm = 0.0;
+  double heading_sigmas = 0.0, gyro_bias_sigmas = 0.0, acc_bias_sigmas = 0.0, dt_sigmas = 0.0;
+};
+
+double sigma_of(const FrameCalibrationResult& r, const std::string& name) {
+  for (std::size_t i = 0; i < r.parameter_names.size(); ++i)
+    if (r.parameter_names[i] == name && Eigen::Index(i) < r.covariance.rows())
+      return std::sqrt(std::max(0.0, r.covariance(Eigen::Index(i), Eigen::Index(i))));
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+// Largest |error_k| / sigma_k of a 3-vector whose sigmas are named prefix.x/y/z.
+double worst_sigmas(const FrameCalibrationResult& r, const std::string& prefix,
+                    const Eigen::Vector3d& error) {
+  double worst = 0.0;
+  const char* axes[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k)
+    worst = std::max(worst, std::abs(error[k]) / sigma_of(r, prefix + "." + axes[k]));
+  return worst;
+}
+
+SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult& base,
+                     const RobotLog& log, std::uint64_t seed, double max_joint_spread_rad) {
+  SeedOutcome o;
+  o.seed = seed;
+  std::mt19937_64 rng(seed * 7919 + 17);
+  // Random base heading and mount (as sim/simulation.cpp draws them).
+  std::uniform_real_distribution<double> yaw(-std::numbers::pi, std::numbers::pi);
+  Eigen::Isometry3d T_W_R = scenario.T_W_R;
+  T_W_R.linear() = Eigen::AngleAxisd(yaw(rng), Eigen::Vector3d::UnitZ()) * T_W_R.linear();
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::Vector3d rotation, translation;
+  for (int i = 0; i < 3; ++i) rotation[i] = normal(rng) * scenario.mount_random_rotation_sigma_rad;
+  for (int i = 0; i < 3; ++i) translation[i] = normal(rng) * scenario.mount_random_position_sigma_m;
+  Eigen::Isometry3d perturbation = Eigen::Isometry3d::Identity();
+  perturbation.linear() = ims::quat_exp<double>(rotation).toRotationMatrix();
+  perturbation.translation() = translation;
+  const Eigen::Isometry3d T_H_S = base.robot.tool.T_H_T * scenario.mount_offset * perturbation;
+
+  // The IMS record of this mount from the plant's link-side motion.
+  const std::vector<Eigen::Isometry3d> T_R_H = sim::flange_poses(base.robot, base.plant);
+  std::vector<ims::PoseSample> poses(T_R_H.size());
+  for (std::size_t k = 0; k < T_R_H.size(); ++k) {
+    const Eigen::Isometry3d T_W_S = T_W_R * T_R_H[k] * T_H_S;
+    poses[k] = {base.plant.samples[k].t_s, T_W_S.translation(),
+                Eigen::Quaterniond(T_W_S.linear()).normalized()};
+  }
+  const ims::SplineTrajectory trajectory(poses);
+  const ims::EarthModel earth(scenario.site);
+  const ims::ImuSeries ideal =
+      ims::synthesize_ideal_increments(trajectory, earth, scenario.imu_rate_hz);
+  const ims::SensorErrorModel errors = ims::draw_sensor_errors(base.sensor_spec, rng);
+  ims::ImuSeries imu = ims::corrupt(ideal, errors, base.sensor_spec, rng());
+  for (auto& s : imu.samples) s.t_s += scenario.imu_clock_offset_s;
+  imu.site = scenario.site;
+
+  // As `imscal calibrate` with the shipped defaults: rests, initial dt, rests again, bundle.
+  const CalibrationConfig config = load_calibration_config(
+      fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "calibration" / "calibrate-default.yaml");
+  RestPoseInput rest_input;
+  rest_input.imu = &imu;
+  rest_input.log = &log;
+  rest_input.robot = &base.robot;
+  rest_input.sensor = base.sensor_spec;
+  rest_input.site = scenario.site;
+  RestPoseOptions rest_options;
+  rest_options.min_duration_s = config.rests.min_duration_s;
+  rest_options.edge_trim_s = config.rests.trim_s;
+  rest_options.max_joint_spread_rad =
+      max_joint_spread_rad > 0.0 ? max_joint_spread_rad : config.rests.max_joint_spread_rad;
+  try {
+    const RestPoseResult first = find_rest_poses(rest_input, rest_options);
+    if (first.detection.intervals.empty()) throw InputError("campaign", 0, "", "no rest at all");
+    const TimeOffsetResult dt0 = estimate_initial_time_offset(imu, log, base.robot.kinematics,
+                                                              first.detection.intervals.front());
+    o.initial_dt_error_s = dt0.offset_s - scenario.imu_clock_offset_s;
+    rest_input.time_offset_s = dt0.offset_s;
+    const RestPoseResult rests = find_rest_poses(rest_input, rest_options);
+    o.rests = rests.rests.size();
+    FrameCalibrationInput in;
+    in.imu = &imu;
+    in.site = scenario.site;
+    in.kinematics = base.robot.kinematics;
+    in.rests = rests.rests;
+    in.robot = robot_joint_series(log);
+    in.noise = imu_noise_model(base.sensor_spec, config.priors);
+    in.time_offset_initial_s = dt0.offset_s;
+    in.source = "campaign";
+    const FrameCalibrationResult r = calibrate_frames(in, config.bundle);
+    o.calibrated = true;
+    o.converged = r.converged;
+
+    // Errors against the truth (T_R_W in the bundle's W-origin convention).
+    const Eigen::Isometry3d T_S_H_true = T_H_S.inverse();
+    o.S_H_rotation_deg = ims::quat_log<double>(
+                             Eigen::Quaterniond(r.T_S_H.linear() * T_S_H_true.linear().transpose()))
+                             .norm() /
+                         kDeg;
+    o.S_H_translation_mm = (r.T_S_H.translation() - T_S_H_true.translation()).norm() * 1e3;
+    const Eigen::Matrix3d R_W_R = r.T_R_W.linear().transpose();
+    const Eigen::Vector3d rotation_error_W =
+        ims::quat_log<double>(Eigen::Quaterniond(R_W_R * T_W_R.linear().transpose()));
+    o.R_W_tilt_deg = rotation_error_W.head<2>().norm() / kDeg;
+    o.heading_sigmas = std::abs(rotation_error_W.z()) / sigma_of(r, "R_W_R.up");
+    // The true link angles at the middle of the first rest (robot clock).
+    const double t_first = 0.5 * (in.rests.front().begin_ims_s + in.rests.front().end_ims_s) -
+                           scenario.imu_clock_offset_s;
+    std::size_t k = 0;
+    while (k + 1 < base.plant.samples.size() && base.plant.samples[k].t_s < t_first) ++k;
+    const Eigen::Isometry3d T_R_W_true = frame_calibration_truth_convention(
+        T_W_R.inverse(), T_S_H_true, base.robot.kinematics, base.plant.samples[k].q_link_rad);
+    o.R_W_translation_mm = (r.T_R_W.translation() - T_R_W_true.translation()).norm() * 1e3;
+    o.gyro_bias_sigmas = worst_sigmas(r, "gyro_bias", r.biases.gyro_rad_s - errors.gyro.bias);
+    o.acc_bias_sigmas = worst_sigmas(r, "acc_bias", r.biases.acc_m_s2 - errors.acc.bias);
+    o.dt_sigmas =
+        std::abs(r.time_offset_s - scenario.imu_clock_offset_s) / sigma_of(r, "time_offset.dt");
+  } catch (const InputError& e) {
+    o.refusal = e.what();
+  }
+  return o;
+}
+
+struct CampaignFigures {
+  std::size_t seeds = 0, calibrated = 0, converged = 0;
+  std::size_t min_rests = 1000, max_rests = 0;
+  double worst_initial_dt_ms = 0.0;
+  double S_H_rotation_deg = 0.0, S_H_translation_mm = 0.0, R_W_tilt_deg = 0.0,
+         R_W_translation_mm = 0.0, heading_sigmas = 0.0, gyro_bias_sigmas = 0.0,
+         acc_bias_sigmas = 0.0, dt_sigmas = 0.0;
+  std::string first_refusal;
+};
+
+// max_joint_spread_rad: 0 for the shipped default (1e-5 rad).
+CampaignFigures run_campaign(const fs::path& scenario_file, const std::string& label,
+                             std::size_t release_seeds, double max_joint_spread_rad = 0.0) {
+  const sim::Scenario scenario = sim::load_scenario(scenario_file);
+  const std::size_t seeds = sanitized() ? 2 : release_seeds;
+  // Under the sanitizers the plant (~15 s in Release) runs the first 60 s only (7 rests).
+  const double duration = sanitized() ? 60.0 : std::numeric_limits<double>::infinity();
+  const sim::SimulationResult base = sim::run_simulation(scenario, scenario.seed, {}, duration);
+  const RobotLog log = sim::make_robot_log(base);
+
+  std::vector<SeedOutcome> outcomes(seeds);
+  std::mutex mutex;
+  std::size_t next = 0;
+  auto worker = [&] {
+    for (;;) {
+      std::size_t i;
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (next >= seeds) return;
+        i = next++;
+      }
+      outcomes[i] = run_seed(scenario, base, log, 1000 + i, max_joint_spread_rad);
+    }
+  };
+  std::thread a(worker), b(worker);  // 2 cores
+  a.join();
+  b.join();
+
+  CampaignFigures f;
+  f.seeds = seeds;
+  for (const auto& o : outcomes) {
+    f.min_rests = std::min(f.min_rests, o.rests);
+    f.max_rests = std::max(f.max_rests, o.rests);
+    f.worst_initial_dt_ms = std::max(f.worst_initial_dt_ms, std::abs(o.initial_dt_error_s) * 1e3);
+    if (!o.calibrated) {
+      if (f.first_refusal.empty()) f.first_refusal = o.refusal;
+      continue;
+    }
+    ++f.calibrated;
+    f.converged += o.converged;
+    f.S_H_rotation_deg = std::max(f.S_H_rotation_deg, o.S_H_rotation_deg);
+    f.S_H_translation_mm = std::max(f.S_H_translation_mm, o.S_H_translation_mm);
+    f.R_W_tilt_deg = std::max(f.R_W_tilt_deg, o.R_W_tilt_deg);
+    f.R_W_translation_mm = std::max(f.R_W_translation_mm, o.R_W_translation_mm);
+    f.heading_sigmas = std::max(f.heading_sigmas, o.heading_sigmas);
+    f.gyro_bias_sigmas = std::max(f.gyro_bias_sigmas, o.gyro_bias_sigmas);
+    f.acc_bias_sigmas = std::max(f.acc_bias_sigmas, o.acc_bias_sigmas);
+    f.dt_sigmas = std::max(f.dt_sigmas, o.dt_sigmas);
+  }
+  std::printf(
+      "campaign %s: %zu seeds, rests found %zu..%zu, calibrated %zu, converged %zu, worst "
+      "initial dt error %.3f ms\n",
+      label.c_str(), f.seeds, f.min_rests, f.max_rests, f.calibrated, f.converged,
+      f.worst_initial_dt_ms);
+  if (f.calibrated)
+    std::printf(
+        "campaign %s worst: T_S_H %.5f deg %.4f mm | T_R_W tilt %.5f deg, translation %.4f mm | "
+        "heading %.2f sigma | gyro bias %.2f sigma | acc bias %.2f sigma | dt %.2f sigma "
+        "(goal 0.005 deg, 0.05 mm, 3 sigma)\n",
+        label.c_str(), f.S_H_rotation_deg, f.S_H_translation_mm, f.R_W_tilt_deg,
+        f.R_W_translation_mm, f.heading_sigmas, f.gyro_bias_sigmas, f.acc_bias_sigmas, f.dt_sigmas);
+  if (!f.first_refusal.empty())
+    std::printf("campaign %s first refusal: %s\n", label.c_str(), f.first_refusal.c_str());
+  return f;
+}
+
+TEST(CalibrateCampaign, MountingScenarioAsShipped) {
+  const CampaignFigures f = run_campaign(
+      fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "scenarios" / "mounting.yaml", "mounting", 50);
+  // Met: the initial clock offset from the cross-correlation of rate magnitudes, within 1 ms of
+  // the simulated 12.3 ms (the robot cycle is 2 ms; the correlation peak is sub-sample).
+  EXPECT_LT(f.worst_initial_dt_ms, 1.0);
+  // Met: no confident wrong answer. With every effect on, the unloaded joints (A1, A4, A6) float
+  // inside their backlash at rest (the link drifts by 0.3-1.9 mrad over a rest in
+  // truth/joints.csv), so the IMS sees no standstill and the rests are refused; every seed is
+  // either refused with the reason, or calibrated and converged.
+  EXPECT_EQ(f.calibrated, f.converged);
+  if (f.calibrated < f.seeds) {
+    EXPECT_FALSE(f.first_refusal.empty());
+  }
+}
+
+using CalibrateCampaignScratch = test_support::ScratchDirTest;
+
+TEST_F(CalibrateCampaignScratch, MountingWithoutBacklash) {
+  // The shipped scenario with the backlash off, paths made absolute for the scratch copy.
+  const fs::path datasets = fs::path(IMSCAL_SOURCE_DIR) / "datasets";
+  std::ifstream in(datasets / "scenarios" / "mounting.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  replace("../robots/", (datasets / "robots").string() + "/");
+  replace("../programs/", (datasets / "programs").string() + "/");
+  replace("../sensors/", (datasets / "sensors").string() + "/");
+  replace("backlash: true", "backlash: false");
+  std::ofstream(dir_ / "mounting-no-backlash.yaml") << text;
+  // 10 seeds (the brief's 50 are spent on the shipped scenario; this one shows what limits the
+  // rest of the chain). The elastic drives still creep by 2e-5..8e-5 rad over a rest after a
+  // move, above the default 1e-5 rad stillness limit of the joint readings: 1e-4 rad here.
+  const CampaignFigures f =
+      run_campaign(dir_ / "mounting-no-backlash.yaml", "no-backlash", 10, 1e-4);
+  EXPECT_LT(f.worst_initial_dt_ms, 1.0);  // as above
+  // Met: every seed finds >= 3 rests and converges from the automatic initial values, and the
+  // time offset lies within 3 sigma of the truth (measured 1.3 sigma at worst). Not met (printed,
+  // reported): T_S_H 0.03 deg / 1.5 mm, T_R_W tilt 0.08 deg, biases 16 / 83 sigma: the unit's
+  // accelerometer scale factors (100 ppm) and misalignments (10 arcsec class) are outside the
+  // bundle's model and the gear deflection is corrected by a model, not measured.
+  EXPECT_EQ(f.calibrated, f.seeds);
+  EXPECT_EQ(f.calibrated, f.converged);
+  EXPECT_LT(f.dt_sigmas, 3.0);
+}
+
+}  // namespace
+}  // namespace imscal::calib

@@ -1,0 +1,534 @@
+// `imscal calibrate --imu FILE --robot-log FILE --robot ROBOT.yaml --sensor SPEC.yaml
+//  [--config YAML] --out DIR [--force]`: the wrist/sensor calibration of the paper. From the raw
+// IMS record and the robot's log: rest poses (calib/rest_poses.hpp), the frame-and-bias bundle
+// (calib/frame_calibration.hpp: T_R_W, T_S_H, biases, time offset with covariance), the mounting
+// validation (calib/mounting_validation.hpp) and the joint errors (calib/joint_space_errors.hpp).
+// Writes, all or nothing (core/output_folder.hpp), the files of datasets/FORMAT.md §16:
+//   frames.json  mounting_report.json  summary.txt  joint_errors.csv
+// Exit codes: 0 verdict pass or warn, 1 verdict fail (the outputs are still written), 2 bad input.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include "calib/calibration_config.hpp"
+#include "calib/frame_calibration.hpp"
+#include "calib/joint_space_errors.hpp"
+#include "calib/mounting_validation.hpp"
+#include "calib/rest_poses.hpp"
+#include "calib/robot_description.hpp"
+#include "calib/robot_log.hpp"
+#include "core/atomic_file.hpp"
+#include "core/input_error.hpp"
+#include "core/output_folder.hpp"
+#include "core/progress.hpp"
+#include "core/sha256.hpp"
+#include "core/version.hpp"
+#include "ident/joint_error_io.hpp"
+#include "ims/imu_conversion.hpp"
+#include "ims/imu_file.hpp"
+#include "ims/sensor_spec.hpp"
+#include "ims/so3.hpp"
+#include "ims/zupt_options.hpp"
+#include "tools/command_registry.hpp"
+
+namespace {
+namespace fs = std::filesystem;
+namespace calib = imscal::calib;
+using nlohmann::json;
+using namespace imscal;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+struct CalibrateArgs {
+  std::string imu;
+  std::string robot_log;
+  std::string robot;
+  std::string sensor;
+  std::string config;
+  std::string out;
+  bool force = false;
+};
+
+json vector_json(const Eigen::VectorXd& v, double scale = 1.0) {
+  json a = json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    a.push_back(std::isfinite(v[i]) ? json(v[i] * scale) : json(nullptr));
+  return a;
+}
+
+json matrix_json(const Eigen::MatrixXd& m) {
+  json rows = json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) rows.push_back(vector_json(m.row(r).transpose()));
+  return rows;
+}
+
+// R = Rz(yaw) Ry(pitch) Rx(roll) (as pose_from_xyz_rpy) [rad].
+Eigen::Vector3d roll_pitch_yaw(const Eigen::Matrix3d& R) {
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  return {std::atan2(R(2, 1), R(2, 2)), pitch, std::atan2(R(1, 0), R(0, 0))};
+}
+
+json pose_json(const Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(T.linear());
+  return {{"xyz_mm", vector_json(T.translation(), 1e3)},
+          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
+          {"rpy_deg", vector_json(roll_pitch_yaw(T.linear()), 1.0 / kDeg)},
+          {"rotation_vector_deg", vector_json(imscal::ims::quat_log<double>(q), 1.0 / kDeg)}};
+}
+
+json estimate_json(const calib::EstimatedVector& e) {
+  return {{"name", e.name},
+          {"unit", e.unit},
+          {"components", e.components},
+          {"value", vector_json(e.value)},
+          {"sigma", vector_json(e.sigma)}};
+}
+
+json residual_json(const calib::PoseResidual& r) {
+  return {{"label", r.label},
+          {"normalised", r.normalised},
+          {"rotation_deg", r.rotation_rad / kDeg},
+          {"position_mm", r.position_m * 1e3},
+          {"outlier", r.outlier}};
+}
+
+json weak_json(const calib::WeakDirection& w) {
+  return {{"description", w.description},
+          {"sigma", w.sigma},
+          {"unit", w.unit},
+          {"suggestion", w.suggestion}};
+}
+
+json mounting_json(const calib::MountingEstimate& e) {
+  const Eigen::Matrix<double, 6, 1> s = e.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  json j = {{"T_S_H", pose_json(e.T_S_H)}};
+  if (e.has_covariance) {
+    j["sigma_rotation_deg"] = vector_json(s.head<3>(), 1.0 / kDeg);
+    j["sigma_translation_mm"] = vector_json(s.tail<3>(), 1e3);
+  }
+  return j;
+}
+
+json difference_json(const calib::MountingDifference& d) {
+  return {{"rotation_deg", d.rotation_rad / kDeg},
+          {"translation_mm", d.translation_m * 1e3},
+          {"difference_rotation_deg", vector_json(d.difference.head<3>(), 1.0 / kDeg)},
+          {"difference_translation_mm", vector_json(d.difference.tail<3>(), 1e3)},
+          {"combined_sigma_rotation_deg", vector_json(d.combined_sigma.head<3>(), 1.0 / kDeg)},
+          {"combined_sigma_translation_mm", vector_json(d.combined_sigma.tail<3>(), 1e3)},
+          {"normalised_sigma", std::isfinite(d.normalised) ? json(d.normalised) : json(nullptr)}};
+}
+
+json part_json(const calib::SessionPart& p) {
+  json j = {{"label", p.label},
+            {"first_rest", p.first_rest + 1},
+            {"last_rest", p.last_rest + 1},
+            {"calibrated", p.calibrated}};
+  if (p.calibrated)
+    j["estimate"] = mounting_json(p.estimate);
+  else
+    j["failure"] = p.failure;
+  return j;
+}
+
+json input_json(const std::string& file) {
+  if (file.empty()) return nullptr;
+  return {{"path", file}, {"sha256", sha256_hex_of_file(file)}};
+}
+
+struct Inputs {
+  calib::CalibrationConfig config;
+  fs::path robot_file, sensor_file;
+  calib::RobotDescription robot;
+  ims::SensorSpec spec;
+  ims::ImuSeries imu;
+  calib::RobotLog log;
+};
+
+Inputs read_inputs(const CalibrateArgs& args) {
+  Inputs in;
+  if (!args.config.empty()) in.config = calib::load_calibration_config(args.config);
+  auto pick = [&](const std::string& given, const std::optional<fs::path>& from_config,
+                  const char* option) {
+    if (!given.empty()) return fs::path(given);
+    if (from_config) return *from_config;
+    throw InputError(
+        args.config.empty() ? "command line" : args.config, 0, option,
+        fmt::format("no {} file: give {} or the config key '{}'", option + 2, option, option + 2));
+  };
+  in.robot_file = pick(args.robot, in.config.robot_file, "--robot");
+  in.sensor_file = pick(args.sensor, in.config.sensor_file, "--sensor");
+  in.robot = calib::load_robot_description(in.robot_file);
+  in.spec = ims::load_sensor_spec(in.sensor_file);
+  ims::ImuReadOptions read_options;
+  if (in.spec.gyro.range > 0.0) read_options.gyro_range_rad_s = in.spec.gyro.range;
+  if (in.spec.acc.range > 0.0) read_options.acc_range_m_s2 = in.spec.acc.range;
+  in.imu = ims::read_imu_file(args.imu, read_options);
+  if (in.imu.quantity == ims::ImuQuantity::kRates) in.imu = ims::rates_to_increments(in.imu);
+  if (!in.imu.site)
+    throw InputError(args.imu, 0, "site",
+                     "the IMS file does not state its site (site_latitude_deg, "
+                     "site_longitude_deg, site_height_m): gravity and Earth rate need it");
+  in.log = calib::read_robot_log_csv(args.robot_log, in.robot.name);
+  // The two records must overlap in time (up to the time-offset search range).
+  const double imu_begin = in.imu.samples.front().t_s, imu_end = in.imu.samples.back().t_s;
+  const double log_begin = in.log.samples.front().t_s, log_end = in.log.samples.back().t_s;
+  const double margin = in.config.max_abs_time_offset_s;
+  if (imu_end + margin < log_begin || log_end + margin < imu_begin)
+    throw InputError(args.imu, 0, "t_s",
+                     fmt::format("the IMS record [{:.3f}, {:.3f}] s and the robot log {} "
+                                 "[{:.3f}, {:.3f}] s do not overlap in time (clock offsets up to "
+                                 "{} s are searched)",
+                                 imu_begin, imu_end, args.robot_log, log_begin, log_end, margin));
+  return in;
+}
+
+std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibrationResult& r,
+                         const calib::MountingValidation& v, const calib::RestPoseResult& rests,
+                         const calib::TimeOffsetResult& dt0, const calib::JointSpaceErrors* je) {
+  std::ostringstream s;
+  auto line = [&](const std::string& text) { s << text << '\n'; };
+  line(fmt::format("imscal {} calibrate", kVersion));
+  line(fmt::format("IMS record  {}", args.imu));
+  line(fmt::format("robot log   {}", args.robot_log));
+  line("");
+  line(fmt::format("VERDICT: {}", calib::to_string(v.verdict)));
+  for (const auto& reason : v.reasons) line("  - " + reason);
+  line("");
+  line(fmt::format("rests used: {}, rejected: {}", rests.rests.size(), rests.rejected.size()));
+  for (const auto& why : rests.rejected) line("  rejected: " + why);
+  line(fmt::format("initial time offset (cross-correlation): {:.3f} ms (peak {:.3f})",
+                   dt0.offset_s * 1e3, dt0.peak_correlation));
+  line(fmt::format("solver: {} ({} iterations, {})", r.converged ? "converged" : "NOT converged",
+                   r.iterations, r.solver_brief_report));
+  line("");
+  line("estimates (value +- 1 sigma):");
+  for (const auto& e : r.estimates) {
+    std::string values;
+    for (Eigen::Index k = 0; k < e.value.size(); ++k)
+      values += fmt::format(
+          "  {}={:.6g}+-{:.2g}",
+          k < Eigen::Index(e.components.size()) ? e.components[std::size_t(k)] : std::to_string(k),
+          e.value[k], k < e.sigma.size() ? e.sigma[k] : 0.0);
+    line(fmt::format("  {} [{}]:{}", e.name, e.unit, values));
+  }
+  const Eigen::Vector3d rpy_S_H = roll_pitch_yaw(r.T_S_H.linear()) / kDeg;
+  line(fmt::format("  T_S_H: xyz {:.4f} {:.4f} {:.4f} mm, rpy {:.5f} {:.5f} {:.5f} deg",
+                   r.T_S_H.translation().x() * 1e3, r.T_S_H.translation().y() * 1e3,
+                   r.T_S_H.translation().z() * 1e3, rpy_S_H.x(), rpy_S_H.y(), rpy_S_H.z()));
+  const Eigen::Vector3d rpy_R_W = roll_pitch_yaw(r.T_R_W.linear()) / kDeg;
+  line(
+      fmt::format("  T_R_W: xyz {:.4f} {:.4f} {:.4f} mm, rpy {:.5f} {:.5f} {:.5f} deg "
+                  "(W origin: the sensor at rest 1)",
+                  r.T_R_W.translation().x() * 1e3, r.T_R_W.translation().y() * 1e3,
+                  r.T_R_W.translation().z() * 1e3, rpy_R_W.x(), rpy_R_W.y(), rpy_R_W.z()));
+  if (!r.weak_directions.empty()) {
+    line("");
+    line("weak directions:");
+    for (const auto& w : r.weak_directions)
+      line(
+          fmt::format("  {}: 1 sigma {:.3g} {}; {}", w.description, w.sigma, w.unit, w.suggestion));
+  }
+  line("");
+  line("mounting checks:");
+  for (const auto& c : v.checks)
+    line(fmt::format("  [{}] {}: {}", calib::to_string(c.level), c.name, c.message));
+  line("");
+  line("rest residuals (normalised, rotation):");
+  for (const auto& p : r.rest_residuals)
+    line(fmt::format("  {:<28} {:7.2f} sigma {:10.6f} deg{}", p.label, p.normalised,
+                     p.rotation_rad / kDeg, p.outlier ? "  OUTLIER" : ""));
+  line("motion residuals (normalised, rotation, position):");
+  for (const auto& p : r.motion_residuals)
+    line(fmt::format("  {:<28} {:7.2f} sigma {:10.6f} deg {:9.4f} mm{}", p.label, p.normalised,
+                     p.rotation_rad / kDeg, p.position_m * 1e3, p.outlier ? "  OUTLIER" : ""));
+  if (je) {
+    line("");
+    line(
+        fmt::format("joint errors: {} samples ({} outside the IMS record, {} inverse-kinematics "
+                    "failures)",
+                    je->t_s.size(), je->outside_record, je->ik_failures));
+    if (!je->t_s.empty()) {
+      for (int j = 0; j < calib::kJointCount; ++j) {
+        double sum = 0.0, worst = 0.0;
+        for (std::size_t k = 0; k < je->t_s.size(); ++k) {
+          const double e = je->q_desired_rad[k][j] - je->q_measured_rad[k][j];
+          sum += e * e;
+          worst = std::max(worst, std::abs(e));
+        }
+        line(fmt::format("  A{}: RMS {:.4f} mrad, max {:.4f} mrad", j + 1,
+                         std::sqrt(sum / double(je->t_s.size())) * 1e3, worst * 1e3));
+      }
+    }
+  }
+  return s.str();
+}
+
+ident::JointErrorLog joint_error_log(const calib::JointSpaceErrors& e, const calib::RobotLog& log,
+                                     const std::string& source) {
+  ident::JointErrorLog out;
+  out.robot = e.robot.empty() ? log.robot_name : e.robot;
+  out.cycle_s = e.cycle_s;
+  out.source = source;
+  out.joint_names.assign(log.joint_names.begin(), log.joint_names.end());
+  out.time_s = e.t_s;
+  out.payload_kg = e.payload_kg;
+  out.q_desired_rad.assign(calib::kJointCount, {});
+  out.q_measured_rad.assign(calib::kJointCount, {});
+  out.q_internal_rad.assign(calib::kJointCount, {});
+  for (std::size_t k = 0; k < e.t_s.size(); ++k)
+    for (int j = 0; j < calib::kJointCount; ++j) {
+      out.q_desired_rad[std::size_t(j)].push_back(e.q_desired_rad[k][j]);
+      out.q_measured_rad[std::size_t(j)].push_back(e.q_measured_rad[k][j]);
+      out.q_internal_rad[std::size_t(j)].push_back(e.q_internal_rad[k][j]);
+    }
+  ident::split_at_gaps(out);
+  return out;
+}
+
+void run(const CalibrateArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  // Refuse existing outputs before any work (exit 2 through InputError).
+  std::vector<fs::path> outputs = {"frames.json", "mounting_report.json", "summary.txt"};
+  {
+    // The config decides whether joint_errors.csv is written; read it first for that.
+    const bool with_joint_errors =
+        args.config.empty() || calib::load_calibration_config(args.config).joint_errors;
+    if (with_joint_errors) outputs.push_back("joint_errors.csv");
+  }
+  const Overwrite overwrite = args.force ? Overwrite::kAllow : Overwrite::kRefuse;
+  { OutputFolder check(args.out, outputs, overwrite); }
+
+  Progress progress;
+  progress.update("read", 0.0);
+  Inputs in = read_inputs(args);
+  const calib::CalibrationConfig& config = in.config;
+
+  // Rest poses and the initial time offset.
+  progress.update("rests", 0.0);
+  calib::RestPoseInput rest_input;
+  rest_input.imu = &in.imu;
+  rest_input.log = &in.log;
+  rest_input.robot = &in.robot;
+  rest_input.sensor = in.spec;
+  rest_input.site = *in.imu.site;
+  rest_input.payload.mass_kg = config.payload.mass_kg;
+  rest_input.payload.com_m = config.payload.com_T_m;
+  rest_input.source = args.imu;
+  calib::RestPoseOptions rest_options;
+  rest_options.min_duration_s = config.rests.min_duration_s;
+  rest_options.edge_trim_s = config.rests.trim_s;
+  rest_options.max_joint_spread_rad = config.rests.max_joint_spread_rad;
+  rest_options.deflection.model_uncertainty_fraction =
+      config.priors.deflection_uncertainty_fraction;
+  rest_options.deflection.sigma_floor_rad = config.priors.joint_sigma_floor_rad;
+  const calib::RestPoseResult detection = calib::find_rest_poses(rest_input, rest_options);
+  if (detection.detection.intervals.empty())
+    throw InputError(args.imu, 0, "",
+                     "no rest found in the IMS record: the record must start at rest and the "
+                     "robot must stop in the calibration poses");
+  progress.update("time offset", 0.0);
+  calib::TimeOffsetOptions dt_options;
+  dt_options.max_abs_offset_s = config.max_abs_time_offset_s;
+  const calib::TimeOffsetResult dt0 = calib::estimate_initial_time_offset(
+      in.imu, in.log, in.robot.kinematics, detection.detection.intervals.front(), dt_options);
+  spdlog::info("calibrate: initial time offset {:.3f} ms (correlation peak {:.3f})",
+               dt0.offset_s * 1e3, dt0.peak_correlation);
+  rest_input.time_offset_s = dt0.offset_s;
+  progress.update("rests", 0.5);
+  const calib::RestPoseResult rests = calib::find_rest_poses(rest_input, rest_options);
+  for (const auto& why : rests.rejected) spdlog::warn("calibrate: rest not used: {}", why);
+  spdlog::info("calibrate: {} rest poses ({} rejected)", rests.rests.size(), rests.rejected.size());
+
+  // The bundle.
+  progress.update("bundle", 0.0);
+  calib::FrameCalibrationInput frame_input;
+  frame_input.imu = &in.imu;
+  frame_input.site = *in.imu.site;
+  frame_input.kinematics = in.robot.kinematics;
+  frame_input.rests = rests.rests;
+  frame_input.robot = calib::robot_joint_series(in.log);
+  frame_input.noise = calib::imu_noise_model(in.spec, config.priors);
+  frame_input.time_offset_initial_s = dt0.offset_s;
+  frame_input.source = args.imu;
+  frame_input.first_rest_position_W_m = config.first_rest_position_W_m;
+  const calib::FrameCalibrationResult result = calib::calibrate_frames(frame_input, config.bundle);
+  spdlog::info("calibrate: bundle {} after {} iterations",
+               result.converged ? "converged" : "did NOT converge", result.iterations);
+
+  // Mounting validation.
+  const calib::MountingValidation validation = calib::validate_mounting(
+      frame_input, config.bundle, result, config.validation,
+      [&](const std::string& stage, double fraction) { progress.update(stage, fraction); });
+
+  // Joint errors.
+  std::optional<calib::JointSpaceErrors> joint_errors;
+  if (config.joint_errors) {
+    progress.update("joint errors", 0.0);
+    calib::JointSpaceInput js;
+    js.imu = &in.imu;
+    js.log = &in.log;
+    js.site = *in.imu.site;
+    js.kinematics = in.robot.kinematics;
+    js.frames = {result.T_R_W, result.T_S_H, result.biases, result.time_offset_s};
+    js.first_rest = rests.rests.front();
+    if (!result.joint_deviation_rad.empty())
+      js.first_rest.q_link_rad += result.joint_deviation_rad.front();
+    js.zupt = ims::zupt_options_from_spec(in.spec);
+    js.source = args.imu;
+    joint_errors = calib::joint_space_errors(js);
+    spdlog::info("calibrate: joint errors at {} robot samples", joint_errors->t_s.size());
+  }
+
+  // Outputs.
+  progress.update("write", 0.0);
+  const std::string created_by = std::string("imscal ") + kVersion;
+  const json inputs = {{"imu", input_json(args.imu)},
+                       {"robot_log", input_json(args.robot_log)},
+                       {"robot", input_json(in.robot_file.string())},
+                       {"sensor", input_json(in.sensor_file.string())},
+                       {"config", input_json(args.config)}};
+  json estimates = json::array();
+  for (const auto& e : result.estimates) estimates.push_back(estimate_json(e));
+  json weak = json::array();
+  for (const auto& w : result.weak_directions) weak.push_back(weak_json(w));
+  const json frames = {
+      {"imscal-frames", 1},
+      {"created_by", created_by},
+      {"conventions",
+       {{"transforms", "T_A_B maps coordinates in B into A (p_A = T_A_B p_B)"},
+        {"W", "Earth-fixed ENU at the site; origin at the sensor's position at rest 1"},
+        {"rpy", "R = Rz(yaw) Ry(pitch) Rx(roll)"},
+        {"time_offset", "t_ims = t_robot + time_offset"}}},
+      {"units",
+       {{"xyz", "mm"},
+        {"angles", "deg"},
+        {"gyro_bias", "deg/h"},
+        {"acc_bias", "ug"},
+        {"time_offset", "ms"},
+        {"covariance_si", "rad, m, rad/s, m/s^2, s (order of parameter_names)"}}},
+      {"T_R_W", pose_json(result.T_R_W)},
+      {"T_S_H", pose_json(result.T_S_H)},
+      {"gyro_bias_deg_per_h", vector_json(result.biases.gyro_rad_s, 3600.0 / kDeg)},
+      {"acc_bias_ug", vector_json(result.biases.acc_m_s2, 1e6 / 9.80665)},
+      {"time_offset_ms", result.time_offset_s * 1e3},
+      {"gyro_scale_factor_ppm", vector_json(result.gyro_scale_factor, 1e6)},
+      {"acc_scale_factor_ppm", vector_json(result.acc_scale_factor, 1e6)},
+      {"estimates", estimates},
+      {"parameter_names", result.parameter_names},
+      {"covariance_si", matrix_json(result.covariance)},
+      {"correlation", matrix_json(result.correlation)},
+      {"covariance_rank_deficient", result.covariance_rank_deficient},
+      {"weak_directions", weak},
+      {"solver",
+       {{"converged", result.converged},
+        {"iterations", result.iterations},
+        {"final_cost", result.final_cost},
+        {"brief_report", result.solver_brief_report}}},
+      {"initial_values",
+       {{"T_R_W", pose_json(result.initial_T_R_W)},
+        {"T_S_H", pose_json(result.initial_T_S_H)},
+        {"time_offset_ms", result.initial_time_offset_s * 1e3},
+        {"time_offset_peak_correlation", dt0.peak_correlation}}},
+      {"rests", {{"used", rests.rests.size()}, {"rejected", rests.rejected}}},
+      {"inputs", inputs}};
+
+  json rest_res = json::array(), motion_res = json::array();
+  for (const auto& p : result.rest_residuals) rest_res.push_back(residual_json(p));
+  for (const auto& p : result.motion_residuals) motion_res.push_back(residual_json(p));
+  json checks = json::array();
+  for (const auto& c : validation.checks)
+    checks.push_back(
+        {{"name", c.name}, {"level", calib::to_string(c.level)}, {"message", c.message}});
+  json halves = json::array(), segments = json::array(), comparisons = json::array();
+  for (const auto& p : validation.halves) halves.push_back(part_json(p));
+  for (const auto& p : validation.segments) segments.push_back(part_json(p));
+  for (const auto& c : validation.segment_comparisons)
+    comparisons.push_back({{"earlier", validation.segments[c.earlier].label},
+                           {"later", validation.segments[c.later].label},
+                           {"slipped", c.slipped},
+                           {"difference", difference_json(c.difference)}});
+  const auto& t = config.validation.thresholds;
+  const json report = {{"imscal-mounting-report", 1},
+                       {"created_by", created_by},
+                       {"verdict", calib::to_string(validation.verdict)},
+                       {"reasons", validation.reasons},
+                       {"checks", checks},
+                       {"combined", mounting_json(validation.combined)},
+                       {"rest_residuals", rest_res},
+                       {"motion_residuals", motion_res},
+                       {"outliers", result.outliers},
+                       {"outlier_count", validation.outlier_count},
+                       {"halves", halves},
+                       {"halves_difference", validation.halves_difference
+                                                 ? difference_json(*validation.halves_difference)
+                                                 : json(nullptr)},
+                       {"segments", segments},
+                       {"segment_comparisons", comparisons},
+                       {"weak_directions", weak},
+                       {"thresholds",
+                        {{"max_outliers_pass", t.max_outliers_pass},
+                         {"max_outlier_fraction_warn", t.max_outlier_fraction_warn},
+                         {"repeat_warn_sigma", t.repeat_warn_sigma},
+                         {"repeat_fail_sigma", t.repeat_fail_sigma},
+                         {"repeat_rotation_floor_deg", t.repeat_rotation_floor_rad / kDeg},
+                         {"repeat_translation_floor_mm", t.repeat_translation_floor_m * 1e3},
+                         {"slip_sigma", t.slip_sigma},
+                         {"max_rotation_sigma_deg", t.max_rotation_sigma_rad / kDeg},
+                         {"max_translation_sigma_mm", t.max_translation_sigma_m * 1e3},
+                         {"segment_rests", config.validation.segment_rests}}},
+                       {"inputs", inputs}};
+
+  OutputFolder folder(args.out, outputs, overwrite);
+  write_file_atomically(folder.staged("frames.json"), frames.dump(1) + "\n");
+  write_file_atomically(folder.staged("mounting_report.json"), report.dump(1) + "\n");
+  write_file_atomically(
+      folder.staged("summary.txt"),
+      summary_text(args, result, validation, rests, dt0, joint_errors ? &*joint_errors : nullptr));
+  if (joint_errors)
+    ident::write_joint_errors_csv(
+        folder.staged("joint_errors.csv"),
+        joint_error_log(*joint_errors, in.log,
+                        fmt::format("{} calibrate --imu {} --robot-log {}", created_by, args.imu,
+                                    args.robot_log)));
+  folder.commit();
+  progress.finish();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << fmt::format("verdict: {}\n", calib::to_string(validation.verdict));
+  for (const auto& reason : validation.reasons) std::cout << "  - " << reason << '\n';
+  spdlog::info("calibrate: wrote {} files to {} in {:.1f} s", outputs.size(), args.out, seconds);
+  if (validation.verdict == calib::Verdict::kFail)
+    throw tools::CheckFailed(fmt::format("mounting verdict fail ({}); outputs written to {}",
+                                         validation.reasons.front(), args.out));
+}
+
+tools::CommandRegistration registration{
+    "calibrate",
+    "Calibrate T_R_W, T_S_H, IMS biases and the clock offset from rest poses; validate the "
+    "mounting; joint errors",
+    [](CLI::App& sub) {
+      auto args = std::make_shared<CalibrateArgs>();
+      sub.add_option("--imu", args->imu, "Raw IMS record (.csv, .imsb, .imu)")->required();
+      sub.add_option("--robot-log", args->robot_log, "Robot controller log (robot.csv)")
+          ->required();
+      sub.add_option("--robot", args->robot,
+                     "Robot description (datasets/robots/*.yaml); default: the config's");
+      sub.add_option("--sensor", args->sensor,
+                     "IMS sensor spec (datasets/sensors/*.yaml); default: the config's");
+      sub.add_option("--config", args->config,
+                     "Calibration config (datasets/calibration/calibrate-default.yaml)");
+      sub.add_option("--out", args->out, "Output folder")->required();
+      sub.add_flag("--force", args->force, "Replace existing outputs");
+      sub.callback([args] { run(*args); });
+    }};
+}  // namespace
