@@ -13,6 +13,7 @@
 
 #include "ident/precontrol.hpp"
 #include "tests/support/arx_systems.hpp"
+#include "tests/support/reference_precontrol.hpp"
 
 namespace {
 
@@ -45,20 +46,25 @@ ParameterTable order_32_table() {
   return t;
 }
 
-void BM_PrecontrolCycle6JointsOrder32(benchmark::State& state) {
+// Times each of kCycles consecutive cycles of `precontrol` (Precontrol or the all-cells
+// reference, same interface) and reports median, 99.9th percentile and maximum in ns, and the
+// fraction of cycles that ended active (the supervisor must not switch the work off).
+template <class Runtime>
+void time_cycles(benchmark::State& state) {
   const ParameterTable table = order_32_table();
   PrecontrolOptions options;
   options.offset_tolerance_rad.fill(1.0);  // keep it active: measure the full work
   options.rate_tolerance_rad_s.fill(1e9);
-  static Precontrol precontrol;  // ~300 kB of fixed state: not on the stack
+  static Runtime precontrol;  // ~300 kB of fixed state: not on the stack
   std::string why;
-  if (!Precontrol::create(table, "kr16", options, &precontrol, &why)) {
+  if (!Runtime::create(table, "kr16", options, &precontrol, &why)) {
     state.SkipWithError(why.c_str());
     return;
   }
   constexpr int kCycles = 1000000;
   std::vector<double> ns(kCycles);
   std::array<double, 6> q{};
+  int active = 0;
   for (auto _ : state) {
     for (int k = 0; k < kCycles; ++k) {
       const double t = k * 0.002;
@@ -67,6 +73,7 @@ void BM_PrecontrolCycle6JointsOrder32(benchmark::State& state) {
       const PrecontrolOutput out = precontrol.cycle(q, 8.0 + 6.0 * std::sin(0.01 * t), k);
       const auto end = std::chrono::steady_clock::now();
       benchmark::DoNotOptimize(out);
+      active += out.state == PrecontrolState::kActive;
       ns[k] = std::chrono::duration<double, std::nano>(end - begin).count();
     }
   }
@@ -74,8 +81,20 @@ void BM_PrecontrolCycle6JointsOrder32(benchmark::State& state) {
   state.counters["median_ns"] = ns[kCycles / 2];
   state.counters["p99.9_ns"] = ns[static_cast<std::size_t>(kCycles * 0.999)];
   state.counters["max_ns"] = ns.back();
+  state.counters["active"] = double(active) / kCycles;
+}
+
+void BM_PrecontrolCycle6JointsOrder32(benchmark::State& state) {
+  time_cycles<Precontrol>(state);
 }
 BENCHMARK(BM_PrecontrolCycle6JointsOrder32)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// The same with the runtime as it was before issue 6's speed work (every cell runs every cycle):
+// the before/after comparison in one run, on the same machine load.
+void BM_AllCellsReferenceCycle6JointsOrder32(benchmark::State& state) {
+  time_cycles<imscal::test_support::AllCellsPrecontrol>(state);
+}
+BENCHMARK(BM_AllCellsReferenceCycle6JointsOrder32)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
 

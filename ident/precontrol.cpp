@@ -1,24 +1,17 @@
 #include "ident/precontrol.hpp"
 
-#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <span>
 
+#include "ident/arx_step_kernel.hpp"
 #include "ident/cell_blending.hpp"
 
 namespace imscal::ident {
 namespace {
 
-constexpr int kOutputRing = kMaxPrecontrolOrder;
-static_assert((kOutputRing & (kOutputRing - 1)) == 0);
-
-// Σ a[i] b[i] by Eigen's vectorised dot product (SIMD packets, several partial sums): a plain
-// loop is one chain of n dependent multiply-adds, latency bound. The rounding differs from a
-// plain loop by a few ulp.
-double dot(const double* a, const double* b, int n) {
-  if (n == 0) return 0.0;
-  return Eigen::Map<const Eigen::VectorXd>(a, n).dot(Eigen::Map<const Eigen::VectorXd>(b, n));
+int round_up(int n, int multiple) {
+  return (n + multiple - 1) / multiple * multiple;
 }
 
 // Pushes `value` as the newest entry of a doubled ring of `ring` entries (newest first).
@@ -128,6 +121,7 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
           static_cast<int>(cell.b.size()) != model.nb) {
         return refuse(name + "cell " + std::to_string(k) + ": order or dead time out of range");
       }
+      model.terms = round_up(std::max(model.na, model.nb), kArxStepLanes);
       for (int i = 0; i < model.na; ++i) model.a[i] = cell.a[i];
       for (int i = 0; i < model.nb; ++i) model.b[i] = cell.b[i];
       const bool finite =
@@ -136,6 +130,8 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
       if (!finite) return refuse(name + "cell " + std::to_string(k) + ": NaN/Inf parameter");
     }
   }
+  // As exp(-w dt) with w = 1 / τ, the smoother's own expression.
+  p.smoother_decay_ = std::exp(-(1.0 / options.smoothing_time_constant_s) * options.caller_cycle_s);
   *out = p;
   return true;
 }
@@ -202,15 +198,19 @@ void Precontrol::model_step(JointModel& joint, double q_desired, double speed, d
   }
   const CellBlend blend = blend_cells(std::span(centres.data(), joint.dims),
                                       std::span<const double>(point.data(), joint.dims));
-  // Every cell model advances (so a cell entering the blend has a settled state); the blend
-  // weights pick their errors.
-  std::array<double, kMaxPrecontrolCells> error{};
+  // Every cell model advances, in or out of the blend: a cell entering the blend needs its own
+  // free-run state (see the header); the blend weights pick their errors.
+  std::array<ArxStepInput, kMaxPrecontrolCells> step;
+  for (int c = 0; c < joint.cells; ++c) {
+    const CellModel& m = joint.cell[c];
+    step[c] = ArxStepInput{m.b.data(), u + m.d, m.a.data(), m.y.data() + m.y_pos, m.terms};
+  }
+  std::array<double, kMaxPrecontrolCells> y, error;
+  arx_free_run_steps(step.data(), joint.cells, y.data());
   for (int c = 0; c < joint.cells; ++c) {
     CellModel& m = joint.cell[c];
-    const double* y_past = m.y.data() + m.y_pos;  // y_past[i] = q̂(k - 1 - i)
-    const double y = dot(m.b.data(), u + m.d, m.nb) - dot(m.a.data(), y_past, m.na);
-    push_newest(m.y, m.y_pos, kOutputRing, y);
-    error[c] = u[m.d] - y;
+    push_newest(m.y, m.y_pos, kOutputRing, y[c]);
+    error[c] = u[m.d] - y[c];
   }
   double blended = 0.0;
   for (int i = 0; i < blend.count; ++i) blended += blend.weight[i] * error[blend.cell[i]];
@@ -289,7 +289,8 @@ PrecontrolOutput Precontrol::cycle(const std::array<double, kPrecontrolJoints>& 
       const double raw =
           error + joint.backlash_l_rad *
                       std::tanh(direction_speed / options_.backlash_velocity_scale_rad_s);
-      if (std::abs(raw) > options_.offset_tolerance_rad[j]) {
+      // Written as !(|x| <= tol) so that a NaN (an overflowing model) deactivates too.
+      if (!(std::abs(raw) <= options_.offset_tolerance_rad[j])) {
         deactivate(cycle_counter, j, PrecontrolCause::kOffsetTolerance, raw);
         break;
       }
@@ -297,10 +298,10 @@ PrecontrolOutput Precontrol::cycle(const std::array<double, kPrecontrolJoints>& 
       // e = x - r, e(t) = (e0 + (v0 + w e0) t) exp(-w t), v(t) = (v0 - w (v0 + w e0) t) exp(-w t).
       const double w = 1.0 / options_.smoothing_time_constant_s;
       const double e0 = joint.smooth - raw, v0 = joint.smooth_rate;
-      const double decay = std::exp(-w * dt);
+      const double decay = smoother_decay_;  // exp(-w dt)
       joint.smooth = raw + (e0 + (v0 + w * e0) * dt) * decay;
       joint.smooth_rate = (v0 - w * (v0 + w * e0) * dt) * decay;
-      if (std::abs(joint.smooth_rate) > options_.rate_tolerance_rad_s[j]) {
+      if (!(std::abs(joint.smooth_rate) <= options_.rate_tolerance_rad_s[j])) {
         deactivate(cycle_counter, j, PrecontrolCause::kRateTolerance, joint.smooth_rate);
         break;
       }

@@ -5,10 +5,20 @@
 // Δq to add to the desired angle, and a status.
 //
 // Per joint and cycle:
-//   1. every cell's ARX model (paper eq. 2) runs in parallel on the desired angle (free run: its
-//      own past outputs), giving Δq̂_c(k) = q_d(k-d) - q̂_c(k) (as ArxModel::predict_joint_error);
-//   2. the cells are blended by the operating point (ident/cell_blending.hpp): continuous across
+//   1. the cells are blended by the operating point (ident/cell_blending.hpp): continuous across
 //      cell boundaries; outside the table the outermost cells are used and an event is logged;
+//   2. every cell's ARX model (paper eq. 2) runs on the desired angle (free run: its own past
+//      outputs), giving Δq̂_c(k) = q_d(k-d) - q̂_c(k) (as ArxModel::predict_joint_error); the
+//      blend is Σ w_c Δq̂_c. The input history is one ring per joint (q_d is the same for all
+//      cells); the output history is per cell. Cells outside the blend run too, on purpose
+//      (issue 6): a cell entering the blend needs its own free-run state, which depends on the
+//      whole past input through its own poles. Starting it instead from the blended past
+//      (q̂_c(k-i) = q_d(k-i-d_c) - Δq̂(k-i)) or from rest excites the cell's transient; in the
+//      companion form of an order-32 model (|a_i| up to ~1e8) that transient reached 2.3 rad in
+//      bench/bench_precontrol.cpp's table within a few cycles, so "only the blended cells" was
+//      rejected. The cycle is made fast instead by the padded SIMD sums of
+//      ident/arx_step_kernel.hpp (same outputs as before within a few ulp:
+//      tests/ident/test_precontrol.cpp compares with the all-cells reference);
 //   3. the backlash term of eq. 3, l · tanh(q̇_d(k - lag) / v_b) with the table's lag: ±l when
 //      moving, a smooth transition through zero velocity instead of a jump at reversals (no
 //      chattering);
@@ -29,6 +39,7 @@
 #include <cstdint>
 #include <string>
 
+#include "ident/arx_step_kernel.hpp"
 #include "ident/parameter_table.hpp"
 
 namespace imscal::ident {
@@ -36,7 +47,7 @@ namespace imscal::ident {
 inline constexpr int kPrecontrolJoints = 6;
 inline constexpr int kMaxPrecontrolOrder = 64;     // na, nb
 inline constexpr int kMaxPrecontrolDeadTime = 64;  // d [samples]
-inline constexpr int kMaxPrecontrolCells = 16;     // cells per joint
+inline constexpr int kMaxPrecontrolCells = 16;     // cells per joint (<= 32: a bit mask)
 inline constexpr int kPrecontrolEventCapacity = 256;
 
 struct PrecontrolOptions {
@@ -102,14 +113,21 @@ class Precontrol {
   // Histories are rings stored twice (each value written at i and i + ring): the newest-first
   // window of any length up to the ring size is then contiguous, so the model's dot products
   // run over plain arrays (vectorised) without index wrapping.
-  static constexpr int kInputRing = 128;  // power of two >= nb + d
+  // The model's sums (ident/arx_step_kernel.hpp) run over max(na, nb) padded to a multiple
+  // of kArxStepLanes with zero coefficients: no remainder loop, no branch (the reads past na, nb
+  // stay inside the rings and are multiplied by 0).
+  static_assert(kMaxPrecontrolOrder % kArxStepLanes == 0);
+  static constexpr int kInputRing = 128;  // power of two >= d + terms
   static_assert(kInputRing >= kMaxPrecontrolOrder + kMaxPrecontrolDeadTime);
+  static constexpr int kOutputRing = kMaxPrecontrolOrder;  // q̂ history
+  static_assert((kOutputRing & (kOutputRing - 1)) == 0);
   static constexpr int kSpeedRing = 128;  // > the largest backlash lag accepted [cycles]
   struct CellModel {
     int na = 0, nb = 0, d = 0;
-    std::array<double, kMaxPrecontrolOrder> a{};
-    std::array<double, kMaxPrecontrolOrder> b{};
-    std::array<double, 2 * kMaxPrecontrolOrder> y{};  // q̂ history, newest at y[y_pos]
+    int terms = 0;  // max(na, nb) rounded up to kArxStepLanes: the length of both sums
+    std::array<double, kMaxPrecontrolOrder> a{};  // a_1..a_na, then zeros
+    std::array<double, kMaxPrecontrolOrder> b{};  // b_0..b_{nb-1}, then zeros
+    std::array<double, 2 * kOutputRing> y{};      // q̂ history, newest at y[y_pos]
     int y_pos = 0;
   };
   struct JointModel {
@@ -127,7 +145,6 @@ class Precontrol {
     int backlash_lag = 0;
     std::array<double, kSpeedRing> speed_history{};
     int speed_pos = 0;
-    // Input history q_d(k), q_d(k-1), ... (ring), newest at u_head.
     std::array<double, 2 * kInputRing> u{};  // q_d history, newest at u[u_pos]
     int u_pos = 0;
     double last_error = 0.0;      // blended Δq̂ of the last model step
@@ -144,8 +161,9 @@ class Precontrol {
 
   PrecontrolOptions options_;
   double model_sample_s_ = 0.002;
-  int steps_per_call_ = 1;  // caller cycle = steps · T
-  int calls_per_step_ = 1;  // caller cycle = T / calls
+  double smoother_decay_ = 0.0;  // exp(-caller cycle / τ), the smoother's decay per call
+  int steps_per_call_ = 1;       // caller cycle = steps · T
+  int calls_per_step_ = 1;       // caller cycle = T / calls
   int call_phase_ = 0;
   std::array<JointModel, kPrecontrolJoints> joints_{};
   std::array<double, kPrecontrolJoints> last_q_{};

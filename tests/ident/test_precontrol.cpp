@@ -15,9 +15,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <new>
+#include <random>
 #include <vector>
 
 #include "ident/arx_model.hpp"
+#include "tests/support/arx_systems.hpp"
+#include "tests/support/reference_precontrol.hpp"
 
 // Counts every heap allocation of this test program (to prove there is none in a cycle).
 static std::atomic<long> g_allocations{0};
@@ -285,6 +288,77 @@ TEST(Precontrol, A4msCallerGetsTheSameOffsetsAsA2msCaller) {
   // interpolation error ~ q'' T^2 / 8 = 0.66 * (0.004)^2 / 8 ~ 1e-6 rad times the model's
   // sensitivity (~0.1): well below 1 % of the offset.
   EXPECT_LT(worst, 0.01 * largest);
+}
+
+TEST(Precontrol, SameOffsetsAsTheAllCellsReferenceWithBlendingAndFaults) {
+  // The runtime before issue 6's speed work (tests/support/reference_precontrol.hpp: Eigen dot
+  // products) against the current one (padded SIMD partial sums, ident/arx_step_kernel.hpp) on
+  // a 3 x 2 table of random order-8 models, dead times 0..3, with blending in both dimensions,
+  // backlash, smoothing, a NaN, a lost cycle and a re-activation.
+  std::mt19937_64 rng(6);
+  ParameterTable t;
+  t.robot = "kr16";
+  t.sample_time_s = kCycle;
+  for (int j = 0; j < 6; ++j) {
+    JointParameters joint;
+    joint.name = "A" + std::to_string(j + 1);
+    joint.dimensions = {CellDimension{OperatingQuantity::kSpeed, {0.0, 0.1, 0.3, 0.6}},
+                        CellDimension{OperatingQuantity::kPayload, {0.0, 5.0, 10.0}}};
+    joint.backlash_l_rad = 1e-4;
+    joint.backlash_lag_samples = static_cast<std::size_t>(j);
+    for (int c = 0; c < 6; ++c) {
+      CellParameters cp;
+      cp.bands = {c / 2, c % 2};
+      const int na = 5 + (c + j) % 4, nb = 3 + c % 6;  // unequal orders: padding exercised
+      cp.structure = {na, nb, (c + j) % 4};
+      const Eigen::VectorXd a =
+          test_support::polynomial_from_poles(test_support::random_poles(na, rng));
+      cp.a.assign(a.data(), a.data() + na);
+      cp.b.assign(static_cast<std::size_t>(nb), (1.0 + a.sum()) * (1.0 + 0.01 * c) / nb);
+      joint.cells.push_back(cp);
+    }
+    t.joints.push_back(joint);
+  }
+  PrecontrolOptions o;
+  o.offset_tolerance_rad.fill(0.05);
+  Precontrol p = make(t, o);
+  test_support::AllCellsPrecontrol reference;
+  std::string why;
+  ASSERT_TRUE(test_support::AllCellsPrecontrol::create(t, "kr16", o, &reference, &why)) << why;
+  double worst = 0.0, largest = 0.0;
+  std::uint64_t counter = 0;
+  std::array<double, 6> qd{};
+  for (int k = 0; k < 6000; ++k, ++counter) {
+    for (int j = 0; j < 6; ++j) qd[j] = 0.2 * std::sin(0.0015 * k * (j + 1)) + 0.1 * j;
+    const double payload = 5.0 + 4.0 * std::sin(0.001 * k);
+    if (k == 2500) qd[1] = std::nan("");
+    if (k == 3500) counter += 3;  // lost cycles
+    if (k == 3000 || k == 4000) {
+      p.reactivate();
+      reference.reactivate();
+    }
+    const PrecontrolOutput a = p.cycle(qd, payload, counter);
+    const PrecontrolOutput b = reference.cycle(qd, payload, counter);
+    ASSERT_EQ(a.state, b.state) << k;
+    ASSERT_EQ(a.outside_table, b.outside_table) << k;
+    for (int j = 0; j < 6; ++j) {
+      worst = std::max(worst, std::abs(a.offset_rad[j] - b.offset_rad[j]));
+      largest = std::max(largest, std::abs(b.offset_rad[j]));
+    }
+  }
+  // Same recursions, sums added in another order: a few ulp (~1e-16 rad) per step, carried by
+  // stable models with sum |a_i| <= 2^8 (poles inside |z| < 0.9): far below 1e-12 rad, while the
+  // offsets themselves are ~1e-4..1e-3 rad.
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_GT(largest, 1e-4);
+  PrecontrolEvent ea[32], eb[32];
+  const int na = p.read_events(ea, 32), nb = reference.read_events(eb, 32);
+  ASSERT_EQ(na, nb);
+  for (int i = 0; i < na; ++i) {
+    EXPECT_EQ(ea[i].cycle, eb[i].cycle);
+    EXPECT_EQ(ea[i].cause, eb[i].cause);
+  }
+  EXPECT_GE(na, 4);  // invalid input, 2 re-activations, lost cycles
 }
 
 TEST(Precontrol, NoHeapAllocationInsideTheCycle) {
