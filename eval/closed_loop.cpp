@@ -1,0 +1,109 @@
+#include "eval/closed_loop.hpp"
+
+#include <algorithm>
+#include <array>
+#include <memory>
+#include <stdexcept>
+
+namespace imscal::eval {
+
+CompensationRun run_precontrol(const ident::ParameterTable& table, const std::string& robot_name,
+                               const sim::DesiredJointPath& path,
+                               const CompensationOptions& options) {
+  if (options.look_ahead_cycles < 0) {
+    throw std::invalid_argument("run_precontrol: look-ahead must be >= 0 cycles");
+  }
+  ident::PrecontrolOptions precontrol_options = options.precontrol;
+  precontrol_options.caller_cycle_s = path.cycle_s;
+  // The precontrol is a large fixed-size object (no heap inside its cycle): keep it on the heap.
+  auto precontrol = std::make_unique<ident::Precontrol>();
+  std::string why;
+  if (!ident::Precontrol::create(table, robot_name, precontrol_options, precontrol.get(), &why)) {
+    throw std::invalid_argument("precontrol refused the parameter table: " + why);
+  }
+  const std::size_t n = path.samples.size();
+  CompensationRun run;
+  run.offset_rad.resize(n);
+  run.state.resize(n);
+  run.outside_table.resize(n);
+  std::array<ident::PrecontrolEvent, ident::kPrecontrolEventCapacity> events{};
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t ahead = std::min(n - 1, k + std::size_t(options.look_ahead_cycles));
+    const sim::DesiredJointSample& s = path.samples[ahead];
+    std::array<double, ident::kPrecontrolJoints> q{};
+    for (int j = 0; j < ident::kPrecontrolJoints; ++j) q[std::size_t(j)] = s.q_rad[j];
+    const double payload_kg =
+        path.payloads.empty() ? 0.0 : path.payloads[std::size_t(s.payload_index)].body.mass_kg;
+    const ident::PrecontrolOutput out = precontrol->cycle(q, payload_kg, k);
+    for (int j = 0; j < ident::kPrecontrolJoints; ++j) {
+      run.offset_rad[k][j] = out.offset_rad[std::size_t(j)];
+    }
+    run.state[k] = out.state;
+    run.outside_table[k] = out.outside_table;
+    const int read = precontrol->read_events(events.data(), int(events.size()));
+    run.events.insert(run.events.end(), events.begin(), events.begin() + read);
+  }
+  return run;
+}
+
+sim::DesiredJointPath command_path(const sim::DesiredJointPath& desired,
+                                   const std::vector<calib::JointVector>& offsets) {
+  const std::size_t n = desired.samples.size();
+  if (offsets.size() != n) {
+    throw std::invalid_argument("command_path: one offset per desired sample needed");
+  }
+  sim::DesiredJointPath command = desired;
+  const double T = desired.cycle_s;
+  // Central differences inside, one-sided at the ends; with one sample the rates are zero.
+  auto rate = [&](const std::vector<calib::JointVector>& x, std::size_t k) -> calib::JointVector {
+    if (n < 2) return calib::JointVector::Zero();
+    if (k == 0) return (x[1] - x[0]) / T;
+    if (k + 1 == n) return (x[n - 1] - x[n - 2]) / T;
+    return (x[k + 1] - x[k - 1]) / (2.0 * T);
+  };
+  std::vector<calib::JointVector> offset_rate(n);
+  for (std::size_t k = 0; k < n; ++k) offset_rate[k] = rate(offsets, k);
+  for (std::size_t k = 0; k < n; ++k) {
+    sim::DesiredJointSample& s = command.samples[k];
+    s.q_rad += offsets[k];
+    s.qd_rad_s += offset_rate[k];
+    s.qdd_rad_s2 += rate(offset_rate, k);
+  }
+  return command;
+}
+
+PlantRun simulator_plant(const sim::PlantConfig& config) {
+  return [config](const sim::DesiredJointPath& command) {
+    return sim::simulate_plant(config, command, command.cycle_s);
+  };
+}
+
+ClosedLoopRun run_closed_loop(const sim::DesiredJointPath& desired,
+                              const ident::ParameterTable& table, const std::string& robot_name,
+                              const PlantRun& plant, const CompensationOptions& options) {
+  ClosedLoopRun run;
+  run.compensation = run_precontrol(table, robot_name, desired, options);
+  run.command = command_path(desired, run.compensation.offset_rad);
+  run.uncompensated = plant(desired);
+  run.compensated = plant(run.command);
+  for (const sim::PlantLog* log : {&run.uncompensated, &run.compensated}) {
+    if (log->samples.size() != desired.samples.size()) {
+      throw std::invalid_argument("run_closed_loop: the plant returned " +
+                                  std::to_string(log->samples.size()) + " samples for " +
+                                  std::to_string(desired.samples.size()) + " commanded");
+    }
+  }
+  return run;
+}
+
+std::vector<calib::JointVector> joint_errors(const sim::DesiredJointPath& desired,
+                                             const sim::PlantLog& attained) {
+  const std::size_t n = std::min(desired.samples.size(), attained.samples.size());
+  std::vector<calib::JointVector> errors(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    errors[k] = desired.samples[k].q_rad - attained.samples[k].q_link_rad;
+  }
+  return errors;
+}
+
+}  // namespace imscal::eval

@@ -1,0 +1,79 @@
+#pragma once
+// The precontrol in the loop of the robot (paper, Fig. 3 and 4): every controller cycle the
+// precontrol (ident/precontrol.hpp) gets the desired joint angles q_d and the payload, and its
+// offset Δq̂ is added to the command the joint controllers receive, q_c = q_d + Δq̂; the plant
+// then follows q_c. The result holds the attained link-side joints with and without compensation.
+//
+// The precontrol sees only the desired values, never the plant, so the offsets of a whole path
+// are computed first and the plant is then run once on the modified command: the same cycle-by-
+// cycle data flow as stepping both together, with the plant free to be any PlantRun (the
+// simulator, or a test's linear plant).
+//
+// Feed-forward: the controller's velocity/acceleration feed-forward of the modified command is
+// q̇_d + ȯ and q̈_d + ö, with ȯ, ö central differences of the offsets over the cycle (one-sided at
+// the path's ends). The interpolator plans ahead, so o(k+1) is known at cycle k.
+//
+// Look-ahead: with look_ahead_cycles = L the precontrol is fed q_d(k + L) at cycle k (held at the
+// path's end) and its output is applied at cycle k. The model's own offset is
+// Δq̂(k) = q_d(k - d) - q̂(k) (paper, eq. 2): with L = d it refers to the desired value of the
+// cycle it is applied in.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "calib/robot_description.hpp"
+#include "ident/parameter_table.hpp"
+#include "ident/precontrol.hpp"
+#include "sim/desired_path.hpp"
+#include "sim/plant_config.hpp"
+#include "sim/plant_simulator.hpp"
+
+namespace imscal::eval {
+
+struct CompensationOptions {
+  ident::PrecontrolOptions precontrol;  // caller_cycle_s is replaced by the path's cycle
+  int look_ahead_cycles = 0;            // L >= 0 [cycles]
+};
+
+// The precontrol's offsets along a desired path, one per path sample.
+struct CompensationRun {
+  std::vector<calib::JointVector> offset_rad;
+  std::vector<ident::PrecontrolState> state;
+  std::vector<bool> outside_table;
+  std::vector<ident::PrecontrolEvent> events;  // in cycle order
+};
+
+// Throws std::invalid_argument when the precontrol refuses the table (reason in the message).
+CompensationRun run_precontrol(const ident::ParameterTable& table, const std::string& robot_name,
+                               const sim::DesiredJointPath& path,
+                               const CompensationOptions& options = {});
+
+// q_c = q_d + o with the feed-forward derivatives described above. offsets.size() must equal
+// path.samples.size() (std::invalid_argument).
+sim::DesiredJointPath command_path(const sim::DesiredJointPath& desired,
+                                   const std::vector<calib::JointVector>& offsets);
+
+// A plant: the commanded path in, the attained joints out, one sample per command sample.
+using PlantRun = std::function<sim::PlantLog(const sim::DesiredJointPath& command)>;
+
+// The robot simulator (sim::simulate_plant) with its output at every controller cycle.
+PlantRun simulator_plant(const sim::PlantConfig& config);
+
+struct ClosedLoopRun {
+  sim::DesiredJointPath command;  // what the controllers got with compensation
+  CompensationRun compensation;
+  sim::PlantLog uncompensated;  // plant on q_d
+  sim::PlantLog compensated;    // plant on q_c
+};
+
+// Runs both. Throws std::invalid_argument when a plant returns a sample count other than the
+// path's.
+ClosedLoopRun run_closed_loop(const sim::DesiredJointPath& desired,
+                              const ident::ParameterTable& table, const std::string& robot_name,
+                              const PlantRun& plant, const CompensationOptions& options = {});
+
+// Link-side joint errors q_d - q_link per cycle (rows: samples).
+std::vector<calib::JointVector> joint_errors(const sim::DesiredJointPath& desired,
+                                             const sim::PlantLog& attained);
+
+}  // namespace imscal::eval

@@ -1,0 +1,338 @@
+#include "eval/gap_candidates.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+namespace imscal::eval {
+namespace {
+
+using Column = Eigen::VectorXd;
+
+Column to_column(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), Eigen::Index(v.size()));
+}
+
+// First-order lag y' = (u - y) / tau, exact discretisation, restarted at every run from u.
+Column lag(const Column& u, double tau_s, const GapSignals& s) {
+  Column y(u.size());
+  const double a = std::exp(-s.cycle_s / tau_s);
+  for (const auto& [b, e] : s.runs) {
+    double state = e > b ? u[Eigen::Index(b)] : 0.0;
+    for (std::size_t k = b; k < e; ++k) {
+      state = a * state + (1.0 - a) * u[Eigen::Index(k)];
+      y[Eigen::Index(k)] = state;
+    }
+  }
+  return y;
+}
+
+// Lightly damped second-order response ω²/(s² + 2ζωs + ω²) to u (semi-implicit Euler with 8
+// substeps per cycle: stable and accurate to < 1 % up to 40 Hz at 2 ms), and its rate / ω.
+std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta,
+                                       const GapSignals& s) {
+  const double w = 2.0 * M_PI * f_hz;
+  const int sub = 8;
+  const double h = s.cycle_s / sub;
+  Column y(u.size()), r(u.size());
+  for (const auto& [b, e] : s.runs) {
+    double p = 0.0, v = 0.0;
+    for (std::size_t k = b; k < e; ++k) {
+      const double x = u[Eigen::Index(k)];
+      for (int i = 0; i < sub; ++i) {
+        v += h * (w * w * (x - p) - 2.0 * zeta * w * v);
+        p += h * v;
+      }
+      y[Eigen::Index(k)] = p;
+      r[Eigen::Index(k)] = v / w;
+    }
+  }
+  return {y, r};
+}
+
+double rms_of(const Column& c) {
+  return c.size() ? std::sqrt(c.squaredNorm() / double(c.size())) : 0.0;
+}
+
+CandidateShape shape(std::string label, std::vector<Column> cols, std::vector<std::string> names) {
+  CandidateShape sh;
+  sh.label = std::move(label);
+  sh.columns.resize(cols.empty() ? 0 : cols[0].size(), Eigen::Index(cols.size()));
+  for (std::size_t i = 0; i < cols.size(); ++i) sh.columns.col(Eigen::Index(i)) = cols[i];
+  sh.parameter_names = std::move(names);
+  return sh;
+}
+
+// Velocity scale of the smooth sign of the desired velocity [rad/s]: 0.3 deg/s, well below any
+// programmed speed.
+constexpr double kSignVelocityScale = 0.005;
+
+// The identified speed range of a joint's table: the upper bound of the highest speed band that
+// holds an identified cell (NaN: no table, or no speed dimension).
+double identified_speed_limit(const GapSignals& s, std::size_t joint) {
+  if (joint >= s.table_dimensions.size()) return std::numeric_limits<double>::quiet_NaN();
+  const auto& dims = s.table_dimensions[joint];
+  int speed_dim = -1;
+  for (std::size_t d = 0; d < dims.size(); ++d)
+    if (dims[d].quantity == ident::OperatingQuantity::kSpeed) speed_dim = int(d);
+  if (speed_dim < 0) return std::numeric_limits<double>::quiet_NaN();
+  const ident::CellGrid grid(dims);
+  int top_band = -1;
+  for (int c = 0; c < grid.cell_count(); ++c)
+    if (s.table_cell_identified[joint][std::size_t(c)])
+      top_band = std::max(top_band, grid.bands_of(c)[std::size_t(speed_dim)]);
+  if (top_band < 0) return std::numeric_limits<double>::quiet_NaN();
+  return dims[std::size_t(speed_dim)].bounds[std::size_t(top_band) + 1];
+}
+
+}  // namespace
+
+const char* to_string(EffectKind kind) {
+  switch (kind) {
+    case EffectKind::kBacklash:
+      return "backlash";
+    case EffectKind::kCoulombFriction:
+      return "coulomb_friction";
+    case EffectKind::kGearCompliance:
+      return "gear_compliance";
+    case EffectKind::kTransmissionError:
+      return "transmission_error";
+    case EffectKind::kResonance:
+      return "structural_resonance";
+    case EffectKind::kTimeOffset:
+      return "time_offset";
+    case EffectKind::kPayloadMismatch:
+      return "payload_mismatch";
+    case EffectKind::kZeroOffset:
+      return "zero_offset";
+    case EffectKind::kThermalDrift:
+      return "thermal_drift";
+    case EffectKind::kOperatingPoint:
+      return "operating_point_extrapolation";
+  }
+  return "?";
+}
+
+EffectKind effect_kind_from_index(int index) {
+  if (index < 0 || index >= kEffectKindCount)
+    throw std::invalid_argument("effect kind index out of range");
+  return static_cast<EffectKind>(index);
+}
+
+std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& s,
+                                             std::size_t joint) {
+  const Eigen::Index n = Eigen::Index(s.sample_count());
+  const Column qd = to_column(s.qd_desired_rad_s[joint]);
+  const Column qdd = to_column(s.qdd_desired_rad_s2[joint]);
+  std::vector<CandidateShape> out;
+  switch (kind) {
+    case EffectKind::kBacklash: {
+      const Column sv = (qd / kSignVelocityScale).array().tanh().matrix();
+      const Column tau = to_column(s.torque_nm[joint]);
+      const double tau_scale = std::max(0.05 * rms_of(tau), 1e-9);
+      const Column st = (tau / tau_scale).array().tanh().matrix();
+      out.push_back(shape("sign(qd_d)", {sv}, {"l_rad"}));
+      out.push_back(
+          shape("sign(qd_d) + lag 30 ms", {sv, lag(sv, 0.03, s)}, {"l_rad", "l_lag_rad"}));
+      // The gear torque must change sign for the play to show as anything but a constant
+      // offset: with less than 5 % of the samples on the minority side, no torque-sign shape.
+      std::size_t positive = 0;
+      for (Eigen::Index k = 0; k < n; ++k) positive += tau[k] > 0.0;
+      const double minority = double(std::min<std::size_t>(positive, std::size_t(n) - positive));
+      if (minority >= 0.05 * double(n)) {
+        out.push_back(shape("sign(tau_d)", {st}, {"l_rad"}));
+        out.push_back(
+            shape("sign(tau_d) + lag 30 ms", {st, lag(st, 0.03, s)}, {"l_rad", "l_lag_rad"}));
+      }
+      break;
+    }
+    case EffectKind::kCoulombFriction: {
+      const Column sv = (qd / kSignVelocityScale).array().tanh().matrix();
+      std::vector<Column> hp;
+      for (double tau : {0.03, 0.1, 0.3}) hp.push_back(sv - lag(sv, tau, s));
+      out.push_back(shape("sign(qd_d) high-passed 30/100/300 ms", hp,
+                          {"hp30ms_rad", "hp100ms_rad", "hp300ms_rad"}));
+      out.push_back(shape("sign(qd_d) high-passed 100 ms", {hp[1]}, {"hp100ms_rad"}));
+      break;
+    }
+    case EffectKind::kGearCompliance: {
+      const Column tau = to_column(s.torque_nm[joint]);
+      out.push_back(shape("tau_d / k", {tau}, {"compliance_rad_per_nm"}));
+      // Gravity and motion torques apart (the load model of the gravity part is the least sure).
+      const Column grav = to_column(s.gravity_torque_nm[joint]);
+      out.push_back(shape("gravity and motion torques / k", {grav, tau - grav},
+                          {"compliance_rad_per_nm", "motion_compliance_rad_per_nm"}));
+      out.push_back(shape("tau_d / k + lags 10/30 ms", {tau, lag(tau, 0.01, s), lag(tau, 0.03, s)},
+                          {"compliance_rad_per_nm", "lag10ms_rad_per_nm", "lag30ms_rad_per_nm"}));
+      break;
+    }
+    case EffectKind::kTransmissionError: {
+      const Column q = to_column(s.q_internal_rad[joint]);
+      const double n_gear = s.gear_ratio[joint];
+      for (int h = 1; h <= 3; ++h) {
+        const Column phase = double(h) * n_gear * q;
+        out.push_back(shape(fmt::format("harmonic {} of the motor angle", h),
+                            {phase.array().sin().matrix(), phase.array().cos().matrix()},
+                            {"sin_rad", "cos_rad"}));
+      }
+      break;
+    }
+    case EffectKind::kResonance: {
+      for (double f : {2.0, 3.0, 4.5, 6.5, 9.0, 12.0, 15.0, 20.0, 27.0, 36.0})
+        for (double zeta : {0.02, 0.05, 0.1, 0.3}) {
+          auto [y, r] = second_order(qdd, f, zeta, s);
+          out.push_back(shape(fmt::format("mode {:.1f} Hz, damping {:.2f}", f, zeta), {y, r},
+                              {"gain_rad_s2_per_rad_s2", "quadrature"}));
+        }
+      break;
+    }
+    case EffectKind::kTimeOffset:
+      out.push_back(shape("qd_d * dt", {qd}, {"dt_s"}));
+      break;
+    case EffectKind::kPayloadMismatch:
+      out.push_back(shape("d tau / d m / k", {to_column(s.unit_payload_nm_kg[joint])},
+                          {"dm_over_k_rad_per_kg"}));
+      break;
+    case EffectKind::kZeroOffset:
+      out.push_back(shape("constant", {Column::Ones(n)}, {"offset_rad"}));
+      break;
+    case EffectKind::kThermalDrift: {
+      const double t0 = s.time_s.front(), t1 = s.time_s.back();
+      const double span = std::max(t1 - t0, s.cycle_s);
+      Column t(n);
+      for (Eigen::Index k = 0; k < n; ++k)
+        t[k] = (s.time_s[std::size_t(k)] - 0.5 * (t0 + t1)) / span;
+      // With its constant: a drift starts from some offset (a pure offset ranks above it by
+      // parsimony, see eval/gap_diagnosis.cpp).
+      out.push_back(shape("constant + linear + quadratic in time",
+                          {Column::Ones(n), t, t.array().square().matrix()},
+                          {"offset_rad", "slope_rad", "curvature_rad"}));
+      break;
+    }
+    case EffectKind::kOperatingPoint: {
+      const double limit = identified_speed_limit(s, joint);
+      if (!std::isfinite(limit) || limit <= 0.0) break;
+      Column o(n), os(n);
+      for (Eigen::Index k = 0; k < n; ++k) {
+        o[k] = std::max(0.0, std::abs(qd[k]) - limit) / limit;
+        os[k] = o[k] * std::tanh(qd[k] / kSignVelocityScale);
+      }
+      if (o.cwiseAbs().maxCoeff() == 0.0) break;  // never outside: nothing to fit
+      out.push_back(shape(fmt::format("beyond identified speed {:.3f} rad/s", limit), {o, os},
+                          {"per_excess_rad", "per_excess_signed_rad"}));
+      break;
+    }
+  }
+  return out;
+}
+
+LinearFit fit_columns(const Eigen::MatrixXd& columns, const std::vector<double>& y,
+                      const std::vector<bool>& use) {
+  std::vector<Eigen::Index> rows;
+  for (std::size_t k = 0; k < use.size(); ++k)
+    if (use[k]) rows.push_back(Eigen::Index(k));
+  const Eigen::Index m = Eigen::Index(rows.size()), p = columns.cols();
+  Eigen::MatrixXd x(m, p);
+  Eigen::VectorXd b(m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    x.row(i) = columns.row(rows[std::size_t(i)]);
+    b[i] = y[std::size_t(rows[std::size_t(i)])];
+  }
+  // Column scaling keeps the QR well conditioned for columns of very different sizes.
+  Eigen::VectorXd scale(p);
+  for (Eigen::Index c = 0; c < p; ++c) {
+    const double nrm = x.col(c).norm();
+    scale[c] = nrm > 0.0 ? nrm : 1.0;
+    x.col(c) /= scale[c];
+  }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(x);
+  LinearFit fit;
+  Eigen::VectorXd theta = qr.solve(b);
+  const Eigen::VectorXd r = b - x * theta;
+  fit.rms = m ? std::sqrt(r.squaredNorm() / double(m)) : 0.0;
+  // Integrated autocorrelation time of the residual (consecutive rows only; summed up to the first
+  // non-positive correlation, at most 200 lags): the effective number of independent rows is
+  // m / tau_int, so sigma grows by sqrt(tau_int).
+  double tau_int = 1.0;
+  const double var = r.squaredNorm() / std::max<double>(double(m), 1.0);
+  if (var > 0.0) {
+    for (Eigen::Index lagk = 1; lagk < std::min<Eigen::Index>(200, m); ++lagk) {
+      double c = 0.0;
+      for (Eigen::Index i = lagk; i < m; ++i)
+        if (rows[std::size_t(i)] - rows[std::size_t(i - lagk)] == lagk) c += r[i] * r[i - lagk];
+      const double rho = c / (double(m) * var);
+      if (rho <= 0.0) break;
+      tau_int += 2.0 * rho;
+    }
+  }
+  fit.inflation = std::sqrt(tau_int);
+  const double dof = std::max<double>(double(m - p), 1.0);
+  const double s2 = r.squaredNorm() / dof;
+  const Eigen::MatrixXd rr =
+      qr.matrixR().topLeftCorner(p, p).template triangularView<Eigen::Upper>();
+  // Cov(theta_scaled) = s2 (R^T R)^-1 in the pivoted order.
+  Eigen::MatrixXd cov_piv =
+      s2 * (rr.transpose() * rr).completeOrthogonalDecomposition().pseudoInverse();
+  const auto perm = qr.colsPermutation();
+  const Eigen::MatrixXd cov = perm * cov_piv * perm.transpose();
+  fit.parameters = theta.cwiseQuotient(scale);
+  fit.sigma = cov.diagonal().cwiseMax(0.0).cwiseSqrt().cwiseQuotient(scale) * fit.inflation;
+  return fit;
+}
+
+std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, std::size_t joint,
+                                          const std::vector<bool>& training) {
+  const std::vector<CandidateShape> shapes = candidate_shapes(kind, s, joint);
+  if (shapes.empty()) return std::nullopt;
+  const double m = double(std::count(training.begin(), training.end(), true));
+  std::optional<CandidateFit> best;
+  double best_bic = std::numeric_limits<double>::infinity();
+  for (const auto& sh : shapes) {
+    const LinearFit f = fit_columns(sh.columns, s.gap_rad[joint], training);
+    // BIC with the effective row count (coloured residuals): a shape with more parameters must
+    // earn them on independent information, not on 2 ms samples of one transient.
+    const double m_eff = std::max(m / (f.inflation * f.inflation), 2.0);
+    const double bic = m_eff * std::log(std::max(f.rms * f.rms, 1e-300)) +
+                       double(sh.columns.cols()) * std::log(m_eff);
+    if (bic < best_bic) {
+      best_bic = bic;
+      CandidateFit c;
+      c.kind = kind;
+      c.joint = joint;
+      c.shape = sh.label;
+      c.parameter_names = sh.parameter_names;
+      c.parameters = f.parameters;
+      c.sigma = f.sigma;
+      c.columns = sh.columns;
+      c.training_rms_rad = f.rms;
+      best = std::move(c);
+    }
+  }
+  CandidateFit& c = *best;
+  const Eigen::VectorXd pred = c.columns * c.parameters;
+  c.prediction.assign(pred.data(), pred.data() + pred.size());
+  // Size in words: the first parameter with its sigma, and the RMS of the modelled gap.
+  const double arcsec = 180.0 / M_PI * 3600.0;
+  std::string first =
+      fmt::format("{} = {:.4g} ± {:.2g}", c.parameter_names[0], c.parameters[0], c.sigma[0]);
+  if (kind == EffectKind::kGearCompliance && c.parameters[0] != 0.0)
+    first += fmt::format(" (stiffness {:.3g} N m/rad)", 1.0 / c.parameters[0]);
+  if (kind == EffectKind::kBacklash)
+    first += fmt::format(" ({:.2f} arcsec, full play {:.2f} arcsec)", c.parameters[0] * arcsec,
+                         2.0 * std::abs(c.parameters[0]) * arcsec);
+  if (kind == EffectKind::kTransmissionError)
+    first = fmt::format("amplitude {:.3g} rad ({:.2f} arcsec)",
+                        std::hypot(c.parameters[0], c.parameters[1]),
+                        std::hypot(c.parameters[0], c.parameters[1]) * arcsec);
+  if (kind == EffectKind::kTimeOffset) first += " s";
+  c.size_text = fmt::format("{}; modelled gap RMS {:.3g} rad ({:.2f} arcsec)", first, rms_of(pred),
+                            rms_of(pred) * arcsec);
+  return best;
+}
+
+}  // namespace imscal::eval

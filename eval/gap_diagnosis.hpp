@@ -1,0 +1,70 @@
+#pragma once
+// How far the sim-to-real gap shrinks once an effect is modelled ("how far", issue 7), and the
+// verdict. The record is cut into alternating blocks (training, held-out, training, ...) so that
+// both parts see every kind of motion; every candidate of eval/gap_candidates.hpp is fitted per
+// joint on the training blocks and judged on the held-out blocks only:
+//
+//   shrinkage = 100 % * (1 - RMS_held-out(g - candidate) / RMS_held-out(g))   (all joints)
+//
+// Significance: a moving-block bootstrap of the held-out per-sample reduction of the squared gap
+// (summed over joints); blocks because the residuals are coloured. A candidate is supported when
+// the bootstrap p-value is below `alpha` and the shrinkage at least `min_shrinkage_percent`.
+// Supported candidates are then combined greedily (a joint fit of the chosen columns per joint),
+// a step kept only when it shrinks the held-out gap significantly further.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "eval/gap_analysis.hpp"
+#include "eval/gap_candidates.hpp"
+
+namespace imscal::eval {
+
+struct DiagnosisOptions {
+  double block_s = 1.0;            // training / held-out alternation [s]
+  double bootstrap_block_s = 0.2;  // moving-block length [s], longer than the gap's memory
+  int bootstrap_resamples = 400;
+  double alpha = 0.01;                        // significance level (one-sided)
+  double min_shrinkage_percent = 5.0;         // below this an effect is not worth modelling
+  double min_combination_gain_percent = 2.0;  // further shrinkage a combination step must add
+  int max_combination = 3;
+  std::uint64_t seed = 1;  // of the bootstrap (deterministic reports)
+};
+
+struct CandidateResult {
+  CandidateFit fit;
+  double shrinkage_percent = 0.0;        // held-out, all joints
+  double joint_shrinkage_percent = 0.0;  // held-out, its own joint
+  double p_value = 1.0;
+  bool supported = false;
+};
+
+struct CombinationStep {
+  std::string label;               // "A2 backlash"
+  double shrinkage_percent = 0.0;  // held-out, all joints, cumulative
+  double p_value = 1.0;            // of this step's further shrinkage
+};
+
+struct Diagnosis {
+  GapAnalysis where;
+  double heldout_rms_rad = 0.0;              // held-out gap before any candidate
+  double heldout_rms_modelled_rad = 0.0;     // after the kept combination
+  std::vector<CandidateResult> candidates;   // sorted by held-out shrinkage, best first
+  std::vector<CombinationStep> combination;  // kept greedy steps
+  bool significant_gap = false;              // some candidate supported
+  std::string verdict;                       // plain words
+  std::vector<std::string> measure_next;     // when the evidence is weak
+};
+
+// Training rows: blocks 0, 2, 4, ... of `block_s` (counted from each run's start).
+std::vector<bool> training_rows(const GapSignals& signals, double block_s);
+
+// Moving-block bootstrap p-value of "mean(d) <= 0" for per-row gains d (held-out rows in order).
+double block_bootstrap_p_value(const std::vector<double>& d, std::size_t block, int resamples,
+                               std::uint64_t seed);
+
+Diagnosis diagnose_gap(const GapSignals& signals, const DiagnosisOptions& options = {});
+
+std::string candidate_label(const GapSignals& signals, const CandidateFit& fit);
+
+}  // namespace imscal::eval

@@ -1,0 +1,117 @@
+#include "eval/gap_report.hpp"
+
+#include <fmt/format.h>
+
+namespace imscal::eval {
+namespace {
+
+nlohmann::json shares_json(const std::vector<GapShare>& shares) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& s : shares) {
+    nlohmann::json o = {{"label", s.label},
+                        {"energy_share", s.energy_share},
+                        {"time_share", s.time_share},
+                        {"rms_rad", s.rms_rad}};
+    if (s.outside_identified_range) o["outside_identified_range"] = true;
+    a.push_back(o);
+  }
+  return a;
+}
+
+constexpr double kArcsec = 180.0 / M_PI * 3600.0;
+
+}  // namespace
+
+nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
+  using nlohmann::json;
+  json joints = json::array();
+  for (const auto& j : d.where.joints)
+    joints.push_back({{"joint", j.joint},
+                      {"rms_rad", j.rms_rad},
+                      {"energy_share", j.energy_share},
+                      {"direction_offset_rad", j.direction_offset_rad},
+                      {"by_phase", shares_json(j.by_phase)},
+                      {"by_band", shares_json(j.by_band)},
+                      {"by_cell", shares_json(j.by_cell)},
+                      {"by_direction", shares_json(j.by_direction)}});
+  json candidates = json::array();
+  for (const auto& c : d.candidates) {
+    json params = json::array();
+    for (Eigen::Index i = 0; i < c.fit.parameters.size(); ++i)
+      params.push_back({{"name", c.fit.parameter_names[std::size_t(i)]},
+                        {"value", c.fit.parameters[i]},
+                        {"sigma", c.fit.sigma[i]}});
+    candidates.push_back({{"effect", to_string(c.fit.kind)},
+                          {"joint", s.joint_names[c.fit.joint]},
+                          {"shape", c.fit.shape},
+                          {"parameters", params},
+                          {"size", c.fit.size_text},
+                          {"training_rms_rad", c.fit.training_rms_rad},
+                          {"heldout_shrinkage_percent", c.shrinkage_percent},
+                          {"heldout_joint_shrinkage_percent", c.joint_shrinkage_percent},
+                          {"p_value", c.p_value},
+                          {"supported", c.supported}});
+  }
+  json combination = json::array();
+  for (const auto& c : d.combination)
+    combination.push_back({{"added", c.label},
+                           {"heldout_shrinkage_percent", c.shrinkage_percent},
+                           {"p_value", c.p_value}});
+  json not_supported = json::array();
+  for (const auto& c : d.candidates)
+    if (!c.supported) not_supported.push_back(candidate_label(s, c.fit));
+  return {{"schema", "imscal-gap-diagnosis"},
+          {"schema_version", 1},
+          {"samples", s.sample_count()},
+          {"cycle_s", s.cycle_s},
+          {"gap_rms_rad", d.where.rms_rad},
+          {"heldout_gap_rms_rad", d.heldout_rms_rad},
+          {"heldout_gap_rms_modelled_rad", d.heldout_rms_modelled_rad},
+          {"significant_gap", d.significant_gap},
+          {"verdict", d.verdict},
+          {"measure_next", d.measure_next},
+          {"band_edges_hz", d.where.band_edges_hz},
+          {"where", joints},
+          {"candidates", candidates},
+          {"combination", combination},
+          {"not_supported", not_supported}};
+}
+
+std::string diagnosis_text(const GapSignals& s, const Diagnosis& d) {
+  std::string t = "imscal gap diagnosis\n====================\n\n" + d.verdict + "\n";
+  for (const auto& m : d.measure_next) t += "  - measure next: " + m + "\n";
+  t += fmt::format("\nWhere (gap RMS {:.3g} rad = {:.2f} arcsec, {} samples)\n", d.where.rms_rad,
+                   d.where.rms_rad * kArcsec, s.sample_count());
+  for (const auto& j : d.where.joints) {
+    t += fmt::format(
+        "  {:<4} RMS {:.3g} rad, {:5.1f} % of the gap energy, direction offset {:.3g} rad\n",
+        j.joint, j.rms_rad, 100.0 * j.energy_share, j.direction_offset_rad);
+    auto line = [&](const char* what, const std::vector<GapShare>& v) {
+      t += fmt::format("       {:<10}", what);
+      for (const auto& x : v)
+        t += fmt::format(" {}{} {:.0f}%/{:.0f}%t", x.label,
+                         x.outside_identified_range ? " (outside)" : "", 100.0 * x.energy_share,
+                         100.0 * x.time_share);
+      t += "\n";
+    };
+    line("phase", j.by_phase);
+    line("band", j.by_band);
+    line("cell", j.by_cell);
+    line("direction", j.by_direction);
+  }
+  t += "\nCandidates (held-out shrinkage of the gap, all joints; best first)\n";
+  for (const auto& c : d.candidates)
+    t += fmt::format("  {:<36} {:6.1f} % (own joint {:6.1f} %)  p {:.3f}  {}  [{}] {}\n",
+                     candidate_label(s, c.fit), c.shrinkage_percent, c.joint_shrinkage_percent,
+                     c.p_value, c.supported ? "supported    " : "not supported", c.fit.shape,
+                     c.fit.size_text);
+  t += "\nGreedy combination\n";
+  for (const auto& c : d.combination)
+    t += fmt::format("  + {:<34} cumulative {:6.1f} %  p {:.3f}\n", c.label, c.shrinkage_percent,
+                     c.p_value);
+  t += fmt::format("Held-out gap RMS {:.3g} rad -> {:.3g} rad once modelled\n", d.heldout_rms_rad,
+                   d.heldout_rms_modelled_rad);
+  return t;
+}
+
+}  // namespace imscal::eval

@@ -1,0 +1,203 @@
+#include "eval/gap_signals.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <stdexcept>
+
+#include "ident/arx_model.hpp"
+#include "ident/cell_blending.hpp"
+#include "ident/operating_point.hpp"
+#include "sim/rigid_body_dynamics.hpp"
+
+namespace imscal::eval {
+namespace {
+
+// Central differences within each run, one-sided at its ends; a one-sample run has 0.
+std::vector<double> derivative(std::span<const double> x,
+                               std::span<const std::pair<std::size_t, std::size_t>> runs,
+                               double dt) {
+  std::vector<double> d(x.size(), 0.0);
+  for (const auto& [b, e] : runs) {
+    if (e - b < 2) continue;
+    d[b] = (x[b + 1] - x[b]) / dt;
+    d[e - 1] = (x[e - 1] - x[e - 2]) / dt;
+    for (std::size_t k = b + 1; k + 1 < e; ++k) d[k] = (x[k + 1] - x[k - 1]) / (2.0 * dt);
+  }
+  return d;
+}
+
+double operating_value(ident::OperatingQuantity q, double speed, double acceleration,
+                       double position, double payload) {
+  switch (q) {
+    case ident::OperatingQuantity::kSpeed:
+      return speed;
+    case ident::OperatingQuantity::kAcceleration:
+      return acceleration;
+    case ident::OperatingQuantity::kPosition:
+      return position;
+    case ident::OperatingQuantity::kPayload:
+      return payload;
+  }
+  return 0.0;
+}
+
+// A point mass at the tool frame origin (the joint errors log only the payload's mass).
+calib::RigidBodyParameters point_mass(double mass_kg) {
+  calib::RigidBodyParameters body;
+  body.mass_kg = mass_kg;
+  body.com_m.setZero();
+  body.inertia_kg_m2.setZero();
+  return body;
+}
+
+// Velocity scale of the smooth backlash sign [rad/s], as the precontrol's default.
+constexpr double kBacklashVelocityScale = 0.002;
+
+}  // namespace
+
+std::vector<std::vector<double>> measured_joint_errors(const ident::JointErrorLog& log) {
+  std::vector<std::vector<double>> e(log.joint_count());
+  for (std::size_t j = 0; j < log.joint_count(); ++j) {
+    e[j].resize(log.sample_count());
+    for (std::size_t k = 0; k < log.sample_count(); ++k)
+      e[j][k] = log.q_desired_rad[j][k] - log.q_measured_rad[j][k];
+  }
+  return e;
+}
+
+std::vector<std::vector<double>> predict_table_joint_errors(const ident::ParameterTable& table,
+                                                            const ident::JointErrorLog& log) {
+  if (table.joints.size() != log.joint_count())
+    throw std::invalid_argument("parameter table has " + std::to_string(table.joints.size()) +
+                                " joints, the joint errors " + std::to_string(log.joint_count()));
+  const auto runs = log.segments();
+  const std::size_t n = log.sample_count();
+  std::vector<std::vector<double>> out(log.joint_count(), std::vector<double>(n, 0.0));
+  for (std::size_t j = 0; j < log.joint_count(); ++j) {
+    const ident::JointParameters& jp = table.joints[j];
+    if (jp.name != log.joint_names[j])
+      throw std::invalid_argument("parameter table joint '" + jp.name +
+                                  "' where the joint errors have '" + log.joint_names[j] + "'");
+    const std::vector<double>& qd = log.q_desired_rad[j];
+    const ident::OperatingSignals ops = ident::operating_signals(qd, runs, log.cycle_s);
+    const std::vector<double> velocity = derivative(qd, runs, log.cycle_s);
+    // Every cell's free-run error on the whole log (runs restart from the model's own rest state).
+    std::vector<std::vector<double>> cell_error(jp.cells.size(), std::vector<double>(n, 0.0));
+    for (std::size_t c = 0; c < jp.cells.size(); ++c) {
+      const ident::ArxModel model = jp.cells[c].model(table.sample_time_s);
+      const std::size_t lag = std::size_t(model.structure().max_lag());
+      const double gain = model.static_gain();
+      for (const auto& [b, e] : runs) {
+        if (e - b <= lag) continue;
+        // At rest before the run the model's output is its steady state G * q_d(start).
+        std::vector<double> initial(std::max<std::size_t>(lag, 1),
+                                    std::isfinite(gain) ? gain * qd[b] : qd[b]);
+        std::span<const double> input(qd.data() + b, e - b);
+        std::span<double> err(cell_error[c].data() + b, e - b);
+        model.predict_joint_error(input, initial, err);
+      }
+    }
+    // Blend by the operating point (cell centres per dimension).
+    std::vector<std::vector<double>> centres;
+    for (const auto& dim : jp.dimensions) centres.push_back(dim.centres());
+    std::vector<std::span<const double>> centre_spans(centres.begin(), centres.end());
+    std::vector<double> point(jp.dimensions.size());
+    const long lag = long(jp.backlash_lag_samples);
+    for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t d = 0; d < jp.dimensions.size(); ++d)
+        point[d] = operating_value(jp.dimensions[d].quantity, ops.speed_rad_s[k],
+                                   ops.acceleration_rad_s2[k], qd[k], log.payload_kg[k]);
+      const ident::CellBlend blend = ident::blend_cells(centre_spans, point);
+      double v = 0.0;
+      for (int c = 0; c < blend.count; ++c)
+        v += blend.weight[std::size_t(c)] * cell_error[std::size_t(blend.cell[std::size_t(c)])][k];
+      const long kl = std::max(0L, long(k) - lag);
+      v += jp.backlash_l_rad * std::tanh(velocity[std::size_t(kl)] / kBacklashVelocityScale);
+      out[j][k] = v;
+    }
+  }
+  return out;
+}
+
+GapSignals make_gap_signals(const ident::JointErrorLog& real,
+                            const std::vector<std::vector<double>>& sim_joint_error_rad,
+                            const calib::RobotDescription& robot,
+                            const ident::ParameterTable* table_or_null) {
+  const std::size_t nj = real.joint_count(), n = real.sample_count();
+  if (nj != calib::kJointCount)
+    throw std::invalid_argument("the joint errors have " + std::to_string(nj) +
+                                " joints, the robot " + std::to_string(calib::kJointCount));
+  for (std::size_t j = 0; j < nj; ++j)
+    if (robot.joints[j].name != real.joint_names[j])
+      throw std::invalid_argument("joint " + std::to_string(j + 1) + " is '" + real.joint_names[j] +
+                                  "' in the joint errors but '" + robot.joints[j].name +
+                                  "' in the robot " + robot.name);
+  if (sim_joint_error_rad.size() != nj)
+    throw std::invalid_argument("sim joint errors: wrong joint count");
+  for (const auto& s : sim_joint_error_rad)
+    if (s.size() != n) throw std::invalid_argument("sim joint errors: wrong sample count");
+
+  GapSignals g;
+  g.cycle_s = real.cycle_s;
+  g.joint_names = real.joint_names;
+  g.time_s = real.time_s;
+  g.payload_kg = real.payload_kg;
+  g.runs = real.segments();
+  g.q_desired_rad = real.q_desired_rad;
+  g.q_internal_rad = real.q_internal_rad;
+  g.gap_rad.assign(nj, std::vector<double>(n));
+  for (std::size_t j = 0; j < nj; ++j) {
+    g.qd_desired_rad_s.push_back(derivative(real.q_desired_rad[j], g.runs, g.cycle_s));
+    g.qdd_desired_rad_s2.push_back(derivative(g.qd_desired_rad_s[j], g.runs, g.cycle_s));
+    for (std::size_t k = 0; k < n; ++k)
+      g.gap_rad[j][k] =
+          real.q_desired_rad[j][k] - real.q_measured_rad[j][k] - sim_joint_error_rad[j][k];
+    g.gear_ratio.push_back(robot.joints[j].drive.gear_ratio);
+    g.max_speed_rad_s.push_back(robot.joints[j].max_velocity_rad_s);
+  }
+  // Torques of the desired motion: the logged payload as a point mass at the tool origin (the
+  // log has no centre of mass); the unit-payload torque is the change for 1 kg more.
+  const Eigen::Vector3d gravity(0.0, 0.0, -9.80665);
+  sim::RigidBodyDynamics dynamics(robot, std::nullopt, gravity);
+  sim::RigidBodyDynamics unit(robot, point_mass(1.0), gravity);
+  sim::RigidBodyDynamics bare(robot, std::nullopt, gravity);
+  g.torque_nm.assign(nj, std::vector<double>(n));
+  g.gravity_torque_nm.assign(nj, std::vector<double>(n));
+  g.unit_payload_nm_kg.assign(nj, std::vector<double>(n));
+  double current_mass = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (real.payload_kg[k] != current_mass) {
+      current_mass = real.payload_kg[k];
+      dynamics.set_payload(current_mass > 0.0 ? std::optional(point_mass(current_mass))
+                                              : std::nullopt);
+    }
+    calib::JointVector q, qd, qdd;
+    for (std::size_t j = 0; j < nj; ++j) {
+      q[long(j)] = g.q_desired_rad[j][k];
+      qd[long(j)] = g.qd_desired_rad_s[j][k];
+      qdd[long(j)] = g.qdd_desired_rad_s2[j][k];
+    }
+    const calib::JointVector tau = dynamics.inverse_dynamics(q, qd, qdd);
+    const calib::JointVector tau_gravity = dynamics.gravity_torque(q);
+    const calib::JointVector tau_unit =
+        unit.inverse_dynamics(q, qd, qdd) - bare.inverse_dynamics(q, qd, qdd);
+    for (std::size_t j = 0; j < nj; ++j) {
+      g.torque_nm[j][k] = tau[long(j)];
+      g.gravity_torque_nm[j][k] = tau_gravity[long(j)];
+      g.unit_payload_nm_kg[j][k] = tau_unit[long(j)];
+    }
+  }
+  if (table_or_null) {
+    for (const auto& jp : table_or_null->joints) {
+      g.table_dimensions.push_back(jp.dimensions);
+      std::vector<bool> identified;
+      for (const auto& c : jp.cells)
+        identified.push_back(c.status == ident::CellStatus::kIdentified);
+      g.table_cell_identified.push_back(identified);
+    }
+  }
+  return g;
+}
+
+}  // namespace imscal::eval

@@ -1,0 +1,67 @@
+#pragma once
+// The data of a sim-to-real gap diagnosis (issue 7): per joint and controller cycle, the gap
+// between the measured ("real") joint error and the predicted ("sim") one, and the known signals
+// from which the candidate effects are built (desired joints and their derivatives, the rigid-
+// body torques of the desired motion, gear ratios, time).
+//
+//   joint error  Δq = q_desired - q_measured   (paper, Fig. 2; ident/joint_error_io.hpp)
+//   gap          g  = Δq_real - Δq_sim         [rad]
+//
+// "sim" is either the identified error model (parameters.json) run on the desired joints, or a
+// second joint_errors.csv (e.g. the simulator's prediction without some effect). The desired
+// derivatives are central differences of q_desired within each run (one-sided at its ends).
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "calib/robot_description.hpp"
+#include "ident/joint_error_io.hpp"
+#include "ident/parameter_table.hpp"
+
+namespace imscal::eval {
+
+struct GapSignals {
+  double cycle_s = 0.002;
+  std::vector<std::string> joint_names;
+  std::vector<double> time_s, payload_kg;
+  std::vector<std::pair<std::size_t, std::size_t>> runs;  // [begin, end) without time gaps
+  // [joint][sample]
+  std::vector<std::vector<double>> q_desired_rad, qd_desired_rad_s, qdd_desired_rad_s2;
+  std::vector<std::vector<double>> q_internal_rad;      // motor encoder / N of the real run
+  std::vector<std::vector<double>> gap_rad;             // real - sim joint error
+  std::vector<std::vector<double>> gravity_torque_nm;   // its gravity part G(q_d)
+  std::vector<std::vector<double>> torque_nm;           // inverse dynamics on q_d, logged payload
+  std::vector<std::vector<double>> unit_payload_nm_kg;  // torque change per kg of extra payload
+  std::vector<double> gear_ratio;                       // motor angle = N * joint angle
+  std::vector<double> max_speed_rad_s;                  // the robot's joint speed limits
+  // The operating-point grids of the identified model (empty without a table), per joint, and
+  // whether each of its cells was identified from data (false: filled from a neighbour).
+  std::vector<std::vector<ident::CellDimension>> table_dimensions;
+  std::vector<std::vector<bool>> table_cell_identified;
+
+  std::size_t sample_count() const { return time_s.size(); }
+  std::size_t joint_count() const { return joint_names.size(); }
+};
+
+// The joint errors the identified model predicts on the log's desired joints: per joint every
+// cell's ARX model runs free on q_d (paper, eq. 2), the cells are blended by the operating point
+// as the precontrol does (ident/cell_blending.hpp), and the backlash term l * sign(q̇_d(k - lag))
+// (eq. 3) is added. Runs restart at every time gap. Result [joint][sample], rad.
+// Throws std::invalid_argument when the table's joints do not match the log's.
+std::vector<std::vector<double>> predict_table_joint_errors(const ident::ParameterTable& table,
+                                                            const ident::JointErrorLog& log);
+
+// Builds the signals: gap = (q_d - q_m)_real - sim_joint_error_rad. The robot gives the torques
+// (KDL inverse dynamics with a point payload of the logged mass at the tool frame origin) and
+// the gear ratios; its joint names must match the log's (std::invalid_argument otherwise).
+GapSignals make_gap_signals(const ident::JointErrorLog& real,
+                            const std::vector<std::vector<double>>& sim_joint_error_rad,
+                            const calib::RobotDescription& robot,
+                            const ident::ParameterTable* table_or_null = nullptr);
+
+// The joint errors q_d - q_m of a log, [joint][sample].
+std::vector<std::vector<double>> measured_joint_errors(const ident::JointErrorLog& log);
+
+}  // namespace imscal::eval

@@ -1,0 +1,411 @@
+#include "eval/verification.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include "calib/forward_kinematics.hpp"
+#include "core/version.hpp"
+#include "eval/iso9283_path.hpp"
+#include "eval/path_deviation.hpp"
+#include "ims/earth_model.hpp"
+#include "sim/motion_planner.hpp"
+#include "sim/motion_program.hpp"
+
+namespace imscal::eval {
+namespace {
+
+// The scenario's plant, feeling the site's normal gravity in R (as sim::run_simulation does).
+sim::PlantConfig scenario_plant(const sim::Scenario& scenario,
+                                const calib::RobotDescription& robot) {
+  sim::PlantConfig config =
+      sim::make_plant_config(robot, scenario.effects ? &*scenario.effects : nullptr,
+                             scenario.integration_step ? &*scenario.integration_step : nullptr);
+  const ims::EarthModel earth(scenario.site);
+  config.gravity_in_base_m_s2 =
+      scenario.T_W_R.linear().transpose() * earth.gravity_W(scenario.T_W_R.translation());
+  return config;
+}
+
+double payload_mass(const sim::DesiredJointPath& path, const sim::DesiredJointSample& s) {
+  return path.payloads.empty() ? 0.0 : path.payloads[std::size_t(s.payload_index)].body.mass_kg;
+}
+
+bool is_cartesian(sim::SegmentKind kind) {
+  return kind == sim::SegmentKind::kLinear || kind == sim::SegmentKind::kCircular;
+}
+
+std::size_t index_of(double t_s, double cycle_s) {
+  return std::size_t(std::max(0L, std::lround(t_s / cycle_s)));
+}
+
+// The path from sample k0 to k1 (inclusive), re-timed to start at 0.
+sim::DesiredJointPath cut_path(const sim::DesiredJointPath& path, std::size_t k0, std::size_t k1) {
+  sim::DesiredJointPath out;
+  out.cycle_s = path.cycle_s;
+  out.payloads = path.payloads;
+  const double t0 = path.samples[k0].t_s, t1 = path.samples[k1].t_s;
+  for (std::size_t k = k0; k <= k1; ++k) {
+    sim::DesiredJointSample s = path.samples[k];
+    s.t_s = double(k - k0) * path.cycle_s;
+    out.samples.push_back(s);
+  }
+  for (sim::PathSegment segment : path.segments) {
+    if (segment.end_s <= t0 || segment.begin_s >= t1) continue;
+    segment.begin_s = std::max(segment.begin_s, t0) - t0;
+    segment.end_s = std::min(segment.end_s, t1) - t0;
+    out.segments.push_back(segment);
+  }
+  return out;
+}
+
+std::vector<PathPose> flange_path(const calib::RobotDescription& robot,
+                                  const std::vector<double>& t_s,
+                                  const std::vector<calib::JointVector>& q) {
+  std::vector<PathPose> poses(q.size());
+  for (std::size_t k = 0; k < q.size(); ++k) {
+    const Eigen::Isometry3d T_R_H = calib::forward_kinematics<double>(robot.kinematics, q[k]);
+    poses[k] = {t_s[k], T_R_H.translation(), Eigen::Quaterniond(T_R_H.linear()).normalized()};
+  }
+  return poses;
+}
+
+std::vector<PathPose> attained_path(const calib::RobotDescription& robot,
+                                    const sim::PlantLog& log) {
+  std::vector<double> t;
+  std::vector<calib::JointVector> q;
+  for (const sim::PlantSample& s : log.samples) {
+    t.push_back(s.t_s);
+    q.push_back(s.q_link_rad);
+  }
+  return flange_path(robot, t, q);
+}
+
+PoseSeries window(const std::vector<PathPose>& poses, double from_s, double to_s) {
+  PoseSeries out;
+  for (const PathPose& p : poses)
+    if (p.t_s >= from_s - 1e-9 && p.t_s <= to_s + 1e-9) out.push_back(p);
+  return out;
+}
+
+PathFigures path_figures(const std::vector<sim::PathSegment>& segments,
+                         const std::vector<sim::PathSegment>& all_segments,
+                         const std::vector<PathPose>& desired,
+                         const std::vector<std::vector<PathPose>>& cycles,
+                         const VerificationOptions& options, PlotSeries* series) {
+  PathFigures f;
+  double worst_av = 0.0;
+  for (const sim::PathSegment& segment : segments) {
+    const PoseSeries commanded = window(desired, segment.begin_s, segment.end_s);
+    std::vector<PoseSeries> attained;
+    for (const auto& cycle : cycles) {
+      attained.push_back(window(cycle, segment.begin_s - options.iso_time_window_s,
+                                segment.end_s + options.iso_time_window_s));
+    }
+    // Commanded speed: the segment's top speed; the velocity characteristics over the part of
+    // the segment where the command runs within 1 % of it.
+    std::vector<double> s(commanded.size(), 0.0), v(commanded.size(), 0.0);
+    for (std::size_t k = 1; k < commanded.size(); ++k) {
+      const double ds = (commanded[k].p_m - commanded[k - 1].p_m).norm();
+      s[k] = s[k - 1] + ds;
+      v[k] = ds / (commanded[k].t_s - commanded[k - 1].t_s);
+    }
+    const double v_c = *std::max_element(v.begin(), v.end());
+    Iso9283Options iso;
+    iso.calculation_points = options.calculation_points;
+    iso.time_window_s = options.iso_time_window_s;
+    iso.velocity_from_m = s.back();
+    iso.velocity_to_m = 0.0;
+    for (std::size_t k = 1; k < v.size(); ++k) {
+      if (v[k] < 0.99 * v_c) continue;
+      iso.velocity_from_m = std::min(iso.velocity_from_m, s[k - 1]);
+      iso.velocity_to_m = std::max(iso.velocity_to_m, s[k]);
+    }
+    const Iso9283PathResult r = iso9283_path(commanded, attained, v_c, iso);
+    f.AT_p_m = std::max(f.AT_p_m, r.AT_p_m);
+    f.RT_p_m = std::max(f.RT_p_m, r.RT_p_m);
+    f.AT_abc_rad = f.AT_abc_rad.cwiseMax(r.AT_abc_rad);
+    f.RT_abc_rad = f.RT_abc_rad.cwiseMax(r.RT_abc_rad);
+    if (std::abs(r.AV_percent) >= std::abs(worst_av)) worst_av = r.AV_percent;
+    f.RV_percent = std::max(f.RV_percent, r.RV_percent);
+    f.FV_m_s = std::max(f.FV_m_s, r.FV_m_s);
+    f.missed_crossings += r.missed_crossings;
+    // Overshoot at the stop of a straight segment: how far the flange runs on beyond the end
+    // point along the line, until the next motion starts (at most 0.5 s after the stop).
+    if (segment.kind == sim::SegmentKind::kLinear) {
+      const Eigen::Vector3d start = commanded.front().p_m, end = commanded.back().p_m;
+      const Eigen::Vector3d direction = (end - start).normalized();
+      double until = segment.end_s + 0.5;
+      for (const sim::PathSegment& next : all_segments) {
+        if (next.begin_s >= segment.end_s - 1e-9 && next.kind != sim::SegmentKind::kRest) {
+          until = std::min(until, next.begin_s);
+          break;
+        }
+      }
+      for (const auto& cycle : cycles)
+        for (const PathPose& p : window(cycle, segment.begin_s, until))
+          f.CO_m = std::max(f.CO_m, (p.p_m - end).dot(direction));
+    }
+  }
+  f.AV_percent = worst_av;
+
+  // Path deviation (Fig. 6): the samples inside the evaluated segments.
+  auto inside = [&](double t) {
+    for (const sim::PathSegment& segment : segments)
+      if (t >= segment.begin_s - 1e-9 && t <= segment.end_s + 1e-9) return true;
+    return false;
+  };
+  std::vector<TimedPoint> desired_points;
+  for (const PathPose& p : desired)
+    if (inside(p.t_s)) desired_points.push_back({p.t_s, p.p_m});
+  double sum_squares = 0.0;
+  std::size_t count = 0;
+  for (std::size_t j = 0; j < cycles.size(); ++j) {
+    std::vector<TimedPoint> actual;
+    for (const PathPose& p : cycles[j])
+      if (inside(p.t_s)) actual.push_back({p.t_s, p.p_m});
+    const PathDeviation d = path_deviation(desired_points, actual, options.deviation_window_s);
+    f.max_path_deviation_m = std::max(f.max_path_deviation_m, d.max_m);
+    for (double e : d.deviation_m) sum_squares += e * e;
+    count += d.deviation_m.size();
+    if (j == 0 && series) {
+      *series = {};
+      double arc = 0.0;
+      for (std::size_t k = 0; k < actual.size(); ++k) {
+        if (k > 0) arc += (desired_points[k].p_m - desired_points[k - 1].p_m).norm();
+        series->t_s.push_back(actual[k].t_s);
+        series->arc_length_m.push_back(arc);
+        series->desired_m.push_back(desired_points[k].p_m);
+        series->attained_m.push_back(actual[k].p_m);
+        series->deviation_m.push_back(d.deviation_m[k]);
+      }
+    }
+  }
+  f.rms_path_deviation_m = count ? std::sqrt(sum_squares / double(count)) : 0.0;
+  return f;
+}
+
+Eigen::Matrix<double, 8, 1> pose_row(const PathPose& p) {
+  Eigen::Matrix<double, 8, 1> row;
+  row << p.t_s, p.p_m.x(), p.p_m.y(), p.p_m.z(), p.q.w(), p.q.x(), p.q.y(), p.q.z();
+  return row;
+}
+
+}  // namespace
+
+ident::JointErrorLog simulate_truth_joint_errors(const sim::Scenario& scenario,
+                                                 double max_duration_s) {
+  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
+  sim::DesiredJointPath path =
+      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
+  while (path.samples.size() > 2 && path.samples.back().t_s > max_duration_s) {
+    path.samples.pop_back();
+  }
+  const sim::PlantLog plant =
+      sim::simulate_plant(scenario_plant(scenario, robot), path, path.cycle_s);
+  ident::JointErrorLog log;
+  log.robot = robot.name;
+  log.cycle_s = path.cycle_s;
+  log.source =
+      fmt::format("simulator truth (q_measured = link-side angles) of scenario {}", scenario.name);
+  for (const auto& joint : robot.joints) log.joint_names.push_back(joint.name);
+  log.q_desired_rad.assign(calib::kJointCount, {});
+  log.q_measured_rad.assign(calib::kJointCount, {});
+  log.q_internal_rad.assign(calib::kJointCount, {});
+  const std::size_t n = std::min(path.samples.size(), plant.samples.size());
+  for (std::size_t k = 0; k < n; ++k) {
+    log.time_s.push_back(path.samples[k].t_s);
+    log.payload_kg.push_back(payload_mass(path, path.samples[k]));
+    for (int j = 0; j < calib::kJointCount; ++j) {
+      log.q_desired_rad[std::size_t(j)].push_back(path.samples[k].q_rad[j]);
+      log.q_measured_rad[std::size_t(j)].push_back(plant.samples[k].q_link_rad[j]);
+      log.q_internal_rad[std::size_t(j)].push_back(plant.samples[k].q_motor_rad[j]);
+    }
+  }
+  return log;
+}
+
+IdentifiedTable identify_table(const ident::JointErrorLog& log,
+                               const ident::IdentificationConfig& config,
+                               const std::string& source_file) {
+  if (config.max_speed_rad_s.size() != log.joint_count()) {
+    throw std::invalid_argument(fmt::format("identify_table: config has {} joints, the data {}",
+                                            config.max_speed_rad_s.size(), log.joint_count()));
+  }
+  IdentifiedTable out;
+  out.table.robot = log.robot;
+  out.table.sample_time_s = log.cycle_s;
+  out.table.created_by = std::string("imscal ") + kVersion;
+  out.table.source = {source_file, "", log.sample_count(), log.source};
+  const auto segments = log.segments();
+  for (std::size_t j = 0; j < log.joint_count(); ++j) {
+    try {
+      out.joints.push_back(ident::identify_joint(
+          log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j], log.payload_kg, segments,
+          log.cycle_s, config.joint_grid(j), config.options));
+    } catch (const std::runtime_error& e) {
+      out.failed_joints.push_back(log.joint_names[j] + ": " + e.what());
+      ident::JointIdentification pass;
+      pass.parameters.name = log.joint_names[j];
+      pass.parameters.dimensions = {
+          {ident::OperatingQuantity::kSpeed, {0.0, config.max_speed_rad_s[j]}}};
+      ident::CellParameters cell;
+      cell.bands = {0};
+      cell.status = ident::CellStatus::kFilled;
+      cell.reason = "no cell identified: pass-through model, no compensation";
+      cell.structure.na = 0;
+      cell.structure.nb = 1;
+      cell.structure.dead_time = 0;
+      cell.b = {1.0};
+      pass.parameters.cells.push_back(cell);
+      out.joints.push_back(pass);
+    }
+    out.table.joints.push_back(out.joints.back().parameters);
+  }
+  return out;
+}
+
+ident::IdentificationConfig without_backlash(ident::IdentificationConfig config) {
+  config.options.identify_backlash = false;
+  return config;
+}
+
+ident::IdentificationConfig single_cell(ident::IdentificationConfig config) {
+  config.speed_fraction_bounds = {0.0, 1.0};
+  config.payload_fraction_bounds = {0.0, 1.0};
+  config.extra_dimensions.clear();
+  return config;
+}
+
+JointFitSummary summarize_fit(const ident::JointIdentification& joint) {
+  JointFitSummary s;
+  double sim = 0.0, err = 0.0;
+  std::size_t err_rows = 0;
+  for (std::size_t c = 0; c < joint.cells.size(); ++c) {
+    if (joint.cells[c].status != ident::CellStatus::kIdentified) continue;
+    const ident::CellFitFigures& f = joint.parameters.cells[c].figures;
+    if (!std::isfinite(f.simulation_fit_percent) || f.validation_rows == 0) continue;
+    sim += f.simulation_fit_percent * double(f.validation_rows);
+    s.validation_rows += f.validation_rows;
+    if (std::isfinite(f.joint_error_fit_percent)) {
+      err += f.joint_error_fit_percent * double(f.validation_rows);
+      err_rows += f.validation_rows;
+    }
+  }
+  if (s.validation_rows) s.simulation_fit_percent = sim / double(s.validation_rows);
+  if (err_rows) s.joint_error_fit_percent = err / double(err_rows);
+  return s;
+}
+
+double reduction_percent(double before, double after) {
+  return 100.0 * (1.0 - after / before);
+}
+
+VerificationResult verify_scenario(const sim::Scenario& scenario,
+                                   const std::vector<NamedTable>& tables,
+                                   const VerificationOptions& options) {
+  if (options.cycles < 1) throw std::invalid_argument("verify: at least one cycle");
+  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
+  const sim::DesiredJointPath full =
+      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
+  const double T = full.cycle_s;
+
+  // The evaluated segments and the part of the program that is run.
+  std::vector<sim::PathSegment> evaluated;
+  for (const sim::PathSegment& s : full.segments)
+    if (is_cartesian(s.kind) && s.label.find(options.segment_filter) != std::string::npos)
+      evaluated.push_back(s);
+  if (evaluated.empty()) {
+    throw std::invalid_argument(
+        fmt::format("verify: no Cartesian segment of scenario {} has '{}' in its label",
+                    scenario.name, options.segment_filter));
+  }
+  std::size_t k0 = index_of(evaluated.front().begin_s - options.lead_in_s, T);
+  const std::size_t k1 =
+      std::min(full.samples.size() - 1, index_of(evaluated.back().end_s + options.lead_out_s, T));
+  for (std::size_t k = k0; k <= index_of(evaluated.front().begin_s, T) && k0 > 0; ++k) {
+    if (full.samples[k].qd_rad_s.norm() != 0.0 || full.samples[k].qdd_rad_s2.norm() != 0.0) {
+      k0 = 0;  // not at rest there: run the program from its start
+    }
+  }
+  const sim::DesiredJointPath path = cut_path(full, k0, k1);
+  const double t0 = full.samples[k0].t_s;
+  for (sim::PathSegment& s : evaluated) s.begin_s -= t0, s.end_s -= t0;
+
+  VerificationResult result;
+  result.scenario = scenario.name;
+  result.cycles = options.cycles;
+  result.evaluated_from_s = evaluated.front().begin_s + t0;
+  result.evaluated_to_s = evaluated.back().end_s + t0;
+  for (const auto& s : evaluated) result.segments.push_back(s.label);
+
+  // The commands: one per table (the precontrol does not depend on the plant's draw).
+  std::vector<CompensationRun> compensations;
+  std::vector<sim::DesiredJointPath> commands;
+  for (const NamedTable& t : tables) {
+    compensations.push_back(run_precontrol(t.table, robot.name, path, options.compensation));
+    commands.push_back(command_path(path, compensations.back().offset_rad));
+  }
+
+  std::vector<double> t_s;
+  std::vector<calib::JointVector> q_d;
+  for (const auto& s : path.samples) t_s.push_back(s.t_s), q_d.push_back(s.q_rad);
+  const std::vector<PathPose> desired = flange_path(robot, t_s, q_d);
+
+  const sim::PlantConfig base = scenario_plant(scenario, robot);
+  std::mt19937_64 rng(options.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<std::vector<std::vector<PathPose>>> cycles(tables.size() + 1);
+  for (int j = 0; j < options.cycles; ++j) {
+    sim::PlantConfig config = base;
+    for (auto& joint : config.robot.joints) {
+      // Clamped to >= 0.5 so that a rare draw cannot make the friction vanish or turn negative.
+      const double factor = std::max(0.5, 1.0 + options.friction_sigma_fraction * normal(rng));
+      joint.drive.coulomb_nm *= factor;
+      joint.drive.viscous_nm_s_per_rad *= factor;
+    }
+    cycles[0].push_back(attained_path(robot, sim::simulate_plant(config, path, T)));
+    for (std::size_t c = 0; c < commands.size(); ++c) {
+      cycles[c + 1].push_back(attained_path(robot, sim::simulate_plant(config, commands[c], T)));
+    }
+  }
+
+  auto make_case = [&](const std::string& label, std::size_t index) {
+    VerificationCase vc;
+    vc.label = label;
+    vc.figures =
+        path_figures(evaluated, path.segments, desired, cycles[index], options, &vc.series);
+    for (double& t : vc.series.t_s) t += t0;  // back to the scenario's clock
+    return vc;
+  };
+  result.before = make_case("uncompensated", 0);
+  for (std::size_t c = 0; c < tables.size(); ++c) {
+    VerificationCase vc = make_case(tables[c].label, c + 1);
+    vc.events = compensations[c].events;
+    for (auto state : compensations[c].state)
+      vc.inactive_cycles += state != ident::PrecontrolState::kActive;
+    result.after.push_back(std::move(vc));
+  }
+  for (const PathPose& p : desired) {
+    PathPose shifted = p;
+    shifted.t_s += t0;
+    result.desired_poses.push_back(pose_row(shifted));
+  }
+  result.attained_poses.resize(cycles.size());
+  for (std::size_t c = 0; c < cycles.size(); ++c) {
+    for (const auto& cycle : cycles[c]) {
+      std::vector<Eigen::Matrix<double, 8, 1>> rows;
+      for (PathPose p : cycle) {
+        p.t_s += t0;
+        rows.push_back(pose_row(p));
+      }
+      result.attained_poses[c].push_back(std::move(rows));
+    }
+  }
+  return result;
+}
+
+}  // namespace imscal::eval

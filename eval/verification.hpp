@@ -1,0 +1,156 @@
+#pragma once
+// Verification of the dynamic calibration (paper, section 4; issue 6): the same path run by the
+// uncalibrated robot and by the robot with the precontrol in the loop (eval/closed_loop.hpp), n
+// cycles each, compared by ISO 9283 path characteristics (eval/iso9283_path.hpp) and by the
+// maximum perpendicular path deviation (eval/path_deviation.hpp, the paper's Fig. 6).
+//
+// Cycles: the simulator is deterministic, so a cycle is one run of the path by a plant whose
+// friction is drawn anew (Coulomb and viscous friction of every joint scaled by 1 + σ N(0, 1),
+// σ = friction_sigma_fraction; run-to-run friction changes with temperature and lubrication are
+// the main cause of path repeatability errors of geared arms). Cycle j uses the same draw with
+// and without compensation, so the comparison is paired.
+//
+// Which part of the path is evaluated: the Cartesian segments (lin, circ/circle) whose label
+// contains segment_filter (all of them when empty). The plant is run from lead_in_s before the
+// first of them (if the robot is at rest there; the plant starts balanced at rest, so this is
+// the same as having arrived and settled) to lead_out_s after the last, to save time.
+//
+// The attained path is the flange's, by forward kinematics of the link-side joint angles the
+// plant reached (what a perfect IMS chain would measure; the IMS chain of `imscal calibrate`
+// can replace it once it exists).
+//
+// Identification from simulator truth: joint errors q_d - q_link of a scenario's run, one sample
+// per controller cycle (a stand-in for the IMS chain's joint_errors.csv), and the parameter
+// table identified from them with an identification config (ident/identification_config.hpp).
+#include <Eigen/Core>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "eval/closed_loop.hpp"
+#include "ident/identification_config.hpp"
+#include "ident/joint_error_io.hpp"
+#include "ident/joint_identification.hpp"
+#include "sim/scenario.hpp"
+
+namespace imscal::eval {
+
+// ---- Identification from the simulator's truth --------------------------------------------
+
+// Runs the scenario's program through its plant and returns q_d and q_link (as q_measured and,
+// for lack of an encoder model here, q_internal = motor angle / N) every controller cycle.
+// max_duration_s cuts the program (lighter runs under sanitizers).
+ident::JointErrorLog simulate_truth_joint_errors(
+    const sim::Scenario& scenario, double max_duration_s = std::numeric_limits<double>::infinity());
+
+struct IdentifiedTable {
+  ident::ParameterTable table;
+  std::vector<ident::JointIdentification> joints;  // reports (chosen orders, fits, backlash)
+  // Joints where no cell could be identified: "A5: <reason>"; their table entry is a single
+  // pass-through cell (q̂ = q_d: no compensation of that joint) so that the rest can be verified.
+  std::vector<std::string> failed_joints;
+};
+
+// identify_joint for every joint of the log (as `imscal identify`). source_file names the data.
+IdentifiedTable identify_table(const ident::JointErrorLog& log,
+                               const ident::IdentificationConfig& config,
+                               const std::string& source_file = "simulator truth");
+
+// The ablation configs: the same config with the backlash identification off, and with one
+// cell per joint (speed 0..max x payload 0..nominal) instead of the operating-point grid.
+ident::IdentificationConfig without_backlash(ident::IdentificationConfig config);
+ident::IdentificationConfig single_cell(ident::IdentificationConfig config);
+
+// Held-out simulation fit of a joint: the identified cells' figures weighted by their held-out
+// rows (NaN when no cell has held-out data).
+struct JointFitSummary {
+  double simulation_fit_percent = std::numeric_limits<double>::quiet_NaN();
+  double joint_error_fit_percent = std::numeric_limits<double>::quiet_NaN();
+  std::size_t validation_rows = 0;
+};
+JointFitSummary summarize_fit(const ident::JointIdentification& joint);
+
+// ---- Verification --------------------------------------------------------------------------
+
+struct VerificationOptions {
+  int cycles = 10;
+  std::uint64_t seed = 1;
+  double friction_sigma_fraction = 0.05;
+  std::string segment_filter;  // label substring of the evaluated Cartesian segments
+  double lead_in_s = 1.0;
+  double lead_out_s = 0.5;
+  // The precontrol's supervisor: 20 mrad per joint (the uncalibrated errors stay below ~5 mrad;
+  // a larger offset is a wrong table), other options at their defaults.
+  CompensationOptions compensation = [] {
+    CompensationOptions c;
+    c.precontrol.offset_tolerance_rad.fill(0.02);
+    return c;
+  }();
+  int calculation_points = 200;      // ISO 9283 calculation points per segment
+  double iso_time_window_s = 0.25;   // a crossing counts within this time of its point
+  double deviation_window_s = 0.25;  // path deviation: desired path within this time
+};
+
+// ISO 9283 path characteristics over the evaluated segments (each segment is one ISO path; the
+// figures are the worst over the segments) and the path deviation (max over the cycles).
+struct PathFigures {
+  double AT_p_m = 0.0, RT_p_m = 0.0;
+  Eigen::Vector3d AT_abc_rad = Eigen::Vector3d::Zero(), RT_abc_rad = Eigen::Vector3d::Zero();
+  // The programs' paths stop at every end (no corner run through), so CO is the overshoot at the
+  // end of each straight segment along its direction (ISO's overshoot applied to the stop) and
+  // CR is not defined (NaN).
+  double CO_m = 0.0;
+  double CR_m = std::numeric_limits<double>::quiet_NaN();
+  double AV_percent = 0.0;  // the segment with the largest |AV|, signed
+  double RV_percent = 0.0, FV_m_s = 0.0;
+  double max_path_deviation_m = 0.0;  // max over cycles and evaluated segments
+  double rms_path_deviation_m = 0.0;  // RMS over cycles and samples
+  int missed_crossings = 0;
+};
+
+// Series of cycle 0 for the paper's Fig. 5 (paths) and Fig. 6 (deviation along the path), at
+// every controller cycle inside the evaluated segments.
+struct PlotSeries {
+  std::vector<double> t_s;
+  std::vector<double> arc_length_m;  // along the desired path, through the evaluated segments
+  std::vector<Eigen::Vector3d> desired_m, attained_m;
+  std::vector<double> deviation_m;
+};
+
+struct VerificationCase {
+  std::string label;  // "uncompensated" or the table's label
+  PathFigures figures;
+  PlotSeries series;
+  std::vector<ident::PrecontrolEvent> events;  // precontrol events (compensated cases)
+  std::size_t inactive_cycles = 0;             // cycles with the precontrol not active
+};
+
+struct NamedTable {
+  std::string label;
+  ident::ParameterTable table;
+};
+
+struct VerificationResult {
+  std::string scenario;
+  int cycles = 0;
+  double evaluated_from_s = 0.0, evaluated_to_s = 0.0;  // scenario clock
+  std::vector<std::string> segments;                    // labels of the evaluated segments
+  VerificationCase before;
+  std::vector<VerificationCase> after;  // one per table, in the given order
+  // Commanded and attained flange poses of every case's cycles, for `imscal evaluate`
+  // (poses[case][cycle], case 0 = before; the commanded path is desired_poses).
+  std::vector<std::vector<std::vector<Eigen::Matrix<double, 8, 1>>>> attained_poses;
+  std::vector<Eigen::Matrix<double, 8, 1>> desired_poses;  // t, x, y, z, qw, qx, qy, qz
+};
+
+// Throws InputError for a scenario that cannot be loaded, std::invalid_argument when no segment
+// matches the filter or a table is refused.
+VerificationResult verify_scenario(const sim::Scenario& scenario,
+                                   const std::vector<NamedTable>& tables,
+                                   const VerificationOptions& options = {});
+
+// 100 (1 - after / before): the reduction in percent.
+double reduction_percent(double before, double after);
+
+}  // namespace imscal::eval

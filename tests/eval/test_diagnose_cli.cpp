@@ -1,0 +1,68 @@
+// `imscal diagnose` end to end: real and sim joint_errors.csv from the simulator (one withheld
+// effect, tests/eval/gap_cases.hpp), the report names it; outputs all or nothing, refusals.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "tests/eval/gap_cases.hpp"
+#include "tests/support/scratch_dir.hpp"
+
+namespace imscal {
+namespace {
+
+namespace fs = std::filesystem;
+using DiagnoseCli = test_support::ScratchDirTest;
+
+int run(const std::string& arguments, const fs::path& log) {
+  const std::string command =
+      std::string(IMSCAL_BINARY) + " " + arguments + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string read(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesAllOrNothing) {
+  const eval::test::GapWorld world;
+  // Joint zero offset injected on A3 (the harness's most clear-cut case class).
+  const auto c = world.make_case({{"zero_offset", 2}}, 14);
+  ident::write_joint_errors_csv(dir_ / "real.csv", c.real);
+  ident::JointErrorLog sim = c.real;
+  for (std::size_t j = 0; j < 6; ++j)
+    for (std::size_t k = 0; k < sim.sample_count(); ++k)
+      sim.q_measured_rad[j][k] = sim.q_desired_rad[j][k] - c.sim_joint_error_rad[j][k];
+  ident::write_joint_errors_csv(dir_ / "sim.csv", sim);
+  const std::string robot = std::string(IMSCAL_SOURCE_DIR) + "/datasets/robots/kr16.yaml";
+  const fs::path out = dir_ / "out";
+  const std::string args = "diagnose --joint-errors " + (dir_ / "real.csv").string() +
+                           " --sim-joint-errors " + (dir_ / "sim.csv").string() + " --robot " +
+                           robot + " --out " + out.string();
+  ASSERT_EQ(run(args, dir_ / "a.log"), 0) << read(dir_ / "a.log");
+  const auto report = nlohmann::json::parse(read(out / "report.json"));
+  EXPECT_TRUE(report["significant_gap"].get<bool>());
+  EXPECT_EQ(report["candidates"][0]["effect"], "zero_offset");
+  EXPECT_EQ(report["candidates"][0]["joint"], "A3");
+  EXPECT_NE(read(out / "report.txt").find("Most likely cause: zero_offset on joint A3"),
+            std::string::npos);
+  // Existing outputs are refused without --force (exit 2, files unchanged), kept with it.
+  const std::string before = read(out / "report.json");
+  EXPECT_EQ(run(args, dir_ / "b.log"), 2) << read(dir_ / "b.log");
+  EXPECT_EQ(read(out / "report.json"), before);
+  EXPECT_EQ(run(args + " --force", dir_ / "c.log"), 0) << read(dir_ / "c.log");
+  // Neither --table nor --sim-joint-errors: refused, nothing written.
+  const fs::path none = dir_ / "none";
+  EXPECT_NE(run("diagnose --joint-errors " + (dir_ / "real.csv").string() + " --robot " + robot +
+                    " --out " + none.string(),
+                dir_ / "d.log"),
+            0);
+  EXPECT_FALSE(fs::exists(none / "report.json"));
+}
+
+}  // namespace
+}  // namespace imscal

@@ -1,0 +1,148 @@
+// `imscal verify`, `imscal evaluate` and `imscal compensate` end to end: with a table whose models
+// predict no error the compensated runs equal the uncompensated ones (reduction 0), every output
+// file is written, `imscal evaluate` on the written path files gives the same AT_p as `verify`
+// computed in memory, and `compensate` writes zero offsets, or refuses a table for another robot
+// with exit code 2 and no output.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "calib/robot_log.hpp"
+#include "ident/parameter_table_io.hpp"
+#include "sim/motion_planner.hpp"
+#include "sim/motion_program.hpp"
+#include "sim/scenario.hpp"
+#include "tests/support/scratch_dir.hpp"
+
+namespace imscal {
+namespace {
+
+namespace fs = std::filesystem;
+using VerifyCli = test_support::ScratchDirTest;
+
+int run(const std::string& arguments, const fs::path& log) {
+  const std::string command =
+      std::string(IMSCAL_BINARY) + " " + arguments + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string read(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// q̂ = q_d for every joint: no offset at all.
+ident::ParameterTable zero_error_table(const std::string& robot) {
+  ident::ParameterTable table;
+  table.robot = robot;
+  table.sample_time_s = 0.002;
+  table.created_by = "test";
+  table.source = {"none", std::string(64, '0'), 0, "hand-made"};
+  for (int j = 0; j < 6; ++j) {
+    ident::JointParameters joint;
+    joint.name = fmt::format("A{}", j + 1);
+    joint.dimensions = {{ident::OperatingQuantity::kSpeed, {0.0, 100.0}}};
+    ident::CellParameters cell;
+    cell.bands = {0};
+    cell.structure.na = 0;
+    cell.structure.nb = 1;
+    cell.structure.dead_time = 0;
+    cell.b = {1.0};
+    joint.cells.push_back(cell);
+    table.joints.push_back(joint);
+  }
+  return table;
+}
+
+TEST_F(VerifyCli, ZeroTableVerifiesUnchangedAndEvaluateAgrees) {
+  const fs::path table = dir_ / "zero.json", out = dir_ / "out";
+  ident::write_parameters_json(table, zero_error_table("kr16"));
+  ASSERT_EQ(run("verify --table " + table.string() +
+                    " --scenario seed-line --segments 'line -y' --cycles 2 --out " + out.string(),
+                dir_ / "verify.log"),
+            0)
+      << read(dir_ / "verify.log");
+  const fs::path s = out / "seed-line";
+  for (const char* f :
+       {"verification.json", "verification.csv", "verification.txt", "fig5_paths.csv",
+        "fig6_deviation.csv", "fig5.gp", "fig6.gp", "commanded.csv", "attained_uncompensated_0.csv",
+        "attained_uncompensated_1.csv", "attained_compensated_1.csv"}) {
+    EXPECT_TRUE(fs::exists(s / f)) << f;
+  }
+  const auto doc = nlohmann::json::parse(read(s / "verification.json"));
+  ASSERT_EQ(doc["cases"].size(), 2u);
+  const auto& before = doc["cases"][0];
+  const auto& after = doc["cases"][1];
+  // Zero offsets: the same deterministic runs, so exactly the same figures.
+  EXPECT_EQ(before["max_path_deviation_mm"], after["max_path_deviation_mm"]);
+  EXPECT_EQ(after["reduction_of_max_path_deviation_percent"].get<double>(), 0.0);
+  EXPECT_GT(before["max_path_deviation_mm"].get<double>(), 1.0);  // the uncalibrated robot errs
+
+  // `imscal evaluate` on the written files over the evaluated segment, same window.
+  ASSERT_EQ(
+      run(fmt::format("evaluate --commanded {} --attained {} --attained {} --from-s {} "
+                      "--to-s {} --window-s 0.25 --out {}",
+                      (s / "commanded.csv").string(), (s / "attained_uncompensated_0.csv").string(),
+                      (s / "attained_uncompensated_1.csv").string(),
+                      doc["evaluated_from_s"].get<double>() - 1e-6,
+                      doc["evaluated_to_s"].get<double>() + 1e-6, (dir_ / "figures.json").string()),
+          dir_ / "evaluate.log"),
+      0)
+      << read(dir_ / "evaluate.log");
+  const auto figures = nlohmann::json::parse(read(dir_ / "figures.json"));
+  // Same commanded samples and crossings; only the 17-digit round trip of the files differs.
+  EXPECT_NEAR(figures["AT_p_mm"].get<double>(), before["AT_p_mm"].get<double>(), 1e-6);
+  EXPECT_NEAR(figures["RT_p_mm"].get<double>(), before["RT_p_mm"].get<double>(), 1e-6);
+  // Refuses to overwrite without --force, and names the file.
+  EXPECT_EQ(
+      run(fmt::format("evaluate --commanded {} --attained {} --out {}",
+                      (s / "commanded.csv").string(), (s / "attained_uncompensated_0.csv").string(),
+                      (dir_ / "figures.json").string()),
+          dir_ / "again.log"),
+      2);
+}
+
+TEST_F(VerifyCli, CompensateWritesOffsetsOrRefusesAnotherRobotsTable) {
+  const sim::Scenario scenario = sim::load_scenario(sim::resolve_scenario("seed-line"));
+  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
+  const sim::DesiredJointPath path =
+      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
+  calib::RobotLog log;
+  log.robot_name = robot.name;
+  log.cycle_s = path.cycle_s;
+  for (std::size_t k = 0; k < path.samples.size() && path.samples[k].t_s <= 7.0; ++k) {
+    log.samples.push_back({path.samples[k].t_s, 5.0, path.samples[k].q_rad, path.samples[k].q_rad});
+  }
+  calib::write_robot_log_csv(dir_ / "robot.csv", log, Overwrite::kAllow);
+  ident::write_parameters_json(dir_ / "zero.json", zero_error_table("kr16"));
+  ASSERT_EQ(run("compensate --table " + (dir_ / "zero.json").string() + " --robot-log " +
+                    (dir_ / "robot.csv").string() + " --out " + (dir_ / "offsets.csv").string(),
+                dir_ / "compensate.log"),
+            0)
+      << read(dir_ / "compensate.log");
+  std::ifstream in(dir_ / "offsets.csv");
+  std::string line;
+  std::size_t rows = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("t_s", 0) == 0) continue;
+    ++rows;
+    // t, state, outside_table, then six offsets: all exactly 0 with this table.
+    EXPECT_NE(line.find(",active,0,0,0,0,0,0,0"), std::string::npos) << line;
+  }
+  EXPECT_EQ(rows, log.samples.size());
+  ident::write_parameters_json(dir_ / "other.json", zero_error_table("other"));
+  EXPECT_EQ(run("compensate --table " + (dir_ / "other.json").string() + " --robot-log " +
+                    (dir_ / "robot.csv").string() + " --out " + (dir_ / "other.csv").string(),
+                dir_ / "other.log"),
+            2)
+      << read(dir_ / "other.log");
+  EXPECT_FALSE(fs::exists(dir_ / "other.csv"));
+}
+
+}  // namespace
+}  // namespace imscal
