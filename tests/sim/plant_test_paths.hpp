@@ -13,6 +13,22 @@
 
 namespace imscal::sim::test {
 
+constexpr double kDeg = M_PI / 180.0;
+
+// The default robot of the plant tests (datasets/robots/kr16.yaml), read once.
+inline const calib::RobotDescription& kr16() {
+  static const auto robot =
+      calib::load_robot_description(IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml");
+  return robot;
+}
+
+// Upper arm vertical, forearm horizontal, hand tilted: gravity loads A2, A3, A5.
+inline calib::JointVector home() {
+  calib::JointVector q;
+  q << 0.0, -90.0 * kDeg, 90.0 * kDeg, 0.0, 45.0 * kDeg, 0.0;
+  return q;
+}
+
 // Position, velocity, acceleration at time t in [0, duration] of a rest-to-rest move of
 // `distance` with cosine ramps of `ramp_s` (<= duration / 2) and constant velocity between.
 struct ProfilePoint {

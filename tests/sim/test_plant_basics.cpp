@@ -17,14 +17,9 @@ using imscal::ConfigNode;
 using imscal::InputError;
 using imscal::calib::JointVector;
 using namespace imscal::sim;
-constexpr double kDeg = M_PI / 180.0;
+using test::kDeg;
+using test::kr16;
 constexpr double kArcsec = kDeg / 3600.0;
-
-const imscal::calib::RobotDescription& kr16() {
-  static const auto robot =
-      imscal::calib::load_robot_description(IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml");
-  return robot;
-}
 
 PlantConfig parse(const std::string& yaml) {
   const ConfigNode root = ConfigNode::load_string(yaml, "scenario.yaml");

@@ -17,22 +17,11 @@ namespace {
 
 using imscal::calib::JointVector;
 using namespace imscal::sim;
-constexpr double kDeg = M_PI / 180.0;
+using test::home;
+using test::kDeg;
+using test::kr16;
 constexpr int kN = 6;
 constexpr double kCycle = 0.002;
-
-const imscal::calib::RobotDescription& kr16() {
-  static const auto robot =
-      imscal::calib::load_robot_description(IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml");
-  return robot;
-}
-
-// Upper arm vertical, forearm horizontal, hand tilted: gravity loads A2, A3, A5.
-JointVector home() {
-  JointVector q;
-  q << 0.0, -90.0 * kDeg, 90.0 * kDeg, 0.0, 45.0 * kDeg, 0.0;
-  return q;
-}
 
 // The reference plant: rigid gears with the motor inertia (the controllers are tuned for
 // M_ii + N^2 J_m; the stiff wrist loops of kr16.yaml are not stable on the link inertia alone:

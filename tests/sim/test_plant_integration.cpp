@@ -14,20 +14,10 @@ namespace {
 
 using imscal::calib::JointVector;
 using namespace imscal::sim;
-constexpr double kDeg = M_PI / 180.0;
+using test::home;
+using test::kDeg;
+using test::kr16;
 constexpr int kN = 6;
-
-const imscal::calib::RobotDescription& kr16() {
-  static const auto robot =
-      imscal::calib::load_robot_description(IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml");
-  return robot;
-}
-
-JointVector home() {
-  JointVector q;
-  q << 0.0, -90.0 * kDeg, 90.0 * kDeg, 0.0, 45.0 * kDeg, 0.0;
-  return q;
-}
 
 // Controller, friction and gear damping off; gravity, gear springs with backlash, motor
 // inertias and the transmission error on: a conservative system. It starts statically balanced
