@@ -9,10 +9,13 @@
 #include <string>
 #include <string_view>
 
+#include "calib/calibration_config.hpp"
 #include "calib/robot_description.hpp"
 #include "calib/robot_log.hpp"
+#include "calib/tool_imu_record.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "ident/identification_config.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "ims/imu_binary.hpp"
@@ -35,6 +38,14 @@ inline void parse_yaml_configs(const std::string& text) {
     ims::parse_sensor_spec(root);
   } catch (const InputError&) {
   }
+  try {
+    calib::parse_calibration_config(root);
+  } catch (const InputError&) {
+  }
+  try {
+    ident::load_identification_config(root);
+  } catch (const InputError&) {
+  }
   ims::parse_sensor_error_model(root);
 }
 
@@ -50,6 +61,8 @@ inline void read_with(std::string_view target, const std::filesystem::path& file
       ims::read_psins(file);
     } else if (target == "robot_log") {
       calib::read_robot_log_csv(file);
+    } else if (target == "tool_imu_record") {
+      calib::read_tool_imu_record(file);
     } else if (target == "nav_trajectory") {
       ims::read_trajectory_csv(file);
     } else if (target == "joint_errors") {

@@ -1,0 +1,146 @@
+// The bad-config catalogue (issue 9): every file in tests/data/bad_inputs/configs/ is a YAML config
+// that a user could write by mistake (typo in a key, unit in the wrong key, text for a number,
+// NaN, a short vector, inverted bounds, a missing referenced file, tabs, an empty file, ...).
+// Each names, in its first line, what the refusal must say:
+//   # expect: line N, field F, "words"
+// and the loader of its kind (the file name's prefix) must refuse it with an InputError that
+// names that file, that line and that field (the words: a substring of the message). A file
+// without an expectation line (the empty file) must be refused naming the file.
+// The run config of `imscal run` is checked through the binary: exit code 2, the message with
+// file and line, and no run folder left behind.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "calib/calibration_config.hpp"
+#include "core/config_node.hpp"
+#include "core/input_error.hpp"
+#include "ident/identification_config.hpp"
+#include "tests/support/scratch_dir.hpp"
+
+namespace imscal {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kCases = fs::path(IMSCAL_TEST_DATA_DIR) / "bad_inputs" / "configs";
+
+struct Expectation {
+  bool given = false;
+  std::size_t line = 0;
+  std::string field, words;
+};
+
+Expectation expectation_of(const fs::path& file) {
+  std::ifstream in(file);
+  std::string first;
+  std::getline(in, first);
+  static const std::regex pattern(R"re(^# expect: line (\d+), field ([^,]*), "(.*)"$)re");
+  std::smatch m;
+  Expectation e;
+  if (std::regex_match(first, m, pattern)) {
+    e.given = true;
+    e.line = std::stoul(m[1]);
+    e.field = m[2];
+    e.words = m[3];
+  }
+  return e;
+}
+
+void load_by_kind(const fs::path& file) {
+  const std::string name = file.filename().string();
+  if (name.rfind("calibration-", 0) == 0) {
+    calib::load_calibration_config(file);
+  } else if (name.rfind("identification-", 0) == 0) {
+    ident::load_identification_config(ConfigNode::load_file(file));
+  } else {
+    FAIL() << "no loader for " << name << " (prefix calibration- or identification-)";
+  }
+}
+
+TEST(ConfigBadInputs, EveryCaseIsRefusedNamingFileLineAndField) {
+  std::vector<fs::path> cases;
+  for (const auto& entry : fs::directory_iterator(kCases))
+    if (entry.path().extension() == ".yaml") cases.push_back(entry.path());
+  std::sort(cases.begin(), cases.end());
+  ASSERT_GE(cases.size(), 20u);
+  for (const fs::path& file : cases) {
+    SCOPED_TRACE(file.filename().string());
+    const Expectation expected = expectation_of(file);
+    try {
+      load_by_kind(file);
+      ADD_FAILURE() << "accepted: " << file;
+    } catch (const InputError& e) {
+      std::printf("%-45s %s\n", file.filename().c_str(), e.what());
+      EXPECT_EQ(fs::path(e.file()).filename(), file.filename()) << e.what();
+      if (expected.given) {
+        EXPECT_EQ(e.line(), expected.line) << e.what();
+        EXPECT_EQ(e.field(), expected.field) << e.what();
+        EXPECT_NE(std::string(e.what()).find(expected.words), std::string::npos) << e.what();
+      }
+    }
+  }
+}
+
+// `imscal run` with a bad run config: exit 2, file:line and key in the message, no run folder.
+using RunConfigBadInputs = test_support::ScratchDirTest;
+
+int run_imscal(const std::string& arguments, const fs::path& log) {
+  const std::string command =
+      std::string(IMSCAL_BINARY) + " " + arguments + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string text_of(const fs::path& file) {
+  std::ifstream in(file);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+TEST_F(RunConfigBadInputs, RefusedWithExitTwoFileLineAndKeyAndNoRunFolder) {
+  std::ofstream(dir_ / "joint_errors.csv") << "placeholder\n";
+  struct Case {
+    std::string name, yaml, where, words;
+  };
+  const std::vector<Case> cases = {
+      {"unknown-key",
+       "imscal-run-config: 1\ninputs: {joint_errors: joint_errors.csv}\nreprot: {}\n", ":3",
+       "reprot"},
+      {"wrong-version", "imscal-run-config: 2\ninputs: {joint_errors: joint_errors.csv}\n", ":1",
+       "version"},
+      {"missing-input-file", "imscal-run-config: 1\ninputs: {imu: nowhere.imsb}\n", ":2",
+       "is not a file"},
+      {"no-inputs", "imscal-run-config: 1\ninputs: {}\n", ":2", "names no input"},
+      {"joint-errors-without-identify",
+       "imscal-run-config: 1\ninputs: {joint_errors: joint_errors.csv}\n", ":2", "identify"},
+      {"negative-overlap",
+       "imscal-run-config: 1\ninputs: {imu: joint_errors.csv}\nvalidate: {min_overlap_s: -1}\n",
+       ":3", "must be > 0"},
+      {"text-for-points",
+       "imscal-run-config: 1\ninputs: {imu: joint_errors.csv}\nreport: {max_points_per_curve: "
+       "lots}\n",
+       ":3", "max_points_per_curve"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path config = dir_ / (c.name + ".yaml");
+    std::ofstream(config) << c.yaml;
+    const fs::path out = dir_ / ("out-" + c.name), log = dir_ / (c.name + ".log");
+    EXPECT_EQ(run_imscal("run " + config.string() + " --out " + out.string(), log), 2);
+    const std::string message = text_of(log);
+    std::printf("%-32s %s", c.name.c_str(), message.c_str());
+    EXPECT_NE(message.find(config.filename().string() + c.where), std::string::npos) << message;
+    EXPECT_NE(message.find(c.words), std::string::npos) << message;
+    EXPECT_FALSE(fs::exists(out)) << "a run folder was left behind";
+  }
+}
+
+}  // namespace
+}  // namespace imscal
