@@ -3,10 +3,10 @@
 // interrupted run resumes. Exit codes: 0 success, 1 a check failed (the reason is printed),
 // 2 bad input or config (file, line, field).
 //
-// The chain is the list built in make_chain(); a stage joins it when its inputs are configured.
-// Extension points, in the order of the paper's chain: calibrate (frames, mounting verdict,
-// joint_errors.csv) after validate, identify reading calibrate's joint_errors.csv when no
-// inputs.joint_errors is given, then verify (ISO 9283 before/after) and diagnose before report.
+// The chain is the list built in make_chain(), in the order of the paper's chain: validate the
+// raw files, calibrate (frames, mounting verdict, joint_errors.csv), identify (from
+// inputs.joint_errors or calibrate's), verify (ISO 9283 before/after in the simulator), diagnose
+// (sim-to-real gap), report. A stage joins the chain when its section (and inputs) are configured.
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -19,8 +19,9 @@
 #include "core/version.hpp"
 #include "tools/command_registry.hpp"
 #include "tools/run_config.hpp"
-#include "tools/stage_identify.hpp"
+#include "tools/stage_chain.hpp"
 #include "tools/stage_report.hpp"
+#include "tools/stage_subcommand.hpp"
 #include "tools/stage_validate.hpp"
 
 namespace {
@@ -37,7 +38,10 @@ std::vector<std::unique_ptr<imscal::Stage>> make_chain(const tools::RunConfig& c
   std::vector<std::unique_ptr<imscal::Stage>> chain;
   if (config.imu || config.robot_log)
     chain.push_back(std::make_unique<tools::ValidateStage>(config));
-  if (config.identify) chain.push_back(std::make_unique<tools::IdentifyStage>(config));
+  if (config.calibrate) chain.push_back(tools::make_calibrate_stage(config));
+  if (config.identify) chain.push_back(tools::make_identify_stage(config));
+  if (config.verify) chain.push_back(tools::make_verify_stage(config));
+  if (config.diagnose) chain.push_back(tools::make_diagnose_stage(config));
   std::vector<std::string> before_report;
   for (const auto& stage : chain) before_report.push_back(stage->name());
   chain.push_back(std::make_unique<tools::ReportStage>(config, before_report));

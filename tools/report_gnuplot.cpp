@@ -42,13 +42,13 @@ std::string html_escape(const std::string& text) {
   return out;
 }
 
-namespace {
 std::string gnuplot_quoted(const fs::path& path) {
   std::string out = "'";
   for (char c : path.string()) out += c == '\'' ? std::string("''") : std::string(1, c);
   return out + "'";
 }
 
+namespace {
 void replace_all(std::string& text, const std::string& from, const std::string& to) {
   for (std::size_t at = 0; (at = text.find(from, at)) != std::string::npos; at += to.size())
     text.replace(at, from.size(), to);

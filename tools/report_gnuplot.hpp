@@ -31,6 +31,9 @@ class GnuplotRenderer {
   int figure_count_ = 0;
 };
 
+// A file name as a quoted gnuplot string ('' inside), for a script that reads the file.
+std::string gnuplot_quoted(const std::filesystem::path& path);
+
 // Text for an HTML element or attribute: & < > " ' escaped.
 std::string html_escape(const std::string& text);
 

@@ -28,8 +28,8 @@ double positive(const ConfigNode& node) {
 RunConfig load_run_config(const fs::path& file) {
   const ConfigNode root = ConfigNode::load_file(file);
   if (!root.is_map()) root.fail("the run config must be a map of keys");
-  root.require_only_keys(
-      {"imscal-run-config", "title", "inputs", "validate", "identify", "report"});
+  root.require_only_keys({"imscal-run-config", "title", "inputs", "validate", "calibrate",
+                          "identify", "verify", "diagnose", "report"});
   if (root.child("imscal-run-config").as_int() != 1)
     root.child("imscal-run-config").fail("only version 1 is known");
   RunConfig config;
@@ -51,10 +51,19 @@ RunConfig load_run_config(const fs::path& file) {
     if (auto n = v->optional_child("min_overlap_s")) config.validate.min_overlap_s = positive(*n);
     config.validate.allow_imu_gaps = v->get_bool("allow_imu_gaps", false);
   }
+  if (auto c = root.optional_child("calibrate")) {
+    c->require_only_keys({"config", "timeout_s"});
+    if (!config.imu || !config.robot_log)
+      c->fail("a calibrate section needs inputs.imu and inputs.robot_log");
+    CalibrateSettings settings;
+    settings.config = existing_file(c->child("config"), base);
+    if (auto n = c->optional_child("timeout_s")) settings.timeout_s = positive(*n);
+    config.calibrate = settings;
+  }
   if (auto i = root.optional_child("identify")) {
     i->require_only_keys({"config", "timeout_s"});
-    if (!config.joint_errors)
-      i->fail("an identify section needs inputs.joint_errors (the data to identify from)");
+    if (!config.joint_errors && !config.calibrate)
+      i->fail("an identify section needs joint errors: inputs.joint_errors or a calibrate section");
     IdentifySettings settings;
     settings.config = existing_file(i->child("config"), base);
     if (auto n = i->optional_child("timeout_s")) settings.timeout_s = positive(*n);
@@ -62,6 +71,41 @@ RunConfig load_run_config(const fs::path& file) {
   } else if (config.joint_errors) {
     inputs.child("joint_errors")
         .fail("joint errors are given but there is no identify section (identify.config)");
+  }
+  if (auto v = root.optional_child("verify")) {
+    v->require_only_keys({"scenarios", "cycles", "timeout_s"});
+    if (!config.identify) v->fail("a verify section needs an identify section (the table)");
+    VerifySettings settings;
+    if (auto list = v->optional_child("scenarios")) {
+      settings.scenarios.clear();
+      for (const ConfigNode& item : list->as_sequence()) {
+        const std::string name = item.as_string();
+        if (name.ends_with(".yaml")) {
+          settings.scenario_files.push_back(existing_file(item, base));
+          settings.scenarios.push_back(settings.scenario_files.back().string());
+        } else if (name.empty() || name.find('/') != std::string::npos) {
+          item.fail("a shipped scenario name (datasets/scenarios/NAME.yaml) or a .yaml file");
+        } else {
+          settings.scenarios.push_back(name);
+        }
+      }
+      if (settings.scenarios.empty()) list->fail("names no scenario");
+    }
+    if (auto n = v->optional_child("cycles")) {
+      const long cycles = n->as_int();
+      if (cycles < 1 || cycles > 100) n->fail("must be in [1, 100]");
+      settings.cycles = static_cast<int>(cycles);
+    }
+    if (auto n = v->optional_child("timeout_s")) settings.timeout_s = positive(*n);
+    config.verify = settings;
+  }
+  if (auto d = root.optional_child("diagnose")) {
+    d->require_only_keys({"robot", "timeout_s"});
+    if (!config.identify) d->fail("a diagnose section needs an identify section (the table)");
+    DiagnoseSettings settings;
+    settings.robot = existing_file(d->child("robot"), base);
+    if (auto n = d->optional_child("timeout_s")) settings.timeout_s = positive(*n);
+    config.diagnose = settings;
   }
   if (auto r = root.optional_child("report")) {
     r->require_only_keys({"gnuplot_timeout_s", "max_points_per_curve"});

@@ -12,8 +12,18 @@
 //     robot: kr16                         # the robot the log must be from (default: any)
 //     min_overlap_s: 1.0                  # IMS and robot clocks must overlap this long
 //     allow_imu_gaps: false
-//   identify:                             # required when inputs.joint_errors is given
-//     config: ../identification/ident-default.yaml
+//   calibrate:                            # needs inputs.imu and inputs.robot_log: frames,
+//     config: ../calibration/calibrate-default.yaml   # mounting verdict, joint_errors.csv
+//     timeout_s: 1800
+//   identify:                             # needs joint errors: inputs.joint_errors, or else
+//     config: ../identification/ident-default.yaml    # the calibrate stage's
+//     timeout_s: 1800
+//   verify:                               # needs identify: closed loop in the simulator with
+//     scenarios: [seed-line]              # and without the precontrol (shipped names or files)
+//     cycles: 3                           # ISO 9283 cycles per case (the standard: 10)
+//     timeout_s: 1800
+//   diagnose:                             # needs identify: the gap between the measured joint
+//     robot: ../robots/kr16.yaml          # errors and the identified model's prediction
 //     timeout_s: 1800
 //   report:
 //     gnuplot_timeout_s: 60               # per figure
@@ -21,6 +31,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/config_node.hpp"
 
@@ -37,6 +48,24 @@ struct IdentifySettings {
   double timeout_s = 1800.0;
 };
 
+struct CalibrateSettings {
+  std::filesystem::path config;
+  double timeout_s = 1800.0;
+};
+
+struct VerifySettings {
+  // Shipped scenario names (datasets/scenarios/NAME.yaml) or scenario files (absolute).
+  std::vector<std::string> scenarios{"seed-line"};
+  std::vector<std::filesystem::path> scenario_files;  // the files among them, for checksums
+  int cycles = 3;
+  double timeout_s = 1800.0;
+};
+
+struct DiagnoseSettings {
+  std::filesystem::path robot;
+  double timeout_s = 1800.0;
+};
+
 struct ReportSettings {
   double gnuplot_timeout_s = 60.0;
   int max_points_per_curve = 2000;
@@ -47,12 +76,15 @@ struct RunConfig {
   std::string title;
   std::optional<std::filesystem::path> imu, robot_log, joint_errors;  // absolute
   ValidateSettings validate;
+  std::optional<CalibrateSettings> calibrate;
   std::optional<IdentifySettings> identify;
+  std::optional<VerifySettings> verify;
+  std::optional<DiagnoseSettings> diagnose;
   ReportSettings report;
 };
 
 // InputError (file, line, key) on unknown keys, wrong types, missing files, a stage section
-// without its inputs or inputs without their stage's section.
+// without its inputs (or its upstream stage) or inputs without their stage's section.
 RunConfig load_run_config(const std::filesystem::path& file);
 
 }  // namespace imscal::tools

@@ -12,8 +12,10 @@
 #include "core/version.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
+#include "tools/report_chain_sections.hpp"
 #include "tools/report_figures.hpp"
 #include "tools/report_gnuplot.hpp"
+#include "tools/stage_chain.hpp"
 
 namespace imscal::tools {
 
@@ -43,7 +45,7 @@ std::string number(double value, int digits = 4) {
 }
 
 std::string not_run(const std::string& what) {
-  return "<p class=\"not-run\">Not run: " + esc(what) + "</p>\n";
+  return not_run_note(what);
 }
 
 std::string section(const std::string& id, const std::string& title, const std::string& intro,
@@ -53,7 +55,7 @@ std::string section(const std::string& id, const std::string& title, const std::
 }
 
 std::string figure(const std::string& svg, const std::string& caption) {
-  return "<figure>\n" + svg + "\n<figcaption>" + esc(caption) + "</figcaption>\n</figure>\n";
+  return figure_html(svg, caption);
 }
 
 std::string stages_section(const std::vector<std::string>& upstream, const StageWorkspace& ws) {
@@ -254,20 +256,22 @@ StageOutcome ReportStage::run(StageWorkspace& workspace) {
   sections += section("mounting", "Frame calibration and mounting verdict",
                       "The robot base in the Earth-fixed frame (R_T_W), the sensor on the "
                       "flange (S_T_H) with their 1-sigma, and the verdict on the IMS mounting.",
-                      not_run("the calibrate stage is not part of this run's chain yet."));
+                      mounting_body(workspace));
   workspace.progress(0.2);
   std::string joint_errors;
-  if (config_.joint_errors) {
-    const ident::JointErrorLog log = ident::read_joint_errors_csv(*config_.joint_errors);
+  if (const auto joint_errors_file = chain_joint_errors(config_, workspace)) {
+    const ident::JointErrorLog log = ident::read_joint_errors_csv(*joint_errors_file);
     joint_errors = figure(
         joint_errors_figure(gnuplot, log, config_.report.max_points_per_curve),
         fmt::format("Joint angle errors of {} ({} samples, {} run(s)): blue the error seen at the "
                     "end effector by the IMS chain, red the error seen by the robot's internal "
                     "sensors (motor encoders); gear compliance and backlash appear only in blue.",
-                    config_.joint_errors->filename().string(), log.sample_count(),
+                    joint_errors_file->filename().string(), log.sample_count(),
                     log.segments().size()));
   } else {
-    joint_errors = not_run("no joint_errors.csv in this run's inputs.");
+    joint_errors = not_run(
+        "no joint_errors.csv in this run's inputs, and no calibrate stage "
+        "that completed.");
   }
   sections += section("joint-errors", "Joint angle errors (paper Fig. 2)",
                       "q_desired - q_measured (IMS) against q_desired - q_internal (internal "
@@ -298,11 +302,11 @@ StageOutcome ReportStage::run(StageWorkspace& workspace) {
                       "Desired and measured paths (xy and yz projections), the path deviation "
                       "along the path and the ISO 9283 path characteristics, uncalibrated and "
                       "calibrated.",
-                      not_run("the verify stage is not part of this run's chain yet."));
+                      paths_body(workspace, gnuplot));
   sections += section("gap", "Sim-to-real gap diagnosis",
                       "What the robot model and the error model still miss, by comparing the "
                       "simulation with the measurement.",
-                      not_run("the diagnose stage is not part of this run's chain yet."));
+                      gap_body(workspace));
 
   const std::string html = fmt::format(
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"

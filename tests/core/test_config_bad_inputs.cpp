@@ -9,7 +9,6 @@
 // The run config of `imscal run` is checked through the binary: exit code 2, the message with
 // file and line, and no run folder left behind.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -24,6 +23,7 @@
 #include "core/input_error.hpp"
 #include "ident/identification_config.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/tools/run_campaign.hpp"
 
 namespace imscal {
 namespace {
@@ -91,18 +91,8 @@ TEST(ConfigBadInputs, EveryCaseIsRefusedNamingFileLineAndField) {
 
 // `imscal run` with a bad run config: exit 2, file:line and key in the message, no run folder.
 using RunConfigBadInputs = test_support::ScratchDirTest;
-
-int run_imscal(const std::string& arguments, const fs::path& log) {
-  const std::string command =
-      std::string(IMSCAL_BINARY) + " " + arguments + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string text_of(const fs::path& file) {
-  std::ifstream in(file);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
+using test_support::read_file_text;
+using test_support::run_imscal;
 
 TEST_F(RunConfigBadInputs, RefusedWithExitTwoFileLineAndKeyAndNoRunFolder) {
   std::ofstream(dir_ / "joint_errors.csv") << "placeholder\n";
@@ -134,7 +124,7 @@ TEST_F(RunConfigBadInputs, RefusedWithExitTwoFileLineAndKeyAndNoRunFolder) {
     std::ofstream(config) << c.yaml;
     const fs::path out = dir_ / ("out-" + c.name), log = dir_ / (c.name + ".log");
     EXPECT_EQ(run_imscal("run " + config.string() + " --out " + out.string(), log), 2);
-    const std::string message = text_of(log);
+    const std::string message = read_file_text(log);
     std::printf("%-32s %s", c.name.c_str(), message.c_str());
     EXPECT_NE(message.find(config.filename().string() + c.where), std::string::npos) << message;
     EXPECT_NE(message.find(c.words), std::string::npos) << message;

@@ -1,0 +1,167 @@
+#include "tools/stage_chain.hpp"
+
+#include <fmt/format.h>
+
+#include <regex>
+#include <stdexcept>
+
+#include "tools/stage_subcommand.hpp"
+
+namespace imscal::tools {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The output of an upstream stage that must exist for this stage to run.
+fs::path upstream_file(const StageWorkspace& ws, const std::string& stage, const char* file) {
+  const auto dir = ws.upstream_dir(stage);
+  if (!dir || !fs::exists(*dir / file))
+    throw std::runtime_error(fmt::format("the {} stage left no {}", stage, file));
+  return *dir / file;
+}
+
+fs::path table_of(const StageWorkspace& ws) {
+  return upstream_file(ws, "identify", "parameters.json");
+}
+
+}  // namespace
+
+std::optional<fs::path> chain_joint_errors(const RunConfig& config, const StageWorkspace& ws) {
+  if (config.joint_errors) return *config.joint_errors;
+  const auto dir = ws.upstream_dir("calibrate");
+  if (dir && fs::exists(*dir / "joint_errors.csv")) return *dir / "joint_errors.csv";
+  return std::nullopt;
+}
+
+std::unique_ptr<Stage> make_calibrate_stage(const RunConfig& config) {
+  SubcommandSpec spec;
+  spec.stage_name = spec.subcommand = "calibrate";
+  spec.timeout_s = config.calibrate->timeout_s;
+  spec.inputs = [&config] {
+    StageInputs in;
+    in.files = {{"imu", *config.imu},
+                {"robot_log", *config.robot_log},
+                {"calibrate_config", config.calibrate->config}};
+    in.config = {{"config", config.calibrate->config.string()},
+                 {"timeout_s", config.calibrate->timeout_s}};
+    return in;
+  };
+  spec.arguments = [&config](const StageWorkspace&, const fs::path& out) {
+    return std::vector<std::string>{"--imu",       config.imu->string(),
+                                    "--robot-log", config.robot_log->string(),
+                                    "--config",    config.calibrate->config.string(),
+                                    "--out",       out.string()};
+  };
+  // `imscal calibrate` logs "<step>: done in <s> s" after each of its steps, in this order.
+  spec.progress_of_line = [](const std::string& line) -> std::optional<double> {
+    static const std::vector<std::pair<std::string, double>> steps = {
+        {"read: done", 0.1},    {"time offset: done", 0.2}, {"bundle: done", 0.4},
+        {"halves: done", 0.55}, {"segments: done", 0.7},    {"joint errors: done", 0.95},
+        {"write: done", 1.0}};
+    for (const auto& [text, fraction] : steps)
+      if (line.find(text) != std::string::npos) return fraction;
+    return std::nullopt;
+  };
+  spec.success_message = "frames calibrated, mounting verdict and joint errors written";
+  return std::make_unique<SubcommandStage>(std::move(spec));
+}
+
+std::unique_ptr<Stage> make_identify_stage(const RunConfig& config) {
+  SubcommandSpec spec;
+  spec.stage_name = spec.subcommand = "identify";
+  spec.timeout_s = config.identify->timeout_s;
+  spec.inputs = [&config] {
+    StageInputs in;
+    if (config.joint_errors)
+      in.files.emplace_back("joint_errors", *config.joint_errors);
+    else
+      in.upstream.push_back("calibrate");
+    in.files.emplace_back("identify_config", config.identify->config);
+    in.config = {{"config", config.identify->config.string()},
+                 {"timeout_s", config.identify->timeout_s}};
+    return in;
+  };
+  spec.arguments = [&config](const StageWorkspace& ws, const fs::path& out) {
+    const auto joint_errors = chain_joint_errors(config, ws);
+    if (!joint_errors) throw std::runtime_error("the calibrate stage left no joint_errors.csv");
+    return std::vector<std::string>{"--joint-errors", joint_errors->string(),
+                                    "--config",       config.identify->config.string(),
+                                    "--out",          out.string()};
+  };
+  // `imscal identify` logs "joint A2 (2/6): ..." when it starts a joint.
+  spec.progress_of_line = [](const std::string& line) -> std::optional<double> {
+    static const std::regex joint_line(R"(joint \S+ \((\d+)/(\d+)\))");
+    std::smatch match;
+    if (!std::regex_search(line, match, joint_line)) return std::nullopt;
+    return (std::stod(match[1]) - 1.0) / std::max(1.0, std::stod(match[2]));
+  };
+  spec.success_message = "parameter tables written";
+  return std::make_unique<SubcommandStage>(std::move(spec));
+}
+
+std::unique_ptr<Stage> make_verify_stage(const RunConfig& config) {
+  SubcommandSpec spec;
+  spec.stage_name = spec.subcommand = "verify";
+  spec.timeout_s = config.verify->timeout_s;
+  spec.inputs = [&config] {
+    StageInputs in;
+    in.upstream = {"identify"};
+    for (std::size_t i = 0; i < config.verify->scenario_files.size(); ++i)
+      in.files.emplace_back(fmt::format("scenario_{}", i + 1), config.verify->scenario_files[i]);
+    in.config = {{"scenarios", config.verify->scenarios},
+                 {"cycles", config.verify->cycles},
+                 {"timeout_s", config.verify->timeout_s}};
+    return in;
+  };
+  spec.arguments = [&config](const StageWorkspace& ws, const fs::path& out) {
+    std::vector<std::string> args = {"--table", table_of(ws).string(), "--cycles",
+                                     std::to_string(config.verify->cycles)};
+    for (const std::string& scenario : config.verify->scenarios) {
+      args.push_back("--scenario");
+      args.push_back(scenario);
+    }
+    args.push_back("--out");
+    args.push_back(out.string());
+    return args;
+  };
+  // `imscal verify` logs "verify: <scenario> (...)" as it starts each scenario.
+  const double scenarios = double(config.verify->scenarios.size());
+  spec.progress_of_line = [scenarios,
+                           count = 0.0](const std::string& line) mutable -> std::optional<double> {
+    if (line.find("verify: ") == std::string::npos || line.find(" cycles x ") == std::string::npos)
+      return std::nullopt;
+    return count++ / scenarios;
+  };
+  spec.success_message = "ISO 9283 before/after written";
+  return std::make_unique<SubcommandStage>(std::move(spec));
+}
+
+std::unique_ptr<Stage> make_diagnose_stage(const RunConfig& config) {
+  SubcommandSpec spec;
+  spec.stage_name = spec.subcommand = "diagnose";
+  spec.timeout_s = config.diagnose->timeout_s;
+  spec.inputs = [&config] {
+    StageInputs in;
+    in.upstream = {"identify"};
+    if (config.joint_errors)
+      in.files.emplace_back("joint_errors", *config.joint_errors);
+    else
+      in.upstream.push_back("calibrate");
+    in.files.emplace_back("robot", config.diagnose->robot);
+    in.config = {{"robot", config.diagnose->robot.string()},
+                 {"timeout_s", config.diagnose->timeout_s}};
+    return in;
+  };
+  spec.arguments = [&config](const StageWorkspace& ws, const fs::path& out) {
+    const auto joint_errors = chain_joint_errors(config, ws);
+    if (!joint_errors) throw std::runtime_error("the calibrate stage left no joint_errors.csv");
+    return std::vector<std::string>{
+        "--joint-errors", joint_errors->string(),          "--table", table_of(ws).string(),
+        "--robot",        config.diagnose->robot.string(), "--out",   out.string()};
+  };
+  spec.success_message = "gap diagnosis written";
+  return std::make_unique<SubcommandStage>(std::move(spec));
+}
+
+}  // namespace imscal::tools
