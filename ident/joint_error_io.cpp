@@ -14,6 +14,7 @@
 
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
+#include "core/sha256.hpp"
 
 namespace imscal::ident {
 namespace {
@@ -232,86 +233,9 @@ void write_joint_errors_csv(const std::filesystem::path& file, const JointErrorL
   out.commit();
 }
 
-// ---------------------------------------------------------------------------------------------
-// SHA-256 (FIPS 180-4).
-
-namespace {
-
-constexpr std::array<std::uint32_t, 64> kSha256Round = {
-    0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4, 0xab1c5ed5,
-    0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3, 0x72be5d74, 0x80deb1fe, 0x9bdc06a7, 0xc19bf174,
-    0xe49b69c1, 0xefbe4786, 0x0fc19dc6, 0x240ca1cc, 0x2de92c6f, 0x4a7484aa, 0x5cb0a9dc, 0x76f988da,
-    0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7, 0xc6e00bf3, 0xd5a79147, 0x06ca6351, 0x14292967,
-    0x27b70a85, 0x2e1b2138, 0x4d2c6dfc, 0x53380d13, 0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85,
-    0xa2bfe8a1, 0xa81a664b, 0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070,
-    0x19a4c116, 0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a, 0x5b9cca4f, 0x682e6ff3,
-    0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2};
-
-std::uint32_t rotr(std::uint32_t x, int n) {
-  return (x >> n) | (x << (32 - n));
-}
-
-void sha256_block(std::array<std::uint32_t, 8>& h, const unsigned char* block) {
-  std::array<std::uint32_t, 64> w{};
-  for (int i = 0; i < 16; ++i)
-    w[i] = std::uint32_t(block[4 * i]) << 24 | std::uint32_t(block[4 * i + 1]) << 16 |
-           std::uint32_t(block[4 * i + 2]) << 8 | std::uint32_t(block[4 * i + 3]);
-  for (int i = 16; i < 64; ++i) {
-    const std::uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
-    const std::uint32_t s1 = rotr(w[i - 2], 17) ^ rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
-    w[i] = w[i - 16] + s0 + w[i - 7] + s1;
-  }
-  auto v = h;
-  for (int i = 0; i < 64; ++i) {
-    const std::uint32_t s1 = rotr(v[4], 6) ^ rotr(v[4], 11) ^ rotr(v[4], 25);
-    const std::uint32_t ch = (v[4] & v[5]) ^ (~v[4] & v[6]);
-    const std::uint32_t t1 = v[7] + s1 + ch + kSha256Round[i] + w[i];
-    const std::uint32_t s0 = rotr(v[0], 2) ^ rotr(v[0], 13) ^ rotr(v[0], 22);
-    const std::uint32_t maj = (v[0] & v[1]) ^ (v[0] & v[2]) ^ (v[1] & v[2]);
-    const std::uint32_t t2 = s0 + maj;
-    v = {t1 + t2, v[0], v[1], v[2], v[3] + t1, v[4], v[5], v[6]};
-  }
-  for (int i = 0; i < 8; ++i) h[i] += v[i];
-}
-
-}  // namespace
-
+// The file's checksum is core's SHA-256 (one implementation for the run folders and the tables).
 std::string file_sha256_hex(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), 0, "", "cannot open the file for its checksum");
-  std::array<std::uint32_t, 8> h = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
-                                    0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
-  std::vector<unsigned char> buffer(1 << 16);
-  std::uint64_t total = 0;
-  std::array<unsigned char, 128> tail{};
-  std::size_t tail_size = 0;
-  while (in) {
-    in.read(reinterpret_cast<char*>(buffer.data()), std::streamsize(buffer.size()));
-    const std::size_t got = static_cast<std::size_t>(in.gcount());
-    total += got;
-    std::size_t i = 0;
-    if (tail_size > 0) {
-      while (tail_size < 64 && i < got) tail[tail_size++] = buffer[i++];
-      if (tail_size < 64) continue;
-      sha256_block(h, tail.data());
-      tail_size = 0;
-    }
-    for (; i + 64 <= got; i += 64) sha256_block(h, buffer.data() + i);
-    while (i < got) tail[tail_size++] = buffer[i++];
-  }
-  tail[tail_size++] = 0x80;
-  if (tail_size > 56) {
-    while (tail_size < 64) tail[tail_size++] = 0;
-    sha256_block(h, tail.data());
-    tail_size = 0;
-  }
-  while (tail_size < 56) tail[tail_size++] = 0;
-  const std::uint64_t bits = total * 8;
-  for (int i = 0; i < 8; ++i) tail[56 + i] = static_cast<unsigned char>(bits >> (56 - 8 * i));
-  sha256_block(h, tail.data());
-  std::string hex;
-  for (auto word : h) hex += fmt::format("{:08x}", word);
-  return hex;
+  return sha256_hex_of_file(file);
 }
 
 }  // namespace imscal::ident

@@ -25,6 +25,14 @@ fs::path table_of(const StageWorkspace& ws) {
   return upstream_file(ws, "identify", "parameters.json");
 }
 
+// The joint errors as a stage input: the configured file (with its checksum), or calibrate's.
+void declare_joint_errors(const RunConfig& config, StageInputs& in) {
+  if (config.joint_errors)
+    in.files.emplace_back("joint_errors", *config.joint_errors);
+  else
+    in.upstream.push_back("calibrate");
+}
+
 }  // namespace
 
 std::optional<fs::path> chain_joint_errors(const RunConfig& config, const StageWorkspace& ws) {
@@ -33,6 +41,14 @@ std::optional<fs::path> chain_joint_errors(const RunConfig& config, const StageW
   if (dir && fs::exists(*dir / "joint_errors.csv")) return *dir / "joint_errors.csv";
   return std::nullopt;
 }
+
+namespace {
+fs::path joint_errors_of(const RunConfig& config, const StageWorkspace& ws) {
+  const auto joint_errors = chain_joint_errors(config, ws);
+  if (!joint_errors) throw std::runtime_error("the calibrate stage left no joint_errors.csv");
+  return *joint_errors;
+}
+}  // namespace
 
 std::unique_ptr<Stage> make_calibrate_stage(const RunConfig& config) {
   SubcommandSpec spec;
@@ -73,19 +89,15 @@ std::unique_ptr<Stage> make_identify_stage(const RunConfig& config) {
   spec.timeout_s = config.identify->timeout_s;
   spec.inputs = [&config] {
     StageInputs in;
-    if (config.joint_errors)
-      in.files.emplace_back("joint_errors", *config.joint_errors);
-    else
-      in.upstream.push_back("calibrate");
+    declare_joint_errors(config, in);
     in.files.emplace_back("identify_config", config.identify->config);
     in.config = {{"config", config.identify->config.string()},
                  {"timeout_s", config.identify->timeout_s}};
     return in;
   };
   spec.arguments = [&config](const StageWorkspace& ws, const fs::path& out) {
-    const auto joint_errors = chain_joint_errors(config, ws);
-    if (!joint_errors) throw std::runtime_error("the calibrate stage left no joint_errors.csv");
-    return std::vector<std::string>{"--joint-errors", joint_errors->string(),
+    const fs::path joint_errors = joint_errors_of(config, ws);
+    return std::vector<std::string>{"--joint-errors", joint_errors.string(),
                                     "--config",       config.identify->config.string(),
                                     "--out",          out.string()};
   };
@@ -144,20 +156,16 @@ std::unique_ptr<Stage> make_diagnose_stage(const RunConfig& config) {
   spec.inputs = [&config] {
     StageInputs in;
     in.upstream = {"identify"};
-    if (config.joint_errors)
-      in.files.emplace_back("joint_errors", *config.joint_errors);
-    else
-      in.upstream.push_back("calibrate");
+    declare_joint_errors(config, in);
     in.files.emplace_back("robot", config.diagnose->robot);
     in.config = {{"robot", config.diagnose->robot.string()},
                  {"timeout_s", config.diagnose->timeout_s}};
     return in;
   };
   spec.arguments = [&config](const StageWorkspace& ws, const fs::path& out) {
-    const auto joint_errors = chain_joint_errors(config, ws);
-    if (!joint_errors) throw std::runtime_error("the calibrate stage left no joint_errors.csv");
+    const fs::path joint_errors = joint_errors_of(config, ws);
     return std::vector<std::string>{
-        "--joint-errors", joint_errors->string(),          "--table", table_of(ws).string(),
+        "--joint-errors", joint_errors.string(),           "--table", table_of(ws).string(),
         "--robot",        config.diagnose->robot.string(), "--out",   out.string()};
   };
   spec.success_message = "gap diagnosis written";
