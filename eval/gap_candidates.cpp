@@ -55,6 +55,40 @@ std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta
   return {y, r};
 }
 
+// Discrete Laguerre filters of u with time scale tau (pole a = exp(-T / tau)):
+// L_0 = sqrt(1 - a²) / (1 - a z^-1), L_i = L_{i-1} (z^-1 - a) / (1 - a z^-1): an orthonormal
+// basis of stable linear responses, so a few columns follow a closed loop's reaction to u without
+// knowing its poles. Each run starts in the steady state of its first input.
+std::vector<Column> laguerre(const Column& u, double tau_s, int order, const GapSignals& s) {
+  const double a = std::exp(-s.cycle_s / tau_s), g0 = std::sqrt(1.0 - a * a);
+  std::vector<Column> out(std::size_t(order), Column(u.size()));
+  for (const auto& [b, e] : s.runs) {
+    if (e <= b) continue;
+    const double u0 = u[Eigen::Index(b)];
+    std::vector<double> y(std::size_t(order), g0 / (1.0 - a) * u0);
+    std::vector<double> x_previous = y;  // each stage's previous input
+    x_previous[0] = u0;
+    for (std::size_t k = b; k < e; ++k) {
+      double x = u[Eigen::Index(k)];
+      for (int i = 0; i < order; ++i) {
+        double& yi = y[std::size_t(i)];
+        const double next = i == 0 ? a * yi + g0 * x : a * yi + x_previous[std::size_t(i)] - a * x;
+        x_previous[std::size_t(i)] = x;
+        yi = next;
+        out[std::size_t(i)][Eigen::Index(k)] = next;
+        x = next;
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> numbered(const std::string& stem, int count) {
+  std::vector<std::string> names;
+  for (int i = 0; i < count; ++i) names.push_back(fmt::format("{}{}_rad", stem, i));
+  return names;
+}
+
 double rms_of(const Column& c) {
   return c.size() ? std::sqrt(c.squaredNorm() / double(c.size())) : 0.0;
 }
@@ -114,6 +148,14 @@ const char* to_string(EffectKind kind) {
       return "thermal_drift";
     case EffectKind::kOperatingPoint:
       return "operating_point_extrapolation";
+    case EffectKind::kKinematicParameters:
+      return "kinematic_parameters";
+    case EffectKind::kSensorMounting:
+      return "sensor_mounting";
+    case EffectKind::kImsScaleFactor:
+      return "ims_scale_factor";
+    case EffectKind::kImsBias:
+      return "ims_bias";
   }
   return "?";
 }
@@ -148,6 +190,12 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
         out.push_back(shape("sign(tau_d)", {st}, {"l_rad"}));
         out.push_back(
             shape("sign(tau_d) + lag 30 ms", {st, lag(st, 0.03, s)}, {"l_rad", "l_lag_rad"}));
+        // The link crosses the play with the gear's own dynamics: a Laguerre basis of 10 ms.
+        std::vector<Column> cols = laguerre(st, 0.01, 4, s);
+        cols.insert(cols.begin(), st);
+        std::vector<std::string> names = numbered("laguerre10ms_", 4);
+        names.insert(names.begin(), "l_rad");
+        out.push_back(shape("sign(tau_d) + Laguerre 10 ms x4", cols, names));
       }
       break;
     }
@@ -158,6 +206,12 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
       out.push_back(shape("sign(qd_d) high-passed 30/100/300 ms", hp,
                           {"hp30ms_rad", "hp100ms_rad", "hp300ms_rad"}));
       out.push_back(shape("sign(qd_d) high-passed 100 ms", {hp[1]}, {"hp100ms_rad"}));
+      // The controller's reaction to the friction step at a reversal, poles unknown: Laguerre
+      // bases of 30 ms (6 columns) and 100 ms (2 columns).
+      out.push_back(shape("sign(qd_d) through Laguerre 30 ms x6", laguerre(sv, 0.03, 6, s),
+                          numbered("laguerre30ms_", 6)));
+      out.push_back(shape("sign(qd_d) through Laguerre 100 ms x2", laguerre(sv, 0.1, 2, s),
+                          numbered("laguerre100ms_", 2)));
       break;
     }
     case EffectKind::kGearCompliance: {
@@ -227,6 +281,58 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
                           {"per_excess_rad", "per_excess_signed_rad"}));
       break;
     }
+    case EffectKind::kKinematicParameters: {
+      if (joint >= s.ims_chain_columns.size()) break;
+      const Eigen::MatrixXd& dh = s.ims_chain_columns[joint].dh;
+      for (int link = 0; link < 6; ++link) {
+        std::vector<Column> cols;
+        std::vector<std::string> names;
+        const char* what[3] = {"a", "alpha", "d"};
+        const char* unit[3] = {"m", "rad", "m"};
+        for (int p = 0; p < 3; ++p) {
+          const Column c = dh.col(3 * link + p);
+          // A parameter that moves this joint's gap by less than 1e-9 rad per unit has no
+          // signature here (e.g. d_1 for a base offset along axis 1).
+          if (rms_of(c) < 1e-9) continue;
+          cols.push_back(c);
+          names.push_back(fmt::format("d{}{}_{}", what[p], link + 1, unit[p]));
+        }
+        if (!cols.empty())
+          out.push_back(shape(fmt::format("DH a/alpha/d of link {}", link + 1), cols, names));
+      }
+      break;
+    }
+    case EffectKind::kSensorMounting: {
+      if (joint >= s.ims_chain_columns.size()) break;
+      const Eigen::MatrixXd& m = s.ims_chain_columns[joint].mounting;
+      out.push_back(shape("mounting rotation", {m.col(3), m.col(4), m.col(5)},
+                          {"rx_rad", "ry_rad", "rz_rad"}));
+      out.push_back(
+          shape("mounting translation", {m.col(0), m.col(1), m.col(2)}, {"tx_m", "ty_m", "tz_m"}));
+      out.push_back(shape("mounting rotation and translation",
+                          {m.col(3), m.col(4), m.col(5), m.col(0), m.col(1), m.col(2)},
+                          {"rx_rad", "ry_rad", "rz_rad", "tx_m", "ty_m", "tz_m"}));
+      break;
+    }
+    case EffectKind::kImsScaleFactor: {
+      if (joint >= s.ims_chain_columns.size()) break;
+      const auto& c = s.ims_chain_columns[joint];
+      const Column gyro = c.gyro_scale.rowwise().sum();
+      out.push_back(shape("gyro scale, isotropic", {gyro}, {"gyro_scale"}));
+      out.push_back(shape("gyro scale per flange axis",
+                          {c.gyro_scale.col(0), c.gyro_scale.col(1), c.gyro_scale.col(2)},
+                          {"gyro_scale_x", "gyro_scale_y", "gyro_scale_z"}));
+      out.push_back(
+          shape("accelerometer scale, isotropic", {c.accel_scale.col(0)}, {"accel_scale"}));
+      break;
+    }
+    case EffectKind::kImsBias: {
+      if (joint >= s.ims_chain_columns.size()) break;
+      const Eigen::MatrixXd& b = s.ims_chain_columns[joint].gyro_bias;
+      out.push_back(shape("gyro bias about the flange axes", {b.col(0), b.col(1), b.col(2)},
+                          {"bx_rad_s", "by_rad_s", "bz_rad_s"}));
+      break;
+    }
   }
   return out;
 }
@@ -281,37 +387,88 @@ LinearFit fit_columns(const Eigen::MatrixXd& columns, const std::vector<double>&
   const auto perm = qr.colsPermutation();
   const Eigen::MatrixXd cov = perm * cov_piv * perm.transpose();
   fit.parameters = theta.cwiseQuotient(scale);
+  const Eigen::VectorXd inverse_scale = scale.cwiseInverse();
+  fit.covariance = inverse_scale.asDiagonal() * cov * inverse_scale.asDiagonal();
+  fit.covariance *= fit.inflation * fit.inflation;
   fit.sigma = cov.diagonal().cwiseMax(0.0).cwiseSqrt().cwiseQuotient(scale) * fit.inflation;
   return fit;
 }
+
+namespace {
+
+// Sum of squared residuals on the rows `check` of the LS fit of columns to y on the rows `fit`
+// (parameters only: no sigma needed to choose a shape).
+double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
+                      const std::vector<Eigen::Index>& fit,
+                      const std::vector<Eigen::Index>& check) {
+  const Eigen::Index p = columns.cols();
+  Eigen::MatrixXd x(Eigen::Index(fit.size()), p);
+  Eigen::VectorXd b(x.rows());
+  for (std::size_t i = 0; i < fit.size(); ++i) {
+    x.row(Eigen::Index(i)) = columns.row(fit[i]);
+    b[Eigen::Index(i)] = y[std::size_t(fit[i])];
+  }
+  Eigen::VectorXd scale(p);
+  for (Eigen::Index c = 0; c < p; ++c) {
+    scale[c] = x.col(c).norm() > 0.0 ? x.col(c).norm() : 1.0;
+    x.col(c) /= scale[c];
+  }
+  const Eigen::VectorXd theta = x.colPivHouseholderQr().solve(b).cwiseQuotient(scale);
+  double sse = 0.0;
+  for (Eigen::Index k : check) {
+    const double r = y[std::size_t(k)] - columns.row(k).dot(theta);
+    sse += r * r;
+  }
+  return sse;
+}
+
+// Relative margin within which the shape with fewer parameters wins the validation.
+constexpr double kShapeParsimony = 0.01;
+
+}  // namespace
 
 std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, std::size_t joint,
                                           const std::vector<bool>& training) {
   const std::vector<CandidateShape> shapes = candidate_shapes(kind, s, joint);
   if (shapes.empty()) return std::nullopt;
-  const double m = double(std::count(training.begin(), training.end(), true));
-  std::optional<CandidateFit> best;
-  double best_bic = std::numeric_limits<double>::infinity();
-  for (const auto& sh : shapes) {
-    const LinearFit f = fit_columns(sh.columns, s.gap_rad[joint], training);
-    // BIC with the effective row count (coloured residuals): a shape with more parameters must
-    // earn them on independent information, not on 2 ms samples of one transient.
-    const double m_eff = std::max(m / (f.inflation * f.inflation), 2.0);
-    const double bic = m_eff * std::log(std::max(f.rms * f.rms, 1e-300)) +
-                       double(sh.columns.cols()) * std::log(m_eff);
-    if (bic < best_bic) {
-      best_bic = bic;
-      CandidateFit c;
-      c.kind = kind;
-      c.joint = joint;
-      c.shape = sh.label;
-      c.parameter_names = sh.parameter_names;
-      c.parameters = f.parameters;
-      c.sigma = f.sigma;
-      c.columns = sh.columns;
-      c.training_rms_rad = f.rms;
-      best = std::move(c);
+  // The shape is chosen by a 2-fold validation inside the training rows: they are cut into
+  // chunks of 1 s of consecutive training rows, alternately in fold A and B; each shape is fitted
+  // on A and judged on B and vice versa. Unlike a BIC it needs no count of independent rows (the
+  // residuals are coloured), and it sees whether the shape carries over to other motion. Of
+  // shapes within 1 % of the best validation error, the one with the fewest parameters.
+  const std::size_t chunk = std::max<std::size_t>(1, std::size_t(std::lround(1.0 / s.cycle_s)));
+  std::vector<Eigen::Index> fold_a, fold_b;
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < training.size(); ++k)
+    if (training[k]) ((count++ / chunk) % 2 == 0 ? fold_a : fold_b).push_back(Eigen::Index(k));
+  std::size_t chosen = 0;
+  if (shapes.size() > 1 && !fold_b.empty()) {
+    std::vector<double> score;
+    for (const auto& sh : shapes)
+      score.push_back(validation_sse(sh.columns, s.gap_rad[joint], fold_a, fold_b) +
+                      validation_sse(sh.columns, s.gap_rad[joint], fold_b, fold_a));
+    const double best_score = *std::min_element(score.begin(), score.end());
+    for (std::size_t i = 0; i < shapes.size(); ++i) {
+      if (score[i] > best_score * (1.0 + kShapeParsimony)) continue;
+      if (score[chosen] > best_score * (1.0 + kShapeParsimony) ||
+          shapes[i].columns.cols() < shapes[chosen].columns.cols() ||
+          (shapes[i].columns.cols() == shapes[chosen].columns.cols() && score[i] < score[chosen]))
+        chosen = i;
     }
+  }
+  const CandidateShape& sh = shapes[chosen];
+  const LinearFit f = fit_columns(sh.columns, s.gap_rad[joint], training);
+  std::optional<CandidateFit> best = CandidateFit{};
+  {
+    CandidateFit& c = *best;
+    c.kind = kind;
+    c.joint = joint;
+    c.shape = sh.label;
+    c.parameter_names = sh.parameter_names;
+    c.parameters = f.parameters;
+    c.sigma = f.sigma;
+    c.columns = sh.columns;
+    c.training_rms_rad = f.rms;
   }
   CandidateFit& c = *best;
   const Eigen::VectorXd pred = c.columns * c.parameters;
@@ -330,6 +487,14 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
                         std::hypot(c.parameters[0], c.parameters[1]),
                         std::hypot(c.parameters[0], c.parameters[1]) * arcsec);
   if (kind == EffectKind::kTimeOffset) first += " s";
+  if (kind == EffectKind::kSensorMounting || kind == EffectKind::kKinematicParameters ||
+      kind == EffectKind::kImsScaleFactor || kind == EffectKind::kImsBias) {
+    std::vector<std::string> all;
+    for (Eigen::Index i = 0; i < c.parameters.size(); ++i)
+      all.push_back(fmt::format("{} = {:.3g} ± {:.2g}", c.parameter_names[std::size_t(i)],
+                                c.parameters[i], c.sigma[i]));
+    first = fmt::format("{}", fmt::join(all, ", "));
+  }
   c.size_text = fmt::format("{}; modelled gap RMS {:.3g} rad ({:.2f} arcsec)", first, rms_of(pred),
                             rms_of(pred) * arcsec);
   return best;

@@ -37,6 +37,18 @@ const char* what_to_measure(EffectKind kind) {
       return "a repeat of the path after a warm-up and the drive temperatures";
     case EffectKind::kOperatingPoint:
       return "identification runs at the speeds and joint positions of this path";
+    case EffectKind::kKinematicParameters:
+      return "static poses spread over the workspace with an external reference (laser tracker), "
+             "or a kinematic calibration (the error depends on the pose, not on the motion)";
+    case EffectKind::kSensorMounting:
+      return "the frame calibration's rest poses again with larger wrist rotations (the mounting "
+             "error grows with the rotation away from the first pose)";
+    case EffectKind::kImsScaleFactor:
+      return "turn tests of the IMS about each axis by a known angle (rotary table or joint 6) "
+             "and a known linear displacement";
+    case EffectKind::kImsBias:
+      return "a longer rest of the IMS before and after the path, and rests during it (the "
+             "rests bound the attitude drift)";
   }
   return "";
 }
@@ -107,6 +119,9 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
     if (!training[k]) rows.heldout.push_back(k);
   const std::size_t block =
       std::max<std::size_t>(1, std::size_t(std::lround(o.bootstrap_block_s / s.cycle_s)));
+  for (std::size_t j = 0; j < s.joint_count(); ++j)
+    out.model_error.push_back(fit_model_error_model(s.q_desired_rad[j], s.gap_rad[j], s.runs,
+                                                    s.cycle_s, training, o.model_error));
   const double e0 = heldout_energy(s.gap_rad, rows);
   const double m = double(std::max<std::size_t>(rows.heldout.size(), 1));
   out.heldout_rms_rad = std::sqrt(e0 / m);

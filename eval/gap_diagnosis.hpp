@@ -17,6 +17,7 @@
 
 #include "eval/gap_analysis.hpp"
 #include "eval/gap_candidates.hpp"
+#include "eval/gap_model_error.hpp"
 
 namespace imscal::eval {
 
@@ -28,7 +29,8 @@ struct DiagnosisOptions {
   double min_shrinkage_percent = 5.0;         // below this an effect is not worth modelling
   double min_combination_gain_percent = 2.0;  // further shrinkage a combination step must add
   int max_combination = 3;
-  std::uint64_t seed = 1;  // of the bootstrap (deterministic reports)
+  std::uint64_t seed = 1;         // of the bootstrap (deterministic reports)
+  ModelErrorOptions model_error;  // of the per-joint model-error model
 };
 
 struct CandidateResult {
@@ -47,6 +49,9 @@ struct CombinationStep {
 
 struct Diagnosis {
   GapAnalysis where;
+  // Per joint: the FIR model of the gap from q_d with its frequency response and confidence
+  // band (eval/gap_model_error.hpp), same training / held-out rows as the candidates.
+  std::vector<ModelErrorModel> model_error;
   double heldout_rms_rad = 0.0;              // held-out gap before any candidate
   double heldout_rms_modelled_rad = 0.0;     // after the kept combination
   std::vector<CandidateResult> candidates;   // sorted by held-out shrinkage, best first

@@ -52,6 +52,30 @@ nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
                           {"p_value", c.p_value},
                           {"supported", c.supported}});
   }
+  json model_error = json::array();
+  for (std::size_t j = 0; j < d.model_error.size(); ++j) {
+    const ModelErrorModel& m = d.model_error[j];
+    json response = json::array();
+    for (const auto& p : m.response)
+      response.push_back({{"frequency_hz", p.frequency_hz},
+                          {"magnitude_rad_per_rad", p.magnitude},
+                          {"phase_rad", p.phase_rad},
+                          {"magnitude_sigma", p.magnitude_sigma},
+                          {"band_lower", p.lower},
+                          {"band_upper", p.upper},
+                          {"significant", p.significant}});
+    std::vector<double> taps(m.taps.data(), m.taps.data() + m.taps.size()),
+        tap_sigma(m.tap_sigma.data(), m.tap_sigma.data() + m.tap_sigma.size());
+    model_error.push_back({{"joint", s.joint_names[j]},
+                           {"input", "q_desired_rad"},
+                           {"tap_period_s", m.tap_period_s},
+                           {"taps_rad_per_rad", taps},
+                           {"tap_sigma", tap_sigma},
+                           {"offset_rad", m.offset_rad},
+                           {"heldout_explained_percent", m.heldout_explained_percent},
+                           {"significant", m.significant},
+                           {"frequency_response", response}});
+  }
   json combination = json::array();
   for (const auto& c : d.combination)
     combination.push_back({{"added", c.label},
@@ -72,6 +96,7 @@ nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
           {"measure_next", d.measure_next},
           {"band_edges_hz", d.where.band_edges_hz},
           {"where", joints},
+          {"model_error", model_error},
           {"candidates", candidates},
           {"combination", combination},
           {"not_supported", not_supported}};
@@ -98,6 +123,23 @@ std::string diagnosis_text(const GapSignals& s, const Diagnosis& d) {
     line("band", j.by_band);
     line("cell", j.by_cell);
     line("direction", j.by_direction);
+  }
+  t += "\nModel-error model (FIR from q_d to the gap; response |G| in rad/rad with its 2-sigma "
+       "band)\n";
+  for (std::size_t j = 0; j < d.model_error.size(); ++j) {
+    const ModelErrorModel& m = d.model_error[j];
+    std::vector<std::string> significant;
+    double peak = 0.0, f_peak = 0.0;
+    for (const auto& p : m.response) {
+      if (p.significant) significant.push_back(fmt::format("{:.2g}", p.frequency_hz));
+      if (p.magnitude > peak) peak = p.magnitude, f_peak = p.frequency_hz;
+    }
+    t += fmt::format("  {:<4} explains {:5.1f} % of the held-out gap; ", s.joint_names[j],
+                     m.heldout_explained_percent);
+    t += significant.empty()
+             ? std::string("G differs from 0 at no frequency (no linear dynamic gap)")
+             : fmt::format("significant at {} Hz", fmt::join(significant, ", "));
+    t += fmt::format("; peak |G| {:.3g} at {:.2g} Hz\n", peak, f_peak);
   }
   t += "\nCandidates (held-out shrinkage of the gap, all joints; best first)\n";
   for (const auto& c : d.candidates)

@@ -5,6 +5,11 @@
 #include <span>
 #include <stdexcept>
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include "calib/forward_kinematics.hpp"
+#include "calib/jacobian.hpp"
 #include "ident/arx_model.hpp"
 #include "ident/cell_blending.hpp"
 #include "ident/operating_point.hpp"
@@ -54,7 +59,138 @@ calib::RigidBodyParameters point_mass(double mass_kg) {
 // Velocity scale of the smooth backlash sign [rad/s], as the precontrol's default.
 constexpr double kBacklashVelocityScale = 0.002;
 
+using Twist = Eigen::Matrix<double, 6, 1>;  // translation [m], rotation [rad]
+
+// Body twist of a near-identity transform (first order).
+Twist small_twist(const Eigen::Isometry3d& e) {
+  const Eigen::Matrix3d& r = e.linear();
+  Twist xi;
+  xi << e.translation(), 0.5 * (r(2, 1) - r(1, 2)), 0.5 * (r(0, 2) - r(2, 0)),
+      0.5 * (r(1, 0) - r(0, 1));
+  return xi;
+}
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
+// Adjoint of T on body twists (translation first): xi in the frame after T -> before it.
+Eigen::Matrix<double, 6, 6> adjoint(const Eigen::Isometry3d& t) {
+  Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Zero();
+  a.topLeftCorner<3, 3>() = t.linear();
+  a.topRightCorner<3, 3>() = skew(t.translation()) * t.linear();
+  a.bottomRightCorner<3, 3>() = t.linear();
+  return a;
+}
+
+// Damping of the body Jacobian's inverse [m or rad]: far below any regular singular value of an
+// industrial arm (~0.1 m .. 1), it only keeps the map finite at a wrist singularity.
+constexpr double kJacobianDamping = 1e-3;
+
 }  // namespace
+
+std::vector<GapSignals::ImsChainColumns> ims_chain_columns(
+    const calib::KinematicModel& kin, const std::vector<std::vector<double>>& q_rad,
+    const std::vector<std::vector<double>>& qd_rad_s, const std::vector<double>& time_s) {
+  const std::size_t n = time_s.size(), nj = calib::kJointCount;
+  std::vector<GapSignals::ImsChainColumns> out(nj);
+  for (auto& c : out) {
+    c.dh.setZero(Eigen::Index(n), 18);
+    c.mounting.setZero(Eigen::Index(n), 6);
+    c.gyro_bias.setZero(Eigen::Index(n), 3);
+    c.gyro_scale.setZero(Eigen::Index(n), 3);
+    c.accel_scale.setZero(Eigen::Index(n), 1);
+  }
+  if (n == 0) return out;
+  const auto joints_at = [&](std::size_t k, const std::vector<std::vector<double>>& x) {
+    calib::JointVector v;
+    for (std::size_t j = 0; j < nj; ++j) v[long(j)] = x[j][k];
+    return v;
+  };
+  const Eigen::Isometry3d T_R_H0 = calib::forward_kinematics<double>(kin, joints_at(0, q_rad));
+  Eigen::Matrix3d bias_integral = Eigen::Matrix3d::Zero(), scale_integral = bias_integral;
+  Eigen::Matrix3d previous_bias_rate = Eigen::Matrix3d::Zero(), previous_scale_rate = bias_integral;
+  // Central-difference step of the DH numbers [m, rad]: truncation ~step² far below the 1e-6
+  // relative accuracy the fit needs, rounding ~1e-16 / step harmless.
+  const double step = 1e-6;
+  for (std::size_t k = 0; k < n; ++k) {
+    const calib::JointVector q = joints_at(k, q_rad), qd = joints_at(k, qd_rad_s);
+    const calib::ChainPoses<double> poses = calib::chain_poses<double>(kin, q);
+    const Eigen::Isometry3d T = poses.T_R_H;
+    const Eigen::Matrix3d& R = T.linear();
+    const calib::Jacobian jg = calib::geometric_jacobian(kin, q);
+    Eigen::Matrix<double, 6, 6> jb;
+    jb.topRows<3>() = R.transpose() * jg.topRows<3>();
+    jb.bottomRows<3>() = R.transpose() * jg.bottomRows<3>();
+    // Damped least-squares inverse Jb^T (Jb Jb^T + λ² I)^-1.
+    const Eigen::Matrix<double, 6, 6> jb_inv =
+        jb.transpose() * (jb * jb.transpose() + kJacobianDamping * kJacobianDamping *
+                                                    Eigen::Matrix<double, 6, 6>::Identity())
+                             .inverse();
+    // The gap per unit body twist of the flange pose error: -(q_m - q).
+    const Eigen::Matrix<double, 6, 6> gap_per_twist = -jb_inv;
+
+    // DH sensitivities: a change of link i's numbers is a local twist xi_l after link frame i+1
+    // (central differences of the link transform alone), moved to the flange by the adjoint.
+    Eigen::Matrix<double, 6, 18> dh_twist;
+    for (int i = 0; i < 6; ++i) {
+      const calib::DhParameters& dh = kin.dh[i];
+      const double theta = q[i] + dh.offset_rad;
+      const Eigen::Isometry3d a_inv =
+          calib::dh_link_transform(kin.convention, dh.a_m, dh.alpha_rad, dh.d_m, theta).inverse();
+      const Eigen::Isometry3d T_next_H = poses.T_R_link[std::size_t(i) + 1].inverse() * T;
+      const Eigen::Matrix<double, 6, 6> to_flange = adjoint(T_next_H.inverse());
+      for (int p = 0; p < 3; ++p) {
+        const double da = p == 0 ? step : 0.0, dalpha = p == 1 ? step : 0.0,
+                     dd = p == 2 ? step : 0.0;
+        const Eigen::Isometry3d plus = calib::dh_link_transform(
+            kin.convention, dh.a_m + da, dh.alpha_rad + dalpha, dh.d_m + dd, theta);
+        const Eigen::Isometry3d minus = calib::dh_link_transform(
+            kin.convention, dh.a_m - da, dh.alpha_rad - dalpha, dh.d_m - dd, theta);
+        const Twist local = (small_twist(a_inv * plus) - small_twist(a_inv * minus)) / (2.0 * step);
+        dh_twist.col(3 * i + p) = to_flange * local;
+      }
+    }
+    const Eigen::Matrix<double, 6, 6> mounting_twist =
+        adjoint((T_R_H0.inverse() * T).inverse()) - Eigen::Matrix<double, 6, 6>::Identity();
+
+    // Attitude error integrals (trapezoid over the sample times), base frame.
+    const Eigen::Vector3d w_body = R.transpose() * (jg.bottomRows<3>() * qd);
+    const Eigen::Matrix3d bias_rate = R;  // column i: R e_i
+    const Eigen::Matrix3d scale_rate = R * w_body.asDiagonal();
+    if (k > 0) {
+      const double dt = time_s[k] - time_s[k - 1];
+      bias_integral += 0.5 * dt * (bias_rate + previous_bias_rate);
+      scale_integral += 0.5 * dt * (scale_rate + previous_scale_rate);
+    }
+    previous_bias_rate = bias_rate;
+    previous_scale_rate = scale_rate;
+    Eigen::Matrix<double, 6, 3> bias_twist = Eigen::Matrix<double, 6, 3>::Zero(),
+                                scale_twist = bias_twist;
+    bias_twist.bottomRows<3>() = R.transpose() * bias_integral;
+    scale_twist.bottomRows<3>() = R.transpose() * scale_integral;
+    Twist accel_twist = Twist::Zero();
+    accel_twist.head<3>() = R.transpose() * (T.translation() - T_R_H0.translation());
+
+    const Eigen::Matrix<double, 6, 18> dh_gap = gap_per_twist * dh_twist;
+    const Eigen::Matrix<double, 6, 6> mounting_gap = gap_per_twist * mounting_twist;
+    const Eigen::Matrix<double, 6, 3> bias_gap = gap_per_twist * bias_twist;
+    const Eigen::Matrix<double, 6, 3> scale_gap = gap_per_twist * scale_twist;
+    const Twist accel_gap = gap_per_twist * accel_twist;
+    const Eigen::Index row = Eigen::Index(k);
+    for (std::size_t j = 0; j < nj; ++j) {
+      const Eigen::Index jr = Eigen::Index(j);
+      out[j].dh.row(row) = dh_gap.row(jr);
+      out[j].mounting.row(row) = mounting_gap.row(jr);
+      out[j].gyro_bias.row(row) = bias_gap.row(jr);
+      out[j].gyro_scale.row(row) = scale_gap.row(jr);
+      out[j].accel_scale(row, 0) = accel_gap[jr];
+    }
+  }
+  return out;
+}
 
 std::vector<std::vector<double>> measured_joint_errors(const ident::JointErrorLog& log) {
   std::vector<std::vector<double>> e(log.joint_count());
@@ -188,6 +324,8 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
       g.unit_payload_nm_kg[j][k] = tau_unit[long(j)];
     }
   }
+  g.ims_chain_columns =
+      ims_chain_columns(robot.kinematics, g.q_desired_rad, g.qd_desired_rad_s, g.time_s);
   if (table_or_null) {
     for (const auto& jp : table_or_null->joints) {
       g.table_dimensions.push_back(jp.dimensions);

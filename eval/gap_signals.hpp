@@ -10,6 +10,7 @@
 // "sim" is either the identified error model (parameters.json) run on the desired joints, or a
 // second joint_errors.csv (e.g. the simulator's prediction without some effect). The desired
 // derivatives are central differences of q_desired within each run (one-sided at its ends).
+#include <Eigen/Core>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -40,6 +41,17 @@ struct GapSignals {
   // whether each of its cells was identified from data (false: filled from a neighbour).
   std::vector<std::vector<ident::CellDimension>> table_dimensions;
   std::vector<std::vector<bool>> table_cell_identified;
+  // The joint-space signatures of geometric errors of the IMS chain (empty without a robot
+  // model, e.g. in synthetic tests), per joint: samples x parameters, the gap [rad] one unit of
+  // each parameter causes. See ImsChainColumns.
+  struct ImsChainColumns {
+    Eigen::MatrixXd dh;         // 18: a_i [m], alpha_i [rad], d_i [m] of links i = 1..6
+    Eigen::MatrixXd mounting;   // 6: sensor mounting error twist in the flange (t_x..z [m], r_x..z)
+    Eigen::MatrixXd gyro_bias;  // 3: rate bias about the flange axes x, y, z [rad/s]
+    Eigen::MatrixXd gyro_scale;   // 3: scale factor error of the flange-axis rates [1]
+    Eigen::MatrixXd accel_scale;  // 1: isotropic accelerometer scale error [1]
+  };
+  std::vector<ImsChainColumns> ims_chain_columns;
 
   std::size_t sample_count() const { return time_s.size(); }
   std::size_t joint_count() const { return joint_names.size(); }
@@ -52,6 +64,24 @@ struct GapSignals {
 // Throws std::invalid_argument when the table's joints do not match the log's.
 std::vector<std::vector<double>> predict_table_joint_errors(const ident::ParameterTable& table,
                                                             const ident::JointErrorLog& log);
+
+// The chain's geometric error signatures (GapSignals::ImsChainColumns) along q_desired, to first
+// order: the IMS chain gives the flange pose T_meas = T_true exp(xi) (xi a body twist of the
+// flange: translation in flange axes [m], rotation [rad]); the inverse kinematics with the nominal
+// model returns q_m = q + Jb^-1 xi (Jb the body Jacobian, damped near singularities), so the
+// joint error q_d - q_m gains -Jb^-1 xi. Per parameter, xi is:
+//   dh           T(q; p)^-1 T(q; p + dp): the real arm's DH numbers differ from the nominal ones
+//   mounting     (Ad(H_T_H0) - I) xi_D: a mounting error D of the sensor, seen relative to the
+//                first sample's pose H0 where the chain is initialised (it cancels there)
+//   gyro_bias    (0, R^T u), u = integral of R_R_H e_i dt: the attitude drifts in the base frame
+//   gyro_scale   (0, R^T u), u = integral of R_R_H e_i (e_i . w_H) dt: rate scaled per axis
+//   accel_scale  (R^T (p - p0), 0): the travelled displacement scaled
+// The sensor is taken to sit at the flange (the diagnosis does not know T_S_H); the smoother's
+// rest updates, which bound these errors in the real chain, are not modelled (open-loop
+// signatures: they give the shape, the fit the size).
+std::vector<GapSignals::ImsChainColumns> ims_chain_columns(
+    const calib::KinematicModel& kinematics, const std::vector<std::vector<double>>& q_rad,
+    const std::vector<std::vector<double>>& qd_rad_s, const std::vector<double>& time_s);
 
 // Builds the signals: gap = (q_d - q_m)_real - sim_joint_error_rad. The robot gives the torques
 // (KDL inverse dynamics with a point payload of the logged mass at the tool frame origin) and

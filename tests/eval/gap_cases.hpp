@@ -10,6 +10,10 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
+#include "calib/forward_kinematics.hpp"
+#include "calib/jacobian.hpp"
 #include "calib/robot_description.hpp"
 #include "eval/gap_candidates.hpp"
 #include "ident/joint_error_io.hpp"
@@ -22,7 +26,9 @@ namespace imscal::eval::test {
 
 struct WithheldEffect {
   std::string name;  // backlash, coulomb, elastic, transmission, time_offset, zero_offset,
-                     // payload, drift
+                     // payload, drift; errors of the IMS chain: kinematic (DH error of link
+                     // `joint`), mounting, ims_scale, ims_bias (`joint` unused: they spread over
+                     // the joints, Case::chain_joint says where they show most)
   int joint = 0;
 };
 
@@ -34,7 +40,41 @@ inline EffectKind expected_kind(const std::string& name) {
   if (name == "time_offset") return EffectKind::kTimeOffset;
   if (name == "zero_offset") return EffectKind::kZeroOffset;
   if (name == "payload") return EffectKind::kPayloadMismatch;
+  if (name == "kinematic") return EffectKind::kKinematicParameters;
+  if (name == "mounting") return EffectKind::kSensorMounting;
+  if (name == "ims_scale") return EffectKind::kImsScaleFactor;
+  if (name == "ims_bias") return EffectKind::kImsBias;
   return EffectKind::kThermalDrift;
+}
+
+inline bool is_chain_effect(const std::string& name) {
+  return name == "kinematic" || name == "mounting" || name == "ims_scale" || name == "ims_bias";
+}
+
+// The joint angles the nominal model's inverse kinematics returns for the flange pose `target`,
+// by Newton steps from `q` (the link-side angles, within ~1e-3 rad of the solution: three steps
+// reach ~1e-12 rad).
+inline calib::JointVector solve_near(const calib::KinematicModel& kin,
+                                     const Eigen::Isometry3d& target, calib::JointVector q) {
+  for (int it = 0; it < 3; ++it) {
+    const Eigen::Isometry3d T = calib::forward_kinematics<double>(kin, q);
+    const Eigen::Isometry3d e = T.inverse() * target;  // body error of the flange
+    const Eigen::AngleAxisd rotation(e.linear());
+    Eigen::Matrix<double, 6, 1> twist;
+    twist << e.translation(), rotation.angle() * rotation.axis();
+    const calib::Jacobian jg = calib::geometric_jacobian(kin, q);
+    Eigen::Matrix<double, 6, 6> jb;
+    jb.topRows<3>() = T.linear().transpose() * jg.topRows<3>();
+    jb.bottomRows<3>() = T.linear().transpose() * jg.bottomRows<3>();
+    q += jb.partialPivLu().solve(twist);
+  }
+  return q;
+}
+
+inline Eigen::Matrix3d rotation_exp(const Eigen::Vector3d& phi) {
+  const double angle = phi.norm();
+  return angle > 0.0 ? Eigen::AngleAxisd(angle, phi / angle).toRotationMatrix()
+                     : Eigen::Matrix3d::Identity();
 }
 
 struct GapWorld {
@@ -81,7 +121,77 @@ struct GapWorld {
     ident::JointErrorLog real;             // with noise
     ident::JointErrorLog real_noise_free;  // = "the sim re-run with the true effects on"
     std::vector<std::vector<double>> sim_joint_error_rad;
+    int chain_joint = -1;  // joint with the most energy of an injected chain error (-1: none)
   };
+
+  // Errors of the IMS chain injected into q_measured: the flange pose the chain would measure
+  // from the true (link-side) motion with the error, through the nominal inverse kinematics.
+  // Returns the joint where the injected error has the most energy.
+  int inject_chain_error(const WithheldEffect& e, std::mt19937_64& rng,
+                         ident::JointErrorLog& log) const {
+    std::uniform_real_distribution<double> size(0.7, 1.3);
+    std::normal_distribution<double> unit(0.0, 1.0);
+    const auto random_direction = [&] {
+      return Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
+    };
+    const calib::KinematicModel& kin = robot.kinematics;
+    const std::size_t n = log.sample_count();
+    const auto link_joints = [&](std::size_t k) {
+      calib::JointVector q;
+      for (int j = 0; j < 6; ++j) q[j] = log.q_measured_rad[std::size_t(j)][k];
+      return q;
+    };
+    calib::KinematicModel real_kin = kin;
+    // Sizes: DH lengths 0.1 mm, twists 0.2 mrad; mounting 0.5 mrad and 0.2 mm; gyro scale
+    // 1000 ppm per axis; gyro bias 20 urad/s (4 deg/h): all x0.7..1.3, joint gaps ~1e-4 rad.
+    const int parameter = int(rng() % 3);
+    if (e.name == "kinematic") {
+      auto& dh = real_kin.dh[std::size_t(e.joint)];
+      if (parameter == 0) dh.a_m += 1e-4 * size(rng);
+      if (parameter == 1) dh.alpha_rad += 2e-4 * size(rng);
+      if (parameter == 2) dh.d_m += 1e-4 * size(rng);
+    }
+    const Eigen::Vector3d mount_rotation = 5e-4 * size(rng) * random_direction();
+    const Eigen::Vector3d mount_translation = 2e-4 * size(rng) * random_direction();
+    Eigen::Isometry3d D = Eigen::Isometry3d::Identity();
+    D.linear() = rotation_exp(mount_rotation);
+    D.translation() = mount_translation;
+    Eigen::Vector3d gyro_scale;
+    for (int i = 0; i < 3; ++i) gyro_scale[i] = 1e-3 * size(rng) * (unit(rng) > 0.0 ? 1 : -1);
+    const Eigen::Vector3d gyro_bias = 2e-5 * size(rng) * random_direction();
+
+    const Eigen::Isometry3d T0 = calib::forward_kinematics<double>(kin, link_joints(0));
+    Eigen::Isometry3d previous = T0;
+    Eigen::Matrix3d attitude = T0.linear();  // the chain's integrated attitude
+    std::vector<calib::JointVector> measured(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const calib::JointVector q = link_joints(k);
+      const Eigen::Isometry3d T = calib::forward_kinematics<double>(kin, q);
+      Eigen::Isometry3d target = T;
+      if (e.name == "kinematic") target = calib::forward_kinematics<double>(real_kin, q);
+      if (e.name == "mounting") target = T0 * D * T0.inverse() * T * D.inverse();
+      if (e.name == "ims_scale" || e.name == "ims_bias") {
+        if (k > 0) {
+          const Eigen::AngleAxisd step(previous.linear().transpose() * T.linear());
+          Eigen::Vector3d phi = step.angle() * step.axis();
+          if (e.name == "ims_scale") phi += gyro_scale.cwiseProduct(phi);
+          if (e.name == "ims_bias") phi += gyro_bias * (log.time_s[k] - log.time_s[k - 1]);
+          attitude = attitude * rotation_exp(phi);
+        }
+        target.linear() = attitude;
+      }
+      previous = T;
+      measured[k] = solve_near(kin, target, q);
+    }
+    std::vector<double> energy(6, 0.0);
+    for (std::size_t k = 0; k < n; ++k)
+      for (int j = 0; j < 6; ++j) {
+        double& qm = log.q_measured_rad[std::size_t(j)][k];
+        energy[std::size_t(j)] += (measured[k][j] - qm) * (measured[k][j] - qm);
+        qm = measured[k][j];
+      }
+    return int(std::max_element(energy.begin(), energy.end()) - energy.begin());
+  }
   Case make_case(const std::vector<WithheldEffect>& effects, std::uint64_t seed) const {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> size(0.7, 1.3);
@@ -115,6 +225,8 @@ struct GapWorld {
             path.samples[k].q_rad[j] - sim_plant.samples[k].q_link_rad[j];
     ident::JointErrorLog log = log_of(real_plant);
     const std::size_t n = log.sample_count();
+    for (const auto& e : effects)
+      if (is_chain_effect(e.name)) c.chain_joint = inject_chain_error(e, rng, log);
     for (const auto& e : effects) {
       auto& qm = log.q_measured_rad[std::size_t(e.joint)];
       if (e.name == "time_offset") {

@@ -64,5 +64,40 @@ TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesAllOrNothing) {
   EXPECT_FALSE(fs::exists(none / "report.json"));
 }
 
+TEST_F(DiagnoseCli, WritesTheModelErrorModelAndFigures) {
+  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "gnuplot is not installed";
+  const eval::test::GapWorld world;
+  // Elastic gear withheld on A3: a linear dynamic gap the model-error model sees.
+  const auto c = world.make_case({{"elastic", 2}}, 8);
+  ident::write_joint_errors_csv(dir_ / "real.csv", c.real);
+  ident::JointErrorLog sim = c.real;
+  for (std::size_t j = 0; j < 6; ++j)
+    for (std::size_t k = 0; k < sim.sample_count(); ++k)
+      sim.q_measured_rad[j][k] = sim.q_desired_rad[j][k] - c.sim_joint_error_rad[j][k];
+  ident::write_joint_errors_csv(dir_ / "sim.csv", sim);
+  const std::string robot = std::string(IMSCAL_SOURCE_DIR) + "/datasets/robots/kr16.yaml";
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(run("diagnose --figures --joint-errors " + (dir_ / "real.csv").string() +
+                    " --sim-joint-errors " + (dir_ / "sim.csv").string() + " --robot " + robot +
+                    " --out " + out.string(),
+                dir_ / "a.log"),
+            0)
+      << read(dir_ / "a.log");
+  for (const char* f : {"gap-spectrum.svg", "gap-where.svg", "gap-model-error.svg"}) {
+    const std::string svg = read(out / f);
+    EXPECT_NE(svg.find("<svg"), std::string::npos) << f;
+    EXPECT_NE(svg.find("<path"), std::string::npos) << f;  // something was drawn
+  }
+  const auto report = nlohmann::json::parse(read(out / "report.json"));
+  ASSERT_EQ(report["model_error"].size(), 6u);
+  const auto& a3 = report["model_error"][2];
+  EXPECT_EQ(a3["joint"], "A3");
+  EXPECT_FALSE(a3["frequency_response"].empty());
+  for (const auto& p : a3["frequency_response"])
+    EXPECT_LE(p["band_lower"].get<double>(), p["magnitude_rad_per_rad"].get<double>());
+  EXPECT_NE(read(out / "report.txt").find("Model-error model"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace imscal
