@@ -86,13 +86,14 @@ void parse_thresholds(const ConfigNode& node, MountingValidationOptions& v) {
 CalibrationConfig parse_calibration_config(const ConfigNode& root) {
   root.require_only_keys({"imscal-calibration-config", "sensor", "robot", "payload", "rests",
                           "time_offset", "bundle", "priors", "validation", "joint_errors",
-                          "first_rest_position_m"});
+                          "first_rest_position_m", "unit_calibration"});
   const ConfigNode version = root.child("imscal-calibration-config");
   if (version.as_int() != 1) version.fail("unknown config version; expected 1");
   CalibrationConfig c;
   c.file = root.file();
   c.sensor_file = existing_file(root, "sensor");
   c.robot_file = existing_file(root, "robot");
+  c.unit_calibration_file = existing_file(root, "unit_calibration");
 
   if (auto p = root.optional_child("payload")) {
     p->require_only_keys({"mass_kg", "com_mm"});
@@ -100,12 +101,14 @@ CalibrationConfig parse_calibration_config(const ConfigNode& root) {
     if (auto com = p->optional_child("com_mm")) c.payload.com_T_m = com->as_vector3() * 1e-3;
   }
   if (auto r = root.optional_child("rests")) {
-    r->require_only_keys(
-        {"min_duration_s", "trim_s", "max_joint_spread_deg", "detector_threshold_sigmas"});
+    r->require_only_keys({"min_duration_s", "trim_s", "max_joint_spread_deg",
+                          "detector_threshold_sigmas", "settle_tolerance_deg"});
     c.rests.min_duration_s = positive(*r, "min_duration_s", c.rests.min_duration_s);
     c.rests.trim_s = non_negative(*r, "trim_s", c.rests.trim_s);
     c.rests.max_joint_spread_rad =
         positive(*r, "max_joint_spread_deg", c.rests.max_joint_spread_rad / kDeg) * kDeg;
+    c.rests.settle_tolerance_rad =
+        non_negative(*r, "settle_tolerance_deg", c.rests.settle_tolerance_rad / kDeg) * kDeg;
     c.rests.detector_threshold_sigmas =
         positive(*r, "detector_threshold_sigmas", c.rests.detector_threshold_sigmas);
     if (2.0 * c.rests.trim_s >= c.rests.min_duration_s)
@@ -119,7 +122,8 @@ CalibrationConfig parse_calibration_config(const ConfigNode& root) {
   if (auto b = root.optional_child("bundle")) {
     b->require_only_keys({"estimate_time_offset", "estimate_scale_factors", "huber_scale_sigma",
                           "outlier_threshold_sigma", "rate_window_s", "min_rate_deg_s",
-                          "max_iterations", "sparse"});
+                          "max_iterations", "sparse", "estimate_deflection_scale",
+                          "deflection_scale_sigma"});
     auto& o = c.bundle;
     o.estimate_time_offset = b->get_bool("estimate_time_offset", o.estimate_time_offset);
     o.estimate_scale_factors = b->get_bool("estimate_scale_factors", o.estimate_scale_factors);
@@ -133,6 +137,9 @@ CalibrationConfig parse_calibration_config(const ConfigNode& root) {
       o.max_iterations = int(n);
     }
     o.sparse = b->get_bool("sparse", o.sparse);
+    o.estimate_deflection_scale =
+        b->get_bool("estimate_deflection_scale", o.estimate_deflection_scale);
+    o.deflection_scale_sigma = positive(*b, "deflection_scale_sigma", o.deflection_scale_sigma);
   }
   if (auto p = root.optional_child("priors")) {
     p->require_only_keys({"gyro_bias_sigma_deg_per_h", "acc_bias_sigma_ug",

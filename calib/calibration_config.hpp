@@ -8,13 +8,15 @@
 //   imscal-calibration-config: 1
 //   sensor: ../sensors/navigation-grade.yaml      # relative to this file
 //   robot: ../robots/kr16.yaml
+//   unit_calibration: unit.yaml                   # the IMS unit's lab calibration (optional)
 //   payload: {mass_kg: 0.0, com_mm: [0, 0, 0]}    # in the tool frame T
 //   rests: {min_duration_s: 2.0, trim_s: 0.5, max_joint_spread_deg: 0.00057,
-//           detector_threshold_sigmas: 5.0}
+//           settle_tolerance_deg: 0, detector_threshold_sigmas: 5.0}
 //   time_offset: {max_abs_offset_s: 0.5}
 //   bundle: {estimate_time_offset: true, estimate_scale_factors: false, huber_scale_sigma: 3,
 //            outlier_threshold_sigma: 4, rate_window_s: 0.02, min_rate_deg_s: 2.9,
-//            max_iterations: 100, sparse: true}
+//            max_iterations: 100, sparse: true, estimate_deflection_scale: true,
+//            deflection_scale_sigma: 1.0}
 //   priors: {gyro_bias_sigma_deg_per_h: ..., acc_bias_sigma_ug: ...,   # default: the spec's
 //            deflection_uncertainty_fraction: 0.05, joint_sigma_floor_urad: 5}
 //   validation: {halves: true, segments: true, segment_rests: 5, ...thresholds}
@@ -41,7 +43,10 @@ struct RestConfig {
   double min_duration_s = 2.0;  // shorter rests are not used
   double trim_s = 0.5;          // cut at both ends of every detected rest
   // Largest spread of the robot's joint readings over a rest (the robot must be still) [rad].
-  double max_joint_spread_rad = 1e-5;      // a few encoder counts
+  double max_joint_spread_rad = 1e-5;  // a few encoder counts
+  // Rests are used from where the joint readings have settled within this of their final value
+  // (calib/rest_poses.hpp) [rad]; 0: not checked.
+  double settle_tolerance_rad = 0.0;
   double detector_threshold_sigmas = 5.0;  // ims/rest_detector.hpp
 };
 
@@ -59,6 +64,11 @@ struct CalibrationConfig {
   std::string file;                                  // where it was read from ("" for the defaults)
   std::optional<std::filesystem::path> sensor_file;  // resolved against the config's folder
   std::optional<std::filesystem::path> robot_file;
+  // The IMS unit's lab (or data-sheet) calibration: scale factors and misalignments of both
+  // triads in the format of ims/sensor_error_model.hpp (as `imscal mechanize --sensor-errors`
+  // takes it). `imscal calibrate` corrects the raw record with it (ims::correct) before anything
+  // else; its biases, usually zero, are subtracted too, and the bundle estimates what remains.
+  std::optional<std::filesystem::path> unit_calibration_file;
   PayloadConfig payload;
   RestConfig rests;
   double max_abs_time_offset_s = 0.5;  // search range of the initial time offset

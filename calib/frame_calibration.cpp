@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <tuple>
 
 #include "calib/forward_kinematics.hpp"
 #include "calib/frame_covariance.hpp"
@@ -48,7 +49,10 @@ struct Parameters {
   double dt[1] = {0};
   double s_g[3] = {0, 0, 0};
   double s_a[3] = {0, 0, 0};
+  double m_w[6] = {0, 0, 0, 0, 0, 0};  // 1 - k_w (estimate_deflection_scale)
+  double m_p[6] = {0, 0, 0, 0, 0, 0};  // 1 - k_p
   std::vector<std::array<double, 6>> dq;
+  const std::vector<RestObservation>* rests = nullptr;
 
   Eigen::Matrix3d R_W_R() const {
     return Eigen::Map<const Eigen::Quaterniond>(q_W_R).toRotationMatrix();
@@ -62,8 +66,10 @@ struct Parameters {
     b.acc_m_s2 = Eigen::Map<const Eigen::Vector3d>(b_a);
     return b;
   }
+  // dq_i plus the scaled wind-up and play of rest i.
   JointVector joint_deviation(std::size_t i) const {
-    return Eigen::Map<const JointVector>(dq[i].data());
+    const RestObservation& r = (*rests)[i];
+    return rest_deviation<double>(dq[i].data(), m_w, m_p, r.q_windup_rad, r.q_play_rad);
   }
 };
 
@@ -243,6 +249,26 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
   Eigen::Map<Eigen::Vector3d>(x.p_S_H) = init.T_S_H.translation();
   x.dt[0] = init.time_offset_s;
   x.dq.assign(rests.size(), std::array<double, 6>{0, 0, 0, 0, 0, 0});
+  x.rests = &input.rests;
+  // Deflection scales: per joint, only where some rest has a modelled wind-up / play.
+  JointVector windup_inverse_sigma = JointVector::Zero(), play_inverse_sigma = JointVector::Zero();
+  std::vector<int> fixed_windup, fixed_play;
+  for (int k = 0; k < kJointCount; ++k) {
+    double windup = 0.0, play = 0.0;
+    for (const RestObservation& r : input.rests) {
+      windup = std::max(windup, std::abs(r.q_windup_rad[k]));
+      play = std::max(play, std::abs(r.q_play_rad[k]));
+    }
+    const bool estimate = options.estimate_deflection_scale && options.deflection_scale_sigma > 0.0;
+    if (estimate && windup > 0.0)
+      windup_inverse_sigma[k] = 1.0 / options.deflection_scale_sigma;
+    else
+      fixed_windup.push_back(k);
+    if (estimate && play > 0.0)
+      play_inverse_sigma[k] = 1.0 / options.deflection_scale_sigma;
+    else
+      fixed_play.push_back(k);
+  }
 
   // Rate windows for the time offset.
   std::unique_ptr<FlangeRateGrid> rate_grid;
@@ -307,6 +333,23 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
     problem.AddParameterBlock(x.b_a, 3);
     problem.AddParameterBlock(x.s_g, 3);
     problem.AddParameterBlock(x.s_a, 3);
+    problem.AddParameterBlock(x.m_w, 6);
+    problem.AddParameterBlock(x.m_p, 6);
+    for (auto [block, fixed] : {std::pair{x.m_w, &fixed_windup}, std::pair{x.m_p, &fixed_play}}) {
+      if (fixed->size() == static_cast<std::size_t>(kJointCount))
+        problem.SetParameterBlockConstant(block);
+      else if (!fixed->empty())
+        problem.SetManifold(block, new ceres::SubsetManifold(6, *fixed));
+    }
+    if (fixed_windup.size() + fixed_play.size() < static_cast<std::size_t>(2 * kJointCount)) {
+      DeflectionScalePriorResidual prior;
+      prior.inverse_sigma_windup = windup_inverse_sigma;
+      prior.inverse_sigma_play = play_inverse_sigma;
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<DeflectionScalePriorResidual, 12, 6, 6>(
+              new DeflectionScalePriorResidual(prior)),
+          nullptr, x.m_w, x.m_p);
+    }
     if (!options.estimate_scale_factors) {
       problem.SetParameterBlockConstant(x.s_g);
       problem.SetParameterBlockConstant(x.s_a);
@@ -352,6 +395,8 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
       RestResidual f;
       f.model = &input.kinematics;
       f.q = input.rests[i].q_link_rad;
+      f.windup = input.rests[i].q_windup_rad;
+      f.play = input.rests[i].q_play_rad;
       f.mean_rate = rests[i].mean_rate_rad_s;
       f.mean_force = rests[i].mean_specific_force_m_s2;
       f.earth_rate_W = earth.earth_rate_W();
@@ -361,10 +406,10 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
       f.force_sigma = sig.force_m_s2;
       stage.rest_functors.push_back(f);
       problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<RestResidual, 6, 4, 4, 6, 3, 3, 3, 3>(
+          new ceres::AutoDiffCostFunction<RestResidual, 6, 4, 4, 6, 3, 3, 3, 3, 6, 6>(
               new RestResidual(f)),
           new ceres::HuberLoss(options.huber_scale_sigma * std::sqrt(6.0)), x.q_W_R, x.q_S_H,
-          x.dq[i].data(), x.b_g, x.b_a, x.s_g, x.s_a);
+          x.dq[i].data(), x.b_g, x.b_a, x.s_g, x.s_a, x.m_w, x.m_p);
     }
     stage.motion_functors.clear();
     stage.motion_covariance_factor.clear();
@@ -374,6 +419,10 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
       f.preintegration = &stage.motions[i];
       f.q_i = input.rests[i].q_link_rad;
       f.q_j = input.rests[i + 1].q_link_rad;
+      f.windup_i = input.rests[i].q_windup_rad;
+      f.play_i = input.rests[i].q_play_rad;
+      f.windup_j = input.rests[i + 1].q_windup_rad;
+      f.play_j = input.rests[i + 1].q_play_rad;
       f.earth_rate_W = earth.earth_rate_W();
       f.gravity_start_W = earth.gravity_W(p_abs[i]);
       f.gravity_gradient_W = earth.gravity_gradient_W();
@@ -384,10 +433,10 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
           Eigen::LLT<Eigen::Matrix<double, 9, 9>>(cov).matrixL());
       stage.motion_functors.push_back(f);
       problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<MotionResidual, 9, 4, 4, 3, 6, 6, 3, 3>(
+          new ceres::AutoDiffCostFunction<MotionResidual, 9, 4, 4, 3, 6, 6, 3, 3, 6, 6>(
               new MotionResidual(f)),
           new ceres::HuberLoss(options.huber_scale_sigma * 3.0), x.q_W_R, x.q_S_H, x.p_S_H,
-          x.dq[i].data(), x.dq[i + 1].data(), x.b_g, x.b_a);
+          x.dq[i].data(), x.dq[i + 1].data(), x.b_g, x.b_a, x.m_w, x.m_p);
     }
     stage.rate_functors.clear();
     if (!rate_windows.empty()) {
@@ -450,6 +499,10 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
   result.gyro_scale_factor = Eigen::Map<const Eigen::Vector3d>(x.s_g);
   result.acc_scale_factor = Eigen::Map<const Eigen::Vector3d>(x.s_a);
   result.time_offset_s = x.dt[0];
+  for (int k = 0; k < kJointCount; ++k) {
+    result.windup_scale[k] = 1.0 - x.m_w[k];
+    result.play_scale[k] = 1.0 - x.m_p[k];
+  }
   for (std::size_t i = 0; i < rests.size(); ++i)
     result.joint_deviation_rad.push_back(x.joint_deviation(i));
   result.solver_brief_report = stage.summary.BriefReport();
@@ -474,6 +527,25 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
     blocks.push_back({"gyro_scale_factor", x.s_g, 3, 1.0, {"x", "y", "z"}});
     blocks.push_back({"acc_scale_factor", x.s_a, 3, 1.0, {"x", "y", "z"}});
   }
+  const bool windup_estimated = fixed_windup.size() < static_cast<std::size_t>(kJointCount);
+  const bool play_estimated = fixed_play.size() < static_cast<std::size_t>(kJointCount);
+  const std::vector<std::string> joint_names = {"A1", "A2", "A3", "A4", "A5", "A6"};
+  // Only the estimated joints of a block are in the covariance: a SubsetManifold's tangent
+  // space leaves out the fixed ones.
+  auto estimated_names = [&](const std::vector<int>& fixed) {
+    std::vector<std::string> names;
+    for (int k = 0; k < kJointCount; ++k)
+      if (std::find(fixed.begin(), fixed.end(), k) == fixed.end()) names.push_back(joint_names[k]);
+    return names;
+  };
+  const std::vector<std::string> windup_names = estimated_names(fixed_windup);
+  const std::vector<std::string> play_names = estimated_names(fixed_play);
+  if (windup_estimated)
+    blocks.push_back({"windup_scale_deviation", x.m_w, static_cast<int>(windup_names.size()), 1.0,
+                      windup_names});
+  if (play_estimated)
+    blocks.push_back(
+        {"play_scale_deviation", x.m_p, static_cast<int>(play_names.size()), 1.0, play_names});
   const FrameCovariance cov = compute_frame_covariance(problem, blocks);
   result.parameter_names = cov.parameter_names;
   result.covariance = cov.covariance;
@@ -532,6 +604,32 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
                                   sigma_of(next + 3, 3) * 1e6});
     }
   }
+  // The deflection scales k = 1 - m with their 1-sigma, per estimated joint.
+  if (cov.computed) {
+    for (auto [prefix, factor, sigma, label] :
+         {std::tuple{"windup_scale_deviation.", &result.windup_scale, &result.windup_scale_sigma,
+                     "windup_scale (gear wind-up found / robot file's)"},
+          std::tuple{"play_scale_deviation.", &result.play_scale, &result.play_scale_sigma,
+                     "play_scale (backlash play found at rest / robot file's)"}}) {
+      std::vector<std::string> components;
+      std::vector<double> values, sigmas;
+      for (std::size_t i = 0; i < cov.parameter_names.size(); ++i) {
+        const std::string& name = cov.parameter_names[i];
+        if (name.rfind(prefix, 0) != 0) continue;
+        const int joint = name.back() - '1';
+        const double s = std::sqrt(std::max(0.0, cov.covariance(Eigen::Index(i), Eigen::Index(i))));
+        (*sigma)[joint] = s;
+        components.push_back(joint_names[static_cast<std::size_t>(joint)]);
+        values.push_back((*factor)[joint]);
+        sigmas.push_back(s);
+      }
+      if (values.empty()) continue;
+      result.estimates.push_back(
+          {label, "1", components,
+           Eigen::Map<const Eigen::VectorXd>(values.data(), Eigen::Index(values.size())),
+           Eigen::Map<const Eigen::VectorXd>(sigmas.data(), Eigen::Index(sigmas.size()))});
+    }
+  }
   std::vector<Eigen::Matrix3d> flange_rotations;
   for (std::size_t i = 0; i + 1 < rests.size(); ++i) {
     flange_rotations.push_back(init.T_R_H_rest[i].linear().transpose() *
@@ -544,7 +642,7 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
   for (std::size_t i = 0; i < rests.size(); ++i) {
     const RestResidual& f = stage.rest_functors[i];
     Eigen::Matrix<double, 6, 1> r;
-    f(x.q_W_R, x.q_S_H, x.dq[i].data(), x.b_g, x.b_a, x.s_g, x.s_a, r.data());
+    f(x.q_W_R, x.q_S_H, x.dq[i].data(), x.b_g, x.b_a, x.s_g, x.s_a, x.m_w, x.m_p, r.data());
     PoseResidual p;
     p.label = input.rests[i].label;
     p.normalised = std::sqrt(r.squaredNorm() / 6.0);
@@ -561,7 +659,8 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
   for (std::size_t i = 0; i + 1 < rests.size(); ++i) {
     const MotionResidual& f = stage.motion_functors[i];
     Eigen::Matrix<double, 9, 1> r;
-    f(x.q_W_R, x.q_S_H, x.p_S_H, x.dq[i].data(), x.dq[i + 1].data(), x.b_g, x.b_a, r.data());
+    f(x.q_W_R, x.q_S_H, x.p_S_H, x.dq[i].data(), x.dq[i + 1].data(), x.b_g, x.b_a, x.m_w, x.m_p,
+      r.data());
     const Eigen::Matrix<double, 9, 1> raw = stage.motion_covariance_factor[i] * r;
     PoseResidual p;
     p.label = fmt::format("{} -> {}", input.rests[i].label, input.rests[i + 1].label);

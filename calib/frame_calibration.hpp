@@ -44,6 +44,11 @@ struct RestObservation {
   double end_ims_s = 0.0;
   JointVector q_link_rad = JointVector::Zero();        // link-side joint angles at rest
   JointVector q_link_sigma_rad = JointVector::Zero();  // prior 1-sigma of their remaining error
+  // The modelled static deflection that q_link_rad was corrected for (calib/static_deflection):
+  // q_link = q_internal - q_windup - q_play. Zero when the readings are link angles. With
+  // FrameCalibrationOptions::estimate_deflection_scale the bundle scales both per joint.
+  JointVector q_windup_rad = JointVector::Zero();  // gear wind-up tau_g / k
+  JointVector q_play_rad = JointVector::Zero();    // backlash play taken up, (b / 2) sign(tau_g)
 };
 
 // The robot's joint readings, for the flange rate during motion (time offset) [robot clock].
@@ -87,6 +92,15 @@ struct FrameCalibrationInput {
 struct FrameCalibrationOptions {
   bool estimate_time_offset = true;
   bool estimate_scale_factors = false;  // accelerometer and gyro scale factors (3 + 3)
+  // Per-joint factors k_w, k_p of the modelled wind-up and play of the rests
+  // (RestObservation::q_windup_rad, q_play_rad): the link angle of rest i is
+  //   q_link + dq_i + (1 - k_w) q_windup + (1 - k_p) q_play,
+  // i.e. k = 1 the robot file's stiffness and play are right, k = 0 the drives are rigid and
+  // without play at rest. Prior N(1, deflection_scale_sigma) each; joints whose modelled
+  // deflection is zero at every rest keep k = 1. The rest poses see k through the gravity
+  // torques that change from pose to pose (wind-up) and the tilt of loaded joints (play).
+  bool estimate_deflection_scale = true;
+  double deflection_scale_sigma = 1.0;
   // Robust loss on the per-pose and per-motion residual blocks (Huber, in units of sigma).
   double huber_scale_sigma = 3.0;
   // A pose or motion whose normalised residual (sqrt of its chi-square / dof) exceeds this is
@@ -134,8 +148,16 @@ struct FrameCalibrationResult {
   ImuBiases biases;
   Eigen::Vector3d gyro_scale_factor = Eigen::Vector3d::Zero();  // dimensionless (1e-6 = 1 ppm)
   Eigen::Vector3d acc_scale_factor = Eigen::Vector3d::Zero();
-  double time_offset_s = 0.0;                    // t_ims = t_robot + time_offset_s
-  std::vector<JointVector> joint_deviation_rad;  // dq_i per rest pose
+  double time_offset_s = 0.0;  // t_ims = t_robot + time_offset_s
+  // Per rest: the estimated link angle minus RestObservation::q_link_rad (dq_i plus the scaled
+  // wind-up and play, see estimate_deflection_scale) [rad].
+  std::vector<JointVector> joint_deviation_rad;
+  // The factors k_w, k_p of estimate_deflection_scale (1: the robot file's model; 1 where not
+  // estimated) with their 1-sigma (0 where not estimated).
+  JointVector windup_scale = JointVector::Ones();
+  JointVector play_scale = JointVector::Ones();
+  JointVector windup_scale_sigma = JointVector::Zero();
+  JointVector play_scale_sigma = JointVector::Zero();
 
   // Tangent-space covariance of the frames, biases and time offset in the order of
   // `parameter_names` (rotations as small angles in the left frame: R_W_R, R_S_H; positions;

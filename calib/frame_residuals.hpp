@@ -4,7 +4,8 @@
 //   q_W_R, q_S_H : Eigen quaternions (x, y, z, w), EigenQuaternionManifold (left perturbation,
 //                  Ceres' tangent delta turns by 2 |delta|);
 //   p_S_H [m], b_g [rad/s], b_a [m/s^2], dt [s] (t_ims = t_robot + dt), s_g, s_a [1] (scale
-//   factors), dq_i [rad] (joint deviation of rest i).
+//   factors), dq_i [rad] (joint deviation of rest i), m_w, m_p [1] (per joint: the fraction of
+//   the modelled wind-up / play that is not there, 1 - k of estimate_deflection_scale).
 // Every residual is whitened (multiplied by the inverse square root of its covariance), so that
 // Huber scales and chi-square tests are in units of sigma.
 #include <ceres/cubic_interpolation.h>
@@ -25,6 +26,15 @@ template <typename T>
 using Vector3T = Eigen::Matrix<T, 3, 1>;
 template <typename T>
 using Matrix3T = Eigen::Matrix<T, 3, 3>;
+
+// The joint deviation of a rest: dq + m_w * windup + m_p * play (per joint).
+template <typename T>
+Eigen::Matrix<T, 6, 1> rest_deviation(const T* dq, const T* m_w, const T* m_p,
+                                      const JointVector& windup, const JointVector& play) {
+  Eigen::Matrix<T, 6, 1> out;
+  for (int k = 0; k < kJointCount; ++k) out[k] = dq[k] + m_w[k] * windup[k] + m_p[k] * play[k];
+  return out;
+}
 
 // R_W_S of a rest from the frames and the joint angles q + dq.
 template <typename T>
@@ -49,6 +59,8 @@ Matrix3T<T> rest_attitude(const KinematicModel& model, const JointVector& q, con
 struct RestResidual {
   const KinematicModel* model = nullptr;
   JointVector q = JointVector::Zero();
+  JointVector windup = JointVector::Zero();  // RestObservation::q_windup_rad
+  JointVector play = JointVector::Zero();    // RestObservation::q_play_rad
   Eigen::Vector3d mean_rate = Eigen::Vector3d::Zero();
   Eigen::Vector3d mean_force = Eigen::Vector3d::Zero();
   Eigen::Vector3d earth_rate_W = Eigen::Vector3d::Zero();
@@ -58,8 +70,10 @@ struct RestResidual {
 
   template <typename T>
   bool operator()(const T* q_W_R, const T* q_S_H, const T* dq, const T* b_g, const T* b_a,
-                  const T* s_g, const T* s_a, T* residual) const {
-    const Matrix3T<T> R_S_W = rest_attitude<T>(*model, q, q_W_R, q_S_H, dq).transpose();
+                  const T* s_g, const T* s_a, const T* m_w, const T* m_p, T* residual) const {
+    const Eigen::Matrix<T, 6, 1> deviation = rest_deviation<T>(dq, m_w, m_p, windup, play);
+    const Matrix3T<T> R_S_W =
+        rest_attitude<T>(*model, q, q_W_R, q_S_H, deviation.data()).transpose();
     const Vector3T<T> rate_true = R_S_W * earth_rate_W.cast<T>();
     const Vector3T<T> force_true = -(R_S_W * gravity_W.cast<T>());
     for (int k = 0; k < 3; ++k) {
@@ -83,6 +97,8 @@ struct MotionResidual {
   const ImuPreintegration* preintegration = nullptr;
   JointVector q_i = JointVector::Zero();
   JointVector q_j = JointVector::Zero();
+  JointVector windup_i = JointVector::Zero(), play_i = JointVector::Zero();
+  JointVector windup_j = JointVector::Zero(), play_j = JointVector::Zero();
   Eigen::Vector3d earth_rate_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d gravity_start_W = Eigen::Vector3d::Zero();  // g at rest i's position
   Eigen::Matrix3d gravity_gradient_W = Eigen::Matrix3d::Zero();
@@ -90,11 +106,15 @@ struct MotionResidual {
 
   template <typename T>
   bool operator()(const T* q_W_R, const T* q_S_H, const T* p_S_H, const T* dq_i, const T* dq_j,
-                  const T* b_g, const T* b_a, T* residual) const {
+                  const T* b_g, const T* b_a, const T* m_w, const T* m_p, T* residual) const {
     const ImuPreintegration& pre = *preintegration;
+    const Eigen::Matrix<T, 6, 1> deviation_i = rest_deviation<T>(dq_i, m_w, m_p, windup_i, play_i);
+    const Eigen::Matrix<T, 6, 1> deviation_j = rest_deviation<T>(dq_j, m_w, m_p, windup_j, play_j);
     Vector3T<T> p_R_S_i, p_R_S_j;
-    const Matrix3T<T> R_i = rest_attitude<T>(*model, q_i, q_W_R, q_S_H, dq_i, &p_R_S_i, p_S_H);
-    const Matrix3T<T> R_j = rest_attitude<T>(*model, q_j, q_W_R, q_S_H, dq_j, &p_R_S_j, p_S_H);
+    const Matrix3T<T> R_i =
+        rest_attitude<T>(*model, q_i, q_W_R, q_S_H, deviation_i.data(), &p_R_S_i, p_S_H);
+    const Matrix3T<T> R_j =
+        rest_attitude<T>(*model, q_j, q_W_R, q_S_H, deviation_j.data(), &p_R_S_j, p_S_H);
     const Matrix3T<T> R_W_R = Eigen::Map<const Eigen::Quaternion<T>>(q_W_R).toRotationMatrix();
     const Vector3T<T> dp_model = R_W_R * (p_R_S_j - p_R_S_i);
 
@@ -180,6 +200,20 @@ struct RateResidual {
     const Vector3T<T> mean_H = sum / T(static_cast<double>(mid_times_ims_s.size()));
     const Vector3T<T> model = R_S_H.cast<T>() * mean_H + offset_S.cast<T>();
     for (int k = 0; k < 3; ++k) residual[k] = (T(mean_rate[k]) - model[k]) / T(sigma);
+    return true;
+  }
+};
+
+// Prior N(0, sigma) of the deflection-scale deviations m_w, m_p (6 + 6; 1/sigma 0: none).
+struct DeflectionScalePriorResidual {
+  JointVector inverse_sigma_windup = JointVector::Zero();
+  JointVector inverse_sigma_play = JointVector::Zero();
+  template <typename T>
+  bool operator()(const T* m_w, const T* m_p, T* residual) const {
+    for (int k = 0; k < kJointCount; ++k) {
+      residual[k] = m_w[k] * T(inverse_sigma_windup[k]);
+      residual[kJointCount + k] = m_p[k] * T(inverse_sigma_play[k]);
+    }
     return true;
   }
 };

@@ -63,9 +63,8 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
                                             seconds(samples.back().t_s)));
       continue;
     }
-    const auto first =
-        std::lower_bound(samples.begin(), samples.end(), robot_begin,
-                         [](const RobotLogSample& s, double t) { return s.t_s < t; });
+    auto first = std::lower_bound(samples.begin(), samples.end(), robot_begin,
+                                  [](const RobotLogSample& s, double t) { return s.t_s < t; });
     const auto last = std::upper_bound(samples.begin(), samples.end(), robot_end,
                                        [](double t, const RobotLogSample& s) { return t < s.t_s; });
     if (last - first < 2) {
@@ -74,17 +73,13 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
     }
     RestPoseDetail detail;
     JointVector low = first->q_internal_rad, high = first->q_internal_rad;
-    JointVector sum = JointVector::Zero();
     double payload_low = first->payload_kg, payload_high = first->payload_kg;
     for (auto it = first; it != last; ++it) {
       low = low.cwiseMin(it->q_internal_rad);
       high = high.cwiseMax(it->q_internal_rad);
-      sum += it->q_internal_rad;
       payload_low = std::min(payload_low, it->payload_kg);
       payload_high = std::max(payload_high, it->payload_kg);
     }
-    detail.robot_samples = static_cast<std::size_t>(last - first);
-    detail.q_internal_mean_rad = sum / static_cast<double>(detail.robot_samples);
     detail.q_internal_spread_rad = high - low;
     int moving = -1;
     detail.q_internal_spread_rad.maxCoeff(&moving);
@@ -95,6 +90,32 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
           options.max_joint_spread_rad));
       continue;
     }
+    // Of a still rest only the settled part: from where every joint's reading stays within
+    // settle_tolerance_rad of its value at the rest's end (the controllers' settling tail).
+    double rest_begin = begin;
+    if (options.settle_tolerance_rad > 0.0) {
+      const JointVector& final_q = (last - 1)->q_internal_rad;
+      auto settled = last - 1;
+      while (settled != first && ((settled - 1)->q_internal_rad - final_q).cwiseAbs().maxCoeff() <=
+                                     options.settle_tolerance_rad)
+        --settled;
+      if (settled != first) {
+        first = settled;
+        rest_begin = first->t_s + input.time_offset_s;
+        const double still_s = end - rest_begin;
+        if (still_s < options.min_settled_s) {
+          result.rejected.push_back(fmt::format(
+              "{}: the joints settle within {:.3g} rad of their final reading only {:.3f} s "
+              "before its end (< {} s): the robot is not still enough there",
+              where, options.settle_tolerance_rad, still_s, options.min_settled_s));
+          continue;
+        }
+      }
+    }
+    JointVector sum = JointVector::Zero();
+    for (auto it = first; it != last; ++it) sum += it->q_internal_rad;
+    detail.robot_samples = static_cast<std::size_t>(last - first);
+    detail.q_internal_mean_rad = sum / static_cast<double>(detail.robot_samples);
     if (payload_high != payload_low) {
       result.rejected.push_back(fmt::format("{}: the payload changes during it", where));
       continue;
@@ -108,10 +129,12 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
 
     RestObservation rest;
     rest.label = fmt::format("rest {} at {:.1f} s", result.rests.size() + 1, begin);
-    rest.begin_ims_s = begin;
+    rest.begin_ims_s = rest_begin;
     rest.end_ims_s = end;
     rest.q_link_rad = detail.deflection.q_link_rad;
     rest.q_link_sigma_rad = detail.deflection.q_link_sigma_rad;
+    rest.q_windup_rad = detail.deflection.windup_rad;
+    rest.q_play_rad = detail.deflection.play_rad;
     result.rests.push_back(rest);
     result.details.push_back(detail);
   }

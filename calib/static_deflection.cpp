@@ -64,6 +64,8 @@ StaticDeflection correct_static_deflection(const RobotDescription& robot,
       const double windup = tau / drive.stiffness_nm_per_rad;
       const double play = out.loaded[i] ? std::copysign(0.5 * drive.backlash_rad, tau) : 0.0;
       next(i) -= windup + play;
+      out.windup_rad(i) = windup;
+      out.play_rad(i) = play;
     }
     const double change = (next - out.q_link_rad).cwiseAbs().maxCoeff();
     out.q_link_rad = next;

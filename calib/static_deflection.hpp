@@ -46,6 +46,12 @@ struct StaticDeflection {
   JointVector q_link_sigma_rad = JointVector::Zero();   // prior 1-sigma of the remaining error
   JointVector gravity_torque_nm = JointVector::Zero();  // tau_g(q_link) [N m]
   JointVector deflection_rad = JointVector::Zero();     // q_internal - q_link
+  // Its two parts (deflection_rad = windup_rad + play_rad): the gear wind-up tau_g / k and the
+  // play taken up on loaded joints (b / 2) sign(tau_g). The bundle may scale each per joint
+  // (calib/frame_calibration.hpp, estimate_deflection_scale): the robot file's stiffness and
+  // play checked by the data.
+  JointVector windup_rad = JointVector::Zero();
+  JointVector play_rad = JointVector::Zero();
   std::array<bool, kJointCount> loaded{};  // backlash side known (|tau_g| above friction)
   int iterations = 0;
 };

@@ -1,5 +1,6 @@
 // `imscal calibrate --imu FILE --robot-log FILE --robot ROBOT.yaml --sensor SPEC.yaml
-//  [--config YAML] --out DIR [--force]`: the wrist/sensor calibration of the paper. From the raw
+//  [--config YAML] [--unit-calibration YAML] --out DIR [--force]`: the wrist/sensor calibration of
+//  the paper. From the raw
 // IMS record and the robot's log: rest poses (calib/rest_poses.hpp), the frame-and-bias bundle
 // (calib/frame_calibration.hpp: T_R_W, T_S_H, biases, time offset with covariance), the mounting
 // validation (calib/mounting_validation.hpp) and the joint errors (calib/joint_space_errors.hpp).
@@ -35,6 +36,7 @@
 #include "ident/joint_error_io.hpp"
 #include "ims/imu_conversion.hpp"
 #include "ims/imu_file.hpp"
+#include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
 #include "ims/so3.hpp"
 #include "ims/zupt_options.hpp"
@@ -54,6 +56,7 @@ struct CalibrateArgs {
   std::string robot;
   std::string sensor;
   std::string config;
+  std::string unit_calibration;
   std::string out;
   bool force = false;
 };
@@ -148,6 +151,7 @@ json input_json(const std::string& file) {
 struct Inputs {
   calib::CalibrationConfig config;
   fs::path robot_file, sensor_file;
+  std::optional<fs::path> unit_calibration_file;
   calib::RobotDescription robot;
   ims::SensorSpec spec;
   ims::ImuSeries imu;
@@ -174,6 +178,14 @@ Inputs read_inputs(const CalibrateArgs& args) {
   if (in.spec.acc.range > 0.0) read_options.acc_range_m_s2 = in.spec.acc.range;
   in.imu = ims::read_imu_file(args.imu, read_options);
   if (in.imu.quantity == ims::ImuQuantity::kRates) in.imu = ims::rates_to_increments(in.imu);
+  // The unit's lab calibration (scale factors, misalignments): applied to the raw record first.
+  in.unit_calibration_file = in.config.unit_calibration_file;
+  if (!args.unit_calibration.empty()) in.unit_calibration_file = fs::path(args.unit_calibration);
+  if (in.unit_calibration_file) {
+    in.imu = ims::correct(in.imu, ims::load_sensor_error_model(*in.unit_calibration_file));
+    spdlog::info("calibrate: corrected {} with the unit calibration {}", args.imu,
+                 in.unit_calibration_file->string());
+  }
   if (!in.imu.site)
     throw InputError(args.imu, 0, "site",
                      "the IMS file does not state its site (site_latitude_deg, "
@@ -328,6 +340,7 @@ void run(const CalibrateArgs& args) {
   rest_options.min_duration_s = config.rests.min_duration_s;
   rest_options.edge_trim_s = config.rests.trim_s;
   rest_options.max_joint_spread_rad = config.rests.max_joint_spread_rad;
+  rest_options.settle_tolerance_rad = config.rests.settle_tolerance_rad;
   rest_options.deflection.model_uncertainty_fraction =
       config.priors.deflection_uncertainty_fraction;
   rest_options.deflection.sigma_floor_rad = config.priors.joint_sigma_floor_rad;
@@ -392,11 +405,14 @@ void run(const CalibrateArgs& args) {
   // Outputs.
   progress.update("write", 0.0);
   const std::string created_by = std::string("imscal ") + kVersion;
-  const json inputs = {{"imu", input_json(args.imu)},
-                       {"robot_log", input_json(args.robot_log)},
-                       {"robot", input_json(in.robot_file.string())},
-                       {"sensor", input_json(in.sensor_file.string())},
-                       {"config", input_json(args.config)}};
+  const json inputs = {
+      {"imu", input_json(args.imu)},
+      {"robot_log", input_json(args.robot_log)},
+      {"robot", input_json(in.robot_file.string())},
+      {"sensor", input_json(in.sensor_file.string())},
+      {"config", input_json(args.config)},
+      {"unit_calibration",
+       input_json(in.unit_calibration_file ? in.unit_calibration_file->string() : std::string())}};
   json estimates = json::array();
   for (const auto& e : result.estimates) estimates.push_back(estimate_json(e));
   json weak = json::array();
@@ -527,6 +543,10 @@ tools::CommandRegistration registration{
                      "IMS sensor spec (datasets/sensors/*.yaml); default: the config's");
       sub.add_option("--config", args->config,
                      "Calibration config (datasets/calibration/calibrate-default.yaml)");
+      sub.add_option("--unit-calibration", args->unit_calibration,
+                     "The IMS unit's lab calibration (scale factors, misalignments; "
+                     "ims/sensor_error_model.hpp format), applied to the raw record; default: "
+                     "the config's unit_calibration");
       sub.add_option("--out", args->out, "Output folder")->required();
       sub.add_flag("--force", args->force, "Replace existing outputs");
       sub.callback([args] { run(*args); });

@@ -12,8 +12,10 @@
 // the rest within 3 sigma. Asserted is what the chain meets (see the comments at the asserts);
 // the figures are printed for the report.
 //
-// Two scenarios: `mounting` as shipped (every plant effect) and the same with the backlash off
-// (a scratch copy), which shows what the other effects leave.
+// Three scenarios: `mounting` as shipped (every plant effect), `mounting-rigid` (rigid drives)
+// and `mounting` with the backlash off (a scratch copy), which shows what the other effects
+// leave. The record is corrected with the unit's lab calibration (its drawn scale factors and
+// misalignments, as the config's unit_calibration does in `imscal calibrate`).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -32,6 +34,7 @@
 #include "core/input_error.hpp"
 #include "ims/imu_noise.hpp"
 #include "ims/imu_synthesis.hpp"
+#include "ims/sensor_error_model.hpp"
 #include "ims/so3.hpp"
 #include "ims/spline_trajectory.hpp"
 #include "sim/scenario.hpp"
@@ -59,6 +62,7 @@ struct SeedOutcome {
   double S_H_rotation_deg = 0.0, S_H_translation_mm = 0.0;
   double R_W_tilt_deg = 0.0, R_W_translation_mm = 0.0;
   double heading_sigmas = 0.0, gyro_bias_sigmas = 0.0, acc_bias_sigmas = 0.0, dt_sigmas = 0.0;
+  std::size_t outliers = 0;
 };
 
 double sigma_of(const FrameCalibrationResult& r, const std::string& name) {
@@ -78,8 +82,12 @@ double worst_sigmas(const FrameCalibrationResult& r, const std::string& prefix,
   return worst;
 }
 
+// unit_calibration: correct the record with the unit's scale factors and misalignments as its
+// lab calibration would (the drawn values exactly, biases left to the bundle), as `imscal
+// calibrate` does with the config's unit_calibration.
 SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult& base,
-                     const RobotLog& log, std::uint64_t seed, double max_joint_spread_rad) {
+                     const RobotLog& log, std::uint64_t seed, double max_joint_spread_rad,
+                     bool unit_calibration, double settle_tolerance_rad) {
   SeedOutcome o;
   o.seed = seed;
   std::mt19937_64 rng(seed * 7919 + 17);
@@ -112,6 +120,12 @@ SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult&
   ims::ImuSeries imu = ims::corrupt(ideal, errors, base.sensor_spec, rng());
   for (auto& s : imu.samples) s.t_s += scenario.imu_clock_offset_s;
   imu.site = scenario.site;
+  if (unit_calibration) {
+    ims::SensorErrorModel lab = errors;
+    lab.gyro.bias.setZero();
+    lab.acc.bias.setZero();
+    imu = ims::correct(imu, lab);
+  }
 
   // As `imscal calibrate` with the shipped defaults: rests, initial dt, rests again, bundle.
   const CalibrationConfig config = load_calibration_config(
@@ -127,6 +141,10 @@ SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult&
   rest_options.edge_trim_s = config.rests.trim_s;
   rest_options.max_joint_spread_rad =
       max_joint_spread_rad > 0.0 ? max_joint_spread_rad : config.rests.max_joint_spread_rad;
+  rest_options.settle_tolerance_rad = settle_tolerance_rad;
+  rest_options.deflection.model_uncertainty_fraction =
+      config.priors.deflection_uncertainty_fraction;
+  rest_options.deflection.sigma_floor_rad = config.priors.joint_sigma_floor_rad;
   try {
     const RestPoseResult first = find_rest_poses(rest_input, rest_options);
     if (first.detection.intervals.empty()) throw InputError("campaign", 0, "", "no rest at all");
@@ -148,6 +166,8 @@ SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult&
     const FrameCalibrationResult r = calibrate_frames(in, config.bundle);
     o.calibrated = true;
     o.converged = r.converged;
+    for (const auto* list : {&r.rest_residuals, &r.motion_residuals})
+      for (const auto& p : *list) o.outliers += p.outlier;
 
     // Errors against the truth (T_R_W in the bundle's W-origin convention).
     const Eigen::Isometry3d T_S_H_true = T_H_S.inverse();
@@ -186,12 +206,14 @@ struct CampaignFigures {
   double S_H_rotation_deg = 0.0, S_H_translation_mm = 0.0, R_W_tilt_deg = 0.0,
          R_W_translation_mm = 0.0, heading_sigmas = 0.0, gyro_bias_sigmas = 0.0,
          acc_bias_sigmas = 0.0, dt_sigmas = 0.0;
+  std::size_t worst_outliers = 0;
   std::string first_refusal;
 };
 
 // max_joint_spread_rad: 0 for the shipped default (1e-5 rad).
 CampaignFigures run_campaign(const fs::path& scenario_file, const std::string& label,
-                             std::size_t release_seeds, double max_joint_spread_rad = 0.0) {
+                             std::size_t release_seeds, double max_joint_spread_rad = 0.0,
+                             bool unit_calibration = true, double settle_tolerance_rad = 0.0) {
   const sim::Scenario scenario = sim::load_scenario(scenario_file);
   const std::size_t seeds = sanitized() ? 2 : release_seeds;
   // Under the sanitizers the plant (~15 s in Release) runs the first 60 s only (7 rests).
@@ -210,7 +232,8 @@ CampaignFigures run_campaign(const fs::path& scenario_file, const std::string& l
         if (next >= seeds) return;
         i = next++;
       }
-      outcomes[i] = run_seed(scenario, base, log, 1000 + i, max_joint_spread_rad);
+      outcomes[i] = run_seed(scenario, base, log, 1000 + i, max_joint_spread_rad, unit_calibration,
+                             settle_tolerance_rad);
     }
   };
   std::thread a(worker), b(worker);  // 2 cores
@@ -237,6 +260,7 @@ CampaignFigures run_campaign(const fs::path& scenario_file, const std::string& l
     f.gyro_bias_sigmas = std::max(f.gyro_bias_sigmas, o.gyro_bias_sigmas);
     f.acc_bias_sigmas = std::max(f.acc_bias_sigmas, o.acc_bias_sigmas);
     f.dt_sigmas = std::max(f.dt_sigmas, o.dt_sigmas);
+    f.worst_outliers = std::max(f.worst_outliers, o.outliers);
   }
   std::printf(
       "campaign %s: %zu seeds, rests found %zu..%zu, calibrated %zu, converged %zu, worst "
@@ -246,10 +270,11 @@ CampaignFigures run_campaign(const fs::path& scenario_file, const std::string& l
   if (f.calibrated)
     std::printf(
         "campaign %s worst: T_S_H %.5f deg %.4f mm | T_R_W tilt %.5f deg, translation %.4f mm | "
-        "heading %.2f sigma | gyro bias %.2f sigma | acc bias %.2f sigma | dt %.2f sigma "
-        "(goal 0.005 deg, 0.05 mm, 3 sigma)\n",
+        "heading %.2f sigma | gyro bias %.2f sigma | acc bias %.2f sigma | dt %.2f sigma | "
+        "outlier blocks %zu (goal 0.005 deg, 0.05 mm, 3 sigma)\n",
         label.c_str(), f.S_H_rotation_deg, f.S_H_translation_mm, f.R_W_tilt_deg,
-        f.R_W_translation_mm, f.heading_sigmas, f.gyro_bias_sigmas, f.acc_bias_sigmas, f.dt_sigmas);
+        f.R_W_translation_mm, f.heading_sigmas, f.gyro_bias_sigmas, f.acc_bias_sigmas, f.dt_sigmas,
+        f.worst_outliers);
   if (!f.first_refusal.empty())
     std::printf("campaign %s first refusal: %s\n", label.c_str(), f.first_refusal.c_str());
   return f;
@@ -271,6 +296,38 @@ TEST(CalibrateCampaign, MountingScenarioAsShipped) {
   }
 }
 
+TEST(CalibrateCampaign, MountingRigid) {
+  // tests/data/scenarios/mounting-rigid.yaml: the same poses on rigid drives (internal reading =
+  // link angle; the robot file's wind-up and play are not there, the bundle's deflection scales
+  // find that) with the unit's lab calibration applied. 10 seeds (2 under the sanitizers).
+  // The rests are used from where the joints have settled within 3e-7 rad of their final
+  // reading (calib/rest_poses.hpp; off in the shipped config, where creeping elastic drives
+  // would lose their rests): without it the worst seed keeps one outlier block and the tilt
+  // reaches 0.0057 deg.
+  const CampaignFigures f =
+      run_campaign(fs::path(IMSCAL_TEST_DATA_DIR) / "scenarios" / "mounting-rigid.yaml", "rigid",
+                   10, 0.0, true, 3e-7);
+  EXPECT_LT(f.worst_initial_dt_ms, 1.0);  // as above
+  EXPECT_EQ(f.calibrated, f.seeds);
+  EXPECT_EQ(f.calibrated, f.converged);
+  if (sanitized()) return;  // 60 s, 7 rests: the figures below are those of the full record
+  // Measured over the 10 seeds (worst): T_S_H 0.0024 deg / 0.034 mm, T_R_W tilt 0.0048 deg,
+  // translation 0.094 mm, heading 1.6 sigma, gyro bias 2.2 sigma, dt 2.6 sigma, no outlier
+  // block. Asserted: issue 4's goals where met (T_S_H 0.005 deg / 0.05 mm; 3 sigma), the tilt
+  // at 0.01 deg (met at 0.0048 with little margin) and the T_R_W translation at 0.2 mm (not met:
+  // the A1/A4/A6 play priors and the deflection scales cost precision). Not asserted: the
+  // accelerometer bias (97 sigma against the drawn turn-on bias: the unit's 10 ug in-run bias
+  // instability moves the bias the record sees; the truth does not carry it).
+  EXPECT_LT(f.S_H_rotation_deg, 0.005);
+  EXPECT_LT(f.S_H_translation_mm, 0.05);
+  EXPECT_LT(f.R_W_tilt_deg, 0.01);
+  EXPECT_LT(f.R_W_translation_mm, 0.2);
+  EXPECT_LT(f.heading_sigmas, 3.0);
+  EXPECT_LT(f.gyro_bias_sigmas, 3.0);
+  EXPECT_LT(f.dt_sigmas, 3.0);
+  EXPECT_EQ(f.worst_outliers, 0u);
+}
+
 using CalibrateCampaignScratch = test_support::ScratchDirTest;
 
 TEST_F(CalibrateCampaignScratch, MountingWithoutBacklash) {
@@ -290,18 +347,26 @@ TEST_F(CalibrateCampaignScratch, MountingWithoutBacklash) {
   std::ofstream(dir_ / "mounting-no-backlash.yaml") << text;
   // 10 seeds (the brief's 50 are spent on the shipped scenario; this one shows what limits the
   // rest of the chain). The elastic drives still creep by 2e-5..8e-5 rad over a rest after a
-  // move, above the default 1e-5 rad stillness limit of the joint readings: 1e-4 rad here.
+  // move, above the default 1e-5 rad stillness limit of the joint readings: 1e-4 rad here (the
+  // settling check stays off: the creep never comes within 3e-7 rad, 3 rests were left). The unit's
+  // lab calibration is applied (as for `rigid`).
   const CampaignFigures f =
       run_campaign(dir_ / "mounting-no-backlash.yaml", "no-backlash", 10, 1e-4);
   EXPECT_LT(f.worst_initial_dt_ms, 1.0);  // as above
-  // Met: every seed finds >= 3 rests and converges from the automatic initial values, and the
-  // time offset lies within 3 sigma of the truth (measured 1.3 sigma at worst). Not met (printed,
-  // reported): T_S_H 0.03 deg / 1.5 mm, T_R_W tilt 0.08 deg, biases 16 / 83 sigma: the unit's
-  // accelerometer scale factors (100 ppm) and misalignments (10 arcsec class) are outside the
-  // bundle's model and the gear deflection is corrected by a model, not measured.
+  // Met: every seed finds >= 3 rests (14) and converges from the automatic initial values, and
+  // the time offset lies within 3 sigma of the truth (measured 0.8 sigma at worst). Measured
+  // (worst of 10): T_S_H 0.0040 deg / 0.117 mm, T_R_W tilt 0.0044 deg, translation 0.165 mm,
+  // heading 8.5 sigma, gyro bias 3.8 sigma, acc bias 74 sigma, up to 16 of 27 outlier blocks
+  // (before the deflection scales and the unit calibration: 0.027 deg / 1.5 mm, tilt 0.083 deg,
+  // biases 16 / 83 sigma). Asserted with ~2x margin on the Release figures; what is left: the
+  // creep at the rests (not settled), the gear's transmission error, the in-run bias drift.
   EXPECT_EQ(f.calibrated, f.seeds);
   EXPECT_EQ(f.calibrated, f.converged);
   EXPECT_LT(f.dt_sigmas, 3.0);
+  if (sanitized()) return;
+  EXPECT_LT(f.S_H_rotation_deg, 0.01);
+  EXPECT_LT(f.S_H_translation_mm, 0.25);
+  EXPECT_LT(f.R_W_tilt_deg, 0.01);
 }
 
 }  // namespace
