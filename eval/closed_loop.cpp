@@ -7,12 +7,11 @@
 
 namespace imscal::eval {
 
-CompensationRun run_precontrol(const ident::ParameterTable& table, const std::string& robot_name,
-                               const sim::DesiredJointPath& path,
-                               const CompensationOptions& options) {
-  if (options.look_ahead_cycles < 0) {
-    throw std::invalid_argument("run_precontrol: look-ahead must be >= 0 cycles");
-  }
+namespace {
+
+// One precontrol (one cascade stage) along `path`.
+CompensationRun run_stage(const ident::ParameterTable& table, const std::string& robot_name,
+                          const sim::DesiredJointPath& path, const CompensationOptions& options) {
   ident::PrecontrolOptions precontrol_options = options.precontrol;
   precontrol_options.caller_cycle_s = path.cycle_s;
   // The precontrol is a large fixed-size object (no heap inside its cycle): keep it on the heap.
@@ -42,6 +41,46 @@ CompensationRun run_precontrol(const ident::ParameterTable& table, const std::st
     run.outside_table[k] = out.outside_table;
     const int read = precontrol->read_events(events.data(), int(events.size()));
     run.events.insert(run.events.end(), events.begin(), events.begin() + read);
+  }
+  return run;
+}
+
+}  // namespace
+
+CompensationRun run_precontrol(const ident::ParameterTable& table, const std::string& robot_name,
+                               const sim::DesiredJointPath& path,
+                               const CompensationOptions& options) {
+  if (options.look_ahead_cycles < 0) {
+    throw std::invalid_argument("run_precontrol: look-ahead must be >= 0 cycles");
+  }
+  if (options.inversion_iterations < 0) {
+    throw std::invalid_argument("run_precontrol: inversion iterations must be >= 0");
+  }
+  if (options.inversion_iterations > 0 && options.look_ahead_cycles > 0) {
+    // Each stage would hand out its output L cycles early, so the cascade's fixed point would no
+    // longer be G(q_d + o) = q_d.
+    throw std::invalid_argument(
+        "run_precontrol: inversion iterations need look-ahead 0 (the cascade's fixed point is "
+        "defined without it)");
+  }
+  CompensationRun run = run_stage(table, robot_name, path, options);
+  for (int i = 0; i < options.inversion_iterations; ++i) {
+    // The next stage sees q_d + o_i; its offset is o_{i+1}. A stage that deactivated hands out
+    // its fade-out (at most what it had): the cascade then falls back towards no compensation.
+    sim::DesiredJointPath input = path;
+    for (std::size_t k = 0; k < path.samples.size(); ++k)
+      input.samples[k].q_rad += run.offset_rad[k];
+    CompensationRun next = run_stage(table, robot_name, input, options);
+    for (std::size_t k = 0; k < path.samples.size(); ++k) {
+      // A cycle is active only when every stage is.
+      if (run.state[k] != ident::PrecontrolState::kActive) next.state[k] = run.state[k];
+      next.outside_table[k] = next.outside_table[k] || run.outside_table[k];
+    }
+    run.events.insert(run.events.end(), next.events.begin(), next.events.end());
+    std::stable_sort(run.events.begin(), run.events.end(),
+                     [](const auto& x, const auto& y) { return x.cycle < y.cycle; });
+    next.events = std::move(run.events);
+    run = std::move(next);
   }
   return run;
 }

@@ -17,6 +17,18 @@
 // path's end) and its output is applied at cycle k. The model's own offset is
 // Δq̂(k) = q_d(k - d) - q̂(k) (paper, eq. 2): with L = d it refers to the desired value of the
 // cycle it is applied in.
+//
+// Inversion of the loop (issue 6): adding the predicted error once, q_c = q_d + Δq̂, leaves the
+// plant's response to the offset itself: with G the loop (q_c -> q) the remainder is
+// (1 - G)^2 q_d instead of (1 - G) q_d. With inversion_iterations = n the offset is the n-th
+// fixed-point iterate of G(q_d + o) = q_d with the model in place of G,
+//   o_0 = P(q_d),  o_{i+1} = P(q_d + o_i),   P(x) = the precontrol's offset for the input x,
+// since P(x) = x - Ĝ x (+ backlash): o_{i+1} = o_i + (q_d - Ĝ(q_d + o_i)). The remainder falls
+// to (1 - G)^(n+2) q_d where the model matches the loop. Every stage is the same causal
+// precontrol fed by the previous stage's command, so this is a cascade of n + 1 precontrols in
+// the controller (computed here stage by stage over the whole path: the same numbers). It needs
+// look_ahead_cycles = 0 (std::invalid_argument otherwise): with every stage's output shifted L
+// cycles early the fixed point would not be G(q_d + o) = q_d.
 #include <functional>
 #include <string>
 #include <vector>
@@ -33,6 +45,7 @@ namespace imscal::eval {
 struct CompensationOptions {
   ident::PrecontrolOptions precontrol;  // caller_cycle_s is replaced by the path's cycle
   int look_ahead_cycles = 0;            // L >= 0 [cycles]
+  int inversion_iterations = 0;         // n >= 0: cascade stages after the first (see above)
 };
 
 // The precontrol's offsets along a desired path, one per path sample.

@@ -248,20 +248,15 @@ IdentifiedTable identify_table(const ident::JointErrorLog& log,
           log.cycle_s, config.joint_grid(j), config.options));
     } catch (const std::runtime_error& e) {
       out.failed_joints.push_back(log.joint_names[j] + ": " + e.what());
-      ident::JointIdentification pass;
-      pass.parameters.name = log.joint_names[j];
-      pass.parameters.dimensions = {
-          {ident::OperatingQuantity::kSpeed, {0.0, config.max_speed_rad_s[j]}}};
-      ident::CellParameters cell;
-      cell.bands = {0};
-      cell.status = ident::CellStatus::kFilled;
-      cell.reason = "no cell identified: pass-through model, no compensation";
-      cell.structure.na = 0;
-      cell.structure.nb = 1;
-      cell.structure.dead_time = 0;
-      cell.b = {1.0};
-      pass.parameters.cells.push_back(cell);
-      out.joints.push_back(pass);
+      ident::JointIdentification neutral;
+      neutral.parameters =
+          ident::neutral_joint_parameters(log.joint_names[j], config.max_speed_rad_s[j], e.what());
+      neutral.backlash.reason = "joint not identified: no backlash term";
+      neutral.cells.resize(1);
+      neutral.cells[0].status = ident::CellStatus::kFilled;
+      neutral.cells[0].label = "neutral";
+      neutral.cells[0].reason = neutral.parameters.cells[0].reason;
+      out.joints.push_back(std::move(neutral));
     }
     out.table.joints.push_back(out.joints.back().parameters);
   }

@@ -130,16 +130,34 @@ BacklashEstimate identify_backlash(std::span<const double> q_desired,
         scale(c) = norm > 0.0 ? 1.0 / norm : 0.0;
       }
       const Eigen::MatrixXd scaled = rows * scale.asDiagonal();
+      // How much of s is independent of [1, q̇, q̈]: the residual of s projected on them.
+      const Eigen::MatrixXd others = scaled.leftCols(3);
+      const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod_others(others);
+      const Eigen::VectorXd s_col = scaled.col(3);
+      const double s_norm = s_col.norm();
+      const double independence =
+          s_norm > 0.0 ? (s_col - others * cod_others.solve(s_col)).norm() / s_norm : 0.0;
+      if (!(independence >= options.min_direction_independence)) {
+        ++est.reversals_ill_conditioned;
+        continue;
+      }
       const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(scaled);
       const Eigen::VectorXd coefficients = scale.cwiseProduct(cod.solve(target));
-      if (std::isfinite(coefficients(3))) est.per_reversal_rad.push_back(coefficients(3));
+      if (!std::isfinite(coefficients(3))) continue;
+      if (std::abs(coefficients(3)) > options.max_l_rad) {
+        ++est.reversals_implausible;
+        continue;
+      }
+      est.per_reversal_rad.push_back(coefficients(3));
     }
   }
   est.reversals_used = int(est.per_reversal_rad.size());
   if (est.reversals_used < std::max(2, options.min_reversals)) {
     est.reason = fmt::format(
-        "{} usable direction reversals (of {} found), need {}: no backlash identified (l = 0)",
-        est.reversals_used, est.reversals_found, std::max(2, options.min_reversals));
+        "{} usable direction reversals (of {} found; {} skipped as not determining l, {} with "
+        "|l_r| > {:.3g} rad), need {}: no backlash identified (l = 0)",
+        est.reversals_used, est.reversals_found, est.reversals_ill_conditioned,
+        est.reversals_implausible, options.max_l_rad, std::max(2, options.min_reversals));
     est.l_rad = 0.0;
     return est;
   }
@@ -149,9 +167,9 @@ BacklashEstimate identify_backlash(std::span<const double> q_desired,
   double var = 0.0;
   for (double l : est.per_reversal_rad) var += (l - mean) * (l - mean);
   var /= est.reversals_used - 1;
-  est.identified = true;
-  est.l_rad = mean;
   est.l_sigma_rad = std::sqrt(var / est.reversals_used);
+  est.identified = true;  // |l| <= max_l_rad: a mean of values that each are
+  est.l_rad = mean;
   return est;
 }
 

@@ -17,6 +17,11 @@
 //     c0 + c1 q̇_d + l_r s: near a reversal the linear (following-error) part of Δq is close to
 //     affine in the velocity, while the backlash part flips sign. Both windows are thus at a
 //     comparable operating point (same place, low speed, the same acceleration).
+//     A reversal whose direction column s is (nearly) in the span of [1, q̇_d, q̈_d] inside its
+//     windows is skipped: there l_r is not determined and the rank-revealing solve returns an
+//     arbitrary (once 7e3 rad) value. The share of s orthogonal to the other columns must be at
+//     least min_direction_independence; a per-reversal l_r beyond max_l_rad is skipped too (a
+//     gear play is a few mrad; such a value is a fit of something else).
 //  3. l = mean of the per-reversal l_r, 1σ = their standard deviation / √(count): the scatter
 //     between reversals is an honest measure of what the noise and the unmodelled dynamics do
 //     to the estimate (residuals inside one window are strongly correlated, so the regression's
@@ -36,6 +41,12 @@ struct BacklashOptions {
   double settle_s = 0.05;         // after a reversal (+ lag): time to cross the play and settle
   double window_s = 0.15;         // length of the fit window on each side
   int min_reversals = 3;          // fewer: backlash not identified (l = 0, reason given)
+  // Per reversal: |s - P s| / |s| with P the projection on [1, q̇_d, q̈_d] (scaled columns);
+  // below it the reversal does not determine l and is skipped.
+  double min_direction_independence = 0.2;
+  // Largest plausible half play [rad] (20 mrad = 1.1 deg, ten times an industrial gear's play):
+  // a per-reversal estimate beyond it is skipped (counted), so |l| <= max_l_rad.
+  double max_l_rad = 0.02;
 };
 
 struct BacklashEstimate {
@@ -44,7 +55,9 @@ struct BacklashEstimate {
   double l_sigma_rad = 0.0;  // 1σ of l_rad
   int reversals_used = 0;
   int reversals_found = 0;
-  std::size_t lag_samples = 0;  // L
+  int reversals_ill_conditioned = 0;  // skipped: s nearly in the span of [1, q̇_d, q̈_d]
+  int reversals_implausible = 0;      // skipped: |l_r| > max_l_rad
+  std::size_t lag_samples = 0;        // L
   std::vector<double> per_reversal_rad;
   std::string reason;  // why not identified (empty when identified)
 };

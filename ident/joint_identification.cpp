@@ -19,13 +19,17 @@ std::size_t rows_of(std::span<const IoSegment> views, std::size_t first_row) {
   return rows;
 }
 
-// NRMSE fit [%] of the free-run joint error on the views: Δq = q_d - q_m against
-// Δq̂ = q_d - (ŷ - l s); Δq - Δq̂ = ŷ - y with y = q_m + l s the fitted output, so only the
-// reference spread differs from the simulation fit. NaN when the joint error is constant.
+// NRMSE fit [%] of the free-run joint error on the views: what the precontrol adds,
+// Δq̂(k) = q_d(k-d) - (ŷ(k) - l s(k)) (eq. 2 + eq. 3), against the error it has to cancel at
+// that cycle, Δq(k) = q_d(k) - q_m(k). With y = q_m + l s the fitted output,
+// Δq - Δq̂ = q_d(k) - q_d(k-d) + ŷ - y: for d > 0 the desired motion over the dead time is part
+// of the misfit (the error is measured against q_d(k), not q_d(k-d)). NaN when the joint error
+// is constant.
 double joint_error_fit(const ArxModel& model, std::span<const IoSegment> views,
                        std::span<const double> output, std::span<const double> q_desired,
                        std::span<const double> q_measured) {
   const auto first = std::size_t(model.structure().max_lag());
+  const auto d = std::size_t(model.structure().dead_time);
   std::vector<double> simulated;
   double misfit = 0.0, sum = 0.0, sum_sq = 0.0;
   std::size_t count = 0;
@@ -34,7 +38,7 @@ double joint_error_fit(const ArxModel& model, std::span<const IoSegment> views,
     simulated.resize(v.output.size());
     model.simulate(v.input, v.output, simulated);
     for (std::size_t k = first; k < v.output.size(); ++k) {
-      const double r = simulated[k] - v.output[k];
+      const double r = v.input[k] - v.input[k - d] + simulated[k] - v.output[k];
       const double error = q_desired[offset + k] - q_measured[offset + k];
       misfit += r * r;
       sum += error;
@@ -71,6 +75,38 @@ void fill_from_nearest(const CellGrid& grid, std::vector<CellIdentification>& re
 }
 
 }  // namespace
+
+ArxModel angle_form_of_error_model(const ArxModel& error_model) {
+  const ArxStructure& e = error_model.structure();
+  const int na = e.na, delta = e.dead_time, nb_e = e.nb;
+  const int nb = std::max(na + 1, delta + nb_e + 1);
+  // B(z) = A(z) - z^-δ (1 - z^-1) β(z), coefficients of z^0 .. z^-(nb-1).
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(nb);
+  b(0) = 1.0;
+  for (int i = 1; i <= na; ++i) b(i) += error_model.a()(i - 1);
+  for (int j = 0; j < nb_e; ++j) {
+    b(delta + j) -= error_model.b()(j);
+    b(delta + j + 1) += error_model.b()(j);
+  }
+  return ArxModel({na, nb, 0}, error_model.a(), b, error_model.sample_time_s());
+}
+
+JointParameters neutral_joint_parameters(const std::string& name, double max_speed_rad_s,
+                                         const std::string& reason) {
+  JointParameters p;
+  p.name = name;
+  p.dimensions = {{OperatingQuantity::kSpeed, {0.0, max_speed_rad_s}}};
+  p.backlash_l_rad = 0.0;
+  p.backlash_identified = false;
+  CellParameters cell;
+  cell.bands = {0};
+  cell.status = CellStatus::kFilled;
+  cell.reason = "not identified, neutral pass-through model (no compensation): " + reason;
+  cell.structure = {0, 1, 0};
+  cell.b = {1.0};
+  p.cells.push_back(cell);
+  return p;
+}
 
 JointIdentification identify_joint(const std::string& name, std::span<const double> q_desired,
                                    std::span<const double> q_measured,
@@ -122,6 +158,21 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
     if (end > cut) held_out.emplace_back(cut, end);
   }
 
+  // The signals the ARX structure is fitted to: (q_d, y), or (w, e) in the joint-error form.
+  const bool error_form = options.form == ArxModelForm::kJointError;
+  std::vector<double> fit_input, fit_output;
+  if (error_form) {
+    fit_input.assign(n, 0.0);
+    fit_output.resize(n);
+    for (std::size_t k = 0; k < n; ++k) fit_output[k] = q_desired[k] - output[k];
+    for (const auto& [begin, end] : segments)
+      for (std::size_t k = begin + 1; k < end; ++k) fit_input[k] = q_desired[k] - q_desired[k - 1];
+  }
+  const std::span<const double> model_input =
+      error_form ? std::span<const double>(fit_input) : q_desired;
+  const std::span<const double> model_output =
+      error_form ? std::span<const double>(fit_output) : std::span<const double>(output);
+
   // 3. Cells and their runs (one pass each).
   const OperatingSignals signals = operating_signals(q_desired, segments, cycle_s);
   const std::vector<int> cell_of = assign_cells(grid, q_desired, payload, signals);
@@ -152,8 +203,9 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
       for (std::size_t k = r.begin; k < r.end; ++k, ++samples)
         speed_sq += signals.speed_rad_s[k] * signals.speed_rad_s[k];
     report.rms_speed_rad_s = samples ? std::sqrt(speed_sq / double(samples)) : 0.0;
-    const auto sweep_est = run_views(runs, q_desired, output, history);
-    const auto sweep_val = run_views(val_runs[std::size_t(cell)], q_desired, output, history);
+    const auto sweep_est = run_views(runs, model_input, model_output, history);
+    const auto sweep_val =
+        run_views(val_runs[std::size_t(cell)], model_input, model_output, history);
     report.estimation_rows = rows_of(sweep_est, history);
     report.validation_rows = rows_of(sweep_val, history);
     auto reject = [&](std::string reason) {
@@ -175,18 +227,20 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
       const ArxStructure chosen = report.sweep->chosen;
       // The final fit on the cell's own rows: views with exactly the chosen model's history.
       const auto lag = std::size_t(chosen.max_lag());
-      const auto fit_est = run_views(runs, q_desired, output, lag);
+      const auto fit_est = run_views(runs, model_input, model_output, lag);
       report.fit = fit_arx(fit_est, chosen, options.fit);
     } catch (const std::exception& e) {
       reject(fmt::format("fit failed: {}", e.what()));
       continue;
     }
-    const ArxModel& model = report.fit->model;
-    report.stability = check_stability(model, options.stability_margin);
+    // Same poles in either form (A(z) is shared).
+    report.stability = check_stability(report.fit->model, options.stability_margin);
     if (!report.stability->stable) {
       reject(report.stability->reason);
       continue;
     }
+    const ArxModel model =
+        error_form ? angle_form_of_error_model(report.fit->model) : report.fit->model;
     params.structure = model.structure();
     params.a.assign(model.a().data(), model.a().data() + model.a().size());
     params.b.assign(model.b().data(), model.b().data() + model.b().size());

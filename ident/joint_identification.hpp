@@ -13,6 +13,22 @@
 //     (ident/model_validation.hpp);
 //  5. cells that failed any step are filled with the model of the nearest identified cell (in
 //     band steps; ties: the lower cell number), with the reason — never silently.
+//
+// Model form (issue 6). The joint error is ~1e-3 of the joint angle, so a least-squares ARX fit
+// of the angle q_m on q_d (ArxModelForm::kAngle, the paper's eq. 2 taken literally) is decided
+// by the angle: a model with 99.8 % angle fit can have a static gain of 1 ± 1e-3 and so predict a
+// joint error off by ~1 mrad per rad of travel (held-out joint-error fit 59 % down to -44 % on
+// the simulated KR 16, and a 2.9 rad "error" at the first cycle of a joint standing at 2.9 rad).
+// ArxModelForm::kJointError (the default) fits the same ARX structure to the joint error itself:
+//
+//   e(k) = q_d(k) - y(k),  w(k) = q_d(k) - q_d(k-1)  (the desired increment)
+//   e(k) + α_1 e(k-1) + ... + α_na e(k-na) = β_0 w(k-δ) + ... + β_{nb-1} w(k-δ-nb+1)
+//
+// (grid, sweep and criteria unchanged, applied to (w, e)), and stores it as the equivalent eq. 2
+// model in q_d and q̂ with dead time 0 (angle_form_of_error_model): A(z) = 1 + Σ α_i z^-i,
+// B(z) = A(z) - z^-δ (1 - z^-1) Σ β_j z^-j. That model has static gain exactly 1 (no error at
+// rest), and its Δq̂(k) = q_d(k) - q̂(k) is the error at the cycle it is applied in, the quantity
+// the data measure, with no q_d(k) - q_d(k - d) part left out.
 #include <cstddef>
 #include <optional>
 #include <span>
@@ -29,7 +45,13 @@
 
 namespace imscal::ident {
 
+enum class ArxModelForm {
+  kJointError,  // fit the joint error on the desired increments (see above); stored with d = 0
+  kAngle,       // fit q_m on q_d (the paper's eq. 2 literally)
+};
+
 struct JointIdentificationOptions {
+  ArxModelForm form = ArxModelForm::kJointError;
   OrderGrid grid{1, 32, 1, 32, 0, 4};
   OrderCriterion criterion = OrderCriterion::kBic;
   double validation_fraction = 0.3;  // of every segment, held out (its end)
@@ -64,6 +86,16 @@ struct JointIdentification {
   BacklashEstimate backlash;
   std::vector<CellIdentification> cells;  // flat order of the grid
 };
+
+// The eq. 2 model (input q_d, output q̂, dead time 0) equivalent to an error model of the form
+// above (input w, output e, its own dead time δ): na unchanged, nb = max(na + 1, δ + nb_e + 1).
+ArxModel angle_form_of_error_model(const ArxModel& error_model);
+
+// The defined neutral model of a joint that could not be identified: one pass-through cell
+// (q̂ = q_d, so Δq̂ = 0) over the speed range 0..max_speed, no backlash, the reason in the cell.
+// The precontrol then adds exactly zero for that joint.
+JointParameters neutral_joint_parameters(const std::string& name, double max_speed_rad_s,
+                                         const std::string& reason);
 
 // segments: [begin, end) ranges of separate runs. Throws std::invalid_argument for bad sizes,
 // std::runtime_error when no cell at all can be identified (with every cell's reason).

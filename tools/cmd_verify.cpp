@@ -39,7 +39,8 @@ struct VerifyArgs {
   std::vector<std::string> scenarios;
   int cycles = 10;
   std::uint64_t seed = 1;
-  int look_ahead = 0;
+  int look_ahead = eval::VerificationOptions{}.compensation.look_ahead_cycles;
+  int inversion_iterations = eval::VerificationOptions{}.compensation.inversion_iterations;
   double offset_tolerance_rad = 0.02;
   bool ablation = true;
   bool force = false;
@@ -151,6 +152,7 @@ void write_scenario(const fs::path& dir, const eval::VerificationResult& r, cons
                     {"cycles", r.cycles},
                     {"seed", args.seed},
                     {"look_ahead_cycles", args.look_ahead},
+                    {"inversion_iterations", args.inversion_iterations},
                     {"segments", r.segments},
                     {"evaluated_from_s", r.evaluated_from_s},
                     {"evaluated_to_s", r.evaluated_to_s},
@@ -278,6 +280,7 @@ void run(const VerifyArgs& args) {
   options.seed = args.seed;
   options.segment_filter = args.segments;
   options.compensation.look_ahead_cycles = args.look_ahead;
+  options.compensation.inversion_iterations = args.inversion_iterations;
   options.compensation.precontrol.offset_tolerance_rad.fill(args.offset_tolerance_rad);
   for (const auto& name : args.scenarios) {
     const imscal::sim::Scenario scenario =
@@ -313,6 +316,9 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--seed", args->seed, "seed of the per-cycle friction draws");
       sub.add_option("--look-ahead", args->look_ahead,
                      "cycles of look-ahead of the precontrol's input");
+      sub.add_option("--inversion-iterations", args->inversion_iterations,
+                     "cascade stages inverting the loop (eval/closed_loop.hpp; 0: offset added "
+                     "once)");
       sub.add_option("--offset-tolerance-rad", args->offset_tolerance_rad,
                      "supervisor tolerance on |offset| per joint [rad]");
       sub.add_flag("!--no-ablation", args->ablation, "skip the ablation tables");

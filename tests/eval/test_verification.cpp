@@ -64,7 +64,11 @@ const Tables& tables() {
 
 int look_ahead() {
   const char* v = std::getenv("IMSCAL_VERIFY_LOOK_AHEAD");
-  return v ? std::atoi(v) : 0;
+  return v ? std::atoi(v) : VerificationOptions{}.compensation.look_ahead_cycles;
+}
+int inversion_iterations() {
+  const char* v = std::getenv("IMSCAL_VERIFY_ITERATIONS");
+  return v ? std::atoi(v) : VerificationOptions{}.compensation.inversion_iterations;
 }
 
 void print_case(const VerificationCase& c, const PathFigures& before) {
@@ -88,6 +92,9 @@ VerificationResult run(const std::string& name, const std::string& filter, bool 
   if (const char* n = std::getenv("IMSCAL_VERIFY_CYCLES")) options.cycles = std::atoi(n);
   options.segment_filter = filter;
   options.compensation.look_ahead_cycles = look_ahead();
+  options.compensation.inversion_iterations = inversion_iterations();
+  if (const char* v = std::getenv("IMSCAL_VERIFY_OFFSET_TOLERANCE_RAD"))
+    options.compensation.precontrol.offset_tolerance_rad.fill(std::atof(v));
   std::vector<NamedTable> named{{"compensated", tables().full.table}};
   if (ablation) {
     named.push_back({"no backlash", tables().no_backlash.table});
@@ -96,7 +103,8 @@ VerificationResult run(const std::string& name, const std::string& filter, bool 
   const VerificationResult r = verify_scenario(scenario(name), named, options);
   std::printf("%s (%d cycles, segments:", name.c_str(), r.cycles);
   for (const auto& s : r.segments) std::printf(" '%s'", s.c_str());
-  std::printf(", look-ahead %d cycles)\n", options.compensation.look_ahead_cycles);
+  std::printf(", look-ahead %d cycles, inversion iterations %d)\n",
+              options.compensation.look_ahead_cycles, options.compensation.inversion_iterations);
   print_case(r.before, r.before.figures);
   for (const auto& c : r.after) {
     print_case(c, r.before.figures);
@@ -111,7 +119,42 @@ VerificationResult run(const std::string& name, const std::string& filter, bool 
 
 TEST(Verification, IdentificationFitPerJoint) {
   const Tables& t = tables();
-  EXPECT_TRUE(t.full.failed_joints.empty());
+  // Release (the whole identification program): every joint identified. Under sanitizers (60 s
+  // of it) A5 can fail (a pole at 0.9995 with that little data); it must then carry the neutral
+  // model: one pass-through cell, no backlash (zero correction, checked in
+  // tests/ident/test_precontrol.cpp).
+  if (!sanitized()) {
+    EXPECT_TRUE(t.full.failed_joints.empty());
+  }
+  for (const auto* table : {&t.full, &t.no_backlash, &t.one_cell}) {
+    for (const auto& failed : table->failed_joints) {
+      const std::string name = failed.substr(0, failed.find(':'));
+      for (const auto& joint : table->joints) {
+        if (joint.parameters.name != name) continue;
+        ASSERT_EQ(joint.parameters.cells.size(), 1u) << failed;
+        EXPECT_EQ(joint.parameters.cells[0].b, std::vector<double>{1.0}) << failed;
+        EXPECT_TRUE(joint.parameters.cells[0].a.empty()) << failed;
+        EXPECT_EQ(joint.parameters.backlash_l_rad, 0.0) << failed;
+      }
+    }
+  }
+  for (const auto* table : {&t.full, &t.no_backlash, &t.one_cell}) {
+    for (const auto& joint : table->joints) {
+      // Backlash estimates are bounded (ident::BacklashOptions::max_l_rad = 20 mrad): an absurd
+      // width (once 7e3 rad on A5/A6) never reaches a table.
+      EXPECT_LE(joint.parameters.backlash_l_rad, 0.02) << joint.parameters.name;
+      EXPECT_GE(joint.parameters.backlash_l_rad, 0.0) << joint.parameters.name;
+      // Every model is at rest where it is told (joint-error form, static gain 1): the error at
+      // rest, q (A(1) - B(1)), is below 3 nrad for |q| <= 3 rad (1e-9: rounding of the sums of
+      // up to ~37 coefficients).
+      for (const auto& cell : joint.parameters.cells) {
+        double a1 = 1.0, b1 = 0.0;
+        for (double a : cell.a) a1 += a;
+        for (double b : cell.b) b1 += b;
+        EXPECT_NEAR(a1 - b1, 0.0, 1e-9) << joint.parameters.name;
+      }
+    }
+  }
   for (const auto& joint : t.full.joints) {
     const JointFitSummary s = summarize_fit(joint);
     std::printf(
@@ -149,6 +192,20 @@ TEST(Verification, SeedLineWithAblation) {
     EXPECT_TRUE(std::isfinite(c.figures.max_path_deviation_m)) << c.label;
     EXPECT_EQ(c.figures.missed_crossings, 0) << c.label;
   }
+  if (!sanitized()) {
+    // What the chain reaches today (Release, 10 cycles, look-ahead 4: compensated 50.3 %, no
+    // backlash 48.2 %, single cell 45.0 %), asserted 5 %-points below to absorb floating-point
+    // differences between compilers (the simulator and the friction draws are deterministic). The
+    // precontrol must stay active through the whole run (it was switched off at cycle 0 by a
+    // garbage A5 table).
+    const double floor_percent[] = {45.0, 40.0, 40.0};
+    for (std::size_t c = 0; c < r.after.size() && c < 3; ++c) {
+      EXPECT_EQ(r.after[c].inactive_cycles, 0u) << r.after[c].label;
+      EXPECT_GE(reduction_percent(before, r.after[c].figures.max_path_deviation_m),
+                floor_percent[c])
+          << r.after[c].label;
+    }
+  }
   if (assert_goals() && !sanitized()) {
     const double full = reduction_percent(before, r.after[0].figures.max_path_deviation_m);
     EXPECT_GE(full, 95.0) << "issue 6 goal on seed-line";
@@ -158,6 +215,14 @@ TEST(Verification, SeedLineWithAblation) {
 TEST(Verification, Iso9283FullVelocity) {
   const VerificationResult r = run("iso9283", "100%", false);
   EXPECT_GT(r.before.figures.max_path_deviation_m, 0.001);
+  if (!sanitized()) {
+    // Today the table's prediction exceeds the supervisor's 20 mrad on A3 (cycle ~1285) and the
+    // compensation is faded out; with 50 mrad it stays on longer and makes the path worse
+    // (20.6 mm against 12.7 mm), so the supervisor is doing its job. Asserted: the compensated
+    // run is never worse than the uncompensated one (1 %: the fade-out ramp; measured 0.0 %).
+    EXPECT_LE(r.after[0].figures.max_path_deviation_m,
+              1.01 * r.before.figures.max_path_deviation_m);
+  }
   if (assert_goals() && !sanitized()) {
     const double full = reduction_percent(r.before.figures.max_path_deviation_m,
                                           r.after[0].figures.max_path_deviation_m);
@@ -206,6 +271,67 @@ TEST(Verification, TrueJointErrorAsOffsetBound) {
   // arm's dynamic error, which a once-added predicted error does not anticipate). Loose bound
   // (half) so that only a broken loop fails it.
   EXPECT_LT(a, 0.5 * b);
+
+  // Look-ahead: the same true error applied L cycles early, o(k) = e(k + L) (held at the end).
+  const std::vector<calib::JointVector> e = joint_errors(path, before);
+  double best_shift = a;
+  // (Skipped under sanitizers, as the inversion below: 7 more plant runs.)
+  for (int L : sanitized() ? std::vector<int>{} : std::vector<int>{4, 8}) {
+    std::vector<calib::JointVector> shifted(e.size());
+    for (std::size_t k = 0; k < e.size(); ++k) shifted[k] = e[std::min(e.size() - 1, k + L)];
+    const double d =
+        max_deviation(sim::simulate_plant(config, command_path(path, shifted), path.cycle_s));
+    best_shift = std::min(best_shift, d);
+    std::printf("  true error applied %d cycles early: %.3f mm (%.1f %%)\n", L, d * 1e3,
+                reduction_percent(b, d));
+  }
+  // Inverting the loop with the true plant (the limit of inversion_iterations with a perfect
+  // model): o_{i+1} = o_i + (q_d - q(q_d + o_i)), o_0 = 0 (i = 1 is the row above).
+  std::vector<calib::JointVector> o(e.size(), calib::JointVector::Zero());
+  double inverted = b;
+  for (int i = 1; i <= (sanitized() ? 0 : 3); ++i) {
+    const sim::PlantLog log = sim::simulate_plant(config, command_path(path, o), path.cycle_s);
+    const std::vector<calib::JointVector> r = joint_errors(path, log);
+    for (std::size_t k = 0; k < o.size(); ++k) o[k] += r[k];
+    inverted = max_deviation(sim::simulate_plant(config, command_path(path, o), path.cycle_s));
+    std::printf("  loop inverted with the true plant, %d iteration(s): %.3f mm (%.1f %%)\n", i,
+                inverted * 1e3, reduction_percent(b, inverted));
+  }
+  if (!sanitized()) {
+    // Where the inversion stops: remaining joint errors and drive torques at their limits.
+    const sim::PlantLog log = sim::simulate_plant(config, command_path(path, o), path.cycle_s);
+    const std::vector<calib::JointVector> r = joint_errors(path, log);
+    calib::JointVector worst = calib::JointVector::Zero(), worst_before = worst;
+    std::array<int, 6> at_limit{}, at_limit_before{};
+    for (std::size_t k = 0; k < r.size(); ++k) {
+      worst = worst.cwiseMax(r[k].cwiseAbs());
+      worst_before = worst_before.cwiseMax(e[k].cwiseAbs());
+      for (int j = 0; j < 6; ++j) {
+        const double limit = robot.joints[std::size_t(j)].controller.torque_limit_nm;
+        at_limit[std::size_t(j)] += std::abs(log.samples[k].tau_drive_nm[j]) >= 0.999 * limit;
+        at_limit_before[std::size_t(j)] +=
+            std::abs(before.samples[k].tau_drive_nm[j]) >= 0.999 * limit;
+      }
+    }
+    for (int j = 0; j < 6; ++j)
+      std::printf(
+          "    A%d: max |joint error| %.4f -> %.4f mrad; cycles at the torque limit %d -> %d\n",
+          j + 1, worst_before[j] * 1e3, worst[j] * 1e3, at_limit_before[std::size_t(j)],
+          at_limit[std::size_t(j)]);
+  }
+  // Measured (Release): L = 8 gives 3.48 mm against 3.99 mm at L = 0 (L = 4: 3.74 mm), so an early
+  // offset helps a little; the deterministic simulator makes this a strict comparison.
+  if (!sanitized()) {
+    EXPECT_LT(best_shift, a);
+  }
+  // The inversion with the TRUE plant does not converge (3.99 -> 3.84 -> 3.97 mm): the residual
+  // is not the loop's response to the offset but vibration the offset cannot reach through the
+  // motor-side loop (A1's remaining joint error grows from 10 to 23 mrad over the iterations,
+  // see the printout). This is the limit of any joint-offset precontrol on this plant, shown
+  // here so that a change of plant or loop that lifts it is noticed: asserted as the L = 0 bound.
+  if (!sanitized()) {
+    EXPECT_LT(inverted, 0.5 * b);
+  }
 }
 
 }  // namespace

@@ -98,4 +98,45 @@ TEST(Backlash, TooFewReversalsReported) {
   EXPECT_NE(est.reason.find("usable direction reversals"), std::string::npos) << est.reason;
 }
 
+// The plausibility bound: per-reversal estimates beyond max_l_rad are refused and counted, and a
+// joint with none left gets no backlash with the reason, instead of an absurd l reaching the
+// table (issue 6: 7e3 rad was once "identified" on A5/A6 of the simulated KR 16). A 2 mrad play
+// with the bound set to 1 mrad: every estimate (~2 mrad) is beyond it.
+TEST(Backlash, ImplausibleWidthRefusedWithReason) {
+  SimulatedJoint joint;
+  joint.backlash_l_rad = 2e-3;
+  const auto rec = simulate_joint(joint, kSamples, kDt, 11);
+  const std::vector<std::pair<std::size_t, std::size_t>> segments{{0, kSamples}};
+  BacklashOptions o = options();
+  o.max_l_rad = 1e-3;
+  const auto est = identify_backlash(rec.q_desired, rec.q_measured, segments, kDt, o);
+  EXPECT_FALSE(est.identified);
+  EXPECT_EQ(est.l_rad, 0.0);
+  EXPECT_GE(est.reversals_implausible, 20);
+  EXPECT_NE(est.reason.find("|l_r| >"), std::string::npos) << est.reason;
+  // With the default bound (20 mrad) the same data give the play within 10 % (as above): the
+  // refusal is the bound's doing, not a failed fit.
+  const auto normal = identify_backlash(rec.q_desired, rec.q_measured, segments, kDt, options());
+  ASSERT_TRUE(normal.identified) << normal.reason;
+  EXPECT_EQ(normal.reversals_implausible, 0);
+  EXPECT_NEAR(normal.l_rad, 2e-3, 0.2e-3);
+}
+
+// A reversal whose direction column is (nearly) a combination of [1, q̇_d, q̈_d] in its windows
+// does not determine l: skipped and counted, never averaged in. Here every reversal's
+// independence is below a threshold set above 1 (impossible to meet).
+TEST(Backlash, IllConditionedReversalsSkipped) {
+  SimulatedJoint joint;
+  joint.backlash_l_rad = 2e-3;
+  const auto rec = simulate_joint(joint, kSamples, kDt, 12);
+  const std::vector<std::pair<std::size_t, std::size_t>> segments{{0, kSamples}};
+  BacklashOptions o = options();
+  o.min_direction_independence = 1.01;
+  const auto est = identify_backlash(rec.q_desired, rec.q_measured, segments, kDt, o);
+  EXPECT_FALSE(est.identified);
+  EXPECT_EQ(est.reversals_used, 0);
+  EXPECT_GT(est.reversals_ill_conditioned, 0);
+  EXPECT_NE(est.reason.find("not determining l"), std::string::npos) << est.reason;
+}
+
 }  // namespace

@@ -7,6 +7,7 @@
 // std::allocator use in this file (a false positive: new and delete here are a matching pair).
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 
+#include "ident/joint_identification.hpp"
 #include "ident/precontrol.hpp"
 
 #include <gtest/gtest.h>
@@ -116,6 +117,31 @@ TEST(Precontrol, OneCellEqualsTheOfflineFreeRunPrediction) {
   // Same recursion, same start (at rest, y = u): equal to rounding of ~1e-16 rad per step.
   EXPECT_LT(worst, 1e-13);
   EXPECT_GT(largest, 1e-5);  // the model does predict a real error on this move
+}
+
+// A joint that could not be identified gets ident::neutral_joint_parameters (issue 6): the
+// precontrol must then add exactly zero on any motion, from the first cycle on (a garbage table
+// once produced a 2.9 rad "offset" at cycle 0 and deactivated the whole compensation).
+TEST(Precontrol, NeutralJointModelAddsExactlyZero) {
+  ParameterTable t = table({cell(0.0)}, {0.0, 10.0}, 1e-3);
+  t.joints[4] = neutral_joint_parameters("A5", 5.76, "no cell could be identified: test");
+  t.joints[5] = neutral_joint_parameters("A6", 10.7, "no cell could be identified: test");
+  EXPECT_EQ(t.joints[4].backlash_l_rad, 0.0);
+  EXPECT_NE(t.joints[4].cells[0].reason.find("no cell could be identified"), std::string::npos);
+  Precontrol p = make(t, raw_options());
+  const std::vector<double> q = move(1200);
+  double largest_identified = 0.0;
+  for (std::size_t k = 0; k < q.size(); ++k) {
+    std::array<double, 6> qd;
+    qd.fill(2.9 + q[k]);  // far from 0 rad: a model without static gain 1 would show it
+    const PrecontrolOutput out = p.cycle(qd, 5.0, k);
+    ASSERT_EQ(out.state, PrecontrolState::kActive) << k;
+    // Exact: q̂ = 1 · q_d and Δq̂ = q_d - q̂ = 0 in floating point, no backlash term.
+    ASSERT_EQ(out.offset_rad[4], 0.0) << k;
+    ASSERT_EQ(out.offset_rad[5], 0.0) << k;
+    largest_identified = std::max(largest_identified, std::abs(out.offset_rad[0]));
+  }
+  EXPECT_GT(largest_identified, 1e-4);  // the identified joints do compensate on this move
 }
 
 TEST(Precontrol, BlendingIsContinuousAcrossCellBoundaries) {
