@@ -177,7 +177,17 @@ std::string gap_body(const StageWorkspace& ws) {
   if (!dir) return not_run_note(why);
   const auto text = read_text(*dir / "report.txt");
   if (!text) return not_run_note("diagnose left no report.txt.");
-  return "<pre>" + esc(*text) + "</pre>\n";
+  std::string body = "<pre>" + esc(*text) + "</pre>\n";
+  // The diagnosis' own gnuplot figures (ids already prefixed per figure by GnuplotRenderer).
+  const std::pair<const char*, const char*> figures[] = {
+      {"gap-where.svg", "Where the gap lies: its energy by joint and by motion phase."},
+      {"gap-spectrum.svg", "Spectrum of the gap per joint (Welch)."},
+      {"gap-model-error.svg",
+       "Model-error model: frequency response from the desired joint angle to the gap, with its "
+       "2-sigma band (frequencies the motion does not excite get wide bands)."}};
+  for (const auto& [file, caption] : figures)
+    if (const auto svg = read_text(*dir / file)) body += figure_html(*svg, caption);
+  return body;
 }
 
 }  // namespace imscal::tools

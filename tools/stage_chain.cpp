@@ -165,8 +165,9 @@ std::unique_ptr<Stage> make_diagnose_stage(const RunConfig& config) {
   spec.arguments = [&config](const StageWorkspace& ws, const fs::path& out) {
     const fs::path joint_errors = joint_errors_of(config, ws);
     return std::vector<std::string>{
-        "--joint-errors", joint_errors.string(),           "--table", table_of(ws).string(),
-        "--robot",        config.diagnose->robot.string(), "--out",   out.string()};
+        "--joint-errors", joint_errors.string(),           "--table",   table_of(ws).string(),
+        "--robot",        config.diagnose->robot.string(), "--figures", "--out",
+        out.string()};
   };
   spec.success_message = "gap diagnosis written";
   return std::make_unique<SubcommandStage>(std::move(spec));

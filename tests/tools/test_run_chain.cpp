@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
+#include "core/run_stage.hpp"
 #include "tests/support/scratch_dir.hpp"
 #include "tests/tools/run_campaign.hpp"
 
