@@ -15,6 +15,7 @@
 #include "calib/tool_imu_record.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "core/numeric_table.hpp"
 #include "ident/identification_config.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
@@ -24,6 +25,9 @@
 #include "ims/psins_reader.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
+#include "sim/motion_program.hpp"
+#include "sim/scenario.hpp"
+#include "tools/run_config.hpp"
 
 namespace imscal::fuzz {
 
@@ -46,6 +50,10 @@ inline void parse_yaml_configs(const std::string& text) {
     ident::load_identification_config(root);
   } catch (const InputError&) {
   }
+  try {
+    sim::parse_motion_program(root);
+  } catch (const InputError&) {
+  }
   ims::parse_sensor_error_model(root);
 }
 
@@ -61,6 +69,10 @@ inline void read_with(std::string_view target, const std::filesystem::path& file
       ims::read_psins(file);
     } else if (target == "robot_log") {
       calib::read_robot_log_csv(file);
+    } else if (target == "run_config") {
+      tools::load_run_config(file);
+    } else if (target == "numeric_table") {
+      read_numeric_table(file);
     } else if (target == "tool_imu_record") {
       calib::read_tool_imu_record(file);
     } else if (target == "nav_trajectory") {
@@ -72,6 +84,11 @@ inline void read_with(std::string_view target, const std::filesystem::path& file
     } else if (target == "yaml_configs") {
       std::ifstream in(file, std::ios::binary);
       parse_yaml_configs(std::string(std::istreambuf_iterator<char>(in), {}));
+      // The scenario loader resolves the files it names relative to its own: from the file.
+      try {
+        sim::load_scenario(file);
+      } catch (const InputError&) {
+      }
     } else {
       throw std::logic_error("no fuzz target '" + std::string(target) + "'");
     }
