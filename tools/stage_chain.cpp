@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include <regex>
+#include <charconv>
 #include <stdexcept>
 
 #include "tools/stage_subcommand.hpp"
@@ -103,10 +103,19 @@ std::unique_ptr<Stage> make_identify_stage(const RunConfig& config) {
   };
   // `imscal identify` logs "joint A2 (2/6): ..." when it starts a joint.
   spec.progress_of_line = [](const std::string& line) -> std::optional<double> {
-    static const std::regex joint_line(R"(joint \S+ \((\d+)/(\d+)\))");
-    std::smatch match;
-    if (!std::regex_search(line, match, joint_line)) return std::nullopt;
-    return (std::stod(match[1]) - 1.0) / std::max(1.0, std::stod(match[2]));
+    // Parsed by hand: std::regex trips GCC 12's -Wmaybe-uninitialized under the sanitizers.
+    const auto at = line.find("joint ");
+    if (at == std::string::npos) return std::nullopt;
+    const auto open = line.find('(', at), slash = line.find('/', open),
+               close = line.find(')', slash);
+    if (open == std::string::npos || slash == std::string::npos || close == std::string::npos)
+      return std::nullopt;
+    int done = 0, of = 0;
+    const char* text = line.data();
+    if (std::from_chars(text + open + 1, text + slash, done).ec != std::errc() ||
+        std::from_chars(text + slash + 1, text + close, of).ec != std::errc() || of < 1)
+      return std::nullopt;
+    return (done - 1.0) / of;
   };
   spec.success_message = "parameter tables written";
   return std::make_unique<SubcommandStage>(std::move(spec));
