@@ -25,14 +25,6 @@ std::optional<std::string> read_text(const fs::path& file) {
   return text.str();
 }
 
-std::optional<json> read_json_file(const fs::path& file) {
-  const auto text = read_text(file);
-  if (!text) return std::nullopt;
-  json value = json::parse(*text, nullptr, false);
-  if (value.is_discarded()) return std::nullopt;
-  return value;
-}
-
 std::string esc(const std::string& text) {
   return html_escape(text);
 }
@@ -61,6 +53,14 @@ std::optional<fs::path> stage_dir(const StageWorkspace& ws, const std::string& s
 }
 
 }  // namespace
+
+std::optional<json> read_json_file(const fs::path& file) {
+  const auto text = read_text(file);
+  if (!text) return std::nullopt;
+  json value = json::parse(*text, nullptr, false);
+  if (value.is_discarded()) return std::nullopt;
+  return value;
+}
 
 std::string not_run_note(const std::string& what) {
   return "<p class=\"not-run\">Not run: " + esc(what) + "</p>\n";

@@ -26,16 +26,6 @@ namespace {
 
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
-std::optional<json> read_json(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return std::nullopt;
-  std::stringstream text;
-  text << in.rdbuf();
-  json value = json::parse(text.str(), nullptr, false);
-  if (value.is_discarded()) return std::nullopt;
-  return value;
-}
-
 std::string esc(const std::string& text) {
   return html_escape(text);
 }
@@ -63,7 +53,7 @@ std::string stages_section(const std::vector<std::string>& upstream, const Stage
   std::string inputs;
   for (const std::string& name : upstream) {
     const auto dir = ws.upstream_dir(name);
-    const auto record = dir ? read_json(*dir / kStageRecordName) : std::nullopt;
+    const auto record = dir ? read_json_file(*dir / kStageRecordName) : std::nullopt;
     if (!record) {
       rows += fmt::format("<tr><td>{}</td><td class=\"not-run\">not run</td><td></td></tr>\n",
                           esc(name));
@@ -87,7 +77,7 @@ std::string stages_section(const std::vector<std::string>& upstream, const Stage
 std::string validation_body(const StageWorkspace& ws) {
   const auto dir = ws.upstream_dir("validate");
   if (!dir) return not_run("no raw IMS file or robot log in this run's inputs.");
-  const auto v = read_json(*dir / "validation.json");
+  const auto v = read_json_file(*dir / "validation.json");
   if (!v) return not_run("validate/validation.json is missing or unreadable.");
   std::string body =
       "<table>\n<tr><th>record</th><th>file</th><th>samples</th><th>first t [s]</th>"
