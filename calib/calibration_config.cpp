@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "core/input_error.hpp"
+#include "core/path_checks.hpp"
 
 namespace imscal::calib {
 namespace {
@@ -41,7 +42,7 @@ std::optional<fs::path> existing_file(const ConfigNode& root, const char* key) {
   const fs::path given = child->as_string();
   const fs::path base = fs::path(root.file()).parent_path();
   const fs::path resolved = given.is_absolute() || base.empty() ? given : base / given;
-  if (!fs::exists(resolved)) child->fail("file '" + resolved.string() + "' does not exist");
+  if (!path_exists(resolved)) child->fail("file '" + resolved.string() + "' does not exist");
   return resolved;
 }
 

@@ -42,7 +42,7 @@ Eigen::Matrix<double, 9, 1> vec(const Eigen::Matrix3d& e) {
 
 ImuPreintegration::ImuPreintegration(const ims::ImuSeries& imu, double t_begin_s, double t_end_s,
                                      const ImuBiases& linearisation)
-    : t_begin_s_(t_begin_s), linearisation_(linearisation) {
+    : linearisation_(linearisation) {
   const std::string source = imu.source.empty() ? std::string("IMS increments") : imu.source;
   if (imu.quantity != ims::ImuQuantity::kIncrements) {
     throw InputError(source, 0, "quantity", "preintegration needs increments, not rates");

@@ -99,7 +99,6 @@ class ImuPreintegration {
                         const ImuBiases& b) const;
 
  private:
-  double t_begin_s_ = 0.0;
   double duration_s_ = 0.0;
   ImuBiases linearisation_;
   Eigen::Matrix3d delta_rotation_ = Eigen::Matrix3d::Identity();

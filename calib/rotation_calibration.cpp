@@ -207,7 +207,9 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
     const double dof = std::max(1.0, 3.0 * windows.size() - parameter_count);
     const double variance = sum / dof;
     double c3[9];
-    covariance.GetCovarianceMatrixInTangentSpace({q_param, q_param}, c3);
+    // The 3x3 tangent-space block of the rotation. (GetCovarianceMatrixInTangentSpace with the
+    // list {q, q} would write the 6x6 joint matrix of that list into this 9-double buffer.)
+    covariance.GetCovarianceBlockInTangentSpace(q_param, q_param, c3);
     for (int i = 0; i < 3; ++i) result.sigma_rotation_rad[i] = std::sqrt(c3[4 * i] * variance);
     // A negative variance means a numerically rank-deficient problem: no usable sigma.
     result.covariance_ok = result.sigma_rotation_rad.allFinite();

@@ -12,14 +12,28 @@ if(IMSCAL_SANITIZE)
   target_link_options(imscal_build_options INTERFACE -fsanitize=address,undefined)
 endif()
 
+# Precompiled headers: the standard, Eigen, fmt and JSON headers nearly every translation unit
+# includes are parsed once per target instead of once per file (about a third of the build time
+# of a file here). `imscal_precompile(target [extra headers...])`.
+option(IMSCAL_PCH "Precompile the common headers" ON)
+set(IMSCAL_COMMON_HEADERS <algorithm> <cmath> <filesystem> <map> <optional> <string> <vector>
+    <Eigen/Core> <Eigen/Geometry> <fmt/format.h> <nlohmann/json.hpp>)
+function(imscal_precompile target)
+  if(IMSCAL_PCH)
+    target_precompile_headers(${target} PRIVATE ${IMSCAL_COMMON_HEADERS} ${ARGN})
+  endif()
+endfunction()
+
 # One library per folder: every .cpp directly in the folder (a folder of headers only makes an
 # INTERFACE target). Headers are included from the repository root: #include "ims/strapdown.hpp".
-# Usage: imscal_folder_library(imscal_ims DEPENDS imscal_core Eigen3::Eigen ...)
+# Usage: imscal_folder_library(imscal_ims DEPENDS imscal_core Eigen3::Eigen ...
+#                              [PRECOMPILE <extra headers to precompile>...])
 function(imscal_folder_library name)
-  cmake_parse_arguments(ARG "" "" "DEPENDS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "DEPENDS;PRECOMPILE" ${ARGN})
   file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   if(sources)
     add_library(${name} STATIC ${sources})
+    imscal_precompile(${name} ${ARG_PRECOMPILE})
     target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/generated)
     target_link_libraries(${name} PUBLIC ${ARG_DEPENDS} PRIVATE imscal_build_options)
     if(IMSCAL_SANITIZE)

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/input_error.hpp"
+#include "core/path_checks.hpp"
 
 namespace imscal {
 
@@ -13,7 +14,7 @@ ConfigNode::ConfigNode(YAML::Node node, std::string file, std::string path)
     : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
 
 ConfigNode ConfigNode::load_file(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) {
+  if (!path_exists(file)) {
     throw InputError(file.string(), 0, "", "file does not exist");
   }
   try {

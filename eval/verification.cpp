@@ -253,7 +253,7 @@ IdentifiedTable identify_table(const ident::JointErrorLog& log,
           ident::neutral_joint_parameters(log.joint_names[j], config.max_speed_rad_s[j], e.what());
       neutral.backlash.reason = "joint not identified: no backlash term";
       neutral.cells.resize(1);
-      neutral.cells[0].status = ident::CellStatus::kFilled;
+      neutral.cells[0].status = ident::CellStatus::kNeutral;
       neutral.cells[0].label = "neutral";
       neutral.cells[0].reason = neutral.parameters.cells[0].reason;
       out.joints.push_back(std::move(neutral));

@@ -76,9 +76,10 @@ struct ArxFitOptions {
   // equations: their relative error is about condition × 1.1e-16, so 1e10 keeps ~6 digits in
   // the worst case (QR keeps about twice as many digits as the normal equations).
   double max_condition_normal_equations = 1e10;
-  // Steps of iterative refinement after a normal-equation solve: θ += (ΦᵀΦ)⁻¹ Φᵀr with the
+  // Steps of iterative refinement after the solve (either method): θ += (ΦᵀΦ)⁻¹ Φᵀr with the
   // residual r recomputed from the data (one pass each). One step brings the normal-equation
-  // solution to QR-level accuracy for condition numbers up to the limit above.
+  // solution to QR-level accuracy for condition numbers up to the limit above, and takes the
+  // rounding of the streamed QR out of a QR solution.
   int refinement_steps = 1;
   double sample_time_s = 0.002;
 };

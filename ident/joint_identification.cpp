@@ -100,7 +100,7 @@ JointParameters neutral_joint_parameters(const std::string& name, double max_spe
   p.backlash_identified = false;
   CellParameters cell;
   cell.bands = {0};
-  cell.status = CellStatus::kFilled;
+  cell.status = CellStatus::kNeutral;
   cell.reason = "not identified, neutral pass-through model (no compensation): " + reason;
   cell.structure = {0, 1, 0};
   cell.b = {1.0};

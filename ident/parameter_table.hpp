@@ -18,6 +18,7 @@ inline constexpr int kParameterTableSchemaVersion = 1;
 enum class CellStatus {
   kIdentified,  // fitted from this cell's own rows
   kFilled,      // copied from the cell `filled_from` (reason says why)
+  kNeutral,     // pass-through, zero correction: the joint could not be identified (reason)
 };
 const char* to_string(CellStatus status);
 

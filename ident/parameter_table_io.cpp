@@ -18,7 +18,15 @@
 namespace imscal::ident {
 
 const char* to_string(CellStatus status) {
-  return status == CellStatus::kIdentified ? "identified" : "filled";
+  switch (status) {
+    case CellStatus::kIdentified:
+      return "identified";
+    case CellStatus::kFilled:
+      return "filled";
+    case CellStatus::kNeutral:
+      return "neutral";
+  }
+  return "?";
 }
 
 ArxModel CellParameters::model(double sample_time_s) const {
@@ -63,10 +71,8 @@ json cell_json(const CellParameters& c) {
               {"whiteness_passed", c.figures.whiteness_passed},
               {"input_residual_passed", c.figures.input_residual_passed},
               {"spectral_radius", number_or_null(c.figures.spectral_radius)}}}};
-  if (c.status == CellStatus::kFilled) {
-    j["filled_from"] = c.filled_from;
-    j["reason"] = c.reason;
-  }
+  if (c.status == CellStatus::kFilled) j["filled_from"] = c.filled_from;
+  if (c.status != CellStatus::kIdentified) j["reason"] = c.reason;
   return j;
 }
 
@@ -204,8 +210,12 @@ CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time
     if (c.filled_from < 0 || c.filled_from >= grid.cell_count())
       n.child("filled_from").fail("not a cell of this joint");
     c.reason = n.child("reason").string();
+  } else if (status == "neutral") {
+    c.status = CellStatus::kNeutral;
+    if (n.has("filled_from")) n.child("filled_from").fail("only a filled cell has filled_from");
+    c.reason = n.child("reason").string();
   } else {
-    n.child("status").fail("expected 'identified' or 'filled', got '" + status + "'");
+    n.child("status").fail("expected 'identified', 'filled' or 'neutral', got '" + status + "'");
   }
   if (c.status == CellStatus::kIdentified && n.has("reason")) c.reason = n.child("reason").string();
   c.structure.na = int(n.child("na").integer());

@@ -27,9 +27,9 @@ namespace {
 // load of one double out of a wider store of the previous sample stalls store forwarding.
 typedef double Lanes __attribute__((vector_size(32)));
 
-#if defined(__GNUC__) && !defined(__clang__)
+#if defined(__GNUC__)
 // Helpers taking and returning Lanes are always inlined, so no function boundary exists whose
-// ABI would depend on AVX; GCC warns about it regardless.
+// ABI would depend on AVX; GCC and clang warn about it regardless.
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 #define IMSCAL_INLINE inline __attribute__((always_inline))

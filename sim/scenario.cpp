@@ -5,6 +5,7 @@
 
 #include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
+#include "core/path_checks.hpp"
 
 #ifndef IMSCAL_DATASETS_DIR
 #define IMSCAL_DATASETS_DIR ""
@@ -19,7 +20,7 @@ constexpr double kDegToRad = M_PI / 180.0;
 fs::path relative_to(const fs::path& scenario_file, const ConfigNode& node) {
   const fs::path given(node.as_string());
   const fs::path resolved = given.is_absolute() ? given : scenario_file.parent_path() / given;
-  if (!fs::exists(resolved)) node.fail("file '" + resolved.string() + "' does not exist");
+  if (!path_exists(resolved)) node.fail("file '" + resolved.string() + "' does not exist");
   return resolved;
 }
 
@@ -113,7 +114,7 @@ Scenario load_scenario(const fs::path& file) {
 }
 
 fs::path resolve_scenario(const std::string& name_or_file) {
-  if (fs::is_regular_file(name_or_file)) return name_or_file;
+  if (is_existing_file(name_or_file)) return name_or_file;
   const bool looks_like_path =
       name_or_file.find('/') != std::string::npos || name_or_file.ends_with(".yaml");
   if (looks_like_path) {
@@ -122,9 +123,9 @@ fs::path resolve_scenario(const std::string& name_or_file) {
   const char* env = std::getenv("IMSCAL_DATASETS");
   const fs::path datasets = env && *env ? fs::path(env) : fs::path(IMSCAL_DATASETS_DIR);
   const fs::path file = datasets / "scenarios" / (name_or_file + ".yaml");
-  if (!fs::is_regular_file(file)) {
+  if (!is_existing_file(file)) {
     std::string known;
-    if (fs::is_directory(datasets / "scenarios")) {
+    if (is_existing_folder(datasets / "scenarios")) {
       for (const auto& entry : fs::directory_iterator(datasets / "scenarios")) {
         if (entry.path().extension() == ".yaml") known.append(" ").append(entry.path().stem());
       }

@@ -177,9 +177,28 @@ void run(const IdentifyArgs& args) {
                  config.options.grid.na_min, config.options.grid.na_max, config.options.grid.nb_min,
                  config.options.grid.nb_max, config.options.grid.dead_time_min,
                  config.options.grid.dead_time_max);
-    const ident::JointIdentification r =
-        ident::identify_joint(log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j],
-                              log.payload_kg, segments, log.cycle_s, grid, config.options);
+    ident::JointIdentification r;
+    try {
+      r = ident::identify_joint(log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j],
+                                log.payload_kg, segments, log.cycle_s, grid, config.options);
+    } catch (const imscal::InputError&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      // No cell of this joint could be identified (e.g. it did not move): the other joints'
+      // models are still good, so this joint gets the neutral model (zero correction) and the
+      // table says why, instead of the whole run failing.
+      spdlog::warn(
+          "joint {}: not identified, its table holds the neutral model (no correction): "
+          "{}",
+          log.joint_names[j], e.what());
+      r.parameters =
+          ident::neutral_joint_parameters(log.joint_names[j], config.max_speed_rad_s[j], e.what());
+      r.backlash.reason = e.what();
+      r.cells.resize(1);
+      r.cells[0].status = ident::CellStatus::kNeutral;
+      r.cells[0].label = "neutral";
+      r.cells[0].reason = r.parameters.cells[0].reason;
+    }
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     int identified = 0;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "core/input_error.hpp"
+#include "core/path_checks.hpp"
 
 namespace imscal::tools {
 
@@ -14,7 +15,7 @@ fs::path existing_file(const ConfigNode& node, const fs::path& base) {
   const std::string text = node.as_string();
   if (text.empty()) node.fail("an empty path");
   const fs::path path = fs::absolute(base / text).lexically_normal();
-  if (!fs::is_regular_file(path)) node.fail(fmt::format("'{}' is not a file", path.string()));
+  if (!is_existing_file(path)) node.fail(fmt::format("'{}' is not a file", path.string()));
   return path;
 }
 

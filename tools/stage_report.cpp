@@ -30,6 +30,13 @@ std::string esc(const std::string& text) {
   return html_escape(text);
 }
 
+// "identified", "filled from <cell>" or "neutral" (the joint could not be identified).
+std::string cell_status_text(const ident::CellParameters& cell) {
+  if (cell.status == ident::CellStatus::kFilled)
+    return fmt::format("filled from {}", cell.filled_from);
+  return ident::to_string(cell.status);
+}
+
 std::string number(double value, int digits = 4) {
   return std::isfinite(value) ? fmt::format("{:.{}g}", value, digits) : "n/a";
 }
@@ -153,9 +160,7 @@ std::string models_body(const ident::ParameterTable& table, GnuplotRenderer& gnu
     for (std::size_t c = 0; c < joint.cells.size(); ++c) {
       const auto& cell = joint.cells[c];
       const auto& f = cell.figures;
-      const std::string status = cell.status == ident::CellStatus::kIdentified
-                                     ? "identified"
-                                     : fmt::format("filled from {}", cell.filled_from);
+      const std::string status = cell_status_text(cell);
       body += fmt::format(
           "<tr><td>{}</td><td>{}</td><td class=\"{}\">{}</td><td>{}</td><td>{}</td><td>{}</td>"
           "<td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
@@ -197,7 +202,7 @@ std::string coverage_body(const ident::ParameterTable& table) {
           esc(joint.name), c, esc(grid.label(int(c))),
           own ? std::to_string(cell.figures.estimation_rows) : "-",
           own ? std::to_string(cell.figures.validation_rows) : "-", own ? "ok" : "filled",
-          own ? "identified" : fmt::format("filled from {}", cell.filled_from), esc(cell.reason));
+          cell_status_text(cell), esc(cell.reason));
     }
     body += fmt::format(
         "<tr class=\"total\"><td>{}</td><td colspan=\"6\">coverage: {} of {} cells identified "

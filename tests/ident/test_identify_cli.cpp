@@ -146,6 +146,38 @@ TEST_F(IdentifyCli, WritesALoadableTableThatFitsHeldOutData) {
   EXPECT_EQ(identify("--force"), 0) << log_text();
 }
 
+// A joint that never moved cannot be identified; the run still succeeds, that joint gets the
+// neutral model (pass-through: zero correction) with the reason, the others their models.
+TEST_F(IdentifyCli, JointThatCannotBeIdentifiedGetsTheNeutralModel) {
+  ident::JointErrorLog log = ident::read_joint_errors_csv(dir_ / "joint_errors.csv");
+  log.joint_names.push_back("A3");
+  log.q_desired_rad.emplace_back(log.sample_count(), 0.25);  // standing still
+  log.q_measured_rad.emplace_back(log.sample_count(), 0.2501);
+  log.q_internal_rad.emplace_back(log.sample_count(), 0.25);
+  std::filesystem::remove(dir_ / "joint_errors.csv");
+  ident::write_joint_errors_csv(dir_ / "joint_errors.csv", log);
+  std::ifstream in(dir_ / "ident.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string config = text.str();
+  const auto at = config.find("max_speed_deg_s: [60, 60]");
+  ASSERT_NE(at, std::string::npos);
+  config.replace(at, 25, "max_speed_deg_s: [60, 60, 60]");
+  std::ofstream(dir_ / "three-joints.yaml") << config;
+
+  ASSERT_EQ(identify("", "three-joints.yaml"), 0) << log_text();
+  EXPECT_NE(log_text().find("A3: not identified"), std::string::npos) << log_text();
+  const ident::ParameterTable table = ident::read_parameters_json(dir_ / "out" / "parameters.json");
+  ASSERT_EQ(table.joints.size(), 3u);
+  EXPECT_TRUE(table.joints[0].backlash_identified);  // A1 keeps its model
+  const auto& neutral = table.joints[2];
+  EXPECT_EQ(neutral.name, "A3");
+  EXPECT_FALSE(neutral.backlash_identified);
+  ASSERT_EQ(neutral.cells.size(), 1u);
+  EXPECT_EQ(neutral.cells[0].status, ident::CellStatus::kNeutral);
+  EXPECT_FALSE(neutral.cells[0].reason.empty());
+}
+
 TEST_F(IdentifyCli, BadConfigRefusedWithoutOutput) {
   std::ofstream(dir_ / "bad.yaml")
       << "imscal-identification-config: 1\n"

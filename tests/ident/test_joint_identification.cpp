@@ -54,8 +54,10 @@ Data simulate(double noise, unsigned seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   d.q_measured.resize(n);
-  for (const auto& [begin, end] : d.segments) {
-    for (std::size_t k = begin; k < end; ++k) {
+  for (const auto& segment : d.segments) {
+    // Not a structured binding: clang 14 cannot capture those in the lambdas below.
+    const std::size_t begin = segment.first;
+    for (std::size_t k = begin; k < segment.second; ++k) {
       const CellTruth& t = kTruth[std::size_t(cells[k] / 2)];  // speed band of sample k
       auto y = [&](std::size_t lag) {
         return k >= begin + lag ? d.q_measured[k - lag] : d.q_desired[begin];
