@@ -248,15 +248,8 @@ IdentifiedTable identify_table(const ident::JointErrorLog& log,
           log.cycle_s, config.joint_grid(j), config.options));
     } catch (const std::runtime_error& e) {
       out.failed_joints.push_back(log.joint_names[j] + ": " + e.what());
-      ident::JointIdentification neutral;
-      neutral.parameters =
-          ident::neutral_joint_parameters(log.joint_names[j], config.max_speed_rad_s[j], e.what());
-      neutral.backlash.reason = "joint not identified: no backlash term";
-      neutral.cells.resize(1);
-      neutral.cells[0].status = ident::CellStatus::kNeutral;
-      neutral.cells[0].label = "neutral";
-      neutral.cells[0].reason = neutral.parameters.cells[0].reason;
-      out.joints.push_back(std::move(neutral));
+      out.joints.push_back(ident::neutral_joint_identification(
+          log.joint_names[j], config.max_speed_rad_s[j], e.what()));
     }
     out.table.joints.push_back(out.joints.back().parameters);
   }

@@ -108,6 +108,18 @@ JointParameters neutral_joint_parameters(const std::string& name, double max_spe
   return p;
 }
 
+JointIdentification neutral_joint_identification(const std::string& name, double max_speed_rad_s,
+                                                 const std::string& reason) {
+  JointIdentification out;
+  out.parameters = neutral_joint_parameters(name, max_speed_rad_s, reason);
+  out.backlash.reason = "joint not identified: no backlash term";
+  out.cells.resize(1);
+  out.cells[0].status = CellStatus::kNeutral;
+  out.cells[0].label = "neutral";
+  out.cells[0].reason = out.parameters.cells[0].reason;
+  return out;
+}
+
 JointIdentification identify_joint(const std::string& name, std::span<const double> q_desired,
                                    std::span<const double> q_measured,
                                    std::span<const double> payload,

@@ -96,6 +96,10 @@ ArxModel angle_form_of_error_model(const ArxModel& error_model);
 // The precontrol then adds exactly zero for that joint.
 JointParameters neutral_joint_parameters(const std::string& name, double max_speed_rad_s,
                                          const std::string& reason);
+// The same as a whole identification result (for reports): those parameters, no backlash, one
+// cell with status kNeutral, label "neutral" and the reason.
+JointIdentification neutral_joint_identification(const std::string& name, double max_speed_rad_s,
+                                                 const std::string& reason);
 
 // segments: [begin, end) ranges of separate runs. Throws std::invalid_argument for bad sizes,
 // std::runtime_error when no cell at all can be identified (with every cell's reason).

@@ -191,13 +191,8 @@ void run(const IdentifyArgs& args) {
           "joint {}: not identified, its table holds the neutral model (no correction): "
           "{}",
           log.joint_names[j], e.what());
-      r.parameters =
-          ident::neutral_joint_parameters(log.joint_names[j], config.max_speed_rad_s[j], e.what());
-      r.backlash.reason = e.what();
-      r.cells.resize(1);
-      r.cells[0].status = ident::CellStatus::kNeutral;
-      r.cells[0].label = "neutral";
-      r.cells[0].reason = r.parameters.cells[0].reason;
+      r = ident::neutral_joint_identification(log.joint_names[j], config.max_speed_rad_s[j],
+                                              e.what());
     }
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
