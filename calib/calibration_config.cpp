@@ -6,7 +6,6 @@
 #include <numbers>
 
 #include "core/input_error.hpp"
-#include "core/path_checks.hpp"
 
 namespace imscal::calib {
 namespace {
@@ -39,11 +38,7 @@ double non_negative(const ConfigNode& node, const char* key, double fallback) {
 std::optional<fs::path> existing_file(const ConfigNode& root, const char* key) {
   const auto child = root.optional_child(key);
   if (!child) return std::nullopt;
-  const fs::path given = child->as_string();
-  const fs::path base = fs::path(root.file()).parent_path();
-  const fs::path resolved = given.is_absolute() || base.empty() ? given : base / given;
-  if (!path_exists(resolved)) child->fail("file '" + resolved.string() + "' does not exist");
-  return resolved;
+  return child->as_existing_file();
 }
 
 void parse_thresholds(const ConfigNode& node, MountingValidationOptions& v) {

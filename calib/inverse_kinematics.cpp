@@ -223,6 +223,20 @@ std::vector<IkResult> InverseKinematics::solve_all(const Eigen::Isometry3d& T_R_
   return out;
 }
 
+IkResult InverseKinematics::solve_nearest(const Eigen::Isometry3d& T_R_H,
+                                          const JointVector& q_reference, IkOptions options) const {
+  if (!options.q_near) options.q_near = q_reference;
+  ArmConfiguration configuration = configuration_of(q_reference);
+  IkResult own = solve(T_R_H, configuration, options);
+  configuration.wrist_flip = !configuration.wrist_flip;
+  IkResult flipped = solve(T_R_H, configuration, options);
+  if (!flipped.ok()) return own;
+  if (!own.ok()) return flipped;
+  const double own_distance = (own.q - q_reference).cwiseAbs().maxCoeff();
+  const double flipped_distance = (flipped.q - q_reference).cwiseAbs().maxCoeff();
+  return flipped_distance < own_distance ? flipped : own;
+}
+
 IkResult InverseKinematics::solve(const Eigen::Isometry3d& T_R_H,
                                   const ArmConfiguration& configuration,
                                   const IkOptions& options) const {

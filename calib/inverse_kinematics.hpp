@@ -99,6 +99,13 @@ class InverseKinematics {
   // The solution of the given configuration for the flange pose T_R_H.
   IkResult solve(const Eigen::Isometry3d& T_R_H, const ArmConfiguration& configuration,
                  const IkOptions& options = {}) const;
+  // The solution nearest (largest joint difference) to a reference reading, e.g. the robot's
+  // own encoders: of q_reference's arm configuration with either wrist branch. Near the wrist
+  // singularity (wrist bend ~ 0) a pose error of microradians can put the pose's wrist bend on
+  // the other side of zero; the reference's own branch is then A4 and A6 turned by ~pi, the
+  // other branch the physical solution. options.q_near defaults to q_reference.
+  IkResult solve_nearest(const Eigen::Isometry3d& T_R_H, const JointVector& q_reference,
+                         IkOptions options = {}) const;
   // All 8 configurations, in the order of all_configurations(); each with its own status.
   std::vector<IkResult> solve_all(const Eigen::Isometry3d& T_R_H,
                                   const IkOptions& options = {}) const;

@@ -37,7 +37,7 @@ bool interpolate_sensor_pose(const std::vector<ims::SmoothedState>& states, doub
 
 JointSpaceErrors joint_errors_along(const std::vector<ims::SmoothedState>& trajectory,
                                     const RobotLog& log, const KinematicModel& kinematics,
-                                    const CalibratedFrames& frames) {
+                                    const CalibratedFrames& frames, double min_wrist_sin) {
   JointSpaceErrors out;
   out.robot = log.robot_name;
   out.cycle_s = log.cycle_s;
@@ -49,15 +49,18 @@ JointSpaceErrors joint_errors_along(const std::vector<ims::SmoothedState>& traje
       continue;
     }
     const Eigen::Isometry3d T_R_H = frames.T_R_W * T_W_S * frames.T_S_H;
-    IkOptions ik_options;
-    ik_options.q_near = sample.q_internal_rad;
-    const IkResult solution =
-        ik.solve(T_R_H, ik.configuration_of(sample.q_internal_rad), ik_options);
+    // The solution nearest the robot's own reading (either wrist branch): near A5 = 0 the
+    // measured pose may lie across the singularity from the encoders' configuration.
+    const IkResult solution = ik.solve_nearest(T_R_H, sample.q_internal_rad);
     if (!solution.ok()) {
       if (out.ik_failures == 0) {
         out.first_ik_failure = fmt::format("t = {:.3f} s: {}", sample.t_s, solution.reason);
       }
       ++out.ik_failures;
+      continue;
+    }
+    if (ik.singularity_measures(solution.q).wrist < min_wrist_sin) {
+      ++out.near_wrist_singularity;
       continue;
     }
     out.t_s.push_back(sample.t_s);
@@ -121,8 +124,8 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   ims::SmoothedState first;
   first.state = initial;
   smoothed.states.insert(smoothed.states.begin(), first);
-  JointSpaceErrors out =
-      joint_errors_along(smoothed.states, *input.log, input.kinematics, input.frames);
+  JointSpaceErrors out = joint_errors_along(smoothed.states, *input.log, input.kinematics,
+                                            input.frames, options.min_wrist_sin);
   out.smoother = smoothed.summary;
   out.trajectory = std::move(smoothed.states);
   return out;

@@ -61,6 +61,11 @@ struct JointSpaceOptions {
   double initial_attitude_sigma_rad = 2e-5;
   double initial_velocity_sigma_m_s = 1e-5;
   double initial_position_sigma_m = 1e-6;
+  // Samples whose measured wrist bend has |sin A5| below this are left out: there axes 4 and 6
+  // nearly align and the flange orientation fixes only A4 + A6; an orientation error e of the
+  // IMS path moves A4 and A6 by ~e / |sin A5| in opposite directions (1e-4 rad at 0.05 gives
+  // 2 mrad; at 1e-4, a whole radian). 0.05: ~2.9 deg around A5 = 0.
+  double min_wrist_sin = 0.05;
 };
 
 // One row per kept robot sample (the joint_errors.csv columns) [robot clock, SI].
@@ -74,8 +79,9 @@ struct JointSpaceErrors {
   std::vector<JointVector> q_internal_rad;
   std::size_t outside_record = 0;  // robot samples without IMS data (before/after the record)
   std::size_t ik_failures = 0;     // robot samples whose inverse kinematics failed
-  std::string first_ik_failure;    // reason of the first failure, in words
-  ims::ZuptSummary smoother;       // rests, innovation statistics
+  std::size_t near_wrist_singularity = 0;  // left out: |sin A5| < JointSpaceOptions::min_wrist_sin
+  std::string first_ik_failure;            // reason of the first failure, in words
+  ims::ZuptSummary smoother;               // rests, innovation statistics
   // The smoothed trajectory (IMS clock), for reports and checks.
   std::vector<ims::SmoothedState> trajectory;
 };
@@ -90,7 +96,8 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
 // Fills everything but `smoother` and `trajectory`.
 JointSpaceErrors joint_errors_along(const std::vector<ims::SmoothedState>& trajectory,
                                     const RobotLog& log, const KinematicModel& kinematics,
-                                    const CalibratedFrames& frames);
+                                    const CalibratedFrames& frames,
+                                    double min_wrist_sin = JointSpaceOptions{}.min_wrist_sin);
 
 // The sensor pose W_T_S at IMS time t from the smoothed states (sorted by time): linear in
 // position, slerp in attitude between the two samples around t; false outside their span.

@@ -126,6 +126,17 @@ std::string ConfigNode::as_string() const {
   return node_.Scalar();
 }
 
+std::filesystem::path ConfigNode::as_existing_file() const {
+  const std::string text = as_string();
+  if (text.empty()) fail("an empty path");
+  const std::filesystem::path given = std::filesystem::path(file_).parent_path() / text;
+  std::error_code error;  // a path the OS refuses (e.g. too long) is "not a file" below
+  std::filesystem::path path = std::filesystem::absolute(given, error);
+  path = (error ? given : path).lexically_normal();
+  if (!is_existing_file(path)) fail(fmt::format("'{}' is not a file", path.string()));
+  return path;
+}
+
 std::vector<ConfigNode> ConfigNode::as_sequence() const {
   if (!node_.IsSequence()) fail("expected a sequence");
   std::vector<ConfigNode> out;

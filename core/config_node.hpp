@@ -30,6 +30,9 @@ class ConfigNode {
   long as_int() const;
   bool as_bool() const;
   std::string as_string() const;
+  // A file named by this string: relative paths are relative to the folder of the config file
+  // this node was read from. Absolute and normalised; InputError when empty or not a file.
+  std::filesystem::path as_existing_file() const;
   std::vector<double> as_doubles() const;  // a sequence of finite numbers
   Eigen::Vector3d as_vector3() const;      // a sequence of exactly 3 finite numbers
   std::vector<ConfigNode> as_sequence() const;

@@ -11,6 +11,7 @@
 #include "core/version.hpp"
 #include "eval/iso9283_path.hpp"
 #include "eval/path_deviation.hpp"
+#include "ident/identify_joints.hpp"
 #include "ims/earth_model.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
@@ -240,18 +241,11 @@ IdentifiedTable identify_table(const ident::JointErrorLog& log,
   out.table.sample_time_s = log.cycle_s;
   out.table.created_by = std::string("imscal ") + kVersion;
   out.table.source = {source_file, "", log.sample_count(), log.source};
-  const auto segments = log.segments();
-  for (std::size_t j = 0; j < log.joint_count(); ++j) {
-    try {
-      out.joints.push_back(ident::identify_joint(
-          log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j], log.payload_kg, segments,
-          log.cycle_s, config.joint_grid(j), config.options));
-    } catch (const std::runtime_error& e) {
-      out.failed_joints.push_back(log.joint_names[j] + ": " + e.what());
-      out.joints.push_back(ident::neutral_joint_identification(
-          log.joint_names[j], config.max_speed_rad_s[j], e.what()));
-    }
-    out.table.joints.push_back(out.joints.back().parameters);
+  for (auto& outcome : ident::identify_joints(log, config)) {
+    if (!outcome.failure.empty())
+      out.failed_joints.push_back(outcome.result.parameters.name + ": " + outcome.failure);
+    out.table.joints.push_back(outcome.result.parameters);
+    out.joints.push_back(std::move(outcome.result));
   }
   return out;
 }

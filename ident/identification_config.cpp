@@ -122,10 +122,12 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
     }
   }
   if (auto v = root.optional_child("validation")) {
-    v->require_only_keys({"fraction", "max_lag", "band_z"});
+    v->require_only_keys({"fraction", "block_s", "max_lag", "band_z"});
     o.validation_fraction = v->get_double("fraction", o.validation_fraction);
     if (!(o.validation_fraction > 0.0 && o.validation_fraction < 1.0))
       v->child("fraction").fail("held-out fraction must be in (0, 1)");
+    o.validation_block_s = v->get_double("block_s", o.validation_block_s);
+    if (!(o.validation_block_s >= 0.0)) v->child("block_s").fail("must be >= 0 (0: whole runs)");
     o.validation.max_lag = int(v->get_int("max_lag", o.validation.max_lag));
     if (o.validation.max_lag < 1) v->child("max_lag").fail("must be >= 1");
     o.validation.band_z = v->get_double("band_z", o.validation.band_z);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -163,11 +164,22 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
 
   // 2. Estimation and held-out parts of every segment.
   Ranges estimation, held_out;
-  for (const auto& [begin, end] : segments) {
-    const std::size_t len = end - begin;
-    const auto cut = end - std::size_t(std::llround(options.validation_fraction * double(len)));
-    if (cut > begin) estimation.emplace_back(begin, cut);
-    if (end > cut) held_out.emplace_back(cut, end);
+  const std::size_t block =
+      options.validation_block_s > 0.0
+          ? std::max<std::size_t>(1,
+                                  std::size_t(std::llround(options.validation_block_s / cycle_s)))
+          : std::numeric_limits<std::size_t>::max();
+  for (const auto& [segment_begin, segment_end] : segments) {
+    for (std::size_t begin = segment_begin; begin < segment_end;) {
+      // The last block takes the remainder when it would be shorter than half a block.
+      std::size_t end = segment_end - begin > block ? begin + block : segment_end;
+      if (segment_end - end < block / 2) end = segment_end;
+      const std::size_t len = end - begin;
+      const auto cut = end - std::size_t(std::llround(options.validation_fraction * double(len)));
+      if (cut > begin) estimation.emplace_back(begin, cut);
+      if (end > cut) held_out.emplace_back(cut, end);
+      begin = end;
+    }
   }
 
   // The signals the ARX structure is fitted to: (q_d, y), or (w, e) in the joint-error form.

@@ -3,7 +3,9 @@
 // angles:
 //  1. backlash l (equation 3) from direction reversals (ident/backlash_identification.hpp), and
 //     the joint angle with the backlash part removed, y = q_m + l s(k);
-//  2. the last validation_fraction of every segment held out;
+//  2. the last validation_fraction of every segment held out, or, with validation_block_s > 0,
+//     of every block of that length (so that every operating point of a long run has held-out
+//     rows, not only where the run ends);
 //  3. every sample assigned to its operating-point cell (ident/operating_point.hpp), the
 //     regression rows of a cell = its samples (regressors reach back into other cells);
 //  4. per cell: checks of row count and excitation, order and dead-time sweep on the cell's
@@ -54,7 +56,8 @@ struct JointIdentificationOptions {
   ArxModelForm form = ArxModelForm::kJointError;
   OrderGrid grid{1, 32, 1, 32, 0, 4};
   OrderCriterion criterion = OrderCriterion::kBic;
-  double validation_fraction = 0.3;  // of every segment, held out (its end)
+  double validation_fraction = 0.3;  // of every segment (or block), held out (its end)
+  double validation_block_s = 0.0;   // > 0: segments cut into blocks of this length [s]
   ValidationOptions validation;
   std::size_t min_rows_per_cell = 1000;  // estimation rows; fewer: the cell is filled
   // Excitation: RMS of the desired speed over the cell's estimation rows [rad/s]; a cell where

@@ -17,13 +17,6 @@ namespace {
 namespace fs = std::filesystem;
 constexpr double kDegToRad = M_PI / 180.0;
 
-fs::path relative_to(const fs::path& scenario_file, const ConfigNode& node) {
-  const fs::path given(node.as_string());
-  const fs::path resolved = given.is_absolute() ? given : scenario_file.parent_path() / given;
-  if (!path_exists(resolved)) node.fail("file '" + resolved.string() + "' does not exist");
-  return resolved;
-}
-
 double non_negative(const ConfigNode& node) {
   const double value = node.as_double();
   if (value < 0.0) node.fail("must not be negative");
@@ -44,9 +37,9 @@ Scenario load_scenario(const fs::path& file) {
   s.file = file;
   s.name = root.child("name").as_string();
   s.description = root.get_string("description", "");
-  s.robot_file = relative_to(file, root.child("robot"));
-  s.program_file = relative_to(file, root.child("program"));
-  s.sensor_file = relative_to(file, root.child("sensor"));
+  s.robot_file = root.child("robot").as_existing_file();
+  s.program_file = root.child("program").as_existing_file();
+  s.sensor_file = root.child("sensor").as_existing_file();
 
   const ConfigNode imu = root.child("imu");
   imu.require_only_keys({"rate_hz", "clock_offset_s", "format"});

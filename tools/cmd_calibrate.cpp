@@ -265,10 +265,10 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
                      p.rotation_rad / kDeg, p.position_m * 1e3, p.outlier ? "  OUTLIER" : ""));
   if (je) {
     line("");
-    line(
-        fmt::format("joint errors: {} samples ({} outside the IMS record, {} inverse-kinematics "
-                    "failures)",
-                    je->t_s.size(), je->outside_record, je->ik_failures));
+    line(fmt::format(
+        "joint errors: {} samples ({} outside the IMS record, {} inverse-kinematics "
+        "failures, {} left out near the wrist singularity)",
+        je->t_s.size(), je->outside_record, je->ik_failures, je->near_wrist_singularity));
     if (!je->t_s.empty()) {
       for (int j = 0; j < calib::kJointCount; ++j) {
         double sum = 0.0, worst = 0.0;

@@ -16,6 +16,7 @@
 #include "core/input_error.hpp"
 #include "core/version.hpp"
 #include "ident/identification_config.hpp"
+#include "ident/identify_joints.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/joint_identification.hpp"
 #include "ident/parameter_table_io.hpp"
@@ -169,33 +170,26 @@ void run(const IdentifyArgs& args) {
   json joints_report = json::array();
   spdlog::info("identify: {} joints, {} samples in {} segments, cycle {} s", log.joint_count(),
                log.sample_count(), segments.size(), log.cycle_s);
+  spdlog::info("identify: per joint {} cells, order sweep na {}..{} nb {}..{} d {}..{}",
+               config.joint_grid(0).cell_count(), config.options.grid.na_min,
+               config.options.grid.na_max, config.options.grid.nb_min, config.options.grid.nb_max,
+               config.options.grid.dead_time_min, config.options.grid.dead_time_max);
+  // Progress: "joint NAME (DONE/TOTAL)" (the identify stage of `imscal run` reads it).
+  const auto outcomes =
+      ident::identify_joints(log, config, 0, [&log](std::size_t joint, std::size_t done) {
+        spdlog::info("joint {} ({}/{}) done", log.joint_names[joint], done, log.joint_count());
+      });
   for (std::size_t j = 0; j < log.joint_count(); ++j) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const ident::CellGrid grid = config.joint_grid(j);
-    spdlog::info("joint {} ({}/{}): {} cells, order sweep na {}..{} nb {}..{} d {}..{}",
-                 log.joint_names[j], j + 1, log.joint_count(), grid.cell_count(),
-                 config.options.grid.na_min, config.options.grid.na_max, config.options.grid.nb_min,
-                 config.options.grid.nb_max, config.options.grid.dead_time_min,
-                 config.options.grid.dead_time_max);
-    ident::JointIdentification r;
-    try {
-      r = ident::identify_joint(log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j],
-                                log.payload_kg, segments, log.cycle_s, grid, config.options);
-    } catch (const imscal::InputError&) {
-      throw;
-    } catch (const std::runtime_error& e) {
+    const ident::JointIdentification& r = outcomes[j].result;
+    const double seconds = outcomes[j].seconds;
+    if (!outcomes[j].failure.empty()) {
       // No cell of this joint could be identified (e.g. it did not move): the other joints'
-      // models are still good, so this joint gets the neutral model (zero correction) and the
+      // models are still good, so this joint has the neutral model (zero correction) and the
       // table says why, instead of the whole run failing.
       spdlog::warn(
-          "joint {}: not identified, its table holds the neutral model (no correction): "
-          "{}",
-          log.joint_names[j], e.what());
-      r = ident::neutral_joint_identification(log.joint_names[j], config.max_speed_rad_s[j],
-                                              e.what());
+          "joint {}: not identified, its table holds the neutral model (no correction): {}",
+          log.joint_names[j], outcomes[j].failure);
     }
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     int identified = 0;
     for (const auto& c : r.cells) identified += c.status == ident::CellStatus::kIdentified;
     spdlog::info("joint {}: {}/{} cells identified, backlash l = {:.3g} ± {:.2g} rad, {:.2f} s",

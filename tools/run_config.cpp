@@ -1,24 +1,12 @@
 #include "tools/run_config.hpp"
 
-#include <fmt/format.h>
-
 #include "core/input_error.hpp"
-#include "core/path_checks.hpp"
 
 namespace imscal::tools {
 
 namespace fs = std::filesystem;
 
 namespace {
-// A path value, resolved against the config's folder; the file must exist.
-fs::path existing_file(const ConfigNode& node, const fs::path& base) {
-  const std::string text = node.as_string();
-  if (text.empty()) node.fail("an empty path");
-  const fs::path path = fs::absolute(base / text).lexically_normal();
-  if (!is_existing_file(path)) node.fail(fmt::format("'{}' is not a file", path.string()));
-  return path;
-}
-
 double positive(const ConfigNode& node) {
   const double value = node.as_double();
   if (!(value > 0.0)) node.fail("must be > 0");
@@ -35,14 +23,13 @@ RunConfig load_run_config(const fs::path& file) {
     root.child("imscal-run-config").fail("only version 1 is known");
   RunConfig config;
   config.file = fs::absolute(file).lexically_normal();
-  const fs::path base = config.file.parent_path();
   config.title = root.get_string("title", "imscal calibration run");
 
   const ConfigNode inputs = root.child("inputs");
   inputs.require_only_keys({"imu", "robot_log", "joint_errors"});
-  if (auto n = inputs.optional_child("imu")) config.imu = existing_file(*n, base);
-  if (auto n = inputs.optional_child("robot_log")) config.robot_log = existing_file(*n, base);
-  if (auto n = inputs.optional_child("joint_errors")) config.joint_errors = existing_file(*n, base);
+  if (auto n = inputs.optional_child("imu")) config.imu = n->as_existing_file();
+  if (auto n = inputs.optional_child("robot_log")) config.robot_log = n->as_existing_file();
+  if (auto n = inputs.optional_child("joint_errors")) config.joint_errors = n->as_existing_file();
   if (!config.imu && !config.robot_log && !config.joint_errors)
     inputs.fail("names no input (imu, robot_log, joint_errors): nothing to run");
 
@@ -57,7 +44,7 @@ RunConfig load_run_config(const fs::path& file) {
     if (!config.imu || !config.robot_log)
       c->fail("a calibrate section needs inputs.imu and inputs.robot_log");
     CalibrateSettings settings;
-    settings.config = existing_file(c->child("config"), base);
+    settings.config = c->child("config").as_existing_file();
     if (auto n = c->optional_child("timeout_s")) settings.timeout_s = positive(*n);
     config.calibrate = settings;
   }
@@ -66,7 +53,7 @@ RunConfig load_run_config(const fs::path& file) {
     if (!config.joint_errors && !config.calibrate)
       i->fail("an identify section needs joint errors: inputs.joint_errors or a calibrate section");
     IdentifySettings settings;
-    settings.config = existing_file(i->child("config"), base);
+    settings.config = i->child("config").as_existing_file();
     if (auto n = i->optional_child("timeout_s")) settings.timeout_s = positive(*n);
     config.identify = settings;
   } else if (config.joint_errors) {
@@ -82,7 +69,7 @@ RunConfig load_run_config(const fs::path& file) {
       for (const ConfigNode& item : list->as_sequence()) {
         const std::string name = item.as_string();
         if (name.ends_with(".yaml")) {
-          settings.scenario_files.push_back(existing_file(item, base));
+          settings.scenario_files.push_back(item.as_existing_file());
           settings.scenarios.push_back(settings.scenario_files.back().string());
         } else if (name.empty() || name.find('/') != std::string::npos) {
           item.fail("a shipped scenario name (datasets/scenarios/NAME.yaml) or a .yaml file");
@@ -104,7 +91,7 @@ RunConfig load_run_config(const fs::path& file) {
     d->require_only_keys({"robot", "timeout_s"});
     if (!config.identify) d->fail("a diagnose section needs an identify section (the table)");
     DiagnoseSettings settings;
-    settings.robot = existing_file(d->child("robot"), base);
+    settings.robot = d->child("robot").as_existing_file();
     if (auto n = d->optional_child("timeout_s")) settings.timeout_s = positive(*n);
     config.diagnose = settings;
   }

@@ -19,6 +19,8 @@
 #include "ident/joint_error_io.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/so3.hpp"
+#include "tests/support/frames_json.hpp"
+#include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal {
@@ -35,24 +37,10 @@ const fs::path kRobot = kSource / "datasets" / "robots" / "kr16.yaml";
 const fs::path kSensor = kSource / "datasets" / "sensors" / "navigation-grade.yaml";
 const fs::path kConfig = kSource / "datasets" / "calibration" / "calibrate-default.yaml";
 
-int run(const std::string& arguments, const fs::path& log) {
-  const std::string command =
-      std::string(IMSCAL_BINARY) + " " + arguments + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+constexpr auto* run = &imscal::test_support::run_imscal;
 
-std::string read(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-Eigen::Quaterniond quaternion(const json& pose) {
-  const auto& q = pose.at("quaternion_wxyz");
-  return Eigen::Quaterniond(q.at(0).get<double>(), q.at(1).get<double>(), q.at(2).get<double>(),
-                            q.at(3).get<double>())
-      .normalized();
-}
+constexpr auto* read = &imscal::test_support::read_file_text;
+using imscal::test_support::quaternion_of;
 
 std::string calibrate_arguments(const fs::path& sim, const fs::path& out,
                                 const fs::path& unit_calibration) {
@@ -117,8 +105,8 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
   // 0.0041 deg tilt of T_R_W. Without --unit-calibration the unit's accelerometer scale factors
   // (100 ppm) and misalignments (10 arcsec class) put T_S_H 0.02 deg off and tilt T_R_W by
   // 0.05-0.15 deg. The campaign test (test_calibrate_campaign.cpp) reports the figures.
-  const Eigen::Quaterniond q_S_H = quaternion(frames.at("T_S_H"));
-  const Eigen::Quaterniond q_S_H_true = quaternion(truth.at("T_S_H"));
+  const Eigen::Quaterniond q_S_H = quaternion_of(frames.at("T_S_H"));
+  const Eigen::Quaterniond q_S_H_true = quaternion_of(truth.at("T_S_H"));
   EXPECT_LT(ims::rotation_angle_between(q_S_H, q_S_H_true), 0.005 * kDeg);
   Eigen::Vector3d p_S_H, p_S_H_true;
   for (int i = 0; i < 3; ++i) {
@@ -127,8 +115,8 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
   }
   EXPECT_LT((p_S_H - p_S_H_true).norm(), 0.05e-3);
   // Tilt of R in W: the vertical of W seen in R (heading is gyrocompass-limited: ~0.1 deg).
-  const Eigen::Vector3d up_R = quaternion(frames.at("T_R_W")) * Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d up_R_true = quaternion(truth.at("T_R_W")) * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d up_R = quaternion_of(frames.at("T_R_W")) * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d up_R_true = quaternion_of(truth.at("T_R_W")) * Eigen::Vector3d::UnitZ();
   EXPECT_LT(std::acos(std::min(1.0, up_R.dot(up_R_true))), 0.005 * kDeg);
   // Clock offset: 12.3 ms in the scenario; the gyro-rate residuals locate it to 0.0002 ms
   // (1-sigma 0.0002 ms, measured error 0.0001 ms): 0.01 ms leaves room for the sampling.

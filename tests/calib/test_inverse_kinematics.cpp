@@ -253,6 +253,33 @@ TEST(InverseKinematics, FailsClearlyAtUnreachableAndSingularPoses) {
   EXPECT_FALSE(r.reason.empty());
 }
 
+// The measured flange pose just across the wrist singularity from the encoders' reading (A5
+// = +2 mrad on the encoders, -1 mrad in the pose, as an IMS pose error of a few microradians
+// can make it): the encoders' own wrist branch is a different physical pose, A4 and A6 turned
+// by ~pi; solve_nearest takes the other branch, which is the pose's true joint angles.
+TEST(InverseKinematics, SolveNearestStaysOnThePhysicalBranchAcrossTheWristSingularity) {
+  const KinematicModel model = kr16();
+  const InverseKinematics ik(model);
+  JointVector q_true, q_encoders;
+  q_true << 0.3, -70 * kDeg, 100 * kDeg, 0.5, -1e-3, 0.2;
+  q_encoders = q_true;
+  q_encoders(4) = 2e-3;
+  const Eigen::Isometry3d pose = imscal::calib::forward_kinematics<double>(model, q_true);
+  IkOptions options;
+  options.q_near = q_encoders;
+  const IkResult own_branch = ik.solve(pose, ik.configuration_of(q_encoders), options);
+  ASSERT_TRUE(own_branch.ok()) << own_branch.reason;
+  EXPECT_GT((own_branch.q - q_true).cwiseAbs().maxCoeff(), 1.0) << "A4/A6 flipped by ~pi";
+  const IkResult nearest = ik.solve_nearest(pose, q_encoders);
+  ASSERT_TRUE(nearest.ok()) << nearest.reason;
+  // 1e-9 rad: the pose is exact, but the wrist bend of 1 mrad amplifies rounding ~1e3 times.
+  EXPECT_LT((nearest.q - q_true).cwiseAbs().maxCoeff(), 1e-9);
+  // Away from the singularity both give the same, the encoders' branch.
+  q_true(4) = q_encoders(4) = 40 * kDeg;
+  const Eigen::Isometry3d away = imscal::calib::forward_kinematics<double>(model, q_true);
+  EXPECT_LT((ik.solve_nearest(away, q_encoders).q - q_true).cwiseAbs().maxCoeff(), 1e-10);
+}
+
 TEST(InverseKinematics, ReportsPosesOutsideTheJointLimits) {
   const KinematicModel model = kr16();
   const InverseKinematics ik(model);

@@ -13,6 +13,7 @@
 #include "calib/forward_kinematics.hpp"
 #include "calib/joint_space_errors.hpp"
 #include "calib/rest_poses.hpp"
+#include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "ims/sensor_error_model.hpp"
@@ -223,6 +224,51 @@ TEST(JointSpaceErrors, TheJointSpaceStepIsExactAlongTheTrueTrajectory) {
   print("seed-line, true sensor trajectory:", all, count);
   // 1 um of interpolation error over a ~1 m lever: 1e-6 rad; the goal is 1e-5 rad.
   for (int i = 0; i < kJointCount; ++i) EXPECT_LT(all(i), 1e-6) << "joint A" << i + 1;
+}
+
+// A wrist move through A5 = 0 (axes 4 and 6 align), measured with a constant flange orientation
+// error of 2e-5 rad (a good IMS path): where |sin A5| is small the pose fixes only A4 + A6 and the
+// error splits them by ~2e-5 / |sin A5| in opposite directions (without a limit: radians, the
+// "1640 mrad" A4/A6 maxima once seen on the mounting run). Samples with |sin A5| < 0.05 are left
+// out and counted; on the rest A4 and A6 stay within 2e-5 / 0.05 = 0.4 mrad (+ rounding).
+TEST(JointSpaceErrors, SamplesNearTheWristSingularityAreLeftOutAndCounted) {
+  const RobotDescription robot =
+      load_robot_description(fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "robots" / "kr16.yaml");
+  RobotLog log;
+  log.robot_name = "kr16";
+  std::vector<ims::SmoothedState> trajectory;
+  const Eigen::Matrix3d orientation_error =
+      Eigen::AngleAxisd(2e-5, Eigen::Vector3d(0.3, -0.5, 0.8).normalized()).toRotationMatrix();
+  for (int k = 0; k <= 1000; ++k) {  // 2 s at 2 ms: A5 from +0.2 to -0.2 rad
+    RobotLogSample sample;
+    sample.t_s = 0.002 * k;
+    sample.q_desired_rad << 0.3, -1.2, 1.7, 0.4, 0.2 - 0.0004 * k, -0.6;
+    sample.q_internal_rad = sample.q_desired_rad;
+    log.samples.push_back(sample);
+    const Eigen::Isometry3d T_R_H =
+        forward_kinematics<double>(robot.kinematics, sample.q_desired_rad);
+    ims::SmoothedState state;
+    state.state.t_s = sample.t_s;
+    state.state.q_W_S = Eigen::Quaterniond(orientation_error * T_R_H.linear());
+    state.state.p_W = T_R_H.translation();
+    trajectory.push_back(state);
+  }
+  const CalibratedFrames frames;  // W = R, S = H, one clock
+  const auto worst_wrist_error = [&](const JointSpaceErrors& errors) {
+    double worst = 0.0;
+    for (std::size_t k = 0; k < errors.t_s.size(); ++k)
+      for (int j : {3, 5})
+        worst = std::max(worst, std::abs(errors.q_measured_rad[k](j) - errors.q_desired_rad[k](j)));
+    return worst;
+  };
+  const JointSpaceErrors kept = joint_errors_along(trajectory, log, robot.kinematics, frames);
+  // |0.2 - 0.0004 k| < asin(0.05): k = 375..625, 251 samples (one more or less at the edges).
+  EXPECT_NEAR(double(kept.near_wrist_singularity), 251.0, 2.0);
+  EXPECT_EQ(kept.ik_failures, 0u);
+  EXPECT_EQ(kept.t_s.size() + kept.near_wrist_singularity, log.samples.size());
+  EXPECT_LT(worst_wrist_error(kept), 2e-5 / 0.05 * 1.1);
+  const JointSpaceErrors all = joint_errors_along(trajectory, log, robot.kinematics, frames, 0.0);
+  EXPECT_GT(worst_wrist_error(all), 0.01) << "the split of A4 and A6 is lost near A5 = 0";
 }
 
 TEST(JointSpaceErrors, InterpolatesPosesBetweenSamples) {

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/eval/gap_cases.hpp"
+#include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal {
@@ -16,17 +17,9 @@ namespace {
 namespace fs = std::filesystem;
 using DiagnoseCli = test_support::ScratchDirTest;
 
-int run(const std::string& arguments, const fs::path& log) {
-  const std::string command =
-      std::string(IMSCAL_BINARY) + " " + arguments + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+constexpr auto* run = &imscal::test_support::run_imscal;
 
-std::string read(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+constexpr auto* read = &imscal::test_support::read_file_text;
 
 TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesAllOrNothing) {
   const eval::test::GapWorld world;

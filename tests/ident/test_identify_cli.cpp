@@ -11,6 +11,7 @@
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "tests/ident/joint_simulation.hpp"
+#include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace {
@@ -77,19 +78,12 @@ class IdentifyCli : public imscal::test_support::ScratchDirTest {
   }
 
   int identify(const std::string& extra = "", const std::string& config = "ident.yaml") {
-    const std::string command = std::string(IMSCAL_BINARY) + " identify --joint-errors " +
-                                (dir_ / "joint_errors.csv").string() + " --config " +
-                                (dir_ / config).string() + " --out " + (dir_ / "out").string() +
-                                " " + extra + " > " + (dir_ / "log.txt").string() + " 2>&1";
-    const int status = std::system(command.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return imscal::test_support::run_imscal(
+        "identify --joint-errors " + (dir_ / "joint_errors.csv").string() + " --config " +
+            (dir_ / config).string() + " --out " + (dir_ / "out").string() + " " + extra,
+        dir_ / "log.txt");
   }
-  std::string log_text() {
-    std::ifstream in(dir_ / "log.txt");
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
+  std::string log_text() { return imscal::test_support::read_file_text(dir_ / "log.txt"); }
 };
 
 TEST_F(IdentifyCli, WritesALoadableTableThatFitsHeldOutData) {

@@ -82,6 +82,37 @@ ident::JointIdentificationOptions options(const ident::OrderGrid& g) {
   return o;
 }
 
+// Held-out rows: the last 30 % of each run, or of each 10 s block (validation_block_s). Here the
+// payload changes early (5 kg for the first 24 s, 15 kg after): the tails of both runs carry
+// 15 kg, so with whole runs the 5 kg cells have no held-out rows and no validation figures; with
+// blocks every cell that has estimation rows has held-out rows too, ~30 % of them.
+TEST(JointIdentification, BlockHoldOutGivesEveryCellValidationRows) {
+  Data d = simulate(1e-6, 3);
+  for (std::size_t k = 12000; k < d.payload.size(); ++k) d.payload[k] = 15.0;
+  auto o = options({1, 3, 1, 3, 0, 2});
+  const auto runs =
+      ident::identify_joint("A1", d.q_desired, d.q_measured, d.payload, d.segments, kDt, grid(), o);
+  o.validation_block_s = 10.0;
+  const auto blocks =
+      ident::identify_joint("A1", d.q_desired, d.q_measured, d.payload, d.segments, kDt, grid(), o);
+  int cells_without_held_out_rows = 0;
+  for (std::size_t c = 0; c < runs.cells.size(); ++c) {
+    SCOPED_TRACE(runs.cells[c].label);
+    if (runs.cells[c].estimation_rows > 0 && runs.cells[c].validation_rows == 0)
+      ++cells_without_held_out_rows;
+    if (blocks.cells[c].estimation_rows == 0) continue;
+    const double held_out =
+        double(blocks.cells[c].validation_rows) /
+        double(blocks.cells[c].validation_rows + blocks.cells[c].estimation_rows);
+    // 30 % of every block; a cell's rows do not split exactly at block boundaries: +-8 pp.
+    EXPECT_NEAR(held_out, 0.3, 0.08);
+    if (blocks.cells[c].status == ident::CellStatus::kIdentified) {
+      EXPECT_TRUE(blocks.cells[c].validation.has_value());
+    }
+  }
+  EXPECT_EQ(cells_without_held_out_rows, 2) << "the 5 kg cells, with whole runs";
+}
+
 TEST(JointIdentification, EachCellRecoversItsOwnModelWithoutNoise) {
   const Data d = simulate(0.0, 1);
   const auto r = ident::identify_joint("A2", d.q_desired, d.q_measured, d.payload, d.segments, kDt,

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -126,7 +127,7 @@ TEST(ShippedPrograms, EveryProgramPlansWithinTheLimits) {
     EXPECT_EQ(rest_moving, 0);
     EXPECT_EQ(ptp_too_hard, 0);
   }
-  EXPECT_EQ(count, 4);  // seed-line, identification, mounting, iso9283
+  EXPECT_EQ(count, 5);  // seed-line, identification, mounting, iso9283, campaign
 }
 
 TEST(ShippedPrograms, SeedLineIsThePapersTestPath) {
@@ -240,17 +241,18 @@ TEST(ShippedPrograms, IdentificationHasSingleJointAndMixedMovesWithTwoPayloads) 
   EXPECT_TRUE(has(0.9, 1.0 + 1e-9));
 }
 
-TEST(ShippedPrograms, MountingHasManyRestPosesTurnedAboutAllFlangeAxes) {
-  const Planned& p = planned("mounting");
-  const DesiredJointPath& path = p.path;
+// The rest poses of a frame-calibration program: at least `min_rests`, each >= `min_rest_s`, the
+// first >= 10 s (IMS alignment), turned about every flange axis and seeing gravity along each.
+void expect_rests_turned_about_all_flange_axes(const DesiredJointPath& path, double min_rest_s,
+                                               std::size_t min_rests) {
   EXPECT_GE(path.segments.front().end_s - path.segments.front().begin_s, 10.0);
   std::vector<Eigen::Matrix3d> rotations;
   for (const PathSegment& seg : path.segments) {
     if (seg.kind != SegmentKind::kRest) continue;
-    EXPECT_GE(seg.end_s - seg.begin_s, 5.0 - 1e-9) << seg.label;
+    EXPECT_GE(seg.end_s - seg.begin_s, min_rest_s - 1e-9) << seg.label;
     rotations.push_back(fk(path.samples[range(path, seg).first].q_rad).linear());
   }
-  EXPECT_GE(rotations.size(), 12u);
+  EXPECT_GE(rotations.size(), min_rests);
   // Rotation of each pose relative to the first, as a rotation vector in the flange axes H:
   // some pose turns by >= 60 deg about each of x_H, y_H, z_H.
   Eigen::Vector3d largest = Eigen::Vector3d::Zero();
@@ -268,6 +270,43 @@ TEST(ShippedPrograms, MountingHasManyRestPosesTurnedAboutAllFlangeAxes) {
     EXPECT_GE(largest(axis), 60.0 * M_PI / 180.0) << "axis " << axis;
     EXPECT_GE(most_positive(axis), 0.7) << "axis " << axis;
     EXPECT_LE(most_negative(axis), -0.7) << "axis " << axis;
+  }
+}
+
+TEST(ShippedPrograms, MountingHasManyRestPosesTurnedAboutAllFlangeAxes) {
+  expect_rests_turned_about_all_flange_axes(planned("mounting").path, 5.0, 12);
+}
+
+// The default campaign (datasets/campaign/): the mounting poses for the frame calibration, with
+// moves at full joint speed for the identification, and the wrist kept away from A5 = 0 so that
+// the inverse kinematics of the measured flange path stays well determined.
+TEST(ShippedPrograms, CampaignHasRestPosesFastMovesAndNoWristSingularity) {
+  const DesiredJointPath& path = planned("campaign").path;
+  expect_rests_turned_about_all_flange_axes(path, 4.0, 13);
+  calib::JointVector peak_speed = calib::JointVector::Zero();
+  std::array<int, 6> reversals{};
+  std::array<double, 6> last_sign{};
+  double lowest_a5 = 1e9, highest_a5 = -1e9;
+  for (const DesiredJointSample& s : path.samples) {
+    lowest_a5 = std::min(lowest_a5, s.q_rad(4));
+    highest_a5 = std::max(highest_a5, s.q_rad(4));
+    for (int i = 0; i < 6; ++i) {
+      peak_speed(i) = std::max(peak_speed(i), std::abs(s.qd_rad_s(i)));
+      if (std::abs(s.qd_rad_s(i)) < 1e-3) continue;
+      const double sign = s.qd_rad_s(i) > 0 ? 1.0 : -1.0;
+      reversals[std::size_t(i)] += last_sign[std::size_t(i)] == -sign;
+      last_sign[std::size_t(i)] = sign;
+    }
+  }
+  // A5 within 45..100 deg everywhere: |sin(A5)| >= 0.7, far from the singular wrist.
+  EXPECT_GE(lowest_a5, 45.0 * M_PI / 180.0 - 1e-9);
+  EXPECT_LE(highest_a5, 100.0 * M_PI / 180.0 + 1e-9);
+  for (int i = 0; i < 6; ++i) {
+    // Every joint reverses (identification needs both directions) and, on its longest move,
+    // reaches at least a third of its maximum speed (trapezoidal at full velocity).
+    EXPECT_GE(reversals[std::size_t(i)], 3) << "A" << i + 1;
+    EXPECT_GE(peak_speed(i), robot().joints[std::size_t(i)].max_velocity_rad_s / 3.0)
+        << "A" << i + 1;
   }
 }
 

@@ -16,6 +16,8 @@
 #include "ims/earth_model.hpp"
 #include "ims/imu_file.hpp"
 #include "ims/nav_trajectory_io.hpp"
+#include "tests/support/frames_json.hpp"
+#include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal {
@@ -26,17 +28,9 @@ using SimulateCli = test_support::ScratchDirTest;
 
 const fs::path kScenario = fs::path(IMSCAL_TEST_DATA_DIR) / "scenarios" / "short.yaml";
 
-int run(const std::string& arguments, const fs::path& log) {
-  const std::string command =
-      std::string(IMSCAL_BINARY) + " " + arguments + " > " + log.string() + " 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+constexpr auto* run = &imscal::test_support::run_imscal;
 
-std::string read(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+constexpr auto* read = &imscal::test_support::read_file_text;
 
 TEST_F(SimulateCli, WritesConsistentFilesAndTheSameBytesForTheSameSeed) {
   const fs::path a = dir_ / "a", b = dir_ / "b", c = dir_ / "c";
@@ -90,8 +84,7 @@ TEST_F(SimulateCli, WritesConsistentFilesAndTheSameBytesForTheSameSeed) {
   const nlohmann::json frames = nlohmann::json::parse(read(a / "truth/frames.json"));
   auto pose = [](const nlohmann::json& j) {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    const auto& q = j["quaternion_wxyz"];
-    T.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
+    T.linear() = imscal::test_support::quaternion_of(j).toRotationMatrix();
     T.translation() = Eigen::Vector3d(j["xyz_m"][0], j["xyz_m"][1], j["xyz_m"][2]);
     return T;
   };

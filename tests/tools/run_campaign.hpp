@@ -15,15 +15,9 @@
 #include "calib/robot_log.hpp"
 #include "ident/joint_error_io.hpp"
 #include "tests/ident/joint_simulation.hpp"
+#include "tests/support/run_imscal.hpp"
 
 namespace imscal::test_support {
-
-inline std::string read_file_text(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 // Writes the campaign into `dir`; returns the path of run.yaml. `extra` is appended to run.yaml.
 inline std::filesystem::path write_campaign(const std::filesystem::path& dir,
@@ -99,14 +93,6 @@ inline std::filesystem::path write_campaign(const std::filesystem::path& dir,
                              "  config: ident.yaml\n"
                           << extra;
   return run_yaml;
-}
-
-// Runs the imscal binary with `arguments`; output to `log`; returns the exit code.
-inline int run_imscal(const std::string& arguments, const std::filesystem::path& log) {
-  const std::string command =
-      std::string(IMSCAL_BINARY) + " " + arguments + " > '" + log.string() + "' 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace imscal::test_support

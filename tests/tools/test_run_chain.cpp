@@ -18,16 +18,11 @@
 
 namespace {
 namespace fs = std::filesystem;
+using imscal::test_support::count_of;
 using imscal::test_support::read_file_text;
 using imscal::test_support::run_imscal;
 
 using RunChain = imscal::test_support::ScratchDirTest;
-
-std::size_t count_of(const std::string& text, const std::string& what) {
-  std::size_t n = 0;
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
 
 TEST_F(RunChain, IdentifyVerifyDiagnoseAndReport) {
   if (std::getenv("IMSCAL_SANITIZED")) GTEST_SKIP() << "Release only (see the file's comment)";

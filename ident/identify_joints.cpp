@@ -1,0 +1,58 @@
+#include "ident/identify_joints.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include "core/input_error.hpp"
+
+namespace imscal::ident {
+
+std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
+                                          const IdentificationConfig& config, unsigned threads,
+                                          const JointDoneCallback& on_done) {
+  const std::size_t joints = log.joint_count();
+  std::vector<JointOutcome> outcomes(joints);
+  std::vector<std::exception_ptr> errors(joints);
+  const auto segments = log.segments();
+  std::atomic<std::size_t> next{0};
+  std::mutex done_mutex;
+  std::size_t done = 0;
+  auto work = [&] {
+    for (std::size_t j = next++; j < joints; j = next++) {
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        outcomes[j].result = identify_joint(log.joint_names[j], log.q_desired_rad[j],
+                                            log.q_measured_rad[j], log.payload_kg, segments,
+                                            log.cycle_s, config.joint_grid(j), config.options);
+      } catch (const InputError&) {
+        errors[j] = std::current_exception();
+      } catch (const std::runtime_error& e) {
+        outcomes[j].failure = e.what();
+        outcomes[j].result =
+            neutral_joint_identification(log.joint_names[j], config.max_speed_rad_s[j], e.what());
+      } catch (...) {
+        errors[j] = std::current_exception();
+      }
+      outcomes[j].seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const std::lock_guard lock(done_mutex);
+      ++done;
+      if (on_done) on_done(j, done);
+    }
+  };
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t helpers = std::min<std::size_t>(threads, joints) - (joints > 0 ? 1 : 0);
+  std::vector<std::jthread> pool;
+  for (std::size_t i = 0; i < helpers; ++i) pool.emplace_back(work);
+  work();        // this thread takes tasks too
+  pool.clear();  // joins
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
+  return outcomes;
+}
+
+}  // namespace imscal::ident

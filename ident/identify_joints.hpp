@@ -1,0 +1,34 @@
+#pragma once
+// The identification of every joint of a joint_errors.csv, as `imscal identify` and the
+// verification run it. The joints are independent least-squares problems on their own data, so
+// they run on worker threads (one joint per task, results in joint order and bit-identical to a
+// sequential run: no joint's arithmetic depends on another's or on the thread).
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "ident/identification_config.hpp"
+#include "ident/joint_error_io.hpp"
+#include "ident/joint_identification.hpp"
+
+namespace imscal::ident {
+
+struct JointOutcome {
+  JointIdentification result;
+  std::string failure;   // empty when identified; else why the joint got the neutral model
+  double seconds = 0.0;  // wall time of this joint's identification
+};
+
+// threads: worker threads, 0 = the machine's hardware concurrency (at most one per joint).
+// A joint for which identify_joint throws std::runtime_error (no cell could be identified, e.g.
+// the joint did not move) gets the neutral model (zero correction) and the reason in `failure`;
+// the other joints' models are still good. InputError and std::logic_error propagate (the first
+// in joint order). on_done(joint, joints_done) is called as each joint finishes (from the worker
+// threads, one call at a time): progress for long runs.
+using JointDoneCallback = std::function<void(std::size_t joint, std::size_t joints_done)>;
+std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
+                                          const IdentificationConfig& config, unsigned threads = 0,
+                                          const JointDoneCallback& on_done = {});
+
+}  // namespace imscal::ident
