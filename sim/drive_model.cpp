@@ -14,7 +14,8 @@ DriveModel::DriveModel(const calib::DriveParameters& drive, const JointEffects& 
     stiffness_ = drive.stiffness_nm_per_rad;
     damping_ = effects.gear_damping ? drive.damping_nm_s_per_rad : 0.0;
     half_backlash_ = effects.backlash ? 0.5 * drive.backlash_rad : 0.0;
-    friction_at_link_ = kind_ == DriveKind::kElastic && effects.friction_at_link;
+    if (kind_ == DriveKind::kElastic)
+      link_share_ = effects.friction_at_link ? 1.0 : effects.link_friction_fraction;
   }
   coulomb_ = effects.coulomb_friction ? drive.coulomb_nm : 0.0;
   coulomb_scale_ = effects.coulomb_velocity_scale_rad_s;

@@ -14,10 +14,11 @@
 // Friction (Coulomb + viscous, values of the robot file in joint-side units) acts on the motor
 // side, i.e. on d(theta)/dt: most of a drive's friction sits in the motor bearings and the fast
 // gear stages (JointEffects::friction_at_link moves it to the link velocity of an elastic
-// drive; the KR 16 robot file's friction numbers are joint-side numbers either way). Smooth
-// Coulomb law F_c tanh(v / v_s); with the reflected motor inertia N^2 J_m the
-// slope F_c / (v_s N^2 J_m) is at most ~1500 1/s on the KR 16 (A6) for v_s = 0.01 rad/s, i.e.
-// lambda * h = 0.75 at h = 0.5 ms, inside RK4's real-axis stability limit of 2.78.
+// drive, JointEffects::link_friction_fraction puts a share of it there: the output bearing; the KR
+// 16 robot file's friction numbers are joint-side numbers either way). Smooth Coulomb law F_c
+// tanh(v / v_s); with the reflected motor inertia N^2 J_m the slope F_c / (v_s N^2 J_m) is at most
+// ~1500 1/s on the KR 16 (A6) for v_s = 0.01 rad/s, i.e. lambda * h = 0.75 at h = 0.5 ms, inside
+// RK4's real-axis stability limit of 2.78.
 //
 // Massless motor (motor_inertia off, elastic_gear on): the motor is a torque source in series
 // with the spring, so the gear passes the drive torque to the link unchanged (friction then acts
@@ -64,8 +65,16 @@ class DriveModel {
   double motor_angle_for(double q_link, double gear_torque_nm) const;
 
   double stiffness_nm_per_rad() const { return stiffness_; }
-  // Elastic drives only: friction acts on the link velocity instead of the motor velocity.
-  bool friction_at_link() const { return friction_at_link_; }
+  // Elastic drives: the share of the friction acting on the link velocity (1 with
+  // friction_at_link, else JointEffects::link_friction_fraction); 0 for other drives.
+  double link_friction_share() const { return link_share_; }
+  // The friction on the motor velocity / on the link velocity of an elastic drive [N m].
+  double motor_friction_nm(double motor_velocity) const {
+    return (1.0 - link_share_) * friction_nm(motor_velocity);
+  }
+  double link_friction_nm(double link_velocity) const {
+    return link_share_ * friction_nm(link_velocity);
+  }
 
  private:
   DriveKind kind_ = DriveKind::kRigid;
@@ -79,7 +88,7 @@ class DriveModel {
   double te_amplitude_ = 0.0;
   double te_frequency_ = 0.0;  // harmonic * N [1/rad of theta]
   double te_phase_ = 0.0;
-  bool friction_at_link_ = false;
+  double link_share_ = 0.0;
 };
 
 }  // namespace imscal::sim

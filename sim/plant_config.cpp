@@ -32,14 +32,15 @@ void read_effects(const ConfigNode& node, bool per_joint, JointEffects& effects)
     node.require_only_keys({"motor_inertia", "elastic_gear", "gear_damping", "backlash",
                             "coulomb_friction", "viscous_friction", "transmission_error",
                             "dead_time_s", "coulomb_velocity_scale_rad_s", "friction_at_link",
-                            "transmission_error_shape"});
+                            "link_friction_fraction", "transmission_error_shape"});
     if (const auto shape = node.optional_child("transmission_error_shape")) {
       read_shape(*shape, effects.transmission_error_shape);
     }
   } else {
     node.require_only_keys({"motor_inertia", "elastic_gear", "gear_damping", "backlash",
                             "coulomb_friction", "viscous_friction", "transmission_error",
-                            "dead_time_s", "coulomb_velocity_scale_rad_s", "friction_at_link"});
+                            "dead_time_s", "coulomb_velocity_scale_rad_s", "friction_at_link",
+                            "link_friction_fraction"});
   }
   effects.motor_inertia = node.get_bool("motor_inertia", effects.motor_inertia);
   effects.elastic_gear = node.get_bool("elastic_gear", effects.elastic_gear);
@@ -49,6 +50,12 @@ void read_effects(const ConfigNode& node, bool per_joint, JointEffects& effects)
   effects.viscous_friction = node.get_bool("viscous_friction", effects.viscous_friction);
   effects.transmission_error = node.get_bool("transmission_error", effects.transmission_error);
   effects.friction_at_link = node.get_bool("friction_at_link", effects.friction_at_link);
+  if (node.has("link_friction_fraction")) {
+    const double fraction = node.child("link_friction_fraction").as_double();
+    if (!(fraction >= 0.0 && fraction <= 1.0))
+      node.child("link_friction_fraction").fail("must be in [0, 1]");
+    effects.link_friction_fraction = fraction;
+  }
   if (node.has("dead_time_s")) {
     const double dead_time = node.child("dead_time_s").as_double();
     if (dead_time < 0.0 || dead_time > 1.0) node.child("dead_time_s").fail("must be in [0, 1] s");
@@ -128,8 +135,10 @@ void validate_plant_config(const PlantConfig& config) {
     if (e.elastic_gear && !(config.robot.joints[i].drive.stiffness_nm_per_rad > 0.0)) {
       throw std::invalid_argument("plant: joint " + name + ": elastic gear without stiffness");
     }
-    if (e.dead_time_s < 0.0 || !(e.coulomb_velocity_scale_rad_s > 0.0)) {
-      throw std::invalid_argument("plant: joint " + name + ": bad dead time or Coulomb scale");
+    if (e.dead_time_s < 0.0 || !(e.coulomb_velocity_scale_rad_s > 0.0) ||
+        !(e.link_friction_fraction >= 0.0 && e.link_friction_fraction <= 1.0)) {
+      throw std::invalid_argument("plant: joint " + name +
+                                  ": bad dead time, Coulomb scale or link friction fraction");
     }
   }
 }

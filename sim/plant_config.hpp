@@ -7,7 +7,8 @@
 //   effects:
 //     all: {motor_inertia: true, elastic_gear: true, gear_damping: true, backlash: true,
 //           coulomb_friction: true, viscous_friction: true, transmission_error: false,
-//           dead_time_s: 0.0, coulomb_velocity_scale_rad_s: 0.01, friction_at_link: false}
+//           dead_time_s: 0.0, coulomb_velocity_scale_rad_s: 0.01, friction_at_link: false,
+//           link_friction_fraction: 0.1}
 //     transmission_error: {amplitude_arcsec: 20, harmonic_per_motor_rev: 1, phase_deg: 0}
 //     A2: {backlash: true, ...}          # per-joint overrides by joint name (same keys as `all`,
 //                                        # plus `transmission_error_shape: {...}` as above)
@@ -43,6 +44,13 @@ struct JointEffects {
   // controller feels it directly), true = gear output (on the link velocity, the controller
   // feels it only through the spring; the link lags by ~F_c / k). Rigid drives: no difference.
   bool friction_at_link = false;
+  // Share of that friction which acts at the gear output (the output bearing and seals) on the
+  // link velocity when friction_at_link is false (elastic drives; the rest acts on the motor).
+  // Why not 0: without it nothing dissipates the link's motion inside the play of an unloaded
+  // gear (the damper works only in contact), and the simulated links of A1/A4/A6 kept drifting
+  // and bouncing inside their backlash at rest (±0.9 mrad on A6 for ever), which no real arm
+  // does and which broke every rest-based step of the chain.
+  double link_friction_fraction = 0.1;
   bool transmission_error = false;  // periodic te(motor angle)
   double dead_time_s = 0.0;         // desired value reaches the controller this much later
   // Velocity scale of the smooth Coulomb law [rad/s, joint side]: 0.01 rad/s = 0.6 deg/s, well

@@ -147,7 +147,7 @@ PlantSimulator::StateVector PlantSimulator::derivative(const PlantState& s,
         const double rate = slope(i) * thetad - s.qd_rad_s(i);
         gear_torque(i) = d.gear_torque_nm(deflection, rate);
         rhs(i) += gear_torque(i);
-        if (d.friction_at_link()) rhs(i) -= d.friction_nm(s.qd_rad_s(i));
+        rhs(i) -= d.link_friction_nm(s.qd_rad_s(i));
         break;
       }
       case DriveKind::kMasslessMotor:
@@ -170,8 +170,7 @@ PlantSimulator::StateVector PlantSimulator::derivative(const PlantState& s,
         dx(i) = s.qd_rad_s(i);
         dx(kN + i) = qdd(i);
         dx(2 * kN + i) = thetad;
-        dx(3 * kN + i) = (torque_(i) - (d.friction_at_link() ? 0.0 : d.friction_nm(thetad)) -
-                          slope(i) * gear_torque(i)) /
+        dx(3 * kN + i) = (torque_(i) - d.motor_friction_nm(thetad) - slope(i) * gear_torque(i)) /
                          d.reflected_inertia_kg_m2();
         break;
       case DriveKind::kMasslessMotor:

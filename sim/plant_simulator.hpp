@@ -10,8 +10,9 @@
 // angle / N). Rigid drives: theta is integrated and q = theta - te(theta) follows; massless
 // motors: q is integrated and theta follows statically (drive_model.hpp). The equations:
 //   link:  M(q) qdd + C(q, qd) qd + G(q) = tau_link
-//   elastic: tau_link = tau_g;     J thetadd = tau - f(thetad) - (1 - te') tau_g
-//            (friction_at_link: tau_link = tau_g - f(qd), no f in the motor equation)
+//   elastic: tau_link = tau_g - s f(qd);   J thetadd = tau - (1 - s) f(thetad) - (1 - te') tau_g
+//            (s = the link share of the friction: JointEffects::link_friction_fraction, 1 with
+//            friction_at_link)
 //   rigid:   J thetadd + (1 - te') tau_link = tau - f(thetad),  q = theta - te(theta)
 //   massless motor: tau_link = tau - f(qd)
 // solved jointly as (M + diag(J_rigid / (1 - te')^2)) qdd = rhs with one 6x6 LDLT.

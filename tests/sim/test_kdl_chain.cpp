@@ -261,9 +261,11 @@ TEST(KdlChain, Kr16DrivesHoldTheNominalPayloadEverywhere) {
     std::printf("A%d: largest gravity torque %.1f N m, limit %.0f N m\n", i + 1, largest(i), limit);
     EXPECT_LT(largest(i), limit) << "A" << i + 1;
   }
-  // "~2x" where gravity acts (A2..A5): between 1.5x and 3x.
-  for (int i : {1, 2, 3, 4}) {
-    EXPECT_GT(robot.joints[i].controller.torque_limit_nm / largest(i), 1.5) << "A" << i + 1;
-    EXPECT_LT(robot.joints[i].controller.torque_limit_nm / largest(i), 3.0) << "A" << i + 1;
+  // As the robot file states: "~2x" on A2, "~3x" on A3..A5 (where gravity acts).
+  EXPECT_GT(robot.joints[1].controller.torque_limit_nm / largest(1), 1.5);
+  EXPECT_LT(robot.joints[1].controller.torque_limit_nm / largest(1), 2.5);
+  for (int i : {2, 3, 4}) {
+    EXPECT_GT(robot.joints[i].controller.torque_limit_nm / largest(i), 2.5) << "A" << i + 1;
+    EXPECT_LT(robot.joints[i].controller.torque_limit_nm / largest(i), 4.0) << "A" << i + 1;
   }
 }
