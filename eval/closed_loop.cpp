@@ -26,8 +26,10 @@ CompensationRun run_stage(const ident::ParameterTable& table, const std::string&
   run.state.resize(n);
   run.outside_table.resize(n);
   std::array<ident::PrecontrolEvent, ident::kPrecontrolEventCapacity> events{};
+  // An inverse-form table is fed q_d its preview ahead, on top of the smoother's look-ahead.
+  const auto look_ahead = std::size_t(options.look_ahead_cycles + table.preview_cycles);
   for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t ahead = std::min(n - 1, k + std::size_t(options.look_ahead_cycles));
+    const std::size_t ahead = std::min(n - 1, k + look_ahead);
     const sim::DesiredJointSample& s = path.samples[ahead];
     std::array<double, ident::kPrecontrolJoints> q{};
     for (int j = 0; j < ident::kPrecontrolJoints; ++j) q[std::size_t(j)] = s.q_rad[j];
@@ -62,6 +64,11 @@ CompensationRun run_precontrol(const ident::ParameterTable& table, const std::st
     throw std::invalid_argument(
         "run_precontrol: inversion iterations need look-ahead 0 (the cascade's fixed point is "
         "defined without it)");
+  }
+  if (options.inversion_iterations > 0 && table.model_form == ident::TableForm::kInverse) {
+    throw std::invalid_argument(
+        "run_precontrol: inversion iterations are for forward-form tables; an inverse-form "
+        "table is the inversion");
   }
   CompensationRun run = run_stage(table, robot_name, path, options);
   for (int i = 0; i < options.inversion_iterations; ++i) {

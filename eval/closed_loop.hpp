@@ -13,8 +13,9 @@
 // q̇_d + ȯ and q̈_d + ö, with ȯ, ö central differences of the offsets over the cycle (one-sided at
 // the path's ends). The interpolator plans ahead, so o(k+1) is known at cycle k.
 //
-// Look-ahead: with look_ahead_cycles = L the precontrol is fed q_d(k + L) at cycle k (held at the
-// path's end) and its output is applied at cycle k. The model's own offset is
+// Look-ahead: with look_ahead_cycles = L the precontrol is fed q_d(k + L + P) at cycle k (held at
+// the path's end; P = the table's preview_cycles, 0 for a forward-form table) and its output is
+// applied at cycle k. The model's own offset is
 // Δq̂(k) = q_d(k - d) - q̂(k) (paper, eq. 2): with L = d it refers to the desired value of the
 // cycle it is applied in.
 //

@@ -8,7 +8,6 @@
 #include <stdexcept>
 
 #include "calib/forward_kinematics.hpp"
-#include "core/version.hpp"
 #include "eval/iso9283_path.hpp"
 #include "eval/path_deviation.hpp"
 #include "ident/identify_joints.hpp"
@@ -237,10 +236,8 @@ IdentifiedTable identify_table(const ident::JointErrorLog& log,
                                             config.max_speed_rad_s.size(), log.joint_count()));
   }
   IdentifiedTable out;
-  out.table.robot = log.robot;
-  out.table.sample_time_s = log.cycle_s;
-  out.table.created_by = std::string("imscal ") + kVersion;
-  out.table.source = {source_file, "", log.sample_count(), log.source};
+  out.table =
+      ident::parameter_table_header(log, config, {source_file, "", log.sample_count(), log.source});
   for (auto& outcome : ident::identify_joints(log, config)) {
     if (!outcome.failure.empty())
       out.failed_joints.push_back(outcome.result.parameters.name + ": " + outcome.failure);

@@ -25,11 +25,20 @@ constexpr std::size_t kChunkRows = 2048;
 // Rows per block of the streamed QR (the block plus the running R are factored together).
 constexpr int kQrBlockRows = 512;
 
-void check_segment(const IoSegment& segment) {
+void check_segment(const IoSegment& segment, int extra_inputs) {
   if (segment.input.size() != segment.output.size())
     throw std::invalid_argument("ARX data segment: input has " +
                                 std::to_string(segment.input.size()) + " samples, output has " +
                                 std::to_string(segment.output.size()));
+  if (segment.extra_count < extra_inputs)
+    throw std::invalid_argument("ARX data segment: " + std::to_string(segment.extra_count) +
+                                " further inputs, the model needs " + std::to_string(extra_inputs));
+  for (int e = 0; e < extra_inputs; ++e)
+    if (segment.extra[static_cast<std::size_t>(e)].size() != segment.output.size())
+      throw std::invalid_argument(
+          "ARX data segment: further input " + std::to_string(e) + " has " +
+          std::to_string(segment.extra[static_cast<std::size_t>(e)].size()) +
+          " samples, output has " + std::to_string(segment.output.size()));
 }
 
 double dot_lagged(const double* a, const double* b, std::size_t length) {
@@ -37,50 +46,71 @@ double dot_lagged(const double* a, const double* b, std::size_t length) {
       .dot(ConstMap(b, static_cast<Eigen::Index>(length)));
 }
 
-// Adds one segment's contribution to `gram` (see build_lagged_gram).
+// One signal of a LaggedGram: its samples and its lag range [lag_min, lag_max], whose columns
+// start at `column`.
+struct LaggedSignal {
+  const double* data = nullptr;
+  int lag_min = 0, lag_max = 0, column = 0;
+  int count() const { return lag_max - lag_min + 1; }
+};
+
+// The signals of a segment in LagSet column order: y, u, x_0, x_1, ...
+std::vector<LaggedSignal> lagged_signals(const IoSegment& segment, const LagSet& lags) {
+  std::vector<LaggedSignal> out{
+      {segment.output.data(), 0, lags.output_lag_max, lags.output_column(0)},
+      {segment.input.data(), lags.input_lag_min, lags.input_lag_max,
+       lags.input_column(lags.input_lag_min)}};
+  for (int e = 0; e < lags.extra_count; ++e)
+    out.push_back({segment.extra[static_cast<std::size_t>(e)].data(), lags.input_lag_min,
+                   lags.extra_lag_max, lags.extra_column(e, lags.input_lag_min)});
+  return out;
+}
+
+// Adds one segment's contribution to `gram` (see build_lagged_gram). For every pair of signals
+// (a, b), E(la, lb) = Σ_k a(k-la) b(k-lb): the entries with la or lb at its signal's smallest lag
+// are dot products over the data (blocked, one pass); every other entry follows from its
+// neighbour (la-1, lb-1) by the sliding update, which moves the summation window by one sample.
 void add_segment_gram(const IoSegment& segment, const LagSet& lags, int first_row,
                       Eigen::MatrixXd& local, Eigen::MatrixXd& gram) {
-  const double* y = segment.output.data();
-  const double* u = segment.input.data();
   const std::size_t n = segment.output.size();
   const std::size_t f = static_cast<std::size_t>(first_row);
-  const int ny = lags.output_columns();
-  const int nu = lags.input_columns();
-  const int lu0 = lags.input_lag_min;
+  const std::vector<LaggedSignal> signals = lagged_signals(segment, lags);
   local.setZero();
+  // Upper-triangle entry of (signal a at lag la, signal b at lag lb).
+  auto entry = [&](const LaggedSignal& a, int la, const LaggedSignal& b, int lb) -> double& {
+    const int r = a.column + la - a.lag_min, c = b.column + lb - b.lag_min;
+    return r <= c ? local(r, c) : local(c, r);
+  };
 
-  // Base sums (one pass over the data, blocked): row y-lag 0 against every column, and row
-  // u-lag lu0 against every input column and every output lag >= 1.
   for (std::size_t c = f; c < n; c += kChunkRows) {
     const std::size_t len = std::min(kChunkRows, n - c);
-    for (int j = 0; j < ny; ++j)
-      local(0, lags.output_column(j)) += dot_lagged(y + c, y + c - j, len);
-    for (int l = 0; l < nu; ++l) {
-      const int lag = lu0 + l;
-      local(0, lags.input_column(lag)) += dot_lagged(y + c, u + c - lag, len);
-      local(lags.input_column(lu0), lags.input_column(lag)) +=
-          dot_lagged(u + c - lu0, u + c - lag, len);
+    for (std::size_t ia = 0; ia < signals.size(); ++ia) {
+      const LaggedSignal& a = signals[ia];
+      for (std::size_t ib = ia; ib < signals.size(); ++ib) {
+        const LaggedSignal& b = signals[ib];
+        // Row la = a.lag_min against every lag of b, and column lb = b.lag_min against the
+        // other lags of a (for a == b the first row covers the upper triangle's base).
+        for (int lb = b.lag_min; lb <= b.lag_max; ++lb)
+          entry(a, a.lag_min, b, lb) += dot_lagged(a.data + c - a.lag_min, b.data + c - lb, len);
+        if (ia == ib) continue;
+        for (int la = a.lag_min + 1; la <= a.lag_max; ++la)
+          entry(a, la, b, b.lag_min) += dot_lagged(a.data + c - la, b.data + c - b.lag_min, len);
+      }
     }
-    for (int i = 1; i < ny; ++i)
-      local(lags.output_column(i), lags.input_column(lu0)) +=
-          dot_lagged(y + c - i, u + c - lu0, len);
   }
 
-  // Sliding update: moving both lags by one shifts the summation window by one sample, which
-  // adds the sample before the window start and drops the last one.
-  auto shifted = [&](const double* s1, int l1, const double* s2, int l2, double previous) {
-    return previous + s1[f - l1] * s2[f - l2] - s1[n - l1] * s2[n - l2];
-  };
-  for (int i = 1; i < ny; ++i)
-    for (int j = i; j < ny; ++j) local(i, j) = shifted(y, i, y, j, local(i - 1, j - 1));
-  for (int la = lu0 + 1; la <= lags.input_lag_max; ++la)
-    for (int lb = la; lb <= lags.input_lag_max; ++lb)
-      local(lags.input_column(la), lags.input_column(lb)) =
-          shifted(u, la, u, lb, local(lags.input_column(la - 1), lags.input_column(lb - 1)));
-  for (int i = 1; i < ny; ++i)
-    for (int lb = lu0 + 1; lb <= lags.input_lag_max; ++lb)
-      local(i, lags.input_column(lb)) =
-          shifted(y, i, u, lb, local(i - 1, lags.input_column(lb - 1)));
+  for (std::size_t ia = 0; ia < signals.size(); ++ia) {
+    const LaggedSignal& a = signals[ia];
+    for (std::size_t ib = ia; ib < signals.size(); ++ib) {
+      const LaggedSignal& b = signals[ib];
+      for (int la = a.lag_min + 1; la <= a.lag_max; ++la) {
+        for (int lb = (ia == ib ? la : b.lag_min + 1); lb <= b.lag_max; ++lb) {
+          entry(a, la, b, lb) = entry(a, la - 1, b, lb - 1) + a.data[f - la] * b.data[f - lb] -
+                                a.data[n - la] * b.data[n - lb];
+        }
+      }
+    }
+  }
 
   gram.triangularView<Eigen::Upper>() += local;  // only the upper triangle of local is filled
 }
@@ -149,7 +179,8 @@ Eigen::MatrixXd streamed_qr_factor(std::span<const IoSegment> segments,
                                    const ArxStructure& structure, const Eigen::VectorXd& scale) {
   const int na = structure.na;
   const int nb = structure.nb;
-  const int p = na + nb;
+  const int nx = structure.nx;
+  const int p = structure.parameter_count();
   const int q = p + 1;
   const std::size_t first = static_cast<std::size_t>(structure.max_lag());
   const std::size_t d = static_cast<std::size_t>(structure.dead_time);
@@ -166,6 +197,11 @@ Eigen::MatrixXd streamed_qr_factor(std::span<const IoSegment> segments,
       auto row = stack.row(q + rows);
       for (int i = 0; i < na; ++i) row(i) = -y[k - 1 - i] * scale(i);
       for (int j = 0; j < nb; ++j) row(na + j) = u[k - d - j] * scale(na + j);
+      for (int e = 0; e < structure.extra_inputs; ++e) {
+        const auto& x = segment.extra[static_cast<std::size_t>(e)];
+        const int c0 = na + nb + e * nx;
+        for (int j = 0; j < nx; ++j) row(c0 + j) = x[k - d - j] * scale(c0 + j);
+      }
       row(p) = y[k];
       if (++rows == kQrBlockRows) flush();
     }
@@ -187,8 +223,9 @@ double residual_pass(std::span<const IoSegment> segments, const ArxStructure& st
   std::array<double, kChunkRows> residual_buffer;
   if (phi_t_r != nullptr) phi_t_r->setZero(theta.size());
   double sum = 0.0;
+  const int nb = structure.nb, nx = structure.nx;
   for (const IoSegment& segment : segments) {
-    check_segment(segment);
+    check_segment(segment, structure.extra_inputs);
     const double* y = segment.output.data();
     const double* u = segment.input.data();
     const std::size_t n = segment.output.size();
@@ -197,12 +234,21 @@ double residual_pass(std::span<const IoSegment> segments, const ArxStructure& st
       Eigen::Map<Eigen::VectorXd> e(residual_buffer.data(), len);
       e = ConstMap(y + c, len);
       for (int i = 0; i < na; ++i) e += theta(i) * ConstMap(y + c - 1 - i, len);
-      for (int j = 0; j < structure.nb; ++j) e -= theta(na + j) * ConstMap(u + c - d - j, len);
+      for (int j = 0; j < nb; ++j) e -= theta(na + j) * ConstMap(u + c - d - j, len);
+      for (int x = 0; x < structure.extra_inputs; ++x) {
+        const double* xs = segment.extra[static_cast<std::size_t>(x)].data();
+        for (int j = 0; j < nx; ++j)
+          e -= theta(na + nb + x * nx + j) * ConstMap(xs + c - d - j, len);
+      }
       sum += e.squaredNorm();
       if (phi_t_r == nullptr) continue;
       for (int i = 0; i < na; ++i) (*phi_t_r)(i) -= e.dot(ConstMap(y + c - 1 - i, len));
-      for (int j = 0; j < structure.nb; ++j)
-        (*phi_t_r)(na + j) += e.dot(ConstMap(u + c - d - j, len));
+      for (int j = 0; j < nb; ++j) (*phi_t_r)(na + j) += e.dot(ConstMap(u + c - d - j, len));
+      for (int x = 0; x < structure.extra_inputs; ++x) {
+        const double* xs = segment.extra[static_cast<std::size_t>(x)].data();
+        for (int j = 0; j < nx; ++j)
+          (*phi_t_r)(na + nb + x * nx + j) += e.dot(ConstMap(xs + c - d - j, len));
+      }
     }
   }
   return sum;
@@ -212,7 +258,10 @@ double residual_pass(std::span<const IoSegment> segments, const ArxStructure& st
 
 LaggedGram build_lagged_gram(std::span<const IoSegment> segments, const LagSet& lags,
                              int first_row) {
-  if (lags.output_lag_max < 0 || lags.input_lag_min < 0 || lags.input_lag_max < lags.input_lag_min)
+  if (lags.output_lag_max < 0 || lags.input_lag_min < 0 ||
+      lags.input_lag_max < lags.input_lag_min || lags.extra_count < 0 ||
+      lags.extra_count > kMaxExtraInputs ||
+      (lags.extra_count > 0 && lags.extra_lag_max < lags.input_lag_min))
     throw std::invalid_argument("build_lagged_gram: invalid lag set");
   if (first_row < lags.max_lag())
     throw std::invalid_argument("build_lagged_gram: first_row " + std::to_string(first_row) +
@@ -224,7 +273,7 @@ LaggedGram build_lagged_gram(std::span<const IoSegment> segments, const LagSet& 
   result.gram = Eigen::MatrixXd::Zero(columns, columns);
   Eigen::MatrixXd local(columns, columns);
   for (const IoSegment& segment : segments) {
-    check_segment(segment);
+    check_segment(segment, lags.extra_count);
     if (segment.output.size() <= static_cast<std::size_t>(first_row)) continue;
     result.row_count += segment.output.size() - static_cast<std::size_t>(first_row);
     add_segment_gram(segment, lags, first_row, local, result.gram);
@@ -243,8 +292,10 @@ ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& st
   structure.validate();
   const int na = structure.na;
   const int nb = structure.nb;
-  const int p = na + nb;
-  const LagSet lags{na, structure.dead_time, structure.dead_time + nb - 1};
+  const int nx = structure.nx;
+  const int p = structure.parameter_count();
+  const LagSet lags{na, structure.dead_time, structure.dead_time + nb - 1, structure.extra_inputs,
+                    structure.dead_time + nx - 1};
   const LaggedGram lagged = build_lagged_gram(segments, lags, structure.max_lag());
   if (lagged.row_count <= static_cast<std::size_t>(p))
     throw std::invalid_argument("fit_arx: " + std::to_string(lagged.row_count) +
@@ -257,6 +308,10 @@ ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& st
   for (int i = 0; i < na; ++i) column[i] = lags.output_column(i + 1), sign(i) = -1.0;
   for (int j = 0; j < nb; ++j)
     column[na + j] = lags.input_column(structure.dead_time + j), sign(na + j) = 1.0;
+  for (int e = 0; e < structure.extra_inputs; ++e)
+    for (int j = 0; j < nx; ++j)
+      column[na + nb + e * nx + j] = lags.extra_column(e, structure.dead_time + j),
+                                sign(na + nb + e * nx + j) = 1.0;
   Eigen::MatrixXd normal(p, p);
   Eigen::VectorXd rhs(p);
   for (int r = 0; r < p; ++r) {
@@ -325,7 +380,8 @@ ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& st
   const double variance = rss / static_cast<double>(lagged.row_count - static_cast<std::size_t>(p));
   Eigen::MatrixXd covariance = variance * scale.asDiagonal() * scaled_inverse * scale.asDiagonal();
   Eigen::VectorXd std_dev = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  return ArxFitResult{ArxModel(structure, theta.head(na), theta.tail(nb), options.sample_time_s),
+  return ArxFitResult{ArxModel(structure, theta.head(na), theta.segment(na, nb),
+                               theta.tail(p - na - nb), options.sample_time_s),
                       std::move(std_dev),
                       std::move(covariance),
                       rss,

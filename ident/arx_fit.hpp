@@ -2,8 +2,9 @@
 // Least-squares fit of one joint's ARX model (ident/arx_structure.hpp) from one or more data
 // segments (separate runs; no regressor crosses a segment boundary).
 //
-// Regression: y(k) = φ(k)ᵀ θ + e(k),  φ(k) = [-y(k-1) .. -y(k-na), u(k-d) .. u(k-d-nb+1)],
-// θ = [a_1..a_na, b_0..b_{nb-1}], rows k = max_lag .. n-1 of every segment.
+// Regression: y(k) = φ(k)ᵀ θ + e(k),  φ(k) = [-y(k-1) .. -y(k-na), u(k-d) .. u(k-d-nb+1),
+// x_e(k-d) .. x_e(k-d-nx+1) for every further input e], θ = [a_1..a_na, b_0..b_{nb-1}, c],
+// rows k = max_lag .. n-1 of every segment.
 //
 // How it is solved (numerically sound and fast on millions of samples):
 //  1. The Gram matrix [Φ y]ᵀ[Φ y] is built without forming Φ. Its entries are lagged correlation
@@ -36,19 +37,29 @@
 namespace imscal::ident {
 
 // The lags held by a LaggedGram: outputs y(k-0) .. y(k-output_lag_max) (lag 0 is the regression
-// target) and inputs u(k-input_lag_min) .. u(k-input_lag_max).
+// target), inputs u(k-input_lag_min) .. u(k-input_lag_max) and, for each of extra_count further
+// inputs, x_e(k-input_lag_min) .. x_e(k-extra_lag_max).
 struct LagSet {
   int output_lag_max = 0;
   int input_lag_min = 0;
   int input_lag_max = 0;
+  int extra_count = 0;
+  int extra_lag_max = 0;
 
   int output_columns() const { return output_lag_max + 1; }
   int input_columns() const { return input_lag_max - input_lag_min + 1; }
-  int columns() const { return output_columns() + input_columns(); }
-  // Column of y(k-lag) / u(k-lag) in LaggedGram::gram.
+  int extra_columns() const { return extra_count > 0 ? extra_lag_max - input_lag_min + 1 : 0; }
+  int columns() const { return output_columns() + input_columns() + extra_count * extra_columns(); }
+  // Column of y(k-lag) / u(k-lag) / x_e(k-lag) in LaggedGram::gram.
   int output_column(int lag) const { return lag; }
   int input_column(int lag) const { return output_columns() + lag - input_lag_min; }
-  int max_lag() const { return output_lag_max > input_lag_max ? output_lag_max : input_lag_max; }
+  int extra_column(int e, int lag) const {
+    return output_columns() + input_columns() + e * extra_columns() + lag - input_lag_min;
+  }
+  int max_lag() const {
+    const int m = output_lag_max > input_lag_max ? output_lag_max : input_lag_max;
+    return extra_count > 0 && extra_lag_max > m ? extra_lag_max : m;
+  }
 };
 
 // Σ over the rows k = first_row .. n-1 of every segment of c(k) c(k)ᵀ, where c(k) holds the
@@ -86,7 +97,7 @@ struct ArxFitOptions {
 
 struct ArxFitResult {
   ArxModel model;
-  Eigen::VectorXd parameter_std;  // σ of θ = [a; b]
+  Eigen::VectorXd parameter_std;  // σ of θ = [a; b; c]
   Eigen::MatrixXd covariance;     // of θ
   double residual_sum_of_squares = 0.0;
   double residual_variance = 0.0;  // RSS / (N - p), the estimate of σ_e²

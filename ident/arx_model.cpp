@@ -11,52 +11,92 @@ namespace imscal::ident {
 
 ArxModel::ArxModel(ArxStructure structure, Eigen::VectorXd a, Eigen::VectorXd b,
                    double sample_time_s)
-    : structure_(structure), a_(std::move(a)), b_(std::move(b)), sample_time_s_(sample_time_s) {
+    : ArxModel(structure, std::move(a), std::move(b), Eigen::VectorXd(), sample_time_s) {}
+
+ArxModel::ArxModel(ArxStructure structure, Eigen::VectorXd a, Eigen::VectorXd b, Eigen::VectorXd c,
+                   double sample_time_s)
+    : structure_(structure),
+      a_(std::move(a)),
+      b_(std::move(b)),
+      c_(std::move(c)),
+      sample_time_s_(sample_time_s) {
   structure_.validate();
-  if (a_.size() != structure_.na || b_.size() != structure_.nb)
+  if (a_.size() != structure_.na || b_.size() != structure_.nb ||
+      c_.size() != structure_.extra_inputs * structure_.nx)
     throw std::invalid_argument("ArxModel: coefficient counts (" + std::to_string(a_.size()) +
-                                ", " + std::to_string(b_.size()) + ") do not match " +
+                                ", " + std::to_string(b_.size()) + ", " +
+                                std::to_string(c_.size()) + ") do not match " +
                                 to_string(structure_));
   if (!(sample_time_s_ > 0.0)) throw std::invalid_argument("ArxModel: sample time must be > 0");
 }
 
 Eigen::VectorXd ArxModel::parameters() const {
-  Eigen::VectorXd theta(a_.size() + b_.size());
-  theta << a_, b_;
+  Eigen::VectorXd theta(a_.size() + b_.size() + c_.size());
+  theta << a_, b_, c_;
   return theta;
 }
+
+namespace {
+
+// sum + Σ_j b_j u(k-d-j) + Σ_e Σ_j c_e,j x_e(k-d-j): the input part of row k, added to the
+// autoregressive part `sum` (in this order: a noise-free model then reproduces its data exactly).
+double add_input_terms(double sum, const ArxStructure& s, const Eigen::VectorXd& b,
+                       const Eigen::VectorXd& c, const IoSegment& segment, std::size_t k) {
+  const std::size_t first = k - static_cast<std::size_t>(s.dead_time);
+  for (int j = 0; j < s.nb; ++j) sum += b[j] * segment.input[first - j];
+  for (int e = 0; e < s.extra_inputs; ++e) {
+    const auto& x = segment.extra[static_cast<std::size_t>(e)];
+    for (int j = 0; j < s.nx; ++j) sum += c[e * s.nx + j] * x[first - j];
+  }
+  return sum;
+}
+
+void check_extras(const ArxStructure& s, const IoSegment& segment, const char* where) {
+  if (segment.extra_count != s.extra_inputs)
+    throw std::invalid_argument(std::string(where) + ": the model has " +
+                                std::to_string(s.extra_inputs) + " further inputs, the data " +
+                                std::to_string(segment.extra_count));
+  for (int e = 0; e < s.extra_inputs; ++e)
+    if (segment.extra[static_cast<std::size_t>(e)].size() != segment.input.size())
+      throw std::invalid_argument(std::string(where) + ": a further input's length differs");
+}
+
+}  // namespace
 
 void ArxModel::predict_one_step(const IoSegment& segment, std::span<double> predicted) const {
   const std::size_t n = segment.output.size();
   if (segment.input.size() != n || predicted.size() != n)
     throw std::invalid_argument("ArxModel::predict_one_step: sizes differ");
+  check_extras(structure_, segment, "ArxModel::predict_one_step");
   const std::size_t first = static_cast<std::size_t>(structure_.max_lag());
-  const auto& u = segment.input;
   const auto& y = segment.output;
   for (std::size_t k = 0; k < std::min(first, n); ++k) predicted[k] = y[k];
   for (std::size_t k = first; k < n; ++k) {
     double sum = 0.0;
     for (int i = 0; i < structure_.na; ++i) sum -= a_[i] * y[k - 1 - i];
-    const std::size_t u_first = k - static_cast<std::size_t>(structure_.dead_time);
-    for (int j = 0; j < structure_.nb; ++j) sum += b_[j] * u[u_first - j];
-    predicted[k] = sum;
+    predicted[k] = add_input_terms(sum, structure_, b_, c_, segment, k);
   }
 }
 
 void ArxModel::simulate(std::span<const double> input, std::span<const double> initial_output,
                         std::span<double> simulated) const {
-  const std::size_t n = input.size();
+  if (structure_.extra_inputs > 0)
+    throw std::invalid_argument("ArxModel::simulate: the model has further inputs");
+  simulate(IoSegment{input, initial_output}, simulated);
+}
+
+void ArxModel::simulate(const IoSegment& segment, std::span<double> simulated) const {
+  const std::size_t n = segment.input.size();
   const std::size_t first = static_cast<std::size_t>(structure_.max_lag());
   if (simulated.size() != n) throw std::invalid_argument("ArxModel::simulate: sizes differ");
-  if (initial_output.size() < std::min(first, n))
+  if (segment.output.size() < std::min(first, n))
     throw std::invalid_argument("ArxModel::simulate: need max_lag initial outputs");
-  for (std::size_t k = 0; k < std::min(first, n); ++k) simulated[k] = initial_output[k];
+  check_extras(structure_, segment, "ArxModel::simulate");
+  for (std::size_t k = 0; k < std::min(first, n); ++k) simulated[k] = segment.output[k];
   for (std::size_t k = first; k < n; ++k) {
     double sum = 0.0;
     for (int i = 0; i < structure_.na; ++i) sum -= a_[i] * simulated[k - 1 - i];
-    const std::size_t u_first = k - static_cast<std::size_t>(structure_.dead_time);
-    for (int j = 0; j < structure_.nb; ++j) sum += b_[j] * input[u_first - j];
-    simulated[k] = sum;
+    simulated[k] = add_input_terms(sum, structure_, b_, c_, segment, k);
   }
 }
 
@@ -93,6 +133,15 @@ double ArxModel::static_gain() const {
   const double a_at_one = 1.0 + a_.sum();
   if (a_at_one == 0.0) return std::numeric_limits<double>::infinity();
   return b_.sum() / a_at_one;
+}
+
+double ArxModel::extra_static_gain(int e) const {
+  if (e < 0 || e >= structure_.extra_inputs)
+    throw std::invalid_argument("ArxModel::extra_static_gain: no further input " +
+                                std::to_string(e));
+  const double a_at_one = 1.0 + a_.sum();
+  if (a_at_one == 0.0) return std::numeric_limits<double>::infinity();
+  return c_.segment(e * structure_.nx, structure_.nx).sum() / a_at_one;
 }
 
 }  // namespace imscal::ident

@@ -30,6 +30,15 @@ void steps_sse2(const ArxStepInput* models, int count, double* output) noexcept 
       out2 = _mm_add_pd(out2, _mm_mul_pd(_mm_loadu_pd(a + 4), _mm_loadu_pd(y + 4)));
       out3 = _mm_add_pd(out3, _mm_mul_pd(_mm_loadu_pd(a + 6), _mm_loadu_pd(y + 6)));
     }
+    for (int e = 0; e < m.extra_count; ++e) {
+      for (int i = 0; i < m.terms; i += kArxStepLanes) {
+        const double *c = m.c[e] + i, *x = m.x_delayed[e] + i;
+        in0 = _mm_add_pd(in0, _mm_mul_pd(_mm_loadu_pd(c), _mm_loadu_pd(x)));
+        in1 = _mm_add_pd(in1, _mm_mul_pd(_mm_loadu_pd(c + 2), _mm_loadu_pd(x + 2)));
+        in2 = _mm_add_pd(in2, _mm_mul_pd(_mm_loadu_pd(c + 4), _mm_loadu_pd(x + 4)));
+        in3 = _mm_add_pd(in3, _mm_mul_pd(_mm_loadu_pd(c + 6), _mm_loadu_pd(x + 6)));
+      }
+    }
     alignas(16) double in[8], out[8];
     _mm_store_pd(in, in0), _mm_store_pd(in + 2, in1), _mm_store_pd(in + 4, in2);
     _mm_store_pd(in + 6, in3);
@@ -51,6 +60,13 @@ __attribute__((target("avx"))) void steps_avx(const ArxStepInput* models, int co
       in1 = _mm256_add_pd(in1, _mm256_mul_pd(_mm256_loadu_pd(b + 4), _mm256_loadu_pd(u + 4)));
       out0 = _mm256_add_pd(out0, _mm256_mul_pd(_mm256_loadu_pd(a), _mm256_loadu_pd(y)));
       out1 = _mm256_add_pd(out1, _mm256_mul_pd(_mm256_loadu_pd(a + 4), _mm256_loadu_pd(y + 4)));
+    }
+    for (int e = 0; e < m.extra_count; ++e) {
+      for (int i = 0; i < m.terms; i += kArxStepLanes) {
+        const double *c = m.c[e] + i, *x = m.x_delayed[e] + i;
+        in0 = _mm256_add_pd(in0, _mm256_mul_pd(_mm256_loadu_pd(c), _mm256_loadu_pd(x)));
+        in1 = _mm256_add_pd(in1, _mm256_mul_pd(_mm256_loadu_pd(c + 4), _mm256_loadu_pd(x + 4)));
+      }
     }
     _mm256_store_pd(in, in0), _mm256_store_pd(in + 4, in1);
     _mm256_store_pd(out, out0), _mm256_store_pd(out + 4, out1);

@@ -1,25 +1,38 @@
 #pragma once
 // Structure of the paper's per-joint ARX model (equation 2), sample time T (2 ms by default):
 //
-//   y(k) + a_1 y(k-1) + ... + a_na y(k-na) = b_0 u(k-d) + ... + b_{nb-1} u(k-d-nb+1) + e(k)
+//   y(k) + a_1 y(k-1) + ... + a_na y(k-na) = b_0 u(k-d) + ... + b_{nb-1} u(k-d-nb+1)
+//                                           + Σ_e [c_e,0 x_e(k-d) + ... + c_e,nx-1 x_e(k-d-nx+1)]
+//                                           + e(k)
 //
 // with y = q̂ (the joint angle the robot reaches), u = q_d (the desired joint angle), d the dead
 // time in samples and e(k) the equation error. na >= 0 (na = 0 is a FIR model), nb >= 1, d >= 0.
+// The x_e are optional further inputs of the multi-input form (imscal's extension, issue 6: the
+// joint torque of the robot's rigid-body model and the direction of motion,
+// ident/joint_identification.hpp), extra_inputs of them with nx coefficients each, lags from d
+// as the main input's. extra_inputs = 0 is the paper's single-input model.
 #include <algorithm>
+#include <array>
 #include <span>
 #include <stdexcept>
 #include <string>
 
 namespace imscal::ident {
 
-struct ArxStructure {
-  int na = 1;         // number of autoregressive coefficients a_1..a_na
-  int nb = 1;         // number of input coefficients b_0..b_{nb-1}
-  int dead_time = 0;  // d: delay of the first input coefficient, in samples
+inline constexpr int kMaxExtraInputs = 2;
 
-  int parameter_count() const { return na + nb; }
+struct ArxStructure {
+  int na = 1;            // number of autoregressive coefficients a_1..a_na
+  int nb = 1;            // number of input coefficients b_0..b_{nb-1}
+  int dead_time = 0;     // d: delay of the first input coefficient, in samples
+  int extra_inputs = 0;  // number of further inputs x_e (0..kMaxExtraInputs)
+  int nx = 0;            // coefficients per further input (>= 1 when extra_inputs > 0)
+
+  int parameter_count() const { return na + nb + extra_inputs * nx; }
   // Largest lag of any regressor: the first sample k that has a complete regressor.
-  int max_lag() const { return std::max(na, dead_time + nb - 1); }
+  int max_lag() const {
+    return std::max({na, dead_time + nb - 1, extra_inputs > 0 ? dead_time + nx - 1 : 0});
+  }
 
   // Throws std::invalid_argument when a field is out of range.
   void validate() const {
@@ -30,6 +43,14 @@ struct ArxStructure {
     if (dead_time < 0)
       throw std::invalid_argument("ArxStructure: dead_time must be >= 0, got " +
                                   std::to_string(dead_time));
+    if (extra_inputs < 0 || extra_inputs > kMaxExtraInputs)
+      throw std::invalid_argument("ArxStructure: extra_inputs must be in 0.." +
+                                  std::to_string(kMaxExtraInputs) + ", got " +
+                                  std::to_string(extra_inputs));
+    if ((extra_inputs > 0) != (nx > 0) || nx < 0)
+      throw std::invalid_argument(
+          "ArxStructure: nx must be >= 1 with further inputs and 0 without, got " +
+          std::to_string(nx));
   }
 
   friend bool operator==(const ArxStructure&, const ArxStructure&) = default;
@@ -41,11 +62,26 @@ struct ArxStructure {
 struct IoSegment {
   std::span<const double> input;   // u(k) = q_d(k) [rad]
   std::span<const double> output;  // y(k) = q̂(k) [rad]
+  // The further inputs x_e(k) of the multi-input form, each of the output's length; the first
+  // extra_count are used (the structure's extra_inputs must match).
+  std::array<std::span<const double>, kMaxExtraInputs> extra{};
+  int extra_count = 0;
+
+  // The same rows [first, first + count) of every signal.
+  IoSegment subspan(std::size_t first, std::size_t count = std::dynamic_extent) const {
+    IoSegment out{input.subspan(first, count), output.subspan(first, count), {}, extra_count};
+    for (int e = 0; e < extra_count; ++e)
+      out.extra[std::size_t(e)] = extra[std::size_t(e)].subspan(first, count);
+    return out;
+  }
 };
 
 inline std::string to_string(const ArxStructure& s) {
-  return "na=" + std::to_string(s.na) + " nb=" + std::to_string(s.nb) +
-         " d=" + std::to_string(s.dead_time);
+  std::string text = "na=" + std::to_string(s.na) + " nb=" + std::to_string(s.nb) +
+                     " d=" + std::to_string(s.dead_time);
+  if (s.extra_inputs > 0)
+    text += " +" + std::to_string(s.extra_inputs) + "x" + std::to_string(s.nx);
+  return text;
 }
 
 }  // namespace imscal::ident

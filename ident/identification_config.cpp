@@ -49,8 +49,8 @@ CellGrid IdentificationConfig::joint_grid(std::size_t joint) const {
 }
 
 IdentificationConfig load_identification_config(const ConfigNode& root) {
-  root.require_only_keys({"imscal-identification-config", "joints", "cells", "order", "validation",
-                          "stability_margin", "backlash"});
+  root.require_only_keys({"imscal-identification-config", "joints", "cells", "model", "order",
+                          "validation", "stability_margin", "backlash"});
   if (root.child("imscal-identification-config").as_int() != 1)
     root.child("imscal-identification-config").fail("unknown config version; expected 1");
   IdentificationConfig c;
@@ -102,6 +102,21 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
     o.min_rows_per_cell = std::size_t(min_rows);
     o.min_rms_speed_rad_s =
         cells->get_double("min_rms_speed_deg_s", o.min_rms_speed_rad_s / kDeg) * kDeg;
+  }
+  if (auto model = root.optional_child("model")) {
+    model->require_only_keys({"form", "preview_cycles"});
+    if (auto n = model->optional_child("form")) {
+      try {
+        o.form = arx_model_form_from_string(n->as_string());
+      } catch (const std::invalid_argument& e) {
+        n->fail(e.what());
+      }
+    }
+    o.preview_cycles = int(model->get_int("preview_cycles", o.preview_cycles));
+    if (o.preview_cycles < 0 || o.preview_cycles > 32)
+      model->child("preview_cycles").fail("must be in 0..32 cycles");
+    if (o.preview_cycles > 0 && o.form != ArxModelForm::kInverse)
+      model->child("preview_cycles").fail("a preview is used only by the inverse form");
   }
   if (auto order = root.optional_child("order")) {
     order->require_only_keys({"na", "nb", "dead_time", "criterion"});

@@ -8,8 +8,25 @@
 #include <thread>
 
 #include "core/input_error.hpp"
+#include "core/version.hpp"
 
 namespace imscal::ident {
+
+ParameterTable parameter_table_header(const JointErrorLog& log, const IdentificationConfig& config,
+                                      DataSource source) {
+  ParameterTable table;
+  table.robot = log.robot;
+  table.sample_time_s = log.cycle_s;
+  table.created_by = std::string("imscal ") + kVersion;
+  table.model_form =
+      config.options.form == ArxModelForm::kInverse ? TableForm::kInverse : TableForm::kForward;
+  table.preview_cycles = config.options.preview_cycles;
+  if (config.options.model_torque_input) table.extra_inputs.push_back(TableInput::kModelTorque);
+  if (config.options.direction_input) table.extra_inputs.push_back(TableInput::kDirection);
+  table.direction_speed_scale_rad_s = config.options.direction_speed_scale_rad_s;
+  table.source = std::move(source);
+  return table;
+}
 
 std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
                                           const IdentificationConfig& config, unsigned threads,
@@ -33,7 +50,8 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
       } catch (const std::runtime_error& e) {
         outcomes[j].failure = e.what();
         outcomes[j].result =
-            neutral_joint_identification(log.joint_names[j], config.max_speed_rad_s[j], e.what());
+            neutral_joint_identification(log.joint_names[j], config.max_speed_rad_s[j], e.what(),
+                                         extra_input_count(config.options));
       } catch (...) {
         errors[j] = std::current_exception();
       }

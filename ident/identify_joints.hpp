@@ -26,6 +26,11 @@ struct JointOutcome {
 // the other joints' models are still good. InputError and std::logic_error propagate (the first
 // in joint order). on_done(joint, joints_done) is called as each joint finishes (from the worker
 // threads, one call at a time): progress for long runs.
+// The table of an identification (robot, cycle, model form and preview from the config, the
+// creating tool's version, the data source) without its joints.
+ParameterTable parameter_table_header(const JointErrorLog& log, const IdentificationConfig& config,
+                                      DataSource source);
+
 using JointDoneCallback = std::function<void(std::size_t joint, std::size_t joints_done)>;
 std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
                                           const IdentificationConfig& config, unsigned threads = 0,

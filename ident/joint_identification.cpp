@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -37,13 +38,39 @@ double joint_error_fit(const ArxModel& model, std::span<const IoSegment> views,
   for (const IoSegment& v : views) {
     const std::size_t offset = std::size_t(v.output.data() - output.data());
     simulated.resize(v.output.size());
-    model.simulate(v.input, v.output, simulated);
+    model.simulate(v, simulated);
     for (std::size_t k = first; k < v.output.size(); ++k) {
       const double r = v.input[k] - v.input[k - d] + simulated[k] - v.output[k];
       const double error = q_desired[offset + k] - q_measured[offset + k];
       misfit += r * r;
       sum += error;
       sum_sq += error * error;
+      ++count;
+    }
+  }
+  const double spread = count ? sum_sq - sum * sum / double(count) : 0.0;
+  if (!(spread > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return 100.0 * (1.0 - std::sqrt(misfit / spread));
+}
+
+// NRMSE fit [%] of the command an inverse-form error model predicts, q̂_d = y + ê (free run of
+// the error model on the link increments), against the command that was given, q_d; the views
+// are (w, e) views into `error` (e = q_d - y). NaN when q_d is constant.
+double command_fit(const ArxModel& error_model, std::span<const IoSegment> views,
+                   std::span<const double> error, std::span<const double> q_desired) {
+  const auto first = std::size_t(error_model.structure().max_lag());
+  std::vector<double> simulated;
+  double misfit = 0.0, sum = 0.0, sum_sq = 0.0;
+  std::size_t count = 0;
+  for (const IoSegment& v : views) {
+    const std::size_t offset = std::size_t(v.output.data() - error.data());
+    simulated.resize(v.output.size());
+    error_model.simulate(v, simulated);
+    for (std::size_t k = first; k < v.output.size(); ++k) {
+      const double r = simulated[k] - v.output[k];
+      misfit += r * r;
+      sum += q_desired[offset + k];
+      sum_sq += q_desired[offset + k] * q_desired[offset + k];
       ++count;
     }
   }
@@ -70,12 +97,33 @@ void fill_from_nearest(const CellGrid& grid, std::vector<CellIdentification>& re
   target.structure = source.structure;
   target.a = source.a;
   target.b = source.b;
+  target.c = source.c;
   target.figures = source.figures;
   target.figures.estimation_rows = report.estimation_rows;
   target.figures.validation_rows = report.validation_rows;
 }
 
 }  // namespace
+
+const char* to_string(ArxModelForm form) {
+  switch (form) {
+    case ArxModelForm::kJointError:
+      return "joint-error";
+    case ArxModelForm::kAngle:
+      return "angle";
+    case ArxModelForm::kInverse:
+      return "inverse";
+  }
+  return "?";
+}
+
+ArxModelForm arx_model_form_from_string(const std::string& text) {
+  for (const ArxModelForm form :
+       {ArxModelForm::kJointError, ArxModelForm::kAngle, ArxModelForm::kInverse})
+    if (text == to_string(form)) return form;
+  throw std::invalid_argument("model form '" + text +
+                              "' unknown; expected joint-error, angle or inverse");
+}
 
 ArxModel angle_form_of_error_model(const ArxModel& error_model) {
   const ArxStructure& e = error_model.structure();
@@ -89,11 +137,24 @@ ArxModel angle_form_of_error_model(const ArxModel& error_model) {
     b(delta + j) -= error_model.b()(j);
     b(delta + j + 1) += error_model.b()(j);
   }
-  return ArxModel({na, nb, 0}, error_model.a(), b, error_model.sample_time_s());
+  if (e.extra_inputs == 0)
+    return ArxModel({na, nb, 0}, error_model.a(), b, error_model.sample_time_s());
+  // Further inputs: q̂ = x - e, so their coefficients change sign and move behind δ zeros (the
+  // angle form has dead time 0): C'_e(z) = -z^-δ C_e(z), δ + nx coefficients each.
+  const int nx = delta + e.nx;
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(e.extra_inputs * nx);
+  for (int x = 0; x < e.extra_inputs; ++x)
+    for (int j = 0; j < e.nx; ++j) c(x * nx + delta + j) = -error_model.c()(x * e.nx + j);
+  return ArxModel({na, nb, 0, e.extra_inputs, nx}, error_model.a(), b, c,
+                  error_model.sample_time_s());
+}
+
+int extra_input_count(const JointIdentificationOptions& options) {
+  return int(options.model_torque_input) + int(options.direction_input);
 }
 
 JointParameters neutral_joint_parameters(const std::string& name, double max_speed_rad_s,
-                                         const std::string& reason) {
+                                         const std::string& reason, int extra_inputs) {
   JointParameters p;
   p.name = name;
   p.dimensions = {{OperatingQuantity::kSpeed, {0.0, max_speed_rad_s}}};
@@ -103,16 +164,17 @@ JointParameters neutral_joint_parameters(const std::string& name, double max_spe
   cell.bands = {0};
   cell.status = CellStatus::kNeutral;
   cell.reason = "not identified, neutral pass-through model (no compensation): " + reason;
-  cell.structure = {0, 1, 0};
+  cell.structure = {0, 1, 0, extra_inputs, extra_inputs > 0 ? 1 : 0};
   cell.b = {1.0};
+  cell.c.assign(std::size_t(extra_inputs), 0.0);  // the further inputs do nothing
   p.cells.push_back(cell);
   return p;
 }
 
 JointIdentification neutral_joint_identification(const std::string& name, double max_speed_rad_s,
-                                                 const std::string& reason) {
+                                                 const std::string& reason, int extra_inputs) {
   JointIdentification out;
-  out.parameters = neutral_joint_parameters(name, max_speed_rad_s, reason);
+  out.parameters = neutral_joint_parameters(name, max_speed_rad_s, reason, extra_inputs);
   out.backlash.reason = "joint not identified: no backlash term";
   out.cells.resize(1);
   out.cells[0].status = CellStatus::kNeutral;
@@ -126,7 +188,8 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
                                    std::span<const double> payload,
                                    std::span<const std::pair<std::size_t, std::size_t>> segments,
                                    double cycle_s, const CellGrid& grid,
-                                   const JointIdentificationOptions& options) {
+                                   const JointIdentificationOptions& options,
+                                   std::span<const double> model_torque_nm) {
   const std::size_t n = q_desired.size();
   if (q_measured.size() != n || payload.size() != n)
     throw std::invalid_argument("identify_joint: signal lengths differ");
@@ -150,7 +213,10 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
       // table holds l >= 0: equation 3 has no meaning for l < 0.
       out.parameters.backlash_l_rad = std::max(out.backlash.l_rad, 0.0);
       out.parameters.backlash_l_sigma_rad = out.backlash.l_sigma_rad;
-      out.parameters.backlash_lag_samples = out.backlash.lag_samples;
+      // The precontrol sees its input P cycles ahead in the inverse form: the same direction
+      // signal is then P cycles further back in its history.
+      out.parameters.backlash_lag_samples =
+          out.backlash.lag_samples + std::size_t(std::max(options.preview_cycles, 0));
       if (out.backlash.l_rad < 0.0) {
         for (std::size_t k = 0; k < n; ++k) output[k] = q_measured[k];
         out.parameters.backlash_identified = false;
@@ -182,20 +248,56 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
     }
   }
 
-  // The signals the ARX structure is fitted to: (q_d, y), or (w, e) in the joint-error form.
-  const bool error_form = options.form == ArxModelForm::kJointError;
+  // The signals the ARX structure is fitted to: (q_d, y), or (w, e) in the joint-error and
+  // inverse forms (w: desired increments, or the link's increments P cycles ahead; 0 beyond the
+  // end of a run, where the robot stands).
+  const bool inverse = options.form == ArxModelForm::kInverse;
+  const bool error_form = options.form == ArxModelForm::kJointError || inverse;
+  if (options.preview_cycles < 0 || (options.preview_cycles > 0 && !inverse))
+    throw std::invalid_argument("identify_joint: preview_cycles >= 0, and only in inverse form");
+  if (options.model_torque_input && model_torque_nm.size() != n)
+    throw std::invalid_argument(
+        "identify_joint: the model torque input needs one torque per sample");
+  const auto preview = std::size_t(options.preview_cycles);
+  // The path the model's input follows: the desired angles, or (inverse form) the play-free link
+  // angle y, whose increments the precontrol is later fed from the desired path.
+  const std::span<const double> driver = inverse ? std::span<const double>(output) : q_desired;
   std::vector<double> fit_input, fit_output;
   if (error_form) {
     fit_input.assign(n, 0.0);
     fit_output.resize(n);
     for (std::size_t k = 0; k < n; ++k) fit_output[k] = q_desired[k] - output[k];
     for (const auto& [begin, end] : segments)
-      for (std::size_t k = begin + 1; k < end; ++k) fit_input[k] = q_desired[k] - q_desired[k - 1];
+      for (std::size_t k = begin; k + preview < end; ++k)
+        if (k + preview > begin) fit_input[k] = driver[k + preview] - driver[k + preview - 1];
   }
-  const std::span<const double> model_input =
-      error_form ? std::span<const double>(fit_input) : q_desired;
-  const std::span<const double> model_output =
-      error_form ? std::span<const double>(fit_output) : std::span<const double>(output);
+  // Further inputs (multi-input form), P cycles ahead like w and held at the end of a run:
+  // the model torque along the driver's path, and the direction of the driver's motion.
+  std::array<std::vector<double>, kMaxExtraInputs> extra;
+  int extra_count = 0;
+  auto ahead = [&](std::span<const double> signal, std::vector<double>& out) {
+    out.resize(n);
+    for (const auto& [begin, end] : segments)
+      for (std::size_t k = begin; k < end; ++k) out[k] = signal[std::min(k + preview, end - 1)];
+  };
+  if (options.model_torque_input) ahead(model_torque_nm, extra[std::size_t(extra_count++)]);
+  if (options.direction_input) {
+    std::vector<double> direction(n, 0.0);
+    for (const auto& [begin, end] : segments)
+      for (std::size_t k = begin + 1; k < end; ++k)
+        direction[k] =
+            std::tanh((driver[k] - driver[k - 1]) / cycle_s / options.direction_speed_scale_rad_s);
+    ahead(direction, extra[std::size_t(extra_count++)]);
+  }
+  auto with_extras = [&](std::span<const double> input, std::span<const double> out_signal) {
+    IoSegment all{input, out_signal, {}, extra_count};
+    for (int e = 0; e < extra_count; ++e) all.extra[std::size_t(e)] = extra[std::size_t(e)];
+    return all;
+  };
+  // (input, output) of the fitted structure, and of the stored angle-form model (forward forms).
+  const IoSegment fit_signals =
+      error_form ? with_extras(fit_input, fit_output) : with_extras(q_desired, output);
+  const IoSegment angle_signals = with_extras(q_desired, output);
 
   // 3. Cells and their runs (one pass each).
   const OperatingSignals signals = operating_signals(q_desired, segments, cycle_s);
@@ -227,9 +329,8 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
       for (std::size_t k = r.begin; k < r.end; ++k, ++samples)
         speed_sq += signals.speed_rad_s[k] * signals.speed_rad_s[k];
     report.rms_speed_rad_s = samples ? std::sqrt(speed_sq / double(samples)) : 0.0;
-    const auto sweep_est = run_views(runs, model_input, model_output, history);
-    const auto sweep_val =
-        run_views(val_runs[std::size_t(cell)], model_input, model_output, history);
+    const auto sweep_est = run_views(runs, fit_signals, history);
+    const auto sweep_val = run_views(val_runs[std::size_t(cell)], fit_signals, history);
     report.estimation_rows = rows_of(sweep_est, history);
     report.validation_rows = rows_of(sweep_val, history);
     auto reject = [&](std::string reason) {
@@ -251,7 +352,7 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
       const ArxStructure chosen = report.sweep->chosen;
       // The final fit on the cell's own rows: views with exactly the chosen model's history.
       const auto lag = std::size_t(chosen.max_lag());
-      const auto fit_est = run_views(runs, model_input, model_output, lag);
+      const auto fit_est = run_views(runs, fit_signals, lag);
       report.fit = fit_arx(fit_est, chosen, options.fit);
     } catch (const std::exception& e) {
       reject(fmt::format("fit failed: {}", e.what()));
@@ -268,12 +369,31 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
     params.structure = model.structure();
     params.a.assign(model.a().data(), model.a().data() + model.a().size());
     params.b.assign(model.b().data(), model.b().data() + model.b().size());
+    params.c.assign(model.c().data(), model.c().data() + model.c().size());
     CellFitFigures& f = params.figures;
     f.estimation_rows = report.fit->row_count;
     f.spectral_radius = report.stability->spectral_radius;
     f.one_step_fit_percent = f.simulation_fit_percent = f.joint_error_fit_percent =
         f.residual_rms_rad = std::numeric_limits<double>::quiet_NaN();
-    const auto val_views = run_views(val_runs[std::size_t(cell)], q_desired, output,
+    if (inverse) {
+      // The inverse model's figures are those of its error model on (w, e): the one-step and
+      // free-run fits of the offset, residual tests against the link increments; the angle
+      // fit is that of the command it predicts, q_d = y + ê.
+      const auto val_views = run_views(val_runs[std::size_t(cell)], fit_signals,
+                                       std::size_t(report.fit->model.structure().max_lag()));
+      if (!val_views.empty()) {
+        report.validation = validate_arx(report.fit->model, val_views, options.validation);
+        f.validation_rows = report.validation->sample_count;
+        f.one_step_fit_percent = report.validation->one_step_fit_percent;
+        f.joint_error_fit_percent = report.validation->simulation_fit_percent;
+        f.simulation_fit_percent = command_fit(report.fit->model, val_views, fit_output, q_desired);
+        f.residual_rms_rad = report.validation->residual_rms;
+        f.whiteness_passed = report.validation->residual_whiteness.passed;
+        f.input_residual_passed = report.validation->input_residual.passed;
+      }
+      continue;
+    }
+    const auto val_views = run_views(val_runs[std::size_t(cell)], angle_signals,
                                      std::size_t(model.structure().max_lag()));
     try {
       if (!val_views.empty()) {

@@ -31,7 +31,24 @@
 // B(z) = A(z) - z^-δ (1 - z^-1) Σ β_j z^-j. That model has static gain exactly 1 (no error at
 // rest), and its Δq̂(k) = q_d(k) - q̂(k) is the error at the cycle it is applied in, the quantity
 // the data measure, with no q_d(k) - q_d(k - d) part left out.
-#include <cstddef>
+//
+// Inverse form (ArxModelForm::kInverse, for the precontrol). Adding the forward model's error
+// once, q_c = q_d + Δq̂, leaves the loop's response to the offset itself: with G the loop
+// (q_c -> q) the remaining error is (1 - G)^2 q_d, i.e. the error is only cut by |1 - G|, and
+// for a joint controller of a few Hz bandwidth that is ~0.5 at the frequencies of a fast path
+// (issue 6). The inverse form identifies instead the command that made the link follow the
+// path it followed: in the identification runs the command was q_d and the (play-free) link
+// angle y, so q_d = y + e, and the same error-form ARX is fitted with the link's increments as
+// input, P cycles ahead (the controller's interpolator knows the path ahead):
+//
+//   w(k) = y(k + P) - y(k + P - 1),   e(k) = q_d(k) - y(k)
+//
+// Fed with the desired angles P cycles ahead, the model gives the offset that makes the link
+// follow q_d (q_c = q_d + ê), to the accuracy of the fit, instead of the first-order (1 - G).
+// It is stored exactly like the joint-error form (angle_form_of_error_model, d = 0): the
+// precontrol computes the same Δq̂(k) = x(k) - q̂(k) = ê(k) from its input x; the table's
+// preview_cycles tells the caller to feed x(k) = q_d(k + P). P covers the loop's dead time and
+// the non-minimum-phase part of the loop, which a causal inverse cannot follow. <cstddef>
 #include <optional>
 #include <span>
 #include <string>
@@ -50,10 +67,29 @@ namespace imscal::ident {
 enum class ArxModelForm {
   kJointError,  // fit the joint error on the desired increments (see above); stored with d = 0
   kAngle,       // fit q_m on q_d (the paper's eq. 2 literally)
+  kInverse,     // fit the joint error on the measured increments with preview (see below)
 };
+const char* to_string(ArxModelForm form);
+// "joint-error", "angle", "inverse"; std::invalid_argument otherwise.
+ArxModelForm arx_model_form_from_string(const std::string& text);
 
 struct JointIdentificationOptions {
   ArxModelForm form = ArxModelForm::kJointError;
+  int preview_cycles = 0;  // P of the inverse form (>= 0; only with kInverse)
+  // Further inputs of the multi-input form (imscal's extension of eq. 2, issue 6), both taken
+  // along the path the model's input follows (q_d, or the link in the inverse form), P cycles
+  // ahead like the increments, OrderGrid::extra_taps coefficients each:
+  //  * the joint torque of the robot's rigid-body model (identify_joint's model_torque_nm, from
+  //    the caller, who has the robot description): the error of a joint controller and the
+  //    gear's deflection are driven by the torque the joint has to produce (inertia of the whole
+  //    arm in its pose, coupling, gravity, the payload), which the joint's own angle alone cannot
+  //    tell; in the inverse form the offset that makes the link follow a path is a fixed linear
+  //    filter of that torque and of the motion (tests/ident/test_joint_identification.cpp);
+  //  * the direction of motion tanh(q̇ / direction_speed_scale): the drive's Coulomb friction
+  //    and the dynamics of crossing the play at a reversal (eq. 3's backlash l is static).
+  bool model_torque_input = false;
+  bool direction_input = false;
+  double direction_speed_scale_rad_s = 0.01;
   OrderGrid grid{1, 32, 1, 32, 0, 4};
   OrderCriterion criterion = OrderCriterion::kBic;
   double validation_fraction = 0.3;  // of every segment (or block), held out (its end)
@@ -97,20 +133,27 @@ ArxModel angle_form_of_error_model(const ArxModel& error_model);
 // The defined neutral model of a joint that could not be identified: one pass-through cell
 // (q̂ = q_d, so Δq̂ = 0) over the speed range 0..max_speed, no backlash, the reason in the cell.
 // The precontrol then adds exactly zero for that joint.
+// extra_inputs: the table's further inputs (the neutral cell gives them zero coefficients).
 JointParameters neutral_joint_parameters(const std::string& name, double max_speed_rad_s,
-                                         const std::string& reason);
+                                         const std::string& reason, int extra_inputs = 0);
 // The same as a whole identification result (for reports): those parameters, no backlash, one
 // cell with status kNeutral, label "neutral" and the reason.
 JointIdentification neutral_joint_identification(const std::string& name, double max_speed_rad_s,
-                                                 const std::string& reason);
+                                                 const std::string& reason, int extra_inputs = 0);
 
-// segments: [begin, end) ranges of separate runs. Throws std::invalid_argument for bad sizes,
+// The number of further inputs the options switch on (model torque, direction).
+int extra_input_count(const JointIdentificationOptions& options);
+
+// segments: [begin, end) ranges of separate runs. model_torque_nm: the joint's model torque per
+// sample (needed with options.model_torque_input), along q_desired in the forward forms and
+// along the measured link path in the inverse form. Throws std::invalid_argument for bad sizes,
 // std::runtime_error when no cell at all can be identified (with every cell's reason).
 JointIdentification identify_joint(const std::string& name, std::span<const double> q_desired_rad,
                                    std::span<const double> q_measured_rad,
                                    std::span<const double> payload_kg,
                                    std::span<const std::pair<std::size_t, std::size_t>> segments,
                                    double cycle_s, const CellGrid& grid,
-                                   const JointIdentificationOptions& options = {});
+                                   const JointIdentificationOptions& options = {},
+                                   std::span<const double> model_torque_nm = {});
 
 }  // namespace imscal::ident

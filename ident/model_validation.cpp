@@ -169,7 +169,7 @@ ArxValidationReport validate_arx(const ArxModel& model, std::span<const IoSegmen
     prediction.resize(n);
     simulation.resize(n);
     model.predict_one_step(segment, prediction);
-    model.simulate(segment.input, segment.output, simulation);
+    model.simulate(segment, simulation);
     std::vector<double>& e = residual_store.emplace_back(n - first);
     for (std::size_t k = first; k < n; ++k) {
       e[k - first] = segment.output[k] - prediction[k];

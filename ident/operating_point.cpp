@@ -203,13 +203,18 @@ std::vector<std::vector<CellRun>> cell_runs(
 
 std::vector<IoSegment> run_views(std::span<const CellRun> runs, std::span<const double> input,
                                  std::span<const double> output, std::size_t history) {
+  return run_views(runs, IoSegment{input, output}, history);
+}
+
+std::vector<IoSegment> run_views(std::span<const CellRun> runs, const IoSegment& signals,
+                                 std::size_t history) {
   std::vector<IoSegment> views;
   views.reserve(runs.size());
   for (const CellRun& r : runs) {
     const std::size_t back = std::min(history, r.begin - r.segment_begin);
     const std::size_t first = r.begin - back;
     if (r.end - first <= history) continue;  // no row with a complete regressor
-    views.push_back({input.subspan(first, r.end - first), output.subspan(first, r.end - first)});
+    views.push_back(signals.subspan(first, r.end - first));
   }
   return views;
 }

@@ -100,5 +100,8 @@ std::vector<std::vector<CellRun>> cell_runs(
 // (those with a complete regressor). Runs too short to hold a row are skipped.
 std::vector<IoSegment> run_views(std::span<const CellRun> runs, std::span<const double> input,
                                  std::span<const double> output, std::size_t history);
+// The same for whole-record signals with further inputs (multi-input form).
+std::vector<IoSegment> run_views(std::span<const CellRun> runs, const IoSegment& signals,
+                                 std::size_t history);
 
 }  // namespace imscal::ident

@@ -11,7 +11,7 @@ namespace {
 
 void validate_grid(const OrderGrid& g) {
   if (g.na_min < 0 || g.na_max < g.na_min || g.nb_min < 1 || g.nb_max < g.nb_min ||
-      g.dead_time_min < 0 || g.dead_time_max < g.dead_time_min)
+      g.dead_time_min < 0 || g.dead_time_max < g.dead_time_min || g.extra_taps < 1)
     throw std::invalid_argument("select_arx_order: invalid grid (na " + std::to_string(g.na_min) +
                                 ".." + std::to_string(g.na_max) + ", nb " +
                                 std::to_string(g.nb_min) + ".." + std::to_string(g.nb_max) +
@@ -70,16 +70,24 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
     const std::size_t n = s.output.size();
     const std::size_t cut =
         n - static_cast<std::size_t>(std::llround(options.validation_fraction * double(n)));
-    estimation.push_back({s.input.first(cut), s.output.first(cut)});
-    held_out.push_back({s.input.subspan(cut), s.output.subspan(cut)});
+    estimation.push_back(s.subspan(0, cut));
+    held_out.push_back(s.subspan(cut));
   }
+  // Further inputs: as many as the data carry (the same in every segment).
+  const int extras = segments.empty() ? 0 : segments.front().extra_count;
+  for (const IoSegment& s : segments)
+    if (s.extra_count != extras)
+      throw std::invalid_argument("select_arx_order: segments carry different further inputs");
+  const int nx = extras > 0 ? grid.extra_taps : 0;
+  const int fixed = extras * nx;  // the further inputs' columns, in every candidate
 
-  const LagSet lags{grid.na_max, grid.dead_time_min, grid.dead_time_max + grid.nb_max - 1};
+  const LagSet lags{grid.na_max, grid.dead_time_min, grid.dead_time_max + grid.nb_max - 1, extras,
+                    grid.dead_time_max + nx - 1};
   const int first_row = lags.max_lag();
   const LaggedGram est = build_lagged_gram(estimation, lags, first_row);
   const LaggedGram val = build_lagged_gram(held_out, lags, first_row);
   const std::size_t n_rows = est.row_count;
-  const int q_max = grid.nb_max + grid.na_max;
+  const int q_max = fixed + grid.nb_max + grid.na_max;
   if (n_rows <= static_cast<std::size_t>(q_max) + 1)
     throw std::invalid_argument("select_arx_order: " + std::to_string(n_rows) +
                                 " estimation rows for up to " + std::to_string(q_max) +
@@ -103,9 +111,11 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
 
   for (int d = grid.dead_time_min; d <= grid.dead_time_max; ++d) {
     for (int nb = grid.nb_min; nb <= grid.nb_max; ++nb) {
-      const int q = nb + grid.na_max;
-      for (int j = 0; j < nb; ++j) column[j] = lags.input_column(d + j);
-      for (int i = 1; i <= grid.na_max; ++i) column[nb + i - 1] = lags.output_column(i);
+      const int q = fixed + nb + grid.na_max;
+      for (int e = 0; e < extras; ++e)
+        for (int j = 0; j < nx; ++j) column[e * nx + j] = lags.extra_column(e, d + j);
+      for (int j = 0; j < nb; ++j) column[fixed + j] = lags.input_column(d + j);
+      for (int i = 1; i <= grid.na_max; ++i) column[fixed + nb + i - 1] = lags.output_column(i);
       for (int r = 0; r < q; ++r) {
         const double diag = est.gram(column[r], column[r]);
         scale(r) = diag > 0.0 ? 1.0 / std::sqrt(diag) : 0.0;
@@ -136,12 +146,12 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
         }
       }
 
-      double explained = z.head(std::min(nb + grid.na_min, rank)).squaredNorm();
+      double explained = z.head(std::min(fixed + nb + grid.na_min, rank)).squaredNorm();
       for (int na = grid.na_min; na <= grid.na_max; ++na) {
-        const int p = nb + na;
+        const int p = fixed + nb + na;
         if (na > grid.na_min && p <= rank) explained += z(p - 1) * z(p - 1);
         OrderCandidate c;
-        c.structure = {na, nb, d};
+        c.structure = {na, nb, d, extras, nx};
         c.valid = p <= rank;
         c.validation_loss = nan;
         if (!c.valid) {

@@ -8,7 +8,8 @@
 //    the largest lag set [y(k), y(k-1..k-na_max), u(k-d_min .. k-d_max-nb_max+1)]
 //    (ident/arx_fit.hpp: built from lagged correlation sums with sliding updates, one pass over
 //    the data). The validation data get a second Gram matrix of the same lag set.
-//  * For each (d, nb) the columns are ordered [u(k-d) .. u(k-d-nb+1), y(k-1) .. y(k-na_max)] and
+//  * For each (d, nb) the columns are ordered [x_e(k-d) .. x_e(k-d-nx+1) for every further input,
+//    u(k-d) .. u(k-d-nb+1), y(k-1) .. y(k-na_max)] and
 //    the column-scaled block is Cholesky-factored once (L Lᵀ). Prefixes of this column order are
 //    exactly the candidates (na = 0 .. na_max), and the Cholesky factor of a leading block is the
 //    leading block of L (order recursion), so with z = L⁻¹ Φᵀy every
@@ -21,7 +22,7 @@
 //    chosen structure is refitted from the data with fit_arx (condition check, QR fallback, exact
 //    residuals), on all the data (estimation and validation).
 //
-// Criteria with N estimation rows, p = na + nb, V = RSS / N:
+// Criteria with N estimation rows, p = na + nb (+ the further inputs' coefficients), V = RSS / N:
 //   AIC = N ln V + 2p,   BIC = N ln V + p ln N,   validation = mean squared one-step error.
 // BIC is the default: it is consistent (picks the true order with probability → 1 as N grows),
 // AIC tends to over-fit.
@@ -38,6 +39,10 @@ struct OrderGrid {
   int na_min = 1, na_max = 32;
   int nb_min = 1, nb_max = 32;
   int dead_time_min = 0, dead_time_max = 8;
+  // Coefficients per further input (multi-input form; fixed, not swept: the further inputs are
+  // the model torque and the direction of motion, whose responses share the poles of A(z)).
+  // Used only when the data carry further inputs; then >= 1.
+  int extra_taps = 8;
 };
 
 enum class OrderCriterion { kAic, kBic, kValidation };

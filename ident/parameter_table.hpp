@@ -13,7 +13,23 @@
 
 namespace imscal::ident {
 
-inline constexpr int kParameterTableSchemaVersion = 1;
+// Version 2 added model_form, preview_cycles, the further inputs (extra_inputs,
+// direction_speed_scale_rad_s; per cell nx and c); version 1 tables are read as single-input
+// forward models without preview.
+inline constexpr int kParameterTableSchemaVersion = 2;
+
+// What the cells' models are (ident/joint_identification.hpp): forward error models of the
+// loop (paper, eq. 2: the predicted error Δq̂ from q_d), or inverse models (the offset that makes
+// the link follow q_d), which the precontrol must be fed P = preview_cycles ahead:
+// x(k) = q_d(k + P). The precontrol's arithmetic is the same for both.
+enum class TableForm { kForward, kInverse };
+const char* to_string(TableForm form);
+
+// The further inputs of the cells' models (ident/joint_identification.hpp), fed by the
+// precontrol in this order: the model torque of the joint [N m] from the caller, and the
+// direction of motion tanh(q̇_x / direction_speed_scale) from its own input x.
+enum class TableInput { kModelTorque, kDirection };
+const char* to_string(TableInput input);
 
 enum class CellStatus {
   kIdentified,  // fitted from this cell's own rows
@@ -47,6 +63,7 @@ struct CellParameters {
   ArxStructure structure;
   std::vector<double> a;  // a_1..a_na
   std::vector<double> b;  // b_0..b_{nb-1}
+  std::vector<double> c;  // further inputs' coefficients, input after input (nx each)
   CellFitFigures figures;
 
   ArxModel model(double sample_time_s) const;
@@ -90,6 +107,10 @@ struct ParameterTable {
   std::string robot;
   double sample_time_s = 0.002;
   std::string created_by;  // "imscal <version>"
+  TableForm model_form = TableForm::kForward;
+  int preview_cycles = 0;  // the precontrol's input leads q_d by this many cycles (inverse form)
+  std::vector<TableInput> extra_inputs;       // every cell's further inputs, in order
+  double direction_speed_scale_rad_s = 0.01;  // of the direction input [rad/s]
   DataSource source;
   std::vector<JointParameters> joints;
 

@@ -29,9 +29,18 @@ const char* to_string(CellStatus status) {
   return "?";
 }
 
+const char* to_string(TableForm form) {
+  return form == TableForm::kInverse ? "inverse" : "forward";
+}
+
+const char* to_string(TableInput input) {
+  return input == TableInput::kModelTorque ? "model_torque" : "direction";
+}
+
 ArxModel CellParameters::model(double sample_time_s) const {
   return ArxModel(structure, Eigen::Map<const Eigen::VectorXd>(a.data(), Eigen::Index(a.size())),
                   Eigen::Map<const Eigen::VectorXd>(b.data(), Eigen::Index(b.size())),
+                  Eigen::Map<const Eigen::VectorXd>(c.data(), Eigen::Index(c.size())),
                   sample_time_s);
 }
 
@@ -59,8 +68,10 @@ json cell_json(const CellParameters& c) {
             {"na", c.structure.na},
             {"nb", c.structure.nb},
             {"dead_time", c.structure.dead_time},
+            {"nx", c.structure.nx},
             {"a", c.a},
             {"b", c.b},
+            {"c", c.c},
             {"fit",
              {{"estimation_rows", c.figures.estimation_rows},
               {"validation_rows", c.figures.validation_rows},
@@ -187,9 +198,14 @@ CellFitFigures read_figures(const Node& n) {
   return f;
 }
 
-CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time_s) {
-  n.only_keys(
-      {"bands", "status", "filled_from", "reason", "na", "nb", "dead_time", "a", "b", "fit"});
+CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time_s,
+                         int extra_inputs) {
+  if (extra_inputs < 0)  // schema version 1: single-input cells
+    n.only_keys(
+        {"bands", "status", "filled_from", "reason", "na", "nb", "dead_time", "a", "b", "fit"});
+  else
+    n.only_keys({"bands", "status", "filled_from", "reason", "na", "nb", "dead_time", "nx", "a",
+                 "b", "c", "fit"});
   CellParameters c;
   const Node bands = n.child("bands");
   for (const Node& b : bands.items()) c.bands.push_back(int(b.integer()));
@@ -221,6 +237,13 @@ CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time
   c.structure.na = int(n.child("na").integer());
   c.structure.nb = int(n.child("nb").integer());
   c.structure.dead_time = int(n.child("dead_time").integer());
+  if (extra_inputs > 0) {
+    c.structure.extra_inputs = extra_inputs;
+    c.structure.nx = int(n.child("nx").integer());
+    if (c.structure.nx < 1) n.child("nx").fail("the table has further inputs: nx must be >= 1");
+  } else if (extra_inputs == 0 && n.child("nx").integer() != 0) {
+    n.child("nx").fail("the table has no further inputs: nx must be 0");
+  }
   try {
     c.structure.validate();
   } catch (const std::invalid_argument& e) {
@@ -228,6 +251,10 @@ CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time
   }
   c.a = n.child("a").numbers();
   c.b = n.child("b").numbers();
+  if (extra_inputs >= 0) c.c = n.child("c").numbers();
+  if (c.c.size() != std::size_t(c.structure.extra_inputs * c.structure.nx))
+    n.child("c").fail(fmt::format("{} coefficients, {} further inputs x nx = {}", c.c.size(),
+                                  c.structure.extra_inputs, c.structure.nx));
   if (c.a.size() != std::size_t(c.structure.na))
     n.child("a").fail(fmt::format("{} coefficients, na = {}", c.a.size(), c.structure.na));
   if (c.b.size() != std::size_t(c.structure.nb))
@@ -238,7 +265,7 @@ CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time
   return c;
 }
 
-JointParameters read_joint(const Node& n, double sample_time_s) {
+JointParameters read_joint(const Node& n, double sample_time_s, int extra_inputs) {
   n.only_keys({"name", "backlash", "dimensions", "cells"});
   JointParameters j;
   j.name = n.child("name").string();
@@ -262,7 +289,7 @@ JointParameters read_joint(const Node& n, double sample_time_s) {
   const Node cells = n.child("cells");
   std::vector<std::optional<CellParameters>> by_flat(std::size_t(grid.cell_count()));
   for (const Node& c : cells.items()) {
-    CellParameters cell = read_cell(c, grid, sample_time_s);
+    CellParameters cell = read_cell(c, grid, sample_time_s, extra_inputs);
     const int flat = grid.flat_index(cell.bands);
     if (by_flat[std::size_t(flat)]) c.child("bands").fail("cell given twice: " + grid.label(flat));
     by_flat[std::size_t(flat)] = std::move(cell);
@@ -297,11 +324,17 @@ std::string parameters_json_text(const ParameterTable& t) {
                       {"dimensions", dims},
                       {"cells", cells}});
   }
+  json extra_names = json::array();
+  for (const TableInput input : t.extra_inputs) extra_names.push_back(to_string(input));
   const json root = {{"schema", kSchemaName},
                      {"schema_version", t.schema_version},
                      {"robot", t.robot},
                      {"sample_time_s", t.sample_time_s},
                      {"created_by", t.created_by},
+                     {"model_form", to_string(t.model_form)},
+                     {"preview_cycles", t.preview_cycles},
+                     {"extra_inputs", extra_names},
+                     {"direction_speed_scale_rad_s", t.direction_speed_scale_rad_s},
                      {"units", units()},
                      {"source",
                       {{"file", t.source.file},
@@ -314,11 +347,11 @@ std::string parameters_json_text(const ParameterTable& t) {
 
 std::string parameters_csv_text(const ParameterTable& t) {
   std::ostringstream s;
-  s << "joint,cell,bands,bounds_si,status,filled_from,na,nb,dead_time,backlash_l_rad,"
+  s << "joint,cell,bands,bounds_si,status,filled_from,na,nb,dead_time,nx,backlash_l_rad,"
        "backlash_l_sigma_rad,estimation_rows,validation_rows,one_step_fit_percent,"
        "simulation_fit_percent,joint_error_fit_percent,residual_rms_rad,whiteness_passed,input_"
        "residual_passed,"
-       "spectral_radius,a,b\n";
+       "spectral_radius,a,b,c\n";
   auto join = [](const std::vector<double>& v) {
     std::string out;
     for (double x : v) out += fmt::format("{}{:.17g}", out.empty() ? "" : " ", x);
@@ -332,13 +365,13 @@ std::string parameters_csv_text(const ParameterTable& t) {
       for (int b : c.bands) bands += fmt::format("{}{}", bands.empty() ? "" : " ", b);
       const auto& f = c.figures;
       s << fmt::format(
-          "{},{},{},\"{}\",{},{},{},{},{},{:.17g},{:.17g},{},{},{},{},{},{},{},{},{},{},{}\n",
+          "{},{},{},\"{}\",{},{},{},{},{},{},{:.17g},{:.17g},{},{},{},{},{},{},{},{},{},{},{},{}\n",
           j.name, flat, bands, grid.label(int(flat)), to_string(c.status), c.filled_from,
-          c.structure.na, c.structure.nb, c.structure.dead_time, j.backlash_l_rad,
+          c.structure.na, c.structure.nb, c.structure.dead_time, c.structure.nx, j.backlash_l_rad,
           j.backlash_l_sigma_rad, f.estimation_rows, f.validation_rows, f.one_step_fit_percent,
           f.simulation_fit_percent, f.joint_error_fit_percent, f.residual_rms_rad,
           f.whiteness_passed ? 1 : 0, f.input_residual_passed ? 1 : 0, f.spectral_radius, join(c.a),
-          join(c.b));
+          join(c.b), join(c.c));
     }
   }
   return s.str();
@@ -362,17 +395,52 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
     throw InputError(origin, 0, "/", fmt::format("not valid JSON: {}", e.what()));
   }
   const Node r(root, "", origin);
-  r.only_keys({"schema", "schema_version", "robot", "sample_time_s", "created_by", "units",
-               "source", "joints"});
+  r.only_keys({"schema", "schema_version", "robot", "sample_time_s", "created_by", "model_form",
+               "preview_cycles", "extra_inputs", "direction_speed_scale_rad_s", "units", "source",
+               "joints"});
   if (r.child("schema").string() != kSchemaName)
     r.child("schema").fail(
         fmt::format("not an imscal parameter table (expected '{}')", kSchemaName));
   ParameterTable t;
   t.schema_version = int(r.child("schema_version").integer());
-  if (t.schema_version != kParameterTableSchemaVersion)
+  if (t.schema_version < 1 || t.schema_version > kParameterTableSchemaVersion)
     r.child("schema_version")
-        .fail(fmt::format("unknown schema version {}; this imscal reads version {}",
+        .fail(fmt::format("unknown schema version {}; this imscal reads versions 1..{}",
                           t.schema_version, kParameterTableSchemaVersion));
+  if (t.schema_version >= 2) {
+    const std::string form = r.child("model_form").string();
+    if (form == to_string(TableForm::kInverse))
+      t.model_form = TableForm::kInverse;
+    else if (form != to_string(TableForm::kForward))
+      r.child("model_form").fail("expected 'forward' or 'inverse', got '" + form + "'");
+    const long preview = r.child("preview_cycles").integer();
+    if (preview < 0 || preview > 64) r.child("preview_cycles").fail("expected 0..64 cycles");
+    if (preview > 0 && t.model_form != TableForm::kInverse)
+      r.child("preview_cycles").fail("only an inverse-form table has a preview");
+    t.preview_cycles = int(preview);
+    const Node inputs = r.child("extra_inputs");
+    for (const Node& i : inputs.items()) {
+      const std::string name = i.string();
+      if (name == to_string(TableInput::kModelTorque))
+        t.extra_inputs.push_back(TableInput::kModelTorque);
+      else if (name == to_string(TableInput::kDirection))
+        t.extra_inputs.push_back(TableInput::kDirection);
+      else
+        i.fail("expected 'model_torque' or 'direction', got '" + name + "'");
+    }
+    if (t.extra_inputs.size() > std::size_t(kMaxExtraInputs))
+      inputs.fail(fmt::format("at most {} further inputs", kMaxExtraInputs));
+    for (std::size_t a = 0; a < t.extra_inputs.size(); ++a)
+      for (std::size_t b = a + 1; b < t.extra_inputs.size(); ++b)
+        if (t.extra_inputs[a] == t.extra_inputs[b]) inputs.fail("an input given twice");
+    t.direction_speed_scale_rad_s = r.child("direction_speed_scale_rad_s").number();
+    if (!(t.direction_speed_scale_rad_s > 0.0))
+      r.child("direction_speed_scale_rad_s").fail("must be > 0");
+  } else {
+    for (const char* key :
+         {"model_form", "preview_cycles", "extra_inputs", "direction_speed_scale_rad_s"})
+      if (r.has(key)) r.child(key).fail("not a key of schema version 1");
+  }
   t.robot = r.child("robot").string();
   t.sample_time_s = r.child("sample_time_s").number();
   if (!(t.sample_time_s > 0.0)) r.child("sample_time_s").fail("sample time must be > 0");
@@ -393,7 +461,8 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
   const Node joints = r.child("joints");
   std::set<std::string> names;
   for (const Node& j : joints.items()) {
-    t.joints.push_back(read_joint(j, t.sample_time_s));
+    t.joints.push_back(
+        read_joint(j, t.sample_time_s, t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1));
     if (!names.insert(t.joints.back().name).second)
       j.child("name").fail("joint '" + t.joints.back().name + "' given twice");
   }

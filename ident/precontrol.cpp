@@ -44,6 +44,8 @@ const char* to_string(PrecontrolCause cause) {
       return "operating point outside the table";
     case PrecontrolCause::kReactivated:
       return "re-activated";
+    case PrecontrolCause::kMissingTorque:
+      return "model torque missing";
   }
   return "?";
 }
@@ -63,6 +65,15 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
   Precontrol p;
   p.options_ = options;
   p.model_sample_s_ = T;
+  if (table.extra_inputs.size() > std::size_t(kArxStepMaxExtras))
+    return refuse("at most " + std::to_string(kArxStepMaxExtras) + " further inputs supported");
+  p.extra_count_ = static_cast<int>(table.extra_inputs.size());
+  for (int e = 0; e < p.extra_count_; ++e) {
+    (table.extra_inputs[std::size_t(e)] == TableInput::kModelTorque ? p.torque_input_
+                                                                    : p.direction_input_) = e;
+  }
+  if (!(table.direction_speed_scale_rad_s > 0.0)) return refuse("direction scale must be > 0");
+  p.direction_scale_ = table.direction_speed_scale_rad_s;
   const double up = c / T, down = T / c;
   if (std::abs(up - std::round(up)) < 1e-9 * up && std::round(up) >= 1 && std::round(up) <= 8) {
     p.steps_per_call_ = static_cast<int>(std::round(up));
@@ -115,18 +126,29 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
       model.na = cell.structure.na;
       model.nb = cell.structure.nb;
       model.d = cell.structure.dead_time;
+      model.nx = cell.structure.nx;
       if (model.na < 0 || model.na > kMaxPrecontrolOrder || model.nb < 1 ||
           model.nb > kMaxPrecontrolOrder || model.d < 0 || model.d > kMaxPrecontrolDeadTime ||
+          model.nx < 0 || model.nx > kMaxPrecontrolOrder ||
           static_cast<int>(cell.a.size()) != model.na ||
           static_cast<int>(cell.b.size()) != model.nb) {
         return refuse(name + "cell " + std::to_string(k) + ": order or dead time out of range");
       }
-      model.terms = round_up(std::max(model.na, model.nb), kArxStepLanes);
+      if (cell.structure.extra_inputs != p.extra_count_ ||
+          cell.c.size() != std::size_t(p.extra_count_ * model.nx)) {
+        return refuse(name + "cell " + std::to_string(k) + ": " +
+                      std::to_string(cell.structure.extra_inputs) +
+                      " further inputs, the table declares " + std::to_string(p.extra_count_));
+      }
+      model.terms = round_up(std::max({model.na, model.nb, model.nx}), kArxStepLanes);
       for (int i = 0; i < model.na; ++i) model.a[i] = cell.a[i];
       for (int i = 0; i < model.nb; ++i) model.b[i] = cell.b[i];
-      const bool finite =
-          std::all_of(cell.a.begin(), cell.a.end(), [](double v) { return std::isfinite(v); }) &&
-          std::all_of(cell.b.begin(), cell.b.end(), [](double v) { return std::isfinite(v); });
+      for (int e = 0; e < p.extra_count_; ++e)
+        for (int i = 0; i < model.nx; ++i) model.c[e][i] = cell.c[std::size_t(e * model.nx + i)];
+      auto all_finite = [](const std::vector<double>& v) {
+        return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+      };
+      const bool finite = all_finite(cell.a) && all_finite(cell.b) && all_finite(cell.c);
       if (!finite) return refuse(name + "cell " + std::to_string(k) + ": NaN/Inf parameter");
     }
   }
@@ -155,12 +177,36 @@ int Precontrol::read_events(PrecontrolEvent* out, int capacity) noexcept {
   return n;
 }
 
-void Precontrol::restart_models(const std::array<double, kPrecontrolJoints>& q) noexcept {
-  // At rest the robot stands where it was told: past inputs and outputs all equal q_d.
+std::array<double, kArxStepMaxExtras> Precontrol::extra_values(double speed,
+                                                               double torque) const noexcept {
+  std::array<double, kArxStepMaxExtras> value{};
+  if (torque_input_ >= 0) value[torque_input_] = torque;
+  if (direction_input_ >= 0) value[direction_input_] = std::tanh(speed / direction_scale_);
+  return value;
+}
+
+void Precontrol::restart_models(const std::array<double, kPrecontrolJoints>& q,
+                                const std::array<double, kPrecontrolJoints>& torque) noexcept {
+  // At rest the robot stands where it was told: past inputs all equal q_d (and the torque of
+  // that pose, direction 0), every model at its steady state for them,
+  // q̂ = (B(1) q_d + Σ C_e(1) x_e) / A(1): q_d for a single-input joint-error model, q_d minus
+  // the static deflection of the pose for a model with the torque input.
   for (int j = 0; j < kPrecontrolJoints; ++j) {
     JointModel& joint = joints_[j];
     joint.u.fill(q[j]);
-    for (int k = 0; k < joint.cells; ++k) joint.cell[k].y.fill(q[j]);
+    const std::array<double, kArxStepMaxExtras> x = extra_values(0.0, torque[j]);
+    for (int e = 0; e < extra_count_; ++e) joint.x[e].fill(x[e]);
+    for (int k = 0; k < joint.cells; ++k) {
+      CellModel& m = joint.cell[k];
+      double a1 = 1.0, b1 = 0.0, steady_extra = 0.0;
+      for (int i = 0; i < m.na; ++i) a1 += m.a[i];
+      for (int i = 0; i < m.nb; ++i) b1 += m.b[i];
+      for (int e = 0; e < extra_count_; ++e)
+        for (int i = 0; i < m.nx; ++i) steady_extra += m.c[e][i] * x[e];
+      // Near an integrator (A(1) ~ 0) the steady state is not defined: start at q_d.
+      const double steady = std::abs(a1) > 1e-9 ? (b1 * q[j] + steady_extra) / a1 : q[j];
+      m.y.fill(steady);
+    }
     joint.last_error = joint.previous_error = 0.0;
     joint.smooth = joint.output;
     joint.smooth_rate = 0.0;
@@ -168,13 +214,19 @@ void Precontrol::restart_models(const std::array<double, kPrecontrolJoints>& q) 
     joint.speed_history.fill(0.0);
   }
   last_q_ = q;
+  last_torque_ = torque;
   call_phase_ = 0;
 }
 
 void Precontrol::model_step(JointModel& joint, double q_desired, double speed, double acceleration,
-                            double payload, bool& outside) noexcept {
+                            double payload, double torque, bool& outside) noexcept {
   push_newest(joint.u, joint.u_pos, kInputRing, q_desired);
   const double* u = joint.u.data() + joint.u_pos;  // u[i] = q_d(k - i)
+  const std::array<double, kArxStepMaxExtras> x = extra_values(speed, torque);
+  for (int e = 0; e < extra_count_; ++e) {
+    joint.x[e][joint.u_pos] = x[e];
+    joint.x[e][joint.u_pos + kInputRing] = x[e];
+  }
 
   std::array<double, 4> point{};
   std::array<std::span<const double>, 4> centres{};
@@ -204,6 +256,11 @@ void Precontrol::model_step(JointModel& joint, double q_desired, double speed, d
   for (int c = 0; c < joint.cells; ++c) {
     const CellModel& m = joint.cell[c];
     step[c] = ArxStepInput{m.b.data(), u + m.d, m.a.data(), m.y.data() + m.y_pos, m.terms};
+    step[c].extra_count = extra_count_;
+    for (int e = 0; e < extra_count_; ++e) {
+      step[c].c[e] = m.c[e].data();
+      step[c].x_delayed[e] = joint.x[e].data() + joint.u_pos + m.d;
+    }
   }
   std::array<double, kMaxPrecontrolCells> y, error;
   arx_free_run_steps(step.data(), joint.cells, y.data());
@@ -230,30 +287,54 @@ void Precontrol::deactivate(std::uint64_t cycle, int joint, PrecontrolCause caus
 void Precontrol::reactivate() noexcept {
   log(last_cycle_, -1, PrecontrolCause::kReactivated, 0.0);
   state_ = PrecontrolState::kActive;
-  if (started_) restart_models(last_q_);
+  if (started_) restart_models(last_q_, last_torque_);
 }
 
 PrecontrolOutput Precontrol::cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
                                    double payload_kg, std::uint64_t cycle_counter) noexcept {
+  return run_cycle(q_desired_rad, payload_kg, nullptr, cycle_counter);
+}
+
+PrecontrolOutput Precontrol::cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
+                                   double payload_kg,
+                                   const std::array<double, kPrecontrolJoints>& model_torque_nm,
+                                   std::uint64_t cycle_counter) noexcept {
+  return run_cycle(q_desired_rad, payload_kg, &model_torque_nm, cycle_counter);
+}
+
+PrecontrolOutput Precontrol::run_cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
+                                       double payload_kg,
+                                       const std::array<double, kPrecontrolJoints>* model_torque_nm,
+                                       std::uint64_t cycle_counter) noexcept {
   const double dt = options_.caller_cycle_s;
   PrecontrolOutput out;
   bool valid = std::isfinite(payload_kg);
   for (double q : q_desired_rad) valid = valid && std::isfinite(q);
-  if (!valid) {
+  std::array<double, kPrecontrolJoints> torque{};
+  if (model_torque_nm != nullptr) {
+    torque = *model_torque_nm;
+    for (double t : torque) valid = valid && std::isfinite(t);
+  }
+  if (needs_model_torque() && model_torque_nm == nullptr) {
+    // A table whose models need the torque cannot run without it: off, as for bad input.
+    if (state_ == PrecontrolState::kActive)
+      deactivate(cycle_counter, -1, PrecontrolCause::kMissingTorque, 0.0);
+    valid = false;
+  } else if (!valid) {
     deactivate(cycle_counter, -1, PrecontrolCause::kInvalidInput, 0.0);
   } else if (!started_) {
-    restart_models(q_desired_rad);
+    restart_models(q_desired_rad, torque);
     started_ = true;
   } else if (cycle_counter != last_cycle_ + 1) {
     const double lost = static_cast<double>(cycle_counter - last_cycle_) - 1.0;
     if (cycle_counter <= last_cycle_ || lost > options_.max_lost_cycles) {
       deactivate(cycle_counter, -1, PrecontrolCause::kLostCycles, lost);
-      restart_models(q_desired_rad);
+      restart_models(q_desired_rad, torque);
     } else {  // bridge: the model sees the last input held over the lost cycles
       bool ignored = false;
       for (int k = 0; k < static_cast<int>(lost) * steps_per_call_; ++k) {
         for (int j = 0; j < kPrecontrolJoints; ++j) {
-          model_step(joints_[j], last_q_[j], 0.0, 0.0, last_payload_, ignored);
+          model_step(joints_[j], last_q_[j], 0.0, 0.0, last_payload_, last_torque_[j], ignored);
         }
       }
     }
@@ -273,7 +354,7 @@ PrecontrolOutput Precontrol::cycle(const std::array<double, kPrecontrolJoints>& 
         for (int s = 1; s <= steps_per_call_; ++s) {
           const double f = static_cast<double>(s) / steps_per_call_;
           model_step(joint, last_q_[j] + f * (q_desired_rad[j] - last_q_[j]), speed, acceleration,
-                     payload_kg, outside);
+                     payload_kg, last_torque_[j] + f * (torque[j] - last_torque_[j]), outside);
         }
       }
       const double phase =
@@ -313,6 +394,7 @@ PrecontrolOutput Precontrol::cycle(const std::array<double, kPrecontrolJoints>& 
   }
   if (valid) {
     last_q_ = q_desired_rad;  // also while inactive: a re-activation restarts from here
+    last_torque_ = torque;
     last_payload_ = payload_kg;
   }
 

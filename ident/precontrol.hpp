@@ -71,6 +71,7 @@ enum class PrecontrolCause : std::uint8_t {
   kLostCycles,       // the cycle counter jumped by more than max_lost_cycles + 1
   kOutsideTable,     // operating point outside the identified grid (not a deactivation)
   kReactivated,
+  kMissingTorque,  // the table's models need the model torque and the caller gave none
 };
 const char* to_string(PrecontrolCause cause);
 
@@ -96,8 +97,18 @@ class Precontrol {
                      const PrecontrolOptions& options, Precontrol* out, std::string* why);
 
   // One control cycle. cycle_counter: the caller's cycle number (consecutive normally).
+  // q_desired_rad: the desired joint angles of the cycle, or, for a table with preview_cycles
+  // P > 0 (inverse form), those P table cycles ahead; the offset is for the current cycle.
   PrecontrolOutput cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
                          double payload_kg, std::uint64_t cycle_counter) noexcept;
+  // The same with the joint torques of the robot's rigid-body model along the desired path at
+  // the time of q_desired_rad [N m], for tables whose models take the model torque as a further
+  // input (needs_model_torque()); without them such a table deactivates (kMissingTorque).
+  PrecontrolOutput cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
+                         double payload_kg,
+                         const std::array<double, kPrecontrolJoints>& model_torque_nm,
+                         std::uint64_t cycle_counter) noexcept;
+  bool needs_model_torque() const noexcept { return torque_input_ >= 0; }
 
   // Explicit re-activation after a deactivation: the models restart from the current desired
   // values (at rest: zero error) and the offsets rise smoothly from zero.
@@ -123,11 +134,13 @@ class Precontrol {
   static_assert((kOutputRing & (kOutputRing - 1)) == 0);
   static constexpr int kSpeedRing = 128;  // > the largest backlash lag accepted [cycles]
   struct CellModel {
-    int na = 0, nb = 0, d = 0;
-    int terms = 0;  // max(na, nb) rounded up to kArxStepLanes: the length of both sums
+    int na = 0, nb = 0, d = 0, nx = 0;
+    int terms = 0;  // max(na, nb, nx) rounded up to kArxStepLanes: the length of every sum
     std::array<double, kMaxPrecontrolOrder> a{};  // a_1..a_na, then zeros
     std::array<double, kMaxPrecontrolOrder> b{};  // b_0..b_{nb-1}, then zeros
-    std::array<double, 2 * kOutputRing> y{};      // q̂ history, newest at y[y_pos]
+    // Further inputs' coefficients c_e,0..c_e,nx-1, then zeros.
+    std::array<std::array<double, kMaxPrecontrolOrder>, kArxStepMaxExtras> c{};
+    std::array<double, 2 * kOutputRing> y{};  // q̂ history, newest at y[y_pos]
     int y_pos = 0;
   };
   struct JointModel {
@@ -147,6 +160,8 @@ class Precontrol {
     int speed_pos = 0;
     std::array<double, 2 * kInputRing> u{};  // q_d history, newest at u[u_pos]
     int u_pos = 0;
+    // Further inputs' histories (model torque, direction), newest at x[e][u_pos].
+    std::array<std::array<double, 2 * kInputRing>, kArxStepMaxExtras> x{};
     double last_error = 0.0;      // blended Δq̂ of the last model step
     double previous_error = 0.0;  // the one before (for output interpolation at T/m cycles)
     double smooth = 0.0, smooth_rate = 0.0;  // smoother state
@@ -154,8 +169,15 @@ class Precontrol {
   };
 
   void model_step(JointModel& joint, double q_desired, double speed, double acceleration,
-                  double payload, bool& outside) noexcept;
-  void restart_models(const std::array<double, kPrecontrolJoints>& q_desired) noexcept;
+                  double payload, double torque, bool& outside) noexcept;
+  // The further inputs' values of a model step (model torque, direction), table order.
+  std::array<double, kArxStepMaxExtras> extra_values(double speed, double torque) const noexcept;
+  void restart_models(const std::array<double, kPrecontrolJoints>& q_desired,
+                      const std::array<double, kPrecontrolJoints>& torque) noexcept;
+  PrecontrolOutput run_cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
+                             double payload_kg,
+                             const std::array<double, kPrecontrolJoints>* model_torque_nm,
+                             std::uint64_t cycle_counter) noexcept;
   void deactivate(std::uint64_t cycle, int joint, PrecontrolCause cause, double value) noexcept;
   void log(std::uint64_t cycle, int joint, PrecontrolCause cause, double value) noexcept;
 
@@ -167,7 +189,12 @@ class Precontrol {
   int call_phase_ = 0;
   std::array<JointModel, kPrecontrolJoints> joints_{};
   std::array<double, kPrecontrolJoints> last_q_{};
+  std::array<double, kPrecontrolJoints> last_torque_{};
   std::array<double, kPrecontrolJoints> last_speed_{};
+  int extra_count_ = 0;            // further inputs of every cell's model
+  int torque_input_ = -1;          // index of the model torque among them, -1: none
+  int direction_input_ = -1;       // index of the direction, -1: none
+  double direction_scale_ = 0.01;  // [rad/s]
   double last_payload_ = 0.0;
   bool started_ = false;
   std::uint64_t last_cycle_ = 0;

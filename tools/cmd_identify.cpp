@@ -161,12 +161,10 @@ void run(const IdentifyArgs& args) {
   fs::create_directories(out_dir);
 
   const auto segments = log.segments();
-  ident::ParameterTable table;
-  table.robot = log.robot;
-  table.sample_time_s = log.cycle_s;
-  table.created_by = std::string("imscal ") + imscal::kVersion;
-  table.source = {args.joint_errors, ident::file_sha256_hex(args.joint_errors), log.sample_count(),
-                  log.source};
+  ident::ParameterTable table =
+      ident::parameter_table_header(log, config,
+                                    {args.joint_errors, ident::file_sha256_hex(args.joint_errors),
+                                     log.sample_count(), log.source});
   json joints_report = json::array();
   spdlog::info("identify: {} joints, {} samples in {} segments, cycle {} s", log.joint_count(),
                log.sample_count(), segments.size(), log.cycle_s);

@@ -49,9 +49,12 @@ const Tables& tables() {
   static const Tables t = [] {
     const ident::JointErrorLog log =
         simulate_truth_joint_errors(scenario("identification"), sanitized() ? 60.0 : 1e9);
-    const ident::IdentificationConfig config =
-        ident::load_identification_config(ConfigNode::load_file(
-            fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-default.yaml"));
+    ident::IdentificationConfig config = ident::load_identification_config(ConfigNode::load_file(
+        fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-default.yaml"));
+    if (const char* v = std::getenv("IMSCAL_VERIFY_FORM"))
+      config.options.form = ident::arx_model_form_from_string(v);
+    if (const char* v = std::getenv("IMSCAL_VERIFY_PREVIEW"))
+      config.options.preview_cycles = std::atoi(v);
     Tables out{identify_table(log, config), identify_table(log, without_backlash(config)),
                identify_table(log, single_cell(config))};
     for (const auto* t : {&out.full, &out.no_backlash, &out.one_cell})

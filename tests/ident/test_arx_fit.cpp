@@ -273,3 +273,91 @@ TEST(ArxModel, SimulationReproducesNoiseFreeDataAndStepGain) {
   m.predict_joint_error(step, rest, joint_error);
   EXPECT_NEAR(joint_error.back(), 1.0 - gain, 1e-12 * (1.0 + std::abs(gain)));
 }
+
+// ---- Multi-input form (further inputs x_e, imscal's extension for the model torque and the
+// direction of motion) ----------------------------------------------------------------------
+
+using imscal::test_support::MultiRecord;
+using imscal::test_support::random_multi_system;
+using imscal::test_support::simulate_multi;
+
+TEST(ArxFit, RecoversNoiseFreeMultiInputSystemExactly) {
+  // Same bound as the single-input case (1e-9 relative, issue 5), both solver paths.
+  std::mt19937_64 rng(21);
+  for (const ArxStructure s : {ArxStructure{4, 3, 2, 1, 5}, ArxStructure{2, 6, 0, 2, 3},
+                               ArxStructure{0, 2, 1, 2, 8}, ArxStructure{16, 16, 3, 2, 8}}) {
+    const ArxModel truth = random_multi_system(s, rng);
+    const MultiRecord run = simulate_multi(truth, 5000, 0.0, rng);
+    const std::vector<IoSegment> data{run.view()};
+    for (const auto method : {LeastSquaresMethod::kAuto, LeastSquaresMethod::kQr}) {
+      ArxFitOptions options;
+      options.method = method;
+      const auto fit = fit_arx(data, s, options);
+      EXPECT_EQ(fit.model.structure(), s);
+      EXPECT_LT(relative_error(fit.model.parameters(), truth.parameters()), 1e-9)
+          << to_string(s) << " method " << int(method);
+      // Each block on its own, so that a small c cannot hide behind a large b.
+      EXPECT_LT(relative_error(fit.model.c(), truth.c()), 1e-9) << to_string(s);
+      EXPECT_EQ(fit.row_count, 5000u - std::size_t(s.max_lag()));
+    }
+    // The model's own simulation reproduces the data (noise-free, same initial values).
+    std::vector<double> simulated(run.y.size());
+    truth.simulate(run.view(), simulated);
+    double worst = 0.0;
+    for (std::size_t k = 0; k < run.y.size(); ++k)
+      worst = std::max(worst, std::abs(simulated[k] - run.y[k]));
+    EXPECT_LT(worst, 1e-9) << to_string(s);
+  }
+}
+
+TEST(ArxFit, MultiInputUnbiasedWithHonestSigma) {
+  // White equation noise: every estimate within 4 sigma of the truth (sigma from the fit).
+  std::mt19937_64 rng(22);
+  const ArxStructure s{3, 4, 1, 2, 4};
+  const ArxModel truth = random_multi_system(s, rng);
+  const MultiRecord run = simulate_multi(truth, sanitized() ? 20000 : 100000, 0.05, rng);
+  const auto fit = fit_arx(std::vector<IoSegment>{run.view()}, s);
+  const Eigen::VectorXd z =
+      (fit.model.parameters() - truth.parameters()).cwiseQuotient(fit.parameter_std);
+  EXPECT_LT(z.cwiseAbs().maxCoeff(), 4.0) << z.transpose();
+  EXPECT_NEAR(std::sqrt(fit.residual_variance), 0.05, 0.005);
+}
+
+TEST(ArxFit, MultiInputLaggedGramEqualsExplicitRegressorProducts) {
+  std::mt19937_64 rng(23);
+  const ArxModel truth = random_multi_system({2, 2, 1, 2, 3}, rng);
+  const MultiRecord a = simulate_multi(truth, 200, 0.1, rng);
+  const MultiRecord b = simulate_multi(truth, 41, 0.1, rng);
+  const std::vector<IoSegment> data{a.view(), b.view()};
+  const LagSet lags{4, 1, 7, 2, 5};  // y 0..4, u 1..7, x_0 and x_1 1..5
+  const int first_row = 9;
+  const auto lagged = build_lagged_gram(data, lags, first_row);
+  Eigen::MatrixXd explicit_gram = Eigen::MatrixXd::Zero(lags.columns(), lags.columns());
+  for (const MultiRecord* run : {&a, &b}) {
+    for (std::size_t k = first_row; k < run->y.size(); ++k) {
+      Eigen::VectorXd row(lags.columns());
+      for (int l = 0; l <= 4; ++l) row(lags.output_column(l)) = run->y[k - l];
+      for (int l = 1; l <= 7; ++l) row(lags.input_column(l)) = run->u[k - l];
+      for (int e = 0; e < 2; ++e)
+        for (int l = 1; l <= 5; ++l) row(lags.extra_column(e, l)) = run->x[std::size_t(e)][k - l];
+      explicit_gram += row * row.transpose();
+    }
+  }
+  EXPECT_LT((lagged.gram - explicit_gram).cwiseAbs().maxCoeff(),
+            1e-12 * explicit_gram.cwiseAbs().maxCoeff());
+}
+
+TEST(ArxFit, MultiInputRefusesDataWithoutTheFurtherInputs) {
+  std::mt19937_64 rng(24);
+  const ArxModel truth = random_multi_system({1, 1, 0, 1, 2}, rng);
+  MultiRecord run = simulate_multi(truth, 100, 0.0, rng);
+  IoSegment missing = run.view();
+  missing.extra_count = 0;
+  EXPECT_THROW(fit_arx(std::vector<IoSegment>{missing}, truth.structure()), std::invalid_argument);
+  IoSegment short_extra = run.view();
+  short_extra.extra[0] = short_extra.extra[0].first(50);
+  EXPECT_THROW(fit_arx(std::vector<IoSegment>{short_extra}, truth.structure()),
+               std::invalid_argument);
+  EXPECT_THROW((ArxStructure{1, 1, 0, 1, 0}.validate()), std::invalid_argument);
+  EXPECT_THROW((ArxStructure{1, 1, 0, 3, 2}.validate()), std::invalid_argument);
+}

@@ -25,6 +25,8 @@ ident::ParameterTable sample_table() {
   t.robot = "kr16";
   t.sample_time_s = 0.002;
   t.created_by = "imscal test";
+  t.model_form = ident::TableForm::kInverse;  // schema 2's keys in the round trip
+  t.preview_cycles = 6;
   t.source = {"/tmp/joint_errors.csv", std::string(64, 'a'), 123456, "simulated"};
   for (const char* name : {"A1", "A2"}) {
     ident::JointParameters j;
@@ -80,6 +82,23 @@ TEST_F(ParameterTableFiles, RoundTripIsExact) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 2 * 4);
 }
 
+TEST(ParameterTable, Version1TablesReadAsForwardModelsWithoutPreview) {
+  json j = json::parse(ident::parameters_json_text(sample_table()));
+  j["schema_version"] = 1;
+  for (const char* key :
+       {"model_form", "preview_cycles", "extra_inputs", "direction_speed_scale_rad_s"})
+    j.erase(key);
+  for (auto& joint : j["joints"])
+    for (auto& cell : joint["cells"]) {
+      cell.erase("nx");
+      cell.erase("c");
+    }
+  const auto back = ident::parse_parameters_json(j.dump(), "v1.json");
+  EXPECT_EQ(back.model_form, ident::TableForm::kForward);
+  EXPECT_EQ(back.preview_cycles, 0);
+  EXPECT_EQ(back.joints.size(), 2u);
+}
+
 TEST(ParameterTable, NotAvailableFiguresRoundTripAsNull) {
   ident::ParameterTable table = sample_table();
   table.joints[0].cells[0].figures.simulation_fit_percent = std::nan("");
@@ -113,8 +132,24 @@ TEST_P(LoaderRefuses, WithPathAndMessage) {
 INSTANTIATE_TEST_SUITE_P(
     BadTables, LoaderRefuses,
     ::testing::Values(
-        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 2; }, "/schema_version",
-                "unknown schema version 2"},
+        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 3; }, "/schema_version",
+                "unknown schema version 3"},
+        Refusal{"UnknownModelForm", [](json& j) { j["model_form"] = "sideways"; }, "/model_form",
+                "expected 'forward' or 'inverse'"},
+        Refusal{"PreviewOfAForwardTable",
+                [](json& j) {
+                  j["model_form"] = "forward";
+                  j["preview_cycles"] = 3;
+                },
+                "/preview_cycles", "only an inverse-form table has a preview"},
+        Refusal{"NegativePreview",
+                [](json& j) {
+                  j["model_form"] = "inverse";
+                  j["preview_cycles"] = -1;
+                },
+                "/preview_cycles", "expected 0..64 cycles"},
+        Refusal{"Version1WithVersion2Keys", [](json& j) { j["schema_version"] = 1; }, "/model_form",
+                "not a key of schema version 1"},
         Refusal{"WrongSchema", [](json& j) { j["schema"] = "something"; }, "/schema",
                 "not an imscal parameter table"},
         Refusal{"ALengthWrong", [](json& j) { j["joints"][0]["cells"][1]["a"].push_back(0.1); },
@@ -148,8 +183,8 @@ INSTANTIATE_TEST_SUITE_P(
                 "/joints/0/cells/0/a", "unstable"},
         Refusal{"MissingKey", [](json& j) { j["joints"][0].erase("backlash"); },
                 "/joints/0/backlash", "missing key"},
-        Refusal{"UnknownKey", [](json& j) { j["joints"][0]["cells"][0]["c"] = 1; },
-                "/joints/0/cells/0/c", "unknown key"},
+        Refusal{"UnknownKey", [](json& j) { j["joints"][0]["cells"][0]["d"] = 1; },
+                "/joints/0/cells/0/d", "unknown key"},
         Refusal{"WrongUnit", [](json& j) { j["units"]["angle"] = "deg"; }, "/units/angle",
                 "expected 'rad'"},
         Refusal{"NegativeBacklash", [](json& j) { j["joints"][1]["backlash"]["l_rad"] = -1e-4; },

@@ -85,4 +85,52 @@ inline ident::IoSegment view(const ArxRecord& r) {
   return {r.u, r.y};
 }
 
+// y(k) = -Σ a_i y(k-i) + Σ b_j u(k-d-j) + Σ_e Σ_j c_e,j x_e(k-d-j) + noise, white inputs,
+// zero before k = 0. Computed here, independently of ArxModel::simulate.
+struct MultiRecord {
+  std::vector<double> u, y;
+  std::vector<std::vector<double>> x;
+  ident::IoSegment view() const {
+    ident::IoSegment s{u, y};
+    s.extra_count = int(x.size());
+    for (std::size_t e = 0; e < x.size(); ++e) s.extra[e] = x[e];
+    return s;
+  }
+};
+
+inline MultiRecord simulate_multi(const ident::ArxModel& m, std::size_t n, double noise_std,
+                                  std::mt19937_64& rng) {
+  const ident::ArxStructure& s = m.structure();
+  std::normal_distribution<double> normal(0.0, 1.0);
+  MultiRecord r;
+  r.u.resize(n);
+  r.y.resize(n);
+  r.x.assign(std::size_t(s.extra_inputs), std::vector<double>(n));
+  for (auto& v : r.u) v = normal(rng);
+  for (auto& x : r.x)
+    for (auto& v : x) v = 100.0 * normal(rng);  // a torque-like scale: 100 N m against 1 rad
+  for (std::size_t k = 0; k < n; ++k) {
+    double sum = noise_std * normal(rng);
+    for (int i = 1; i <= s.na; ++i)
+      if (k >= std::size_t(i)) sum -= m.a()(i - 1) * r.y[k - std::size_t(i)];
+    for (int j = 0; j < s.nb; ++j) {
+      const long idx = long(k) - s.dead_time - j;
+      if (idx >= 0) sum += m.b()(j) * r.u[std::size_t(idx)];
+    }
+    for (int e = 0; e < s.extra_inputs; ++e)
+      for (int j = 0; j < s.nx; ++j) {
+        const long idx = long(k) - s.dead_time - j;
+        if (idx >= 0) sum += m.c()(e * s.nx + j) * r.x[std::size_t(e)][std::size_t(idx)];
+      }
+    r.y[k] = sum;
+  }
+  return r;
+}
+
+inline ident::ArxModel random_multi_system(const ident::ArxStructure& s, std::mt19937_64& rng) {
+  Eigen::VectorXd c = 1e-3 * random_b(s.extra_inputs * s.nx, rng);
+  return ident::ArxModel(s, polynomial_from_poles(random_poles(s.na, rng)), random_b(s.nb, rng), c,
+                         0.002);
+}
+
 }  // namespace imscal::test_support

@@ -236,11 +236,18 @@ inline int AllCellsPrecontrol::read_events(PrecontrolEvent* out, int capacity) n
 
 inline void AllCellsPrecontrol::restart_models(
     const std::array<double, kPrecontrolJoints>& q) noexcept {
-  // At rest the robot stands where it was told: past inputs and outputs all equal q_d.
+  // At rest the robot stands where it was told: past inputs all equal q_d, every model at its
+  // steady state B(1) q_d / A(1) (q_d itself near an integrator, A(1) ~ 0).
   for (int j = 0; j < kPrecontrolJoints; ++j) {
     JointModel& joint = joints_[j];
     joint.u.fill(q[j]);
-    for (int k = 0; k < joint.cells; ++k) joint.cell[k].y.fill(q[j]);
+    for (int k = 0; k < joint.cells; ++k) {
+      CellModel& m = joint.cell[k];
+      double a1 = 1.0, b1 = 0.0;
+      for (int i = 0; i < m.na; ++i) a1 += m.a[i];
+      for (int i = 0; i < m.nb; ++i) b1 += m.b[i];
+      m.y.fill(std::abs(a1) > 1e-9 ? b1 * q[j] / a1 : q[j]);
+    }
     joint.last_error = joint.previous_error = 0.0;
     joint.smooth = joint.output;
     joint.smooth_rate = 0.0;
