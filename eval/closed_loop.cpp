@@ -21,6 +21,14 @@ CompensationRun run_stage(const ident::ParameterTable& table, const std::string&
     throw std::invalid_argument("precontrol refused the parameter table: " + why);
   }
   const std::size_t n = path.samples.size();
+  std::vector<calib::JointVector> torque;
+  if (precontrol->needs_model_torque()) {
+    if (!options.model_torque)
+      throw std::invalid_argument(
+          "the parameter table's models take the model torque: the robot's rigid-body model is "
+          "needed (CompensationOptions::model_torque)");
+    torque = model_torques_along(*options.model_torque, path);
+  }
   CompensationRun run;
   run.offset_rad.resize(n);
   run.state.resize(n);
@@ -35,7 +43,11 @@ CompensationRun run_stage(const ident::ParameterTable& table, const std::string&
     for (int j = 0; j < ident::kPrecontrolJoints; ++j) q[std::size_t(j)] = s.q_rad[j];
     const double payload_kg =
         path.payloads.empty() ? 0.0 : path.payloads[std::size_t(s.payload_index)].body.mass_kg;
-    const ident::PrecontrolOutput out = precontrol->cycle(q, payload_kg, k);
+    std::array<double, ident::kPrecontrolJoints> tau{};
+    if (!torque.empty())
+      for (int j = 0; j < ident::kPrecontrolJoints; ++j) tau[std::size_t(j)] = torque[ahead][j];
+    const ident::PrecontrolOutput out = torque.empty() ? precontrol->cycle(q, payload_kg, k)
+                                                       : precontrol->cycle(q, payload_kg, tau, k);
     for (int j = 0; j < ident::kPrecontrolJoints; ++j) {
       run.offset_rad[k][j] = out.offset_rad[std::size_t(j)];
     }

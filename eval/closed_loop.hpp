@@ -31,10 +31,12 @@
 // look_ahead_cycles = 0 (std::invalid_argument otherwise): with every stage's output shifted L
 // cycles early the fixed point would not be G(q_d + o) = q_d.
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "calib/robot_description.hpp"
+#include "eval/model_torque.hpp"
 #include "ident/parameter_table.hpp"
 #include "ident/precontrol.hpp"
 #include "sim/desired_path.hpp"
@@ -47,6 +49,10 @@ struct CompensationOptions {
   ident::PrecontrolOptions precontrol;  // caller_cycle_s is replaced by the path's cycle
   int look_ahead_cycles = 0;            // L >= 0 [cycles]
   int inversion_iterations = 0;         // n >= 0: cascade stages after the first (see above)
+  // The robot's rigid-body model, for tables whose models take the model torque: the precontrol
+  // is then fed the torque along the desired path at the sample it is fed (eval/model_torque.hpp).
+  // Such a table without it: std::invalid_argument.
+  std::optional<ModelTorqueSource> model_torque;
 };
 
 // The precontrol's offsets along a desired path, one per path sample.

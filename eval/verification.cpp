@@ -228,9 +228,26 @@ ident::JointErrorLog simulate_truth_joint_errors(const sim::Scenario& scenario,
   return log;
 }
 
+ModelTorqueSource scenario_model_torque(const sim::Scenario& scenario) {
+  ModelTorqueSource model;
+  model.robot = calib::load_robot_description(scenario.robot_file);
+  model.gravity_in_base_m_s2 = scenario_plant(scenario, model.robot).gravity_in_base_m_s2;
+  return model;
+}
+
 IdentifiedTable identify_table(const ident::JointErrorLog& log,
                                const ident::IdentificationConfig& config,
-                               const std::string& source_file) {
+                               const std::string& source_file,
+                               const ModelTorqueSource* torque_model) {
+  if (config.options.model_torque_input && log.model_torque_nm.empty()) {
+    if (torque_model == nullptr)
+      throw std::invalid_argument(
+          "identify_table: the config's models take the model torque; give the robot's "
+          "rigid-body model");
+    ident::JointErrorLog with_torque = log;
+    attach_model_torques(with_torque, *torque_model, config.options);
+    return identify_table(with_torque, config, source_file);
+  }
   if (config.max_speed_rad_s.size() != log.joint_count()) {
     throw std::invalid_argument(fmt::format("identify_table: config has {} joints, the data {}",
                                             config.max_speed_rad_s.size(), log.joint_count()));
@@ -321,11 +338,15 @@ VerificationResult verify_scenario(const sim::Scenario& scenario,
   result.evaluated_to_s = evaluated.back().end_s + t0;
   for (const auto& s : evaluated) result.segments.push_back(s.label);
 
-  // The commands: one per table (the precontrol does not depend on the plant's draw).
+  // The commands: one per table (the precontrol does not depend on the plant's draw). Tables
+  // whose models take the model torque get it from the scenario's robot unless the caller gave
+  // a model.
+  CompensationOptions compensation = options.compensation;
+  if (!compensation.model_torque) compensation.model_torque = scenario_model_torque(scenario);
   std::vector<CompensationRun> compensations;
   std::vector<sim::DesiredJointPath> commands;
   for (const NamedTable& t : tables) {
-    compensations.push_back(run_precontrol(t.table, robot.name, path, options.compensation));
+    compensations.push_back(run_precontrol(t.table, robot.name, path, compensation));
     commands.push_back(command_path(path, compensations.back().offset_rad));
   }
 

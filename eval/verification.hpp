@@ -53,10 +53,18 @@ struct IdentifiedTable {
   std::vector<std::string> failed_joints;
 };
 
+// The rigid-body model of a scenario's robot, with the site's normal gravity in R (as the
+// plant feels it): the model torques of multi-input tables (eval/model_torque.hpp).
+ModelTorqueSource scenario_model_torque(const sim::Scenario& scenario);
+
 // identify_joint for every joint of the log (as `imscal identify`). source_file names the data.
+// A config whose models take the model torque needs `torque_model` (the torques are attached to
+// a copy of the log along the path its form reads) or torques already in the log
+// (std::invalid_argument otherwise).
 IdentifiedTable identify_table(const ident::JointErrorLog& log,
                                const ident::IdentificationConfig& config,
-                               const std::string& source_file = "simulator truth");
+                               const std::string& source_file = "simulator truth",
+                               const ModelTorqueSource* torque_model = nullptr);
 
 // The ablation configs: the same config with the backlash identification off, and with one
 // cell per joint (speed 0..max x payload 0..nominal) instead of the operating-point grid.

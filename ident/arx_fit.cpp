@@ -62,7 +62,8 @@ std::vector<LaggedSignal> lagged_signals(const IoSegment& segment, const LagSet&
        lags.input_column(lags.input_lag_min)}};
   for (int e = 0; e < lags.extra_count; ++e)
     out.push_back({segment.extra[static_cast<std::size_t>(e)].data(), lags.input_lag_min,
-                   lags.extra_lag_max, lags.extra_column(e, lags.input_lag_min)});
+                   lags.extra_lag_max[static_cast<std::size_t>(e)],
+                   lags.extra_column(e, lags.input_lag_min)});
   return out;
 }
 
@@ -179,7 +180,6 @@ Eigen::MatrixXd streamed_qr_factor(std::span<const IoSegment> segments,
                                    const ArxStructure& structure, const Eigen::VectorXd& scale) {
   const int na = structure.na;
   const int nb = structure.nb;
-  const int nx = structure.nx;
   const int p = structure.parameter_count();
   const int q = p + 1;
   const std::size_t first = static_cast<std::size_t>(structure.max_lag());
@@ -199,8 +199,9 @@ Eigen::MatrixXd streamed_qr_factor(std::span<const IoSegment> segments,
       for (int j = 0; j < nb; ++j) row(na + j) = u[k - d - j] * scale(na + j);
       for (int e = 0; e < structure.extra_inputs; ++e) {
         const auto& x = segment.extra[static_cast<std::size_t>(e)];
-        const int c0 = na + nb + e * nx;
-        for (int j = 0; j < nx; ++j) row(c0 + j) = x[k - d - j] * scale(c0 + j);
+        const int c0 = na + nb + structure.extra_offset(e);
+        for (int j = 0; j < structure.nx[std::size_t(e)]; ++j)
+          row(c0 + j) = x[k - d - j] * scale(c0 + j);
       }
       row(p) = y[k];
       if (++rows == kQrBlockRows) flush();
@@ -223,7 +224,7 @@ double residual_pass(std::span<const IoSegment> segments, const ArxStructure& st
   std::array<double, kChunkRows> residual_buffer;
   if (phi_t_r != nullptr) phi_t_r->setZero(theta.size());
   double sum = 0.0;
-  const int nb = structure.nb, nx = structure.nx;
+  const int nb = structure.nb;
   for (const IoSegment& segment : segments) {
     check_segment(segment, structure.extra_inputs);
     const double* y = segment.output.data();
@@ -237,8 +238,9 @@ double residual_pass(std::span<const IoSegment> segments, const ArxStructure& st
       for (int j = 0; j < nb; ++j) e -= theta(na + j) * ConstMap(u + c - d - j, len);
       for (int x = 0; x < structure.extra_inputs; ++x) {
         const double* xs = segment.extra[static_cast<std::size_t>(x)].data();
-        for (int j = 0; j < nx; ++j)
-          e -= theta(na + nb + x * nx + j) * ConstMap(xs + c - d - j, len);
+        const int c0 = na + nb + structure.extra_offset(x);
+        for (int j = 0; j < structure.nx[std::size_t(x)]; ++j)
+          e -= theta(c0 + j) * ConstMap(xs + c - d - j, len);
       }
       sum += e.squaredNorm();
       if (phi_t_r == nullptr) continue;
@@ -246,8 +248,9 @@ double residual_pass(std::span<const IoSegment> segments, const ArxStructure& st
       for (int j = 0; j < nb; ++j) (*phi_t_r)(na + j) += e.dot(ConstMap(u + c - d - j, len));
       for (int x = 0; x < structure.extra_inputs; ++x) {
         const double* xs = segment.extra[static_cast<std::size_t>(x)].data();
-        for (int j = 0; j < nx; ++j)
-          (*phi_t_r)(na + nb + x * nx + j) += e.dot(ConstMap(xs + c - d - j, len));
+        const int c0 = na + nb + structure.extra_offset(x);
+        for (int j = 0; j < structure.nx[std::size_t(x)]; ++j)
+          (*phi_t_r)(c0 + j) += e.dot(ConstMap(xs + c - d - j, len));
       }
     }
   }
@@ -260,9 +263,12 @@ LaggedGram build_lagged_gram(std::span<const IoSegment> segments, const LagSet& 
                              int first_row) {
   if (lags.output_lag_max < 0 || lags.input_lag_min < 0 ||
       lags.input_lag_max < lags.input_lag_min || lags.extra_count < 0 ||
-      lags.extra_count > kMaxExtraInputs ||
-      (lags.extra_count > 0 && lags.extra_lag_max < lags.input_lag_min))
+      lags.extra_count > kMaxExtraInputs)
     throw std::invalid_argument("build_lagged_gram: invalid lag set");
+  for (int e = 0; e < lags.extra_count; ++e)
+    if (lags.extra_lag_max[std::size_t(e)] < lags.input_lag_min)
+      throw std::invalid_argument("build_lagged_gram: invalid lag set (further input " +
+                                  std::to_string(e) + ")");
   if (first_row < lags.max_lag())
     throw std::invalid_argument("build_lagged_gram: first_row " + std::to_string(first_row) +
                                 " is below the largest lag " + std::to_string(lags.max_lag()));
@@ -292,10 +298,10 @@ ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& st
   structure.validate();
   const int na = structure.na;
   const int nb = structure.nb;
-  const int nx = structure.nx;
   const int p = structure.parameter_count();
-  const LagSet lags{na, structure.dead_time, structure.dead_time + nb - 1, structure.extra_inputs,
-                    structure.dead_time + nx - 1};
+  LagSet lags{na, structure.dead_time, structure.dead_time + nb - 1, structure.extra_inputs, {}};
+  for (int e = 0; e < structure.extra_inputs; ++e)
+    lags.extra_lag_max[std::size_t(e)] = structure.dead_time + structure.nx[std::size_t(e)] - 1;
   const LaggedGram lagged = build_lagged_gram(segments, lags, structure.max_lag());
   if (lagged.row_count <= static_cast<std::size_t>(p))
     throw std::invalid_argument("fit_arx: " + std::to_string(lagged.row_count) +
@@ -309,9 +315,11 @@ ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& st
   for (int j = 0; j < nb; ++j)
     column[na + j] = lags.input_column(structure.dead_time + j), sign(na + j) = 1.0;
   for (int e = 0; e < structure.extra_inputs; ++e)
-    for (int j = 0; j < nx; ++j)
-      column[na + nb + e * nx + j] = lags.extra_column(e, structure.dead_time + j),
-                                sign(na + nb + e * nx + j) = 1.0;
+    for (int j = 0; j < structure.nx[std::size_t(e)]; ++j) {
+      const int r = na + nb + structure.extra_offset(e) + j;
+      column[r] = lags.extra_column(e, structure.dead_time + j);
+      sign(r) = 1.0;
+    }
   Eigen::MatrixXd normal(p, p);
   Eigen::VectorXd rhs(p);
   for (int r = 0; r < p; ++r) {

@@ -28,6 +28,8 @@
 // The model has no constant term (as in the paper): signals with a large offset and little
 // motion make the regressors nearly collinear; the condition number in the result shows it.
 #include <Eigen/Core>
+#include <algorithm>
+#include <array>
 #include <cstddef>
 #include <span>
 
@@ -44,21 +46,28 @@ struct LagSet {
   int input_lag_min = 0;
   int input_lag_max = 0;
   int extra_count = 0;
-  int extra_lag_max = 0;
+  std::array<int, kMaxExtraInputs> extra_lag_max{};  // of each further input (>= input_lag_min)
 
   int output_columns() const { return output_lag_max + 1; }
   int input_columns() const { return input_lag_max - input_lag_min + 1; }
-  int extra_columns() const { return extra_count > 0 ? extra_lag_max - input_lag_min + 1 : 0; }
-  int columns() const { return output_columns() + input_columns() + extra_count * extra_columns(); }
+  int extra_columns(int e) const { return extra_lag_max[std::size_t(e)] - input_lag_min + 1; }
+  int columns() const {
+    int sum = output_columns() + input_columns();
+    for (int e = 0; e < extra_count; ++e) sum += extra_columns(e);
+    return sum;
+  }
   // Column of y(k-lag) / u(k-lag) / x_e(k-lag) in LaggedGram::gram.
   int output_column(int lag) const { return lag; }
   int input_column(int lag) const { return output_columns() + lag - input_lag_min; }
   int extra_column(int e, int lag) const {
-    return output_columns() + input_columns() + e * extra_columns() + lag - input_lag_min;
+    int first = output_columns() + input_columns();
+    for (int i = 0; i < e; ++i) first += extra_columns(i);
+    return first + lag - input_lag_min;
   }
   int max_lag() const {
-    const int m = output_lag_max > input_lag_max ? output_lag_max : input_lag_max;
-    return extra_count > 0 && extra_lag_max > m ? extra_lag_max : m;
+    int m = output_lag_max > input_lag_max ? output_lag_max : input_lag_max;
+    for (int e = 0; e < extra_count; ++e) m = std::max(m, extra_lag_max[std::size_t(e)]);
+    return m;
   }
 };
 

@@ -22,7 +22,7 @@ ArxModel::ArxModel(ArxStructure structure, Eigen::VectorXd a, Eigen::VectorXd b,
       sample_time_s_(sample_time_s) {
   structure_.validate();
   if (a_.size() != structure_.na || b_.size() != structure_.nb ||
-      c_.size() != structure_.extra_inputs * structure_.nx)
+      c_.size() != structure_.extra_coefficient_count())
     throw std::invalid_argument("ArxModel: coefficient counts (" + std::to_string(a_.size()) +
                                 ", " + std::to_string(b_.size()) + ", " +
                                 std::to_string(c_.size()) + ") do not match " +
@@ -46,7 +46,8 @@ double add_input_terms(double sum, const ArxStructure& s, const Eigen::VectorXd&
   for (int j = 0; j < s.nb; ++j) sum += b[j] * segment.input[first - j];
   for (int e = 0; e < s.extra_inputs; ++e) {
     const auto& x = segment.extra[static_cast<std::size_t>(e)];
-    for (int j = 0; j < s.nx; ++j) sum += c[e * s.nx + j] * x[first - j];
+    const int c0 = s.extra_offset(e);
+    for (int j = 0; j < s.nx[std::size_t(e)]; ++j) sum += c[c0 + j] * x[first - j];
   }
   return sum;
 }
@@ -141,7 +142,7 @@ double ArxModel::extra_static_gain(int e) const {
                                 std::to_string(e));
   const double a_at_one = 1.0 + a_.sum();
   if (a_at_one == 0.0) return std::numeric_limits<double>::infinity();
-  return c_.segment(e * structure_.nx, structure_.nx).sum() / a_at_one;
+  return c_.segment(structure_.extra_offset(e), structure_.nx[std::size_t(e)]).sum() / a_at_one;
 }
 
 }  // namespace imscal::ident

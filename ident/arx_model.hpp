@@ -20,7 +20,7 @@ class ArxModel {
   // A structure with further inputs needs the constructor with c.
   ArxModel(ArxStructure structure, Eigen::VectorXd a, Eigen::VectorXd b,
            double sample_time_s = 0.002);
-  // c: the further inputs' coefficients, input after input (c_e,0..c_e,nx-1 for e = 0, 1, ...).
+  // c: the further inputs' coefficients, input after input (c_e,0..c_e,nx[e]-1 for e = 0, 1, ...).
   ArxModel(ArxStructure structure, Eigen::VectorXd a, Eigen::VectorXd b, Eigen::VectorXd c,
            double sample_time_s);
 

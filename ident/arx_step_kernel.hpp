@@ -18,7 +18,7 @@ namespace imscal::ident {
 
 inline constexpr int kArxStepLanes = 8;
 
-inline constexpr int kArxStepMaxExtras = 2;
+inline constexpr int kArxStepMaxExtras = 3;
 
 struct ArxStepInput {
   const double* b;          // b_0 .. b_{terms-1}

@@ -19,19 +19,37 @@
 
 namespace imscal::ident {
 
-inline constexpr int kMaxExtraInputs = 2;
+inline constexpr int kMaxExtraInputs = 3;
 
 struct ArxStructure {
   int na = 1;            // number of autoregressive coefficients a_1..a_na
   int nb = 1;            // number of input coefficients b_0..b_{nb-1}
   int dead_time = 0;     // d: delay of the first input coefficient, in samples
   int extra_inputs = 0;  // number of further inputs x_e (0..kMaxExtraInputs)
-  int nx = 0;            // coefficients per further input (>= 1 when extra_inputs > 0)
+  // Coefficients of each further input, c_e,0..c_e,nx[e]-1 (>= 1 for e < extra_inputs, 0 for the
+  // unused entries): a slowly varying input (the torque's sign) needs one, a dynamic one many.
+  std::array<int, kMaxExtraInputs> nx{};
 
-  int parameter_count() const { return na + nb + extra_inputs * nx; }
+  // Coefficients of all further inputs, and where those of input e start in c.
+  int extra_coefficient_count() const {
+    int sum = 0;
+    for (int e = 0; e < extra_inputs; ++e) sum += nx[std::size_t(e)];
+    return sum;
+  }
+  int extra_offset(int e) const {
+    int sum = 0;
+    for (int i = 0; i < e; ++i) sum += nx[std::size_t(i)];
+    return sum;
+  }
+  int max_nx() const {
+    int m = 0;
+    for (int e = 0; e < extra_inputs; ++e) m = std::max(m, nx[std::size_t(e)]);
+    return m;
+  }
+  int parameter_count() const { return na + nb + extra_coefficient_count(); }
   // Largest lag of any regressor: the first sample k that has a complete regressor.
   int max_lag() const {
-    return std::max({na, dead_time + nb - 1, extra_inputs > 0 ? dead_time + nx - 1 : 0});
+    return std::max({na, dead_time + nb - 1, extra_inputs > 0 ? dead_time + max_nx() - 1 : 0});
   }
 
   // Throws std::invalid_argument when a field is out of range.
@@ -47,10 +65,15 @@ struct ArxStructure {
       throw std::invalid_argument("ArxStructure: extra_inputs must be in 0.." +
                                   std::to_string(kMaxExtraInputs) + ", got " +
                                   std::to_string(extra_inputs));
-    if ((extra_inputs > 0) != (nx > 0) || nx < 0)
-      throw std::invalid_argument(
-          "ArxStructure: nx must be >= 1 with further inputs and 0 without, got " +
-          std::to_string(nx));
+    for (int e = 0; e < kMaxExtraInputs; ++e) {
+      const int n = nx[std::size_t(e)];
+      if (e < extra_inputs ? n < 1 : n != 0) {
+        std::string what = "ArxStructure: nx of further input " + std::to_string(e);
+        what += e < extra_inputs ? " must be >= 1, got " : " must be 0 (unused), got ";
+        what += std::to_string(n);
+        throw std::invalid_argument(what);
+      }
+    }
   }
 
   friend bool operator==(const ArxStructure&, const ArxStructure&) = default;
@@ -79,8 +102,13 @@ struct IoSegment {
 inline std::string to_string(const ArxStructure& s) {
   std::string text = "na=" + std::to_string(s.na) + " nb=" + std::to_string(s.nb) +
                      " d=" + std::to_string(s.dead_time);
-  if (s.extra_inputs > 0)
-    text += " +" + std::to_string(s.extra_inputs) + "x" + std::to_string(s.nx);
+  if (s.extra_inputs > 0) {
+    text += " nx=";
+    for (int e = 0; e < s.extra_inputs; ++e) {
+      if (e > 0) text += ',';
+      text += std::to_string(s.nx[std::size_t(e)]);
+    }
+  }
   return text;
 }
 

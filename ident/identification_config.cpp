@@ -104,7 +104,9 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
         cells->get_double("min_rms_speed_deg_s", o.min_rms_speed_rad_s / kDeg) * kDeg;
   }
   if (auto model = root.optional_child("model")) {
-    model->require_only_keys({"form", "preview_cycles"});
+    model->require_only_keys({"form", "preview_cycles", "model_torque", "direction",
+                              "direction_speed_scale_deg_s", "torque_sign",
+                              "torque_sign_scale_fraction", "input_taps", "torque_sign_taps"});
     if (auto n = model->optional_child("form")) {
       try {
         o.form = arx_model_form_from_string(n->as_string());
@@ -117,6 +119,26 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
       model->child("preview_cycles").fail("must be in 0..32 cycles");
     if (o.preview_cycles > 0 && o.form != ArxModelForm::kInverse)
       model->child("preview_cycles").fail("a preview is used only by the inverse form");
+    o.model_torque_input = model->get_bool("model_torque", o.model_torque_input);
+    o.direction_input = model->get_bool("direction", o.direction_input);
+    o.direction_speed_scale_rad_s =
+        model->get_double("direction_speed_scale_deg_s", o.direction_speed_scale_rad_s / kDeg) *
+        kDeg;
+    if (!(o.direction_speed_scale_rad_s > 0.0))
+      model->child("direction_speed_scale_deg_s").fail("must be > 0");
+    o.torque_sign_input = model->get_bool("torque_sign", o.torque_sign_input);
+    o.torque_sign_scale_fraction =
+        model->get_double("torque_sign_scale_fraction", o.torque_sign_scale_fraction);
+    if (!(o.torque_sign_scale_fraction > 0.0 && o.torque_sign_scale_fraction <= 1.0))
+      model->child("torque_sign_scale_fraction").fail("must be in (0, 1] of the RMS torque");
+    if (o.torque_sign_input && !o.model_torque_input)
+      model->child("torque_sign").fail("the torque-sign input needs model_torque: true");
+    o.input_taps = int(model->get_int("input_taps", o.input_taps));
+    if (o.input_taps < 1 || o.input_taps > 64)
+      model->child("input_taps").fail("must be in 1..64 coefficients per further input");
+    o.torque_sign_taps = int(model->get_int("torque_sign_taps", o.torque_sign_taps));
+    if (o.torque_sign_taps < 1 || o.torque_sign_taps > 64)
+      model->child("torque_sign_taps").fail("must be in 1..64 coefficients");
   }
   if (auto order = root.optional_child("order")) {
     order->require_only_keys({"na", "nb", "dead_time", "criterion"});

@@ -23,6 +23,7 @@ ParameterTable parameter_table_header(const JointErrorLog& log, const Identifica
   table.preview_cycles = config.options.preview_cycles;
   if (config.options.model_torque_input) table.extra_inputs.push_back(TableInput::kModelTorque);
   if (config.options.direction_input) table.extra_inputs.push_back(TableInput::kDirection);
+  if (config.options.torque_sign_input) table.extra_inputs.push_back(TableInput::kTorqueSign);
   table.direction_speed_scale_rad_s = config.options.direction_speed_scale_rad_s;
   table.source = std::move(source);
   return table;
@@ -34,6 +35,10 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
   const std::size_t joints = log.joint_count();
   std::vector<JointOutcome> outcomes(joints);
   std::vector<std::exception_ptr> errors(joints);
+  if (config.options.model_torque_input && log.model_torque_nm.size() != joints)
+    throw std::invalid_argument(
+        "identify_joints: the config's models take the model torque, but no torques are attached "
+        "to the joint errors (the robot's rigid-body model is needed: eval/model_torque.hpp)");
   const auto segments = log.segments();
   std::atomic<std::size_t> next{0};
   std::mutex done_mutex;
@@ -42,9 +47,11 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
     for (std::size_t j = next++; j < joints; j = next++) {
       const auto start = std::chrono::steady_clock::now();
       try {
-        outcomes[j].result = identify_joint(log.joint_names[j], log.q_desired_rad[j],
-                                            log.q_measured_rad[j], log.payload_kg, segments,
-                                            log.cycle_s, config.joint_grid(j), config.options);
+        const std::span<const double> torque =
+            log.model_torque_nm.empty() ? std::span<const double>() : log.model_torque_nm[j];
+        outcomes[j].result = identify_joint(
+            log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j], log.payload_kg,
+            segments, log.cycle_s, config.joint_grid(j), config.options, torque);
       } catch (const InputError&) {
         errors[j] = std::current_exception();
       } catch (const std::runtime_error& e) {
@@ -52,6 +59,10 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
         outcomes[j].result =
             neutral_joint_identification(log.joint_names[j], config.max_speed_rad_s[j], e.what(),
                                          extra_input_count(config.options));
+        // A table with the torque-sign input needs a scale for every joint; the neutral cell's
+        // coefficient is zero, so any positive one serves.
+        if (config.options.torque_sign_input)
+          outcomes[j].result.parameters.torque_sign_scale_nm = 1.0;
       } catch (...) {
         errors[j] = std::current_exception();
       }

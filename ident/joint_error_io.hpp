@@ -34,6 +34,10 @@ struct JointErrorLog {
   std::vector<double> payload_kg;
   // [joint][sample], SI (rad)
   std::vector<std::vector<double>> q_desired_rad, q_measured_rad, q_internal_rad;
+  // The joint torques of the robot's rigid-body model [joint][sample] [N m], along the path the
+  // identification's model form reads (eval/model_torque.hpp); empty unless a caller attached
+  // them for a multi-input identification. Not a column of joint_errors.csv.
+  std::vector<std::vector<double>> model_torque_nm;
   // First sample of every segment (a run without gaps); segment_starts[0] == 0.
   std::vector<std::size_t> segment_starts{0};
   std::size_t first_data_line = 0;  // 1-based line of the first sample (0: not read from a file)

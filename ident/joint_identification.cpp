@@ -140,17 +140,19 @@ ArxModel angle_form_of_error_model(const ArxModel& error_model) {
   if (e.extra_inputs == 0)
     return ArxModel({na, nb, 0}, error_model.a(), b, error_model.sample_time_s());
   // Further inputs: q̂ = x - e, so their coefficients change sign and move behind δ zeros (the
-  // angle form has dead time 0): C'_e(z) = -z^-δ C_e(z), δ + nx coefficients each.
-  const int nx = delta + e.nx;
-  Eigen::VectorXd c = Eigen::VectorXd::Zero(e.extra_inputs * nx);
+  // angle form has dead time 0): C'_e(z) = -z^-δ C_e(z), δ + nx[e] coefficients each.
+  ArxStructure angle{na, nb, 0, e.extra_inputs, {}};
+  for (int x = 0; x < e.extra_inputs; ++x) angle.nx[std::size_t(x)] = delta + e.nx[std::size_t(x)];
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(angle.extra_coefficient_count());
   for (int x = 0; x < e.extra_inputs; ++x)
-    for (int j = 0; j < e.nx; ++j) c(x * nx + delta + j) = -error_model.c()(x * e.nx + j);
-  return ArxModel({na, nb, 0, e.extra_inputs, nx}, error_model.a(), b, c,
-                  error_model.sample_time_s());
+    for (int j = 0; j < e.nx[std::size_t(x)]; ++j)
+      c(angle.extra_offset(x) + delta + j) = -error_model.c()(e.extra_offset(x) + j);
+  return ArxModel(angle, error_model.a(), b, c, error_model.sample_time_s());
 }
 
 int extra_input_count(const JointIdentificationOptions& options) {
-  return int(options.model_torque_input) + int(options.direction_input);
+  return int(options.model_torque_input) + int(options.direction_input) +
+         int(options.torque_sign_input);
 }
 
 JointParameters neutral_joint_parameters(const std::string& name, double max_speed_rad_s,
@@ -164,7 +166,8 @@ JointParameters neutral_joint_parameters(const std::string& name, double max_spe
   cell.bands = {0};
   cell.status = CellStatus::kNeutral;
   cell.reason = "not identified, neutral pass-through model (no compensation): " + reason;
-  cell.structure = {0, 1, 0, extra_inputs, extra_inputs > 0 ? 1 : 0};
+  cell.structure = {0, 1, 0, extra_inputs, {}};
+  for (int e = 0; e < extra_inputs; ++e) cell.structure.nx[std::size_t(e)] = 1;
   cell.b = {1.0};
   cell.c.assign(std::size_t(extra_inputs), 0.0);  // the further inputs do nothing
   p.cells.push_back(cell);
@@ -255,9 +258,10 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
   const bool error_form = options.form == ArxModelForm::kJointError || inverse;
   if (options.preview_cycles < 0 || (options.preview_cycles > 0 && !inverse))
     throw std::invalid_argument("identify_joint: preview_cycles >= 0, and only in inverse form");
-  if (options.model_torque_input && model_torque_nm.size() != n)
+  if ((options.model_torque_input || options.torque_sign_input) && model_torque_nm.size() != n)
     throw std::invalid_argument(
-        "identify_joint: the model torque input needs one torque per sample");
+        "identify_joint: the model torque and torque-sign inputs need one model torque per "
+        "sample");
   const auto preview = std::size_t(options.preview_cycles);
   // The path the model's input follows: the desired angles, or (inverse form) the play-free link
   // angle y, whose increments the precontrol is later fed from the desired path.
@@ -289,6 +293,21 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
             std::tanh((driver[k] - driver[k - 1]) / cycle_s / options.direction_speed_scale_rad_s);
     ahead(direction, extra[std::size_t(extra_count++)]);
   }
+  if (options.torque_sign_input) {
+    double sum_sq = 0.0;
+    std::size_t count = 0;
+    for (const auto& [begin, end] : segments)
+      for (std::size_t k = begin; k < end; ++k, ++count)
+        sum_sq += model_torque_nm[k] * model_torque_nm[k];
+    const double scale =
+        count ? options.torque_sign_scale_fraction * std::sqrt(sum_sq / double(count)) : 0.0;
+    if (!(scale > 0.0))
+      throw std::runtime_error(fmt::format("joint {}: the model torque is zero throughout", name));
+    out.parameters.torque_sign_scale_nm = scale;
+    std::vector<double> side(n);
+    for (std::size_t k = 0; k < n; ++k) side[k] = std::tanh(model_torque_nm[k] / scale);
+    ahead(side, extra[std::size_t(extra_count++)]);
+  }
   auto with_extras = [&](std::span<const double> input, std::span<const double> out_signal) {
     IoSegment all{input, out_signal, {}, extra_count};
     for (int e = 0; e < extra_count; ++e) all.extra[std::size_t(e)] = extra[std::size_t(e)];
@@ -307,6 +326,15 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
 
   OrderSelectionOptions sweep_options;
   sweep_options.grid = options.grid;
+  {  // the further inputs' taps, in the order they were added above
+    int e = 0;
+    if (options.model_torque_input)
+      sweep_options.grid.extra_taps[std::size_t(e++)] = options.input_taps;
+    if (options.direction_input)
+      sweep_options.grid.extra_taps[std::size_t(e++)] = options.input_taps;
+    if (options.torque_sign_input)
+      sweep_options.grid.extra_taps[std::size_t(e++)] = options.torque_sign_taps;
+  }
   sweep_options.criterion = options.criterion;
   sweep_options.min_relative_pivot = options.min_relative_pivot;
   sweep_options.final_fit = options.fit;

@@ -86,10 +86,21 @@ struct JointIdentificationOptions {
   //    tell; in the inverse form the offset that makes the link follow a path is a fixed linear
   //    filter of that torque and of the motion (tests/ident/test_joint_identification.cpp);
   //  * the direction of motion tanh(q̇ / direction_speed_scale): the drive's Coulomb friction
-  //    and the dynamics of crossing the play at a reversal (eq. 3's backlash l is static).
+  //    and the dynamics of crossing the play at a reversal (eq. 3's backlash l is static);
+  //  * the side of the gear the model torque presses on, tanh(τ / τ_s) with τ_s =
+  //    torque_sign_scale_fraction × the RMS model torque of the joint's data: a backlashed gear
+  //    carrying torque sits on one flank, half its play off centre (a constant for a
+  //    gravity-loaded joint, which the error form with its static gain of 1 cannot otherwise
+  //    hold), and crosses the play where the torque changes sign. Needs the model torque.
+  // Taps: input_taps for the model torque and the direction, torque_sign_taps for the sign
+  // (identify_joint sets OrderGrid::extra_taps from them).
   bool model_torque_input = false;
   bool direction_input = false;
+  bool torque_sign_input = false;
   double direction_speed_scale_rad_s = 0.01;
+  double torque_sign_scale_fraction = 0.01;
+  int input_taps = 32;
+  int torque_sign_taps = 1;
   OrderGrid grid{1, 32, 1, 32, 0, 4};
   OrderCriterion criterion = OrderCriterion::kBic;
   double validation_fraction = 0.3;  // of every segment (or block), held out (its end)

@@ -1,6 +1,7 @@
 #include "ident/order_selection.hpp"
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -11,7 +12,8 @@ namespace {
 
 void validate_grid(const OrderGrid& g) {
   if (g.na_min < 0 || g.na_max < g.na_min || g.nb_min < 1 || g.nb_max < g.nb_min ||
-      g.dead_time_min < 0 || g.dead_time_max < g.dead_time_min || g.extra_taps < 1)
+      g.dead_time_min < 0 || g.dead_time_max < g.dead_time_min ||
+      std::any_of(g.extra_taps.begin(), g.extra_taps.end(), [](int n) { return n < 1; }))
     throw std::invalid_argument("select_arx_order: invalid grid (na " + std::to_string(g.na_min) +
                                 ".." + std::to_string(g.na_max) + ", nb " +
                                 std::to_string(g.nb_min) + ".." + std::to_string(g.nb_max) +
@@ -78,11 +80,15 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
   for (const IoSegment& s : segments)
     if (s.extra_count != extras)
       throw std::invalid_argument("select_arx_order: segments carry different further inputs");
-  const int nx = extras > 0 ? grid.extra_taps : 0;
-  const int fixed = extras * nx;  // the further inputs' columns, in every candidate
-
-  const LagSet lags{grid.na_max, grid.dead_time_min, grid.dead_time_max + grid.nb_max - 1, extras,
-                    grid.dead_time_max + nx - 1};
+  // The further inputs' coefficients (OrderGrid::extra_taps, fixed), in every candidate.
+  std::array<int, kMaxExtraInputs> nx{};
+  int fixed = 0;
+  LagSet lags{grid.na_max, grid.dead_time_min, grid.dead_time_max + grid.nb_max - 1, extras, {}};
+  for (int e = 0; e < extras; ++e) {
+    nx[std::size_t(e)] = grid.extra_taps[std::size_t(e)];
+    fixed += nx[std::size_t(e)];
+    lags.extra_lag_max[std::size_t(e)] = grid.dead_time_max + nx[std::size_t(e)] - 1;
+  }
   const int first_row = lags.max_lag();
   const LaggedGram est = build_lagged_gram(estimation, lags, first_row);
   const LaggedGram val = build_lagged_gram(held_out, lags, first_row);
@@ -112,8 +118,8 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
   for (int d = grid.dead_time_min; d <= grid.dead_time_max; ++d) {
     for (int nb = grid.nb_min; nb <= grid.nb_max; ++nb) {
       const int q = fixed + nb + grid.na_max;
-      for (int e = 0; e < extras; ++e)
-        for (int j = 0; j < nx; ++j) column[e * nx + j] = lags.extra_column(e, d + j);
+      for (int e = 0, r = 0; e < extras; ++e)
+        for (int j = 0; j < nx[std::size_t(e)]; ++j) column[r++] = lags.extra_column(e, d + j);
       for (int j = 0; j < nb; ++j) column[fixed + j] = lags.input_column(d + j);
       for (int i = 1; i <= grid.na_max; ++i) column[fixed + nb + i - 1] = lags.output_column(i);
       for (int r = 0; r < q; ++r) {

@@ -26,6 +26,7 @@
 //   AIC = N ln V + 2p,   BIC = N ln V + p ln N,   validation = mean squared one-step error.
 // BIC is the default: it is consistent (picks the true order with probability → 1 as N grows),
 // AIC tends to over-fit.
+#include <array>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -39,10 +40,10 @@ struct OrderGrid {
   int na_min = 1, na_max = 32;
   int nb_min = 1, nb_max = 32;
   int dead_time_min = 0, dead_time_max = 8;
-  // Coefficients per further input (multi-input form; fixed, not swept: the further inputs are
-  // the model torque and the direction of motion, whose responses share the poles of A(z)).
-  // Used only when the data carry further inputs; then >= 1.
-  int extra_taps = 8;
+  // Coefficients of each further input (multi-input form; fixed, not swept: the further inputs
+  // are the model torque, the direction of motion and the torque's sign, whose responses share
+  // the poles of A(z)). The first as many as the data carry are used; each >= 1.
+  std::array<int, kMaxExtraInputs> extra_taps{8, 8, 8};
 };
 
 enum class OrderCriterion { kAic, kBic, kValidation };

@@ -25,11 +25,14 @@ inline constexpr int kParameterTableSchemaVersion = 2;
 enum class TableForm { kForward, kInverse };
 const char* to_string(TableForm form);
 
-// The further inputs of the cells' models (ident/joint_identification.hpp), fed by the
-// precontrol in this order: the model torque of the joint [N m] from the caller, and the
-// direction of motion tanh(q̇_x / direction_speed_scale) from its own input x.
-enum class TableInput { kModelTorque, kDirection };
-const char* to_string(TableInput input);
+// The further inputs of the cells' models (ident/joint_identification.hpp), in the order the
+// table lists them: the model torque of the joint [N m] from the caller, the direction of motion
+// tanh(q̇_x / direction_speed_scale) from the precontrol's own input x, and the side of the gear
+// the model torque presses on, tanh(torque / torque_sign_scale of the joint).
+enum class TableInput { kModelTorque, kDirection, kTorqueSign };
+inline constexpr TableInput kTableInputs[] = {TableInput::kModelTorque, TableInput::kDirection,
+                                              TableInput::kTorqueSign};
+const char* to_string(TableInput input);  // "model_torque", "direction", "torque_sign"
 
 enum class CellStatus {
   kIdentified,  // fitted from this cell's own rows
@@ -77,7 +80,9 @@ struct JointParameters {
   double backlash_l_sigma_rad = 0.0;
   bool backlash_identified = false;
   std::size_t backlash_lag_samples = 0;  // lag used for the direction of motion
-  std::vector<CellParameters> cells;     // flat (row-major) order of the grid
+  // Scale of the torque-sign input [N m] (> 0 when the table has that input, else 0).
+  double torque_sign_scale_nm = 0.0;
+  std::vector<CellParameters> cells;  // flat (row-major) order of the grid
 
   CellGrid grid() const { return CellGrid(dimensions); }
   friend bool operator==(const JointParameters& x, const JointParameters& y) {
@@ -89,7 +94,8 @@ struct JointParameters {
     return x.name == y.name && x.backlash_l_rad == y.backlash_l_rad &&
            x.backlash_l_sigma_rad == y.backlash_l_sigma_rad &&
            x.backlash_identified == y.backlash_identified &&
-           x.backlash_lag_samples == y.backlash_lag_samples && x.cells == y.cells;
+           x.backlash_lag_samples == y.backlash_lag_samples &&
+           x.torque_sign_scale_nm == y.torque_sign_scale_nm && x.cells == y.cells;
   }
 };
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
@@ -34,7 +35,15 @@ const char* to_string(TableForm form) {
 }
 
 const char* to_string(TableInput input) {
-  return input == TableInput::kModelTorque ? "model_torque" : "direction";
+  switch (input) {
+    case TableInput::kModelTorque:
+      return "model_torque";
+    case TableInput::kDirection:
+      return "direction";
+    case TableInput::kTorqueSign:
+      return "torque_sign";
+  }
+  return "?";
 }
 
 ArxModel CellParameters::model(double sample_time_s) const {
@@ -68,7 +77,8 @@ json cell_json(const CellParameters& c) {
             {"na", c.structure.na},
             {"nb", c.structure.nb},
             {"dead_time", c.structure.dead_time},
-            {"nx", c.structure.nx},
+            {"nx", std::vector<int>(c.structure.nx.begin(),
+                                    c.structure.nx.begin() + c.structure.extra_inputs)},
             {"a", c.a},
             {"b", c.b},
             {"c", c.c},
@@ -237,12 +247,18 @@ CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time
   c.structure.na = int(n.child("na").integer());
   c.structure.nb = int(n.child("nb").integer());
   c.structure.dead_time = int(n.child("dead_time").integer());
-  if (extra_inputs > 0) {
+  if (extra_inputs >= 0) {  // schema 2: one coefficient count per further input of the table
+    const Node nx = n.child("nx");
+    const std::vector<Node> counts = nx.items();
+    if (counts.size() != std::size_t(extra_inputs))
+      nx.fail(
+          fmt::format("{} counts for the table's {} further inputs", counts.size(), extra_inputs));
     c.structure.extra_inputs = extra_inputs;
-    c.structure.nx = int(n.child("nx").integer());
-    if (c.structure.nx < 1) n.child("nx").fail("the table has further inputs: nx must be >= 1");
-  } else if (extra_inputs == 0 && n.child("nx").integer() != 0) {
-    n.child("nx").fail("the table has no further inputs: nx must be 0");
+    for (int e = 0; e < extra_inputs; ++e) {
+      const long count = counts[std::size_t(e)].integer();
+      if (count < 1 || count > 256) counts[std::size_t(e)].fail("expected 1..256 coefficients");
+      c.structure.nx[std::size_t(e)] = int(count);
+    }
   }
   try {
     c.structure.validate();
@@ -252,9 +268,9 @@ CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time
   c.a = n.child("a").numbers();
   c.b = n.child("b").numbers();
   if (extra_inputs >= 0) c.c = n.child("c").numbers();
-  if (c.c.size() != std::size_t(c.structure.extra_inputs * c.structure.nx))
-    n.child("c").fail(fmt::format("{} coefficients, {} further inputs x nx = {}", c.c.size(),
-                                  c.structure.extra_inputs, c.structure.nx));
+  if (c.c.size() != std::size_t(c.structure.extra_coefficient_count()))
+    n.child("c").fail(fmt::format("{} coefficients, the further inputs' nx add up to {}",
+                                  c.c.size(), c.structure.extra_coefficient_count()));
   if (c.a.size() != std::size_t(c.structure.na))
     n.child("a").fail(fmt::format("{} coefficients, na = {}", c.a.size(), c.structure.na));
   if (c.b.size() != std::size_t(c.structure.nb))
@@ -265,11 +281,24 @@ CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time
   return c;
 }
 
-JointParameters read_joint(const Node& n, double sample_time_s, int extra_inputs) {
-  n.only_keys({"name", "backlash", "dimensions", "cells"});
+// extra_inputs: the table's further inputs (-1: schema version 1); torque_sign: whether one of
+// them is the torque's sign (the joint then needs its scale).
+JointParameters read_joint(const Node& n, double sample_time_s, int extra_inputs,
+                           bool torque_sign) {
+  if (extra_inputs < 0)
+    n.only_keys({"name", "backlash", "dimensions", "cells"});
+  else
+    n.only_keys({"name", "backlash", "torque_sign_scale_nm", "dimensions", "cells"});
   JointParameters j;
   j.name = n.child("name").string();
   if (j.name.empty()) n.child("name").fail("empty joint name");
+  if (extra_inputs >= 0) {
+    j.torque_sign_scale_nm = n.child("torque_sign_scale_nm").number();
+    if (torque_sign ? !(j.torque_sign_scale_nm > 0.0) : j.torque_sign_scale_nm != 0.0)
+      n.child("torque_sign_scale_nm")
+          .fail(torque_sign ? "the table has the torque-sign input: the scale must be > 0"
+                            : "the table has no torque-sign input: the scale must be 0");
+  }
   const Node bl = n.child("backlash");
   bl.only_keys({"l_rad", "l_sigma_rad", "identified", "lag_samples"});
   j.backlash_l_rad = bl.child("l_rad").number();
@@ -321,6 +350,7 @@ std::string parameters_json_text(const ParameterTable& t) {
                         {"l_sigma_rad", j.backlash_l_sigma_rad},
                         {"identified", j.backlash_identified},
                         {"lag_samples", j.backlash_lag_samples}}},
+                      {"torque_sign_scale_nm", j.torque_sign_scale_nm},
                       {"dimensions", dims},
                       {"cells", cells}});
   }
@@ -345,6 +375,18 @@ std::string parameters_json_text(const ParameterTable& t) {
   return root.dump(1) + "\n";
 }
 
+namespace {
+
+// The further inputs' coefficient counts, space-separated (empty without further inputs).
+std::string join_counts(const ArxStructure& s) {
+  std::string out;
+  for (int e = 0; e < s.extra_inputs; ++e)
+    out += fmt::format("{}{}", out.empty() ? "" : " ", s.nx[std::size_t(e)]);
+  return out;
+}
+
+}  // namespace
+
 std::string parameters_csv_text(const ParameterTable& t) {
   std::ostringstream s;
   s << "joint,cell,bands,bounds_si,status,filled_from,na,nb,dead_time,nx,backlash_l_rad,"
@@ -367,11 +409,11 @@ std::string parameters_csv_text(const ParameterTable& t) {
       s << fmt::format(
           "{},{},{},\"{}\",{},{},{},{},{},{},{:.17g},{:.17g},{},{},{},{},{},{},{},{},{},{},{},{}\n",
           j.name, flat, bands, grid.label(int(flat)), to_string(c.status), c.filled_from,
-          c.structure.na, c.structure.nb, c.structure.dead_time, c.structure.nx, j.backlash_l_rad,
-          j.backlash_l_sigma_rad, f.estimation_rows, f.validation_rows, f.one_step_fit_percent,
-          f.simulation_fit_percent, f.joint_error_fit_percent, f.residual_rms_rad,
-          f.whiteness_passed ? 1 : 0, f.input_residual_passed ? 1 : 0, f.spectral_radius, join(c.a),
-          join(c.b), join(c.c));
+          c.structure.na, c.structure.nb, c.structure.dead_time, join_counts(c.structure),
+          j.backlash_l_rad, j.backlash_l_sigma_rad, f.estimation_rows, f.validation_rows,
+          f.one_step_fit_percent, f.simulation_fit_percent, f.joint_error_fit_percent,
+          f.residual_rms_rad, f.whiteness_passed ? 1 : 0, f.input_residual_passed ? 1 : 0,
+          f.spectral_radius, join(c.a), join(c.b), join(c.c));
     }
   }
   return s.str();
@@ -421,12 +463,11 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
     const Node inputs = r.child("extra_inputs");
     for (const Node& i : inputs.items()) {
       const std::string name = i.string();
-      if (name == to_string(TableInput::kModelTorque))
-        t.extra_inputs.push_back(TableInput::kModelTorque);
-      else if (name == to_string(TableInput::kDirection))
-        t.extra_inputs.push_back(TableInput::kDirection);
-      else
-        i.fail("expected 'model_torque' or 'direction', got '" + name + "'");
+      const auto* kind = std::find_if(std::begin(kTableInputs), std::end(kTableInputs),
+                                      [&](TableInput k) { return name == to_string(k); });
+      if (kind == std::end(kTableInputs))
+        i.fail("expected 'model_torque', 'direction' or 'torque_sign', got '" + name + "'");
+      t.extra_inputs.push_back(*kind);
     }
     if (t.extra_inputs.size() > std::size_t(kMaxExtraInputs))
       inputs.fail(fmt::format("at most {} further inputs", kMaxExtraInputs));
@@ -461,8 +502,10 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
   const Node joints = r.child("joints");
   std::set<std::string> names;
   for (const Node& j : joints.items()) {
-    t.joints.push_back(
-        read_joint(j, t.sample_time_s, t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1));
+    const bool torque_sign = std::find(t.extra_inputs.begin(), t.extra_inputs.end(),
+                                       TableInput::kTorqueSign) != t.extra_inputs.end();
+    t.joints.push_back(read_joint(
+        j, t.sample_time_s, t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1, torque_sign));
     if (!names.insert(t.joints.back().name).second)
       j.child("name").fail("joint '" + t.joints.back().name + "' given twice");
   }

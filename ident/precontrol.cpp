@@ -69,9 +69,20 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
     return refuse("at most " + std::to_string(kArxStepMaxExtras) + " further inputs supported");
   p.extra_count_ = static_cast<int>(table.extra_inputs.size());
   for (int e = 0; e < p.extra_count_; ++e) {
-    (table.extra_inputs[std::size_t(e)] == TableInput::kModelTorque ? p.torque_input_
-                                                                    : p.direction_input_) = e;
+    switch (table.extra_inputs[std::size_t(e)]) {
+      case TableInput::kModelTorque:
+        p.torque_input_ = e;
+        break;
+      case TableInput::kDirection:
+        p.direction_input_ = e;
+        break;
+      case TableInput::kTorqueSign:
+        p.torque_sign_input_ = e;
+        break;
+    }
   }
+  if (p.torque_sign_input_ >= 0 && p.torque_input_ < 0)
+    return refuse("the torque-sign input needs the model torque input");
   if (!(table.direction_speed_scale_rad_s > 0.0)) return refuse("direction scale must be > 0");
   p.direction_scale_ = table.direction_speed_scale_rad_s;
   const double up = c / T, down = T / c;
@@ -120,31 +131,36 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
                     " samples exceeds the supported " + std::to_string(kSpeedRing - 1));
     }
     joint.backlash_lag = static_cast<int>(source.backlash_lag_samples);
+    joint.torque_sign_scale_nm = source.torque_sign_scale_nm;
+    if (p.torque_sign_input_ >= 0 && !(joint.torque_sign_scale_nm > 0.0))
+      return refuse(name + "the torque-sign input needs a scale > 0");
     for (int k = 0; k < joint.cells; ++k) {
       const CellParameters& cell = source.cells[k];
       CellModel& model = joint.cell[k];
       model.na = cell.structure.na;
       model.nb = cell.structure.nb;
       model.d = cell.structure.dead_time;
-      model.nx = cell.structure.nx;
-      if (model.na < 0 || model.na > kMaxPrecontrolOrder || model.nb < 1 ||
-          model.nb > kMaxPrecontrolOrder || model.d < 0 || model.d > kMaxPrecontrolDeadTime ||
-          model.nx < 0 || model.nx > kMaxPrecontrolOrder ||
-          static_cast<int>(cell.a.size()) != model.na ||
-          static_cast<int>(cell.b.size()) != model.nb) {
-        return refuse(name + "cell " + std::to_string(k) + ": order or dead time out of range");
-      }
       if (cell.structure.extra_inputs != p.extra_count_ ||
-          cell.c.size() != std::size_t(p.extra_count_ * model.nx)) {
+          cell.c.size() != std::size_t(cell.structure.extra_coefficient_count())) {
         return refuse(name + "cell " + std::to_string(k) + ": " +
                       std::to_string(cell.structure.extra_inputs) +
                       " further inputs, the table declares " + std::to_string(p.extra_count_));
       }
+      model.nx = cell.structure.max_nx();
+      if (model.na < 0 || model.na > kMaxPrecontrolOrder || model.nb < 1 ||
+          model.nb > kMaxPrecontrolOrder || model.d < 0 || model.d > kMaxPrecontrolDeadTime ||
+          model.nx > kMaxPrecontrolOrder || static_cast<int>(cell.a.size()) != model.na ||
+          static_cast<int>(cell.b.size()) != model.nb) {
+        return refuse(name + "cell " + std::to_string(k) + ": order or dead time out of range");
+      }
       model.terms = round_up(std::max({model.na, model.nb, model.nx}), kArxStepLanes);
       for (int i = 0; i < model.na; ++i) model.a[i] = cell.a[i];
       for (int i = 0; i < model.nb; ++i) model.b[i] = cell.b[i];
-      for (int e = 0; e < p.extra_count_; ++e)
-        for (int i = 0; i < model.nx; ++i) model.c[e][i] = cell.c[std::size_t(e * model.nx + i)];
+      for (int e = 0; e < p.extra_count_; ++e) {
+        model.c[e].fill(0.0);  // beyond nx[e]: zeros, so every sum runs over `terms` entries
+        for (int i = 0; i < cell.structure.nx[std::size_t(e)]; ++i)
+          model.c[e][i] = cell.c[std::size_t(cell.structure.extra_offset(e) + i)];
+      }
       auto all_finite = [](const std::vector<double>& v) {
         return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
       };
@@ -177,11 +193,14 @@ int Precontrol::read_events(PrecontrolEvent* out, int capacity) noexcept {
   return n;
 }
 
-std::array<double, kArxStepMaxExtras> Precontrol::extra_values(double speed,
+std::array<double, kArxStepMaxExtras> Precontrol::extra_values(const JointModel& joint,
+                                                               double speed,
                                                                double torque) const noexcept {
   std::array<double, kArxStepMaxExtras> value{};
   if (torque_input_ >= 0) value[torque_input_] = torque;
   if (direction_input_ >= 0) value[direction_input_] = std::tanh(speed / direction_scale_);
+  if (torque_sign_input_ >= 0)
+    value[torque_sign_input_] = std::tanh(torque / joint.torque_sign_scale_nm);
   return value;
 }
 
@@ -194,7 +213,7 @@ void Precontrol::restart_models(const std::array<double, kPrecontrolJoints>& q,
   for (int j = 0; j < kPrecontrolJoints; ++j) {
     JointModel& joint = joints_[j];
     joint.u.fill(q[j]);
-    const std::array<double, kArxStepMaxExtras> x = extra_values(0.0, torque[j]);
+    const std::array<double, kArxStepMaxExtras> x = extra_values(joint, 0.0, torque[j]);
     for (int e = 0; e < extra_count_; ++e) joint.x[e].fill(x[e]);
     for (int k = 0; k < joint.cells; ++k) {
       CellModel& m = joint.cell[k];
@@ -222,7 +241,7 @@ void Precontrol::model_step(JointModel& joint, double q_desired, double speed, d
                             double payload, double torque, bool& outside) noexcept {
   push_newest(joint.u, joint.u_pos, kInputRing, q_desired);
   const double* u = joint.u.data() + joint.u_pos;  // u[i] = q_d(k - i)
-  const std::array<double, kArxStepMaxExtras> x = extra_values(speed, torque);
+  const std::array<double, kArxStepMaxExtras> x = extra_values(joint, speed, torque);
   for (int e = 0; e < extra_count_; ++e) {
     joint.x[e][joint.u_pos] = x[e];
     joint.x[e][joint.u_pos + kInputRing] = x[e];

@@ -153,6 +153,7 @@ class Precontrol {
     std::array<int, 4> centre_count{};
     std::array<double, 4> lower{}, upper{};  // grid bounds (outside: event)
     double backlash_l_rad = 0.0;
+    double torque_sign_scale_nm = 0.0;  // of the torque-sign input [N m]
     // The identification's direction of motion is the desired velocity `backlash_lag` cycles
     // earlier (ident/backlash_identification.hpp): a ring of past speeds [rad/s].
     int backlash_lag = 0;
@@ -171,7 +172,8 @@ class Precontrol {
   void model_step(JointModel& joint, double q_desired, double speed, double acceleration,
                   double payload, double torque, bool& outside) noexcept;
   // The further inputs' values of a model step (model torque, direction), table order.
-  std::array<double, kArxStepMaxExtras> extra_values(double speed, double torque) const noexcept;
+  std::array<double, kArxStepMaxExtras> extra_values(const JointModel& joint, double speed,
+                                                     double torque) const noexcept;
   void restart_models(const std::array<double, kPrecontrolJoints>& q_desired,
                       const std::array<double, kPrecontrolJoints>& torque) noexcept;
   PrecontrolOutput run_cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
@@ -194,6 +196,7 @@ class Precontrol {
   int extra_count_ = 0;            // further inputs of every cell's model
   int torque_input_ = -1;          // index of the model torque among them, -1: none
   int direction_input_ = -1;       // index of the direction, -1: none
+  int torque_sign_input_ = -1;     // index of the torque's sign, -1: none
   double direction_scale_ = 0.01;  // [rad/s]
   double last_payload_ = 0.0;
   bool started_ = false;

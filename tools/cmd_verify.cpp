@@ -246,6 +246,16 @@ void run(const VerifyArgs& args) {
     throw imscal::InputError("", 0, "--table",
                              "give --table, --joint-errors or --identify-scenario");
   }
+  // The robot's rigid-body model for multi-input tables: that of the identification scenario,
+  // else of the first verified scenario (the joint errors' robot must be the same).
+  const eval::ModelTorqueSource torque_model =
+      eval::scenario_model_torque(imscal::sim::load_scenario(imscal::sim::resolve_scenario(
+          args.identify_scenario.empty() ? args.scenarios.front() : args.identify_scenario)));
+  if (log && log->robot != torque_model.robot.name)
+    throw imscal::InputError(source, 0, "robot",
+                             fmt::format("the joint errors are of robot '{}', the scenarios' "
+                                         "robot is '{}'",
+                                         log->robot, torque_model.robot.name));
   std::optional<ident::IdentificationConfig> config;
   if (log) {
     const std::string config_file =
@@ -260,7 +270,7 @@ void run(const VerifyArgs& args) {
     tables.push_back({"compensated", ident::read_parameters_json(args.table)});
   } else {
     spdlog::info("verify: identifying the table from {}", source);
-    const eval::IdentifiedTable t = eval::identify_table(*log, *config, source);
+    const eval::IdentifiedTable t = eval::identify_table(*log, *config, source, &torque_model);
     for (const auto& f : t.failed_joints) spdlog::warn("verify: not identified: {}", f);
     ident::write_parameters_json(out / "parameters.json", t.table, overwrite);
     tables.push_back({"compensated", t.table});
@@ -269,7 +279,7 @@ void run(const VerifyArgs& args) {
     for (const auto& [label, cfg] : {std::pair{"no backlash", eval::without_backlash(*config)},
                                      std::pair{"single cell", eval::single_cell(*config)}}) {
       spdlog::info("verify: ablation table '{}'", label);
-      const eval::IdentifiedTable t = eval::identify_table(*log, cfg, source);
+      const eval::IdentifiedTable t = eval::identify_table(*log, cfg, source, &torque_model);
       for (const auto& f : t.failed_joints)
         spdlog::warn("verify: {}: not identified: {}", label, f);
       tables.push_back({label, t.table});

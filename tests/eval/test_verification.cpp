@@ -47,16 +47,22 @@ struct Tables {
 
 const Tables& tables() {
   static const Tables t = [] {
+    const sim::Scenario identification = scenario("identification");
     const ident::JointErrorLog log =
-        simulate_truth_joint_errors(scenario("identification"), sanitized() ? 60.0 : 1e9);
+        simulate_truth_joint_errors(identification, sanitized() ? 60.0 : 1e9);
+    const char* config_file = std::getenv("IMSCAL_VERIFY_CONFIG");
     ident::IdentificationConfig config = ident::load_identification_config(ConfigNode::load_file(
-        fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-default.yaml"));
+        config_file ? fs::path(config_file)
+                    : fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-default.yaml"));
     if (const char* v = std::getenv("IMSCAL_VERIFY_FORM"))
       config.options.form = ident::arx_model_form_from_string(v);
     if (const char* v = std::getenv("IMSCAL_VERIFY_PREVIEW"))
       config.options.preview_cycles = std::atoi(v);
-    Tables out{identify_table(log, config), identify_table(log, without_backlash(config)),
-               identify_table(log, single_cell(config))};
+    const ModelTorqueSource torque_model = scenario_model_torque(identification);
+    const std::string source = "simulator truth";
+    Tables out{identify_table(log, config, source, &torque_model),
+               identify_table(log, without_backlash(config), source, &torque_model),
+               identify_table(log, single_cell(config), source, &torque_model)};
     for (const auto* t : {&out.full, &out.no_backlash, &out.one_cell})
       for (const auto& failed : t->failed_joints)
         std::printf("not identified: %s\n", failed.c_str());
@@ -98,6 +104,10 @@ VerificationResult run(const std::string& name, const std::string& filter, bool 
   options.compensation.inversion_iterations = inversion_iterations();
   if (const char* v = std::getenv("IMSCAL_VERIFY_OFFSET_TOLERANCE_RAD"))
     options.compensation.precontrol.offset_tolerance_rad.fill(std::atof(v));
+  if (const char* v = std::getenv("IMSCAL_VERIFY_RATE_TOLERANCE_RAD_S"))
+    options.compensation.precontrol.rate_tolerance_rad_s.fill(std::atof(v));
+  if (const char* v = std::getenv("IMSCAL_VERIFY_RATE_LIMIT_RAD_S"))
+    options.compensation.precontrol.rate_limit_rad_s.fill(std::atof(v));
   std::vector<NamedTable> named{{"compensated", tables().full.table}};
   if (ablation) {
     named.push_back({"no backlash", tables().no_backlash.table});

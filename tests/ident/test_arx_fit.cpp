@@ -284,8 +284,10 @@ using imscal::test_support::simulate_multi;
 TEST(ArxFit, RecoversNoiseFreeMultiInputSystemExactly) {
   // Same bound as the single-input case (1e-9 relative, issue 5), both solver paths.
   std::mt19937_64 rng(21);
-  for (const ArxStructure s : {ArxStructure{4, 3, 2, 1, 5}, ArxStructure{2, 6, 0, 2, 3},
-                               ArxStructure{0, 2, 1, 2, 8}, ArxStructure{16, 16, 3, 2, 8}}) {
+  // Unequal tap counts per further input (e.g. a one-tap torque sign beside 8-tap inputs).
+  for (const ArxStructure s :
+       {ArxStructure{4, 3, 2, 1, {5}}, ArxStructure{2, 6, 0, 2, {3, 1}},
+        ArxStructure{0, 2, 1, 2, {8, 8}}, ArxStructure{16, 16, 3, 3, {8, 1, 12}}}) {
     const ArxModel truth = random_multi_system(s, rng);
     const MultiRecord run = simulate_multi(truth, 5000, 0.0, rng);
     const std::vector<IoSegment> data{run.view()};
@@ -313,7 +315,7 @@ TEST(ArxFit, RecoversNoiseFreeMultiInputSystemExactly) {
 TEST(ArxFit, MultiInputUnbiasedWithHonestSigma) {
   // White equation noise: every estimate within 4 sigma of the truth (sigma from the fit).
   std::mt19937_64 rng(22);
-  const ArxStructure s{3, 4, 1, 2, 4};
+  const ArxStructure s{3, 4, 1, 2, {4, 1}};
   const ArxModel truth = random_multi_system(s, rng);
   const MultiRecord run = simulate_multi(truth, sanitized() ? 20000 : 100000, 0.05, rng);
   const auto fit = fit_arx(std::vector<IoSegment>{run.view()}, s);
@@ -325,11 +327,11 @@ TEST(ArxFit, MultiInputUnbiasedWithHonestSigma) {
 
 TEST(ArxFit, MultiInputLaggedGramEqualsExplicitRegressorProducts) {
   std::mt19937_64 rng(23);
-  const ArxModel truth = random_multi_system({2, 2, 1, 2, 3}, rng);
+  const ArxModel truth = random_multi_system({2, 2, 1, 2, {3, 5}}, rng);
   const MultiRecord a = simulate_multi(truth, 200, 0.1, rng);
   const MultiRecord b = simulate_multi(truth, 41, 0.1, rng);
   const std::vector<IoSegment> data{a.view(), b.view()};
-  const LagSet lags{4, 1, 7, 2, 5};  // y 0..4, u 1..7, x_0 and x_1 1..5
+  const LagSet lags{4, 1, 7, 2, {5, 6}};  // y 0..4, u 1..7, x_0 1..5, x_1 1..6
   const int first_row = 9;
   const auto lagged = build_lagged_gram(data, lags, first_row);
   Eigen::MatrixXd explicit_gram = Eigen::MatrixXd::Zero(lags.columns(), lags.columns());
@@ -338,8 +340,8 @@ TEST(ArxFit, MultiInputLaggedGramEqualsExplicitRegressorProducts) {
       Eigen::VectorXd row(lags.columns());
       for (int l = 0; l <= 4; ++l) row(lags.output_column(l)) = run->y[k - l];
       for (int l = 1; l <= 7; ++l) row(lags.input_column(l)) = run->u[k - l];
-      for (int e = 0; e < 2; ++e)
-        for (int l = 1; l <= 5; ++l) row(lags.extra_column(e, l)) = run->x[std::size_t(e)][k - l];
+      for (int l = 1; l <= 5; ++l) row(lags.extra_column(0, l)) = run->x[0][k - l];
+      for (int l = 1; l <= 6; ++l) row(lags.extra_column(1, l)) = run->x[1][k - l];
       explicit_gram += row * row.transpose();
     }
   }
@@ -349,7 +351,7 @@ TEST(ArxFit, MultiInputLaggedGramEqualsExplicitRegressorProducts) {
 
 TEST(ArxFit, MultiInputRefusesDataWithoutTheFurtherInputs) {
   std::mt19937_64 rng(24);
-  const ArxModel truth = random_multi_system({1, 1, 0, 1, 2}, rng);
+  const ArxModel truth = random_multi_system({1, 1, 0, 1, {2}}, rng);
   MultiRecord run = simulate_multi(truth, 100, 0.0, rng);
   IoSegment missing = run.view();
   missing.extra_count = 0;
@@ -358,6 +360,7 @@ TEST(ArxFit, MultiInputRefusesDataWithoutTheFurtherInputs) {
   short_extra.extra[0] = short_extra.extra[0].first(50);
   EXPECT_THROW(fit_arx(std::vector<IoSegment>{short_extra}, truth.structure()),
                std::invalid_argument);
-  EXPECT_THROW((ArxStructure{1, 1, 0, 1, 0}.validate()), std::invalid_argument);
-  EXPECT_THROW((ArxStructure{1, 1, 0, 3, 2}.validate()), std::invalid_argument);
+  EXPECT_THROW((ArxStructure{1, 1, 0, 1, {0}}.validate()), std::invalid_argument);        // nx < 1
+  EXPECT_THROW((ArxStructure{1, 1, 0, 1, {2, 1}}.validate()), std::invalid_argument);     // unused
+  EXPECT_THROW((ArxStructure{1, 1, 0, 4, {2, 2, 2}}.validate()), std::invalid_argument);  // > 3
 }

@@ -168,21 +168,21 @@ TEST(OrderSelection, MultiInputSweepEqualsDirectFitsAndFindsTheTrueStructure) {
   // (na, nb, d) must give the same losses as direct fits on the same rows (1e-9, as above) and
   // choose the true structure.
   std::mt19937_64 rng(31);
-  const ArxStructure truth_structure{2, 3, 1, 2, 4};
+  const ArxStructure truth_structure{2, 3, 1, 2, {4, 1}};
   const ArxModel truth = imscal::test_support::random_multi_system(truth_structure, rng);
   const auto est = imscal::test_support::simulate_multi(truth, 3000, 0.05, rng);
   const auto val = imscal::test_support::simulate_multi(truth, 1500, 0.05, rng);
   const std::vector<IoSegment> estimation{est.view()}, validation{val.view()};
   OrderSelectionOptions options;
   options.grid = {0, 4, 1, 4, 0, 3};
-  options.grid.extra_taps = 4;
+  options.grid.extra_taps = {4, 1, 1};
   const auto result = select_arx_order(estimation, options, validation);
   ASSERT_EQ(result.candidates.size(), 5u * 4u * 4u);
   const int first_row = std::max(4, 3 + 4 - 1);  // largest lag of the grid (u and x: d + n - 1)
   for (const OrderCandidate& c : result.candidates) {
     ASSERT_TRUE(c.valid) << to_string(c.structure);
     EXPECT_EQ(c.structure.extra_inputs, 2);
-    EXPECT_EQ(c.structure.nx, 4);
+    EXPECT_EQ(c.structure.nx, (std::array<int, 3>{4, 1, 0}));
     const std::size_t skip = std::size_t(first_row - c.structure.max_lag());
     const std::vector<IoSegment> rows{estimation[0].subspan(skip)};
     const auto fit = fit_arx(rows, c.structure);

@@ -27,6 +27,8 @@ ident::ParameterTable sample_table() {
   t.created_by = "imscal test";
   t.model_form = ident::TableForm::kInverse;  // schema 2's keys in the round trip
   t.preview_cycles = 6;
+  t.extra_inputs = {ident::TableInput::kModelTorque, ident::TableInput::kTorqueSign};
+  t.direction_speed_scale_rad_s = 0.0123;
   t.source = {"/tmp/joint_errors.csv", std::string(64, 'a'), 123456, "simulated"};
   for (const char* name : {"A1", "A2"}) {
     ident::JointParameters j;
@@ -37,14 +39,16 @@ ident::ParameterTable sample_table() {
     j.backlash_l_sigma_rad = 1e-5 * uniform(rng);
     j.backlash_identified = true;
     j.backlash_lag_samples = 17;
+    j.torque_sign_scale_nm = 10.0 * uniform(rng) + 0.1;
     const ident::CellGrid grid(j.dimensions);
     for (int flat = 0; flat < grid.cell_count(); ++flat) {
       ident::CellParameters c;
       c.bands = grid.bands_of(flat);
-      c.structure = {2 + flat % 3, 1 + flat % 2, flat % 4};
-      const auto model = imscal::test_support::random_system(c.structure, rng);
+      c.structure = {2 + flat % 3, 1 + flat % 2, flat % 4, 2, {3 + flat % 2, 1}};
+      const auto model = imscal::test_support::random_multi_system(c.structure, rng);
       c.a.assign(model.a().data(), model.a().data() + model.a().size());
       c.b.assign(model.b().data(), model.b().data() + model.b().size());
+      c.c.assign(model.c().data(), model.c().data() + model.c().size());
       c.figures.estimation_rows = 5000u + unsigned(flat);
       c.figures.validation_rows = 2000;
       c.figures.one_step_fit_percent = 99.1 * uniform(rng);
@@ -88,11 +92,13 @@ TEST(ParameterTable, Version1TablesReadAsForwardModelsWithoutPreview) {
   for (const char* key :
        {"model_form", "preview_cycles", "extra_inputs", "direction_speed_scale_rad_s"})
     j.erase(key);
-  for (auto& joint : j["joints"])
+  for (auto& joint : j["joints"]) {
+    joint.erase("torque_sign_scale_nm");
     for (auto& cell : joint["cells"]) {
       cell.erase("nx");
       cell.erase("c");
     }
+  }
   const auto back = ident::parse_parameters_json(j.dump(), "v1.json");
   EXPECT_EQ(back.model_form, ident::TableForm::kForward);
   EXPECT_EQ(back.preview_cycles, 0);
@@ -134,6 +140,17 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 3; }, "/schema_version",
                 "unknown schema version 3"},
+        Refusal{"CountsForTheFurtherInputs",
+                [](json& j) { j["joints"][0]["cells"][0]["nx"] = json::array({3}); },
+                "/joints/0/cells/0/nx", "1 counts for the table's 2 further inputs"},
+        Refusal{"FurtherCoefficientsMissing",
+                [](json& j) { j["joints"][0]["cells"][0]["c"].erase(0); }, "/joints/0/cells/0/c",
+                "the further inputs' nx add up to"},
+        Refusal{"UnknownFurtherInput", [](json& j) { j["extra_inputs"][1] = "temperature"; },
+                "/extra_inputs/1", "expected 'model_torque', 'direction' or 'torque_sign'"},
+        Refusal{"TorqueSignWithoutScale",
+                [](json& j) { j["joints"][1]["torque_sign_scale_nm"] = 0.0; },
+                "/joints/1/torque_sign_scale_nm", "the scale must be > 0"},
         Refusal{"UnknownModelForm", [](json& j) { j["model_form"] = "sideways"; }, "/model_form",
                 "expected 'forward' or 'inverse'"},
         Refusal{"PreviewOfAForwardTable",

@@ -85,7 +85,7 @@ inline ident::IoSegment view(const ArxRecord& r) {
   return {r.u, r.y};
 }
 
-// y(k) = -Σ a_i y(k-i) + Σ b_j u(k-d-j) + Σ_e Σ_j c_e,j x_e(k-d-j) + noise, white inputs,
+// y(k) = -Σ a_i y(k-i) + Σ b_j u(k-d-j) + Σ_e Σ_{j<nx[e]} c_e,j x_e(k-d-j) + noise, white inputs,
 // zero before k = 0. Computed here, independently of ArxModel::simulate.
 struct MultiRecord {
   std::vector<double> u, y;
@@ -118,9 +118,9 @@ inline MultiRecord simulate_multi(const ident::ArxModel& m, std::size_t n, doubl
       if (idx >= 0) sum += m.b()(j) * r.u[std::size_t(idx)];
     }
     for (int e = 0; e < s.extra_inputs; ++e)
-      for (int j = 0; j < s.nx; ++j) {
+      for (int j = 0; j < s.nx[std::size_t(e)]; ++j) {
         const long idx = long(k) - s.dead_time - j;
-        if (idx >= 0) sum += m.c()(e * s.nx + j) * r.x[std::size_t(e)][std::size_t(idx)];
+        if (idx >= 0) sum += m.c()(s.extra_offset(e) + j) * r.x[std::size_t(e)][std::size_t(idx)];
       }
     r.y[k] = sum;
   }
@@ -128,7 +128,7 @@ inline MultiRecord simulate_multi(const ident::ArxModel& m, std::size_t n, doubl
 }
 
 inline ident::ArxModel random_multi_system(const ident::ArxStructure& s, std::mt19937_64& rng) {
-  Eigen::VectorXd c = 1e-3 * random_b(s.extra_inputs * s.nx, rng);
+  Eigen::VectorXd c = 1e-3 * random_b(s.extra_coefficient_count(), rng);
   return ident::ArxModel(s, polynomial_from_poles(random_poles(s.na, rng)), random_b(s.nb, rng), c,
                          0.002);
 }
