@@ -245,14 +245,21 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
         "the time) and in the {} band ({:.0f} %).",
         out.where.rms_rad, out.where.rms_rad * arcsec, ja.joint, 100.0 * ja.energy_share, ph.label,
         100.0 * ph.energy_share, 100.0 * ph.time_share, band.label, 100.0 * band.energy_share);
+    // Cells outside the identified range, on every joint that runs in them.
     std::vector<std::string> outside;
-    for (const auto& c : ja.by_cell)
-      if (c.outside_identified_range && c.time_share > 0.0)
-        outside.push_back(
-            fmt::format("{} ({:.0f} % of the gap energy)", c.label, 100.0 * c.energy_share));
+    for (const auto& jo : out.where.joints) {
+      double time = 0.0, energy = 0.0;
+      for (const auto& c : jo.by_cell)
+        if (c.outside_identified_range) time += c.time_share, energy += c.energy_share;
+      if (time > 0.0)
+        outside.push_back(fmt::format("{} {:.0f} % of the time ({:.0f} % of its gap energy)",
+                                      jo.joint, 100.0 * time, 100.0 * energy));
+    }
     if (!outside.empty())
-      where += fmt::format(" Operating-point cells outside the identified range: {}.",
-                           fmt::join(outside, ", "));
+      where += fmt::format(
+          " The path runs at operating points outside the identified range (cells of the error "
+          "model not identified from data): {}.",
+          fmt::join(outside, ", "));
   }
   if (!out.significant_gap) {
     out.verdict = fmt::format(
