@@ -41,7 +41,7 @@ std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta
   const double h = s.cycle_s / sub;
   Column y(u.size()), r(u.size());
   for (const auto& [b, e] : s.runs) {
-    double p = 0.0, v = 0.0;
+    double p = e > b ? u[Eigen::Index(b)] : 0.0, v = 0.0;  // at rest in its first input
     for (std::size_t k = b; k < e; ++k) {
       const double x = u[Eigen::Index(k)];
       for (int i = 0; i < sub; ++i) {
@@ -83,6 +83,12 @@ std::vector<Column> laguerre(const Column& u, double tau_s, int order, const Gap
   return out;
 }
 
+Eigen::MatrixXd matrix_of(const std::vector<Column>& cols) {
+  Eigen::MatrixXd m(cols.empty() ? 0 : cols[0].size(), Eigen::Index(cols.size()));
+  for (std::size_t i = 0; i < cols.size(); ++i) m.col(Eigen::Index(i)) = cols[i];
+  return m;
+}
+
 std::vector<std::string> numbered(const std::string& stem, int count) {
   std::vector<std::string> names;
   for (int i = 0; i < count; ++i) names.push_back(fmt::format("{}{}_rad", stem, i));
@@ -91,15 +97,6 @@ std::vector<std::string> numbered(const std::string& stem, int count) {
 
 double rms_of(const Column& c) {
   return c.size() ? std::sqrt(c.squaredNorm() / double(c.size())) : 0.0;
-}
-
-CandidateShape shape(std::string label, std::vector<Column> cols, std::vector<std::string> names) {
-  CandidateShape sh;
-  sh.label = std::move(label);
-  sh.columns.resize(cols.empty() ? 0 : cols[0].size(), Eigen::Index(cols.size()));
-  for (std::size_t i = 0; i < cols.size(); ++i) sh.columns.col(Eigen::Index(i)) = cols[i];
-  sh.parameter_names = std::move(names);
-  return sh;
 }
 
 // Velocity scale of the smooth sign of the desired velocity [rad/s]: 0.3 deg/s, well below any
@@ -169,60 +166,106 @@ EffectKind effect_kind_from_index(int index) {
 std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& s,
                                              std::size_t joint) {
   const Eigen::Index n = Eigen::Index(s.sample_count());
+  const std::size_t nj = s.joint_count();
   const Column qd = to_column(s.qd_desired_rad_s[joint]);
   const Column qdd = to_column(s.qdd_desired_rad_s2[joint]);
+  // The drive's actual motion (q_internal) where known: its velocity and its torque.
+  const bool actual = joint < s.qd_internal_rad_s.size() && joint < s.torque_internal_nm.size() &&
+                      rms_of(to_column(s.qd_internal_rad_s[joint])) > 0.0;
+  const Column qd_actual = actual ? to_column(s.qd_internal_rad_s[joint]) : qd;
+  const Column tau_actual =
+      actual ? to_column(s.torque_internal_nm[joint]) : to_column(s.torque_nm[joint]);
+  // A shape on this joint only.
+  const auto local = [&](std::string label, std::vector<Column> cols,
+                         std::vector<std::string> names) {
+    CandidateShape sh;
+    sh.label = std::move(label);
+    sh.columns.assign(nj, Eigen::MatrixXd());
+    sh.columns[joint] = matrix_of(cols);
+    sh.parameter_names = std::move(names);
+    return sh;
+  };
+  // A shape with the same parameters on every joint: column block `cols` of joint j's matrix.
+  const auto shared = [&](std::string label, const auto& matrix_of_joint, std::vector<int> cols,
+                          std::vector<std::string> names) {
+    CandidateShape sh;
+    sh.label = std::move(label);
+    for (std::size_t j = 0; j < nj; ++j) {
+      const Eigen::MatrixXd& m = matrix_of_joint(j);
+      Eigen::MatrixXd c(n, Eigen::Index(cols.size()));
+      for (std::size_t i = 0; i < cols.size(); ++i) c.col(Eigen::Index(i)) = m.col(cols[i]);
+      sh.columns.push_back(c);
+    }
+    sh.parameter_names = std::move(names);
+    return sh;
+  };
   std::vector<CandidateShape> out;
   switch (kind) {
     case EffectKind::kBacklash: {
-      const Column sv = (qd / kSignVelocityScale).array().tanh().matrix();
-      const Column tau = to_column(s.torque_nm[joint]);
-      const double tau_scale = std::max(0.05 * rms_of(tau), 1e-9);
-      const Column st = (tau / tau_scale).array().tanh().matrix();
-      out.push_back(shape("sign(qd_d)", {sv}, {"l_rad"}));
-      out.push_back(
-          shape("sign(qd_d) + lag 30 ms", {sv, lag(sv, 0.03, s)}, {"l_rad", "l_lag_rad"}));
+      const Column sv = (qd_actual / kSignVelocityScale).array().tanh().matrix();
+      out.push_back(local("sign(qd)", {sv}, {"l_rad"}));
+      out.push_back(local("sign(qd) + lag 30 ms", {sv, lag(sv, 0.03, s)}, {"l_rad", "l_lag_rad"}));
       // The gear torque must change sign for the play to show as anything but a constant
       // offset: with less than 5 % of the samples on the minority side, no torque-sign shape.
       std::size_t positive = 0;
-      for (Eigen::Index k = 0; k < n; ++k) positive += tau[k] > 0.0;
+      for (Eigen::Index k = 0; k < n; ++k) positive += tau_actual[k] > 0.0;
       const double minority = double(std::min<std::size_t>(positive, std::size_t(n) - positive));
       if (minority >= 0.05 * double(n)) {
-        out.push_back(shape("sign(tau_d)", {st}, {"l_rad"}));
-        out.push_back(
-            shape("sign(tau_d) + lag 30 ms", {st, lag(st, 0.03, s)}, {"l_rad", "l_lag_rad"}));
-        // The link crosses the play with the gear's own dynamics: a Laguerre basis of 10 ms.
-        std::vector<Column> cols = laguerre(st, 0.01, 4, s);
-        cols.insert(cols.begin(), st);
-        std::vector<std::string> names = numbered("laguerre10ms_", 4);
-        names.insert(names.begin(), "l_rad");
-        out.push_back(shape("sign(tau_d) + Laguerre 10 ms x4", cols, names));
+        // The torque's zero crossing is blurred by the unknown load model: scales 1, 5, 20 % of
+        // its RMS. The link crosses the play and lands with the gear's own dynamics: Laguerre
+        // bases of 10, 30 and 100 ms.
+        for (double fraction : {0.01, 0.05, 0.2}) {
+          const double tau_scale = std::max(fraction * rms_of(tau_actual), 1e-9);
+          const Column st = (tau_actual / tau_scale).array().tanh().matrix();
+          const int percent = int(std::lround(100.0 * fraction));
+          out.push_back(
+              local(fmt::format("sign(tau) at {} % of its RMS", percent), {st}, {"l_rad"}));
+          for (double tl : {0.01, 0.03, 0.1}) {
+            std::vector<Column> cols = laguerre(st, tl, 4, s);
+            cols.insert(cols.begin(), st);
+            const int ms = int(std::lround(1000.0 * tl));
+            std::vector<std::string> names = numbered(fmt::format("laguerre{}ms_", ms), 4);
+            names.insert(names.begin(), "l_rad");
+            out.push_back(
+                local(fmt::format("sign(tau) at {} % of its RMS + Laguerre {} ms x4", percent, ms),
+                      cols, names));
+          }
+        }
       }
       break;
     }
     case EffectKind::kCoulombFriction: {
-      const Column sv = (qd / kSignVelocityScale).array().tanh().matrix();
-      std::vector<Column> hp;
-      for (double tau : {0.03, 0.1, 0.3}) hp.push_back(sv - lag(sv, tau, s));
-      out.push_back(shape("sign(qd_d) high-passed 30/100/300 ms", hp,
-                          {"hp30ms_rad", "hp100ms_rad", "hp300ms_rad"}));
-      out.push_back(shape("sign(qd_d) high-passed 100 ms", {hp[1]}, {"hp100ms_rad"}));
-      // The controller's reaction to the friction step at a reversal, poles unknown: Laguerre
-      // bases of 30 ms (6 columns) and 100 ms (2 columns).
-      out.push_back(shape("sign(qd_d) through Laguerre 30 ms x6", laguerre(sv, 0.03, 6, s),
-                          numbered("laguerre30ms_", 6)));
-      out.push_back(shape("sign(qd_d) through Laguerre 100 ms x2", laguerre(sv, 0.1, 2, s),
-                          numbered("laguerre100ms_", 2)));
+      for (double scale : {0.005, 0.01, 0.02}) {
+        const Column sv = (qd_actual / scale).array().tanh().matrix();
+        const int mrad = int(std::lround(1000.0 * scale));
+        std::vector<Column> hp;
+        for (double tau : {0.03, 0.1, 0.3}) hp.push_back(sv - lag(sv, tau, s));
+        out.push_back(local(fmt::format("sign(qd / {} mrad/s) high-passed 30/100/300 ms", mrad), hp,
+                            {"hp30ms_rad", "hp100ms_rad", "hp300ms_rad"}));
+        for (const auto& [tl, order] : {std::pair{0.1, 6}, std::pair{0.1, 4}, std::pair{0.03, 6}}) {
+          const int ms = int(std::lround(1000.0 * tl));
+          out.push_back(
+              local(fmt::format("sign(qd / {} mrad/s) through Laguerre {} ms x{}", mrad, ms, order),
+                    laguerre(sv, tl, order, s), numbered(fmt::format("laguerre{}ms_", ms), order)));
+        }
+      }
       break;
     }
     case EffectKind::kGearCompliance: {
       const Column tau = to_column(s.torque_nm[joint]);
-      out.push_back(shape("tau_d / k", {tau}, {"compliance_rad_per_nm"}));
+      out.push_back(local("tau_d / k", {tau}, {"compliance_rad_per_nm"}));
       // Gravity and motion torques apart (the load model of the gravity part is the least sure).
       const Column grav = to_column(s.gravity_torque_nm[joint]);
-      out.push_back(shape("gravity and motion torques / k", {grav, tau - grav},
+      out.push_back(local("gravity and motion torques / k", {grav, tau - grav},
                           {"compliance_rad_per_nm", "motion_compliance_rad_per_nm"}));
-      out.push_back(shape("tau_d / k + lags 10/30 ms", {tau, lag(tau, 0.01, s), lag(tau, 0.03, s)},
-                          {"compliance_rad_per_nm", "lag10ms_rad_per_nm", "lag30ms_rad_per_nm"}));
+      // The deflection's dynamics (gear damping, the link's mode): Laguerre bases of 30 ms.
+      for (int order : {2, 6}) {
+        std::vector<Column> cols = laguerre(tau, 0.03, order, s);
+        cols.insert(cols.begin(), tau);
+        std::vector<std::string> names = numbered("laguerre30ms_", order);
+        names.insert(names.begin(), "compliance_rad_per_nm");
+        out.push_back(local(fmt::format("tau_d / k + Laguerre 30 ms x{}", order), cols, names));
+      }
       break;
     }
     case EffectKind::kTransmissionError: {
@@ -230,9 +273,18 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
       const double n_gear = s.gear_ratio[joint];
       for (int h = 1; h <= 3; ++h) {
         const Column phase = double(h) * n_gear * q;
-        out.push_back(shape(fmt::format("harmonic {} of the motor angle", h),
-                            {phase.array().sin().matrix(), phase.array().cos().matrix()},
+        const Column sn = phase.array().sin().matrix(), cs = phase.array().cos().matrix();
+        out.push_back(local(fmt::format("harmonic {} of the motor angle", h), {sn, cs},
                             {"sin_rad", "cos_rad"}));
+        for (double f : {5.0, 8.0, 11.0, 15.0, 20.0})
+          for (double zeta : {0.2, 0.4}) {
+            const Column ys = second_order(sn, f, zeta, s).first;
+            const Column yc = second_order(cs, f, zeta, s).first;
+            out.push_back(local(fmt::format("harmonic {} of the motor angle through a {:.0f} Hz "
+                                            "mode, damping {:.1f}",
+                                            h, f, zeta),
+                                {ys, yc}, {"sin_rad", "cos_rad"}));
+          }
       }
       break;
     }
@@ -240,20 +292,58 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
       for (double f : {2.0, 3.0, 4.5, 6.5, 9.0, 12.0, 15.0, 20.0, 27.0, 36.0})
         for (double zeta : {0.02, 0.05, 0.1, 0.3}) {
           auto [y, r] = second_order(qdd, f, zeta, s);
-          out.push_back(shape(fmt::format("mode {:.1f} Hz, damping {:.2f}", f, zeta), {y, r},
+          out.push_back(local(fmt::format("mode {:.1f} Hz, damping {:.2f}", f, zeta), {y, r},
                               {"gain_rad_s2_per_rad_s2", "quadrature"}));
         }
       break;
     }
     case EffectKind::kTimeOffset:
-      out.push_back(shape("qd_d * dt", {qd}, {"dt_s"}));
+      out.push_back(local("qd_d * dt", {qd}, {"dt_s"}));
       break;
-    case EffectKind::kPayloadMismatch:
-      out.push_back(shape("d tau / d m / k", {to_column(s.unit_payload_nm_kg[joint])},
-                          {"dm_over_k_rad_per_kg"}));
+    case EffectKind::kPayloadMismatch: {
+      if (joint != 0) break;  // one candidate for all joints, as the IMS chain's errors below
+      // Every joint the payload loads (d tau / d m above 1e-6 N m/kg), each with its own
+      // parameters: the same mass error acts on each through that joint's own compliance and loop.
+      std::vector<std::size_t> loaded;
+      for (std::size_t j = 0; j < nj; ++j)
+        if (rms_of(to_column(s.unit_payload_nm_kg[j])) > 1e-6) loaded.push_back(j);
+      if (loaded.empty()) break;
+      const auto per_joint = [&](std::string label, int width, const auto& columns_of,
+                                 const std::string& stem) {
+        CandidateShape sh;
+        sh.label = std::move(label);
+        sh.columns.assign(nj, Eigen::MatrixXd());
+        const Eigen::Index p = Eigen::Index(width * int(loaded.size()));
+        for (std::size_t i = 0; i < loaded.size(); ++i) {
+          const std::size_t j = loaded[i];
+          Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n, p);
+          c.middleCols(Eigen::Index(i) * width, width) = matrix_of(columns_of(j));
+          sh.columns[j] = c;
+          for (int w = 0; w < width; ++w)
+            sh.parameter_names.push_back(
+                width == 1 ? fmt::format("dm_over_k_{}_rad_per_kg", s.joint_names[j])
+                           : fmt::format("{}{}_{}_rad_per_kg", stem, w, s.joint_names[j]));
+        }
+        return sh;
+      };
+      out.push_back(per_joint(
+          "d tau / d m / k on every loaded joint", 1,
+          [&](std::size_t j) { return std::vector<Column>{to_column(s.unit_payload_nm_kg[j])}; },
+          ""));
+      for (const auto& [tl, order] : {std::pair{0.03, 4}, std::pair{0.1, 6}}) {
+        const int ms = int(std::lround(1000.0 * tl));
+        out.push_back(per_joint(
+            fmt::format("d tau / d m through Laguerre {} ms x{} on every loaded joint", ms, order),
+            order,
+            [&](std::size_t j) {
+              return laguerre(to_column(s.unit_payload_nm_kg[j]), tl, order, s);
+            },
+            fmt::format("laguerre{}ms_", ms)));
+      }
       break;
+    }
     case EffectKind::kZeroOffset:
-      out.push_back(shape("constant", {Column::Ones(n)}, {"offset_rad"}));
+      out.push_back(local("constant", {Column::Ones(n)}, {"offset_rad"}));
       break;
     case EffectKind::kThermalDrift: {
       const double t0 = s.time_s.front(), t1 = s.time_s.back();
@@ -263,7 +353,7 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
         t[k] = (s.time_s[std::size_t(k)] - 0.5 * (t0 + t1)) / span;
       // With its constant: a drift starts from some offset (a pure offset ranks above it by
       // parsimony, see eval/gap_diagnosis.cpp).
-      out.push_back(shape("constant + linear + quadratic in time",
+      out.push_back(local("constant + linear + quadratic in time",
                           {Column::Ones(n), t, t.array().square().matrix()},
                           {"offset_rad", "slope_rad", "curvature_rad"}));
       break;
@@ -277,60 +367,74 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
         os[k] = o[k] * std::tanh(qd[k] / kSignVelocityScale);
       }
       if (o.cwiseAbs().maxCoeff() == 0.0) break;  // never outside: nothing to fit
-      out.push_back(shape(fmt::format("beyond identified speed {:.3f} rad/s", limit), {o, os},
+      out.push_back(local(fmt::format("beyond identified speed {:.3f} rad/s", limit), {o, os},
                           {"per_excess_rad", "per_excess_signed_rad"}));
       break;
     }
+    // The IMS chain's errors: one parameter vector for all joints (see the header). They are the
+    // same candidate whatever `joint` is asked for: only joint 0 returns them.
     case EffectKind::kKinematicParameters: {
-      if (joint >= s.ims_chain_columns.size()) break;
-      const Eigen::MatrixXd& dh = s.ims_chain_columns[joint].dh;
+      if (joint != 0 || s.ims_chain_columns.size() != nj) break;
+      const auto dh = [&](std::size_t j) -> const Eigen::MatrixXd& {
+        return s.ims_chain_columns[j].dh;
+      };
       for (int link = 0; link < 6; ++link) {
-        std::vector<Column> cols;
+        std::vector<int> cols;
         std::vector<std::string> names;
         const char* what[3] = {"a", "alpha", "d"};
         const char* unit[3] = {"m", "rad", "m"};
         for (int p = 0; p < 3; ++p) {
-          const Column c = dh.col(3 * link + p);
-          // A parameter that moves this joint's gap by less than 1e-9 rad per unit has no
-          // signature here (e.g. d_1 for a base offset along axis 1).
-          if (rms_of(c) < 1e-9) continue;
-          cols.push_back(c);
+          // A parameter that moves no joint's gap by 1e-9 rad per unit has no signature here
+          // (e.g. d_1 for a base offset along axis 1).
+          double largest = 0.0;
+          for (std::size_t j = 0; j < nj; ++j)
+            largest = std::max(largest, rms_of(dh(j).col(3 * link + p)));
+          if (largest < 1e-9) continue;
+          cols.push_back(3 * link + p);
           names.push_back(fmt::format("d{}{}_{}", what[p], link + 1, unit[p]));
         }
         if (!cols.empty())
-          out.push_back(shape(fmt::format("DH a/alpha/d of link {}", link + 1), cols, names));
+          out.push_back(shared(fmt::format("DH a/alpha/d of link {}", link + 1), dh, cols, names));
       }
       break;
     }
     case EffectKind::kSensorMounting: {
-      if (joint >= s.ims_chain_columns.size()) break;
-      const Eigen::MatrixXd& m = s.ims_chain_columns[joint].mounting;
-      out.push_back(shape("mounting rotation", {m.col(3), m.col(4), m.col(5)},
-                          {"rx_rad", "ry_rad", "rz_rad"}));
-      out.push_back(
-          shape("mounting translation", {m.col(0), m.col(1), m.col(2)}, {"tx_m", "ty_m", "tz_m"}));
-      out.push_back(shape("mounting rotation and translation",
-                          {m.col(3), m.col(4), m.col(5), m.col(0), m.col(1), m.col(2)},
-                          {"rx_rad", "ry_rad", "rz_rad", "tx_m", "ty_m", "tz_m"}));
+      if (joint != 0 || s.ims_chain_columns.size() != nj) break;
+      const auto m = [&](std::size_t j) -> const Eigen::MatrixXd& {
+        return s.ims_chain_columns[j].mounting;
+      };
+      out.push_back(shared("mounting rotation", m, {3, 4, 5}, {"rx_rad", "ry_rad", "rz_rad"}));
+      out.push_back(shared("mounting translation", m, {0, 1, 2}, {"tx_m", "ty_m", "tz_m"}));
+      out.push_back(shared("mounting rotation and translation", m, {3, 4, 5, 0, 1, 2},
+                           {"rx_rad", "ry_rad", "rz_rad", "tx_m", "ty_m", "tz_m"}));
       break;
     }
     case EffectKind::kImsScaleFactor: {
-      if (joint >= s.ims_chain_columns.size()) break;
-      const auto& c = s.ims_chain_columns[joint];
-      const Column gyro = c.gyro_scale.rowwise().sum();
-      out.push_back(shape("gyro scale, isotropic", {gyro}, {"gyro_scale"}));
-      out.push_back(shape("gyro scale per flange axis",
-                          {c.gyro_scale.col(0), c.gyro_scale.col(1), c.gyro_scale.col(2)},
-                          {"gyro_scale_x", "gyro_scale_y", "gyro_scale_z"}));
-      out.push_back(
-          shape("accelerometer scale, isotropic", {c.accel_scale.col(0)}, {"accel_scale"}));
+      if (joint != 0 || s.ims_chain_columns.size() != nj) break;
+      std::vector<Eigen::MatrixXd> isotropic;
+      for (std::size_t j = 0; j < nj; ++j) {
+        const auto& c = s.ims_chain_columns[j];
+        Eigen::MatrixXd m(n, 2);
+        m << c.gyro_scale.rowwise().sum(), c.accel_scale.col(0);
+        isotropic.push_back(m);
+      }
+      const auto iso = [&](std::size_t j) -> const Eigen::MatrixXd& { return isotropic[j]; };
+      const auto gyro = [&](std::size_t j) -> const Eigen::MatrixXd& {
+        return s.ims_chain_columns[j].gyro_scale;
+      };
+      out.push_back(shared("gyro scale, isotropic", iso, {0}, {"gyro_scale"}));
+      out.push_back(shared("gyro scale per flange axis", gyro, {0, 1, 2},
+                           {"gyro_scale_x", "gyro_scale_y", "gyro_scale_z"}));
+      out.push_back(shared("accelerometer scale, isotropic", iso, {1}, {"accel_scale"}));
       break;
     }
     case EffectKind::kImsBias: {
-      if (joint >= s.ims_chain_columns.size()) break;
-      const Eigen::MatrixXd& b = s.ims_chain_columns[joint].gyro_bias;
-      out.push_back(shape("gyro bias about the flange axes", {b.col(0), b.col(1), b.col(2)},
-                          {"bx_rad_s", "by_rad_s", "bz_rad_s"}));
+      if (joint != 0 || s.ims_chain_columns.size() != nj) break;
+      const auto b = [&](std::size_t j) -> const Eigen::MatrixXd& {
+        return s.ims_chain_columns[j].gyro_bias;
+      };
+      out.push_back(shared("gyro bias about the flange axes", b, {0, 1, 2},
+                           {"bx_rad_s", "by_rad_s", "bz_rad_s"}));
       break;
     }
   }
@@ -396,6 +500,39 @@ LinearFit fit_columns(const Eigen::MatrixXd& columns, const std::vector<double>&
 
 namespace {
 
+// The rows of the joints that have columns, stacked: joint after joint, all samples each.
+struct Stacked {
+  Eigen::MatrixXd x;
+  std::vector<double> y;
+  std::vector<std::size_t> joints;  // in stacking order
+};
+
+Stacked stack(const std::vector<Eigen::MatrixXd>& columns,
+              const std::vector<std::vector<double>>& gap) {
+  Stacked st;
+  Eigen::Index p = 0, n = 0;
+  for (std::size_t j = 0; j < columns.size(); ++j)
+    if (columns[j].size() > 0) {
+      st.joints.push_back(j);
+      p = columns[j].cols();
+      n = columns[j].rows();
+    }
+  st.x.resize(n * Eigen::Index(st.joints.size()), p);
+  st.y.reserve(std::size_t(st.x.rows()));
+  for (std::size_t i = 0; i < st.joints.size(); ++i) {
+    st.x.middleRows(Eigen::Index(i) * n, n) = columns[st.joints[i]];
+    st.y.insert(st.y.end(), gap[st.joints[i]].begin(), gap[st.joints[i]].end());
+  }
+  return st;
+}
+
+std::vector<bool> repeat(const std::vector<bool>& use, std::size_t times) {
+  std::vector<bool> out;
+  out.reserve(use.size() * times);
+  for (std::size_t i = 0; i < times; ++i) out.insert(out.end(), use.begin(), use.end());
+  return out;
+}
+
 // Sum of squared residuals on the rows `check` of the LS fit of columns to y on the rows `fit`
 // (parameters only: no sigma needed to choose a shape).
 double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
@@ -425,7 +562,53 @@ double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>&
 // Relative margin within which the shape with fewer parameters wins the validation.
 constexpr double kShapeParsimony = 0.01;
 
+// The rows of `fold` (sample indices) on every stacked joint.
+std::vector<Eigen::Index> stacked_rows(const std::vector<Eigen::Index>& fold, std::size_t joints,
+                                       Eigen::Index samples) {
+  std::vector<Eigen::Index> rows;
+  rows.reserve(fold.size() * joints);
+  for (std::size_t i = 0; i < joints; ++i)
+    for (Eigen::Index k : fold) rows.push_back(Eigen::Index(i) * samples + k);
+  return rows;
+}
+
 }  // namespace
+
+LinearFit fit_joint_columns(const std::vector<Eigen::MatrixXd>& columns,
+                            const std::vector<std::vector<double>>& gap,
+                            const std::vector<bool>& use) {
+  const Stacked st = stack(columns, gap);
+  return fit_columns(st.x, st.y, repeat(use, st.joints.size()));
+}
+
+std::vector<std::vector<double>> predict_joint_columns(const std::vector<Eigen::MatrixXd>& columns,
+                                                       const Eigen::VectorXd& parameters) {
+  std::vector<std::vector<double>> out(columns.size());
+  for (std::size_t j = 0; j < columns.size(); ++j) {
+    if (columns[j].size() == 0) continue;
+    const Eigen::VectorXd p = columns[j] * parameters;
+    out[j].assign(p.data(), p.data() + p.size());
+  }
+  return out;
+}
+
+std::vector<Eigen::MatrixXd> join_columns(const std::vector<Eigen::MatrixXd>& a,
+                                          const std::vector<Eigen::MatrixXd>& b,
+                                          std::size_t samples) {
+  Eigen::Index pa = 0, pb = 0;
+  for (const auto& m : a) pa = std::max(pa, m.cols());
+  for (const auto& m : b) pb = std::max(pb, m.cols());
+  std::vector<Eigen::MatrixXd> out(std::max(a.size(), b.size()));
+  const Eigen::Index n = Eigen::Index(samples);
+  for (std::size_t j = 0; j < out.size(); ++j) {
+    const bool has_a = j < a.size() && a[j].size() > 0, has_b = j < b.size() && b[j].size() > 0;
+    if (!has_a && !has_b) continue;
+    out[j] = Eigen::MatrixXd::Zero(n, pa + pb);
+    if (has_a) out[j].leftCols(pa) = a[j];
+    if (has_b) out[j].rightCols(pb) = b[j];
+  }
+  return out;
+}
 
 std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, std::size_t joint,
                                           const std::vector<bool>& training) {
@@ -441,38 +624,50 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
   std::size_t count = 0;
   for (std::size_t k = 0; k < training.size(); ++k)
     if (training[k]) ((count++ / chunk) % 2 == 0 ? fold_a : fold_b).push_back(Eigen::Index(k));
+  const Eigen::Index n = Eigen::Index(s.sample_count());
   std::size_t chosen = 0;
   if (shapes.size() > 1 && !fold_b.empty()) {
     std::vector<double> score;
-    for (const auto& sh : shapes)
-      score.push_back(validation_sse(sh.columns, s.gap_rad[joint], fold_a, fold_b) +
-                      validation_sse(sh.columns, s.gap_rad[joint], fold_b, fold_a));
+    for (const auto& sh : shapes) {
+      const Stacked st = stack(sh.columns, s.gap_rad);
+      const auto a = stacked_rows(fold_a, st.joints.size(), n);
+      const auto b = stacked_rows(fold_b, st.joints.size(), n);
+      score.push_back(validation_sse(st.x, st.y, a, b) + validation_sse(st.x, st.y, b, a));
+    }
     const double best_score = *std::min_element(score.begin(), score.end());
+    const auto width = [&](std::size_t i) { return shapes[i].parameter_names.size(); };
     for (std::size_t i = 0; i < shapes.size(); ++i) {
       if (score[i] > best_score * (1.0 + kShapeParsimony)) continue;
-      if (score[chosen] > best_score * (1.0 + kShapeParsimony) ||
-          shapes[i].columns.cols() < shapes[chosen].columns.cols() ||
-          (shapes[i].columns.cols() == shapes[chosen].columns.cols() && score[i] < score[chosen]))
+      if (score[chosen] > best_score * (1.0 + kShapeParsimony) || width(i) < width(chosen) ||
+          (width(i) == width(chosen) && score[i] < score[chosen]))
         chosen = i;
     }
   }
   const CandidateShape& sh = shapes[chosen];
-  const LinearFit f = fit_columns(sh.columns, s.gap_rad[joint], training);
-  std::optional<CandidateFit> best = CandidateFit{};
-  {
-    CandidateFit& c = *best;
-    c.kind = kind;
-    c.joint = joint;
-    c.shape = sh.label;
-    c.parameter_names = sh.parameter_names;
-    c.parameters = f.parameters;
-    c.sigma = f.sigma;
-    c.columns = sh.columns;
-    c.training_rms_rad = f.rms;
+  const LinearFit f = fit_joint_columns(sh.columns, s.gap_rad, training);
+  CandidateFit c;
+  c.kind = kind;
+  c.joint = joint;
+  c.shape = sh.label;
+  c.parameter_names = sh.parameter_names;
+  c.parameters = f.parameters;
+  c.sigma = f.sigma;
+  c.columns = sh.columns;
+  c.training_rms_rad = f.rms;
+  c.prediction = predict_joint_columns(c.columns, c.parameters);
+  // Acting on several joints: located where its modelled gap has the most energy.
+  std::size_t acting = 0;
+  double most = -1.0, total = 0.0;
+  for (std::size_t j = 0; j < c.prediction.size(); ++j) {
+    if (c.prediction[j].empty()) continue;
+    ++acting;
+    double e = 0.0;
+    for (double v : c.prediction[j]) e += v * v;
+    total += e;
+    if (e > most) most = e, c.joint = j;
   }
-  CandidateFit& c = *best;
-  const Eigen::VectorXd pred = c.columns * c.parameters;
-  c.prediction.assign(pred.data(), pred.data() + pred.size());
+  c.spans_joints = acting > 1;
+  const double modelled_rms = std::sqrt(total / double(std::max<Eigen::Index>(n, 1)));
   // Size in words: the first parameter with its sigma, and the RMS of the modelled gap.
   const double arcsec = 180.0 / M_PI * 3600.0;
   std::string first =
@@ -495,9 +690,10 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
                                 c.parameters[i], c.sigma[i]));
     first = fmt::format("{}", fmt::join(all, ", "));
   }
-  c.size_text = fmt::format("{}; modelled gap RMS {:.3g} rad ({:.2f} arcsec)", first, rms_of(pred),
-                            rms_of(pred) * arcsec);
-  return best;
+  c.size_text =
+      fmt::format("{}; modelled gap RMS {:.3g} rad ({:.2f} arcsec){}", first, modelled_rms,
+                  modelled_rms * arcsec, c.spans_joints ? " over all joints" : "");
+  return c;
 }
 
 }  // namespace imscal::eval

@@ -8,33 +8,39 @@
 // inflated by the residual's integrated autocorrelation (the residuals are coloured, so the plain
 // LS sigma would be far too small).
 //
-// Candidates (u: the candidate's driving signal; LP_tau: first-order lag, HP_tau = 1 - LP_tau):
-//   backlash        u = tanh(q̇_d / 5 mrad/s) or tanh(tau_d / 5 % of its RMS): the gear play shows
-//                   where the motion (or the gear torque) changes sign; [u], [u, LP_30ms u] or
-//                   (torque sign) [u, Laguerre_10ms,0..3 u] (eval/gap_candidates.cpp laguerre)
-//                   (torque sign only when >= 5 % of the samples lie on its minority side)
-//   coulomb         u = tanh(q̇_d / 5 mrad/s) through the joint controller: the PI loop removes the
-//                   steady part, so only transients after every reversal remain:
-//                   [HP_30ms u, HP_100ms u, HP_300ms u] (chosen from the simulator's data: a static
-//                   sign explains < 10 % of a withheld motor-side friction, the high-passes ~50 %),
-//                   [HP_100ms u], Laguerre bases [L_30ms,0..5 u] or [L_100ms,0..1 u]
+// Candidates (u: the candidate's driving signal; L_tau,i: the i-th discrete Laguerre filter of
+// time scale tau, an orthonormal basis of stable linear responses: the closed joint loop's
+// reaction to u without knowing its poles; HP_tau = 1 - first-order lag):
+//   backlash        u = tanh(tau_a / 1, 5 or 20 % of its RMS), tau_a the rigid-body torque of the
+//                   drive's actual motion (q_internal): the link crosses the play where the gear
+//                   torque changes sign; [u] or [u, L_10/30/100ms,0..3 u]; or u = tanh(q̇_a / 5
+//                   mrad/s) (paper, eq. 3) as [u] or [u, LP_30ms u] (torque-sign shapes only when
+//                   >= 5 % of the samples lie on its minority side)
+//   coulomb         u = tanh(q̇_a / v_s), q̇_a the motor's own velocity (q_internal), v_s 5, 10,
+//                   20 mrad/s: the friction acts on it and the PI loop works it off after every
+//                   reversal: [L_100ms,0..5 u], [L_100ms,0..3 u], [L_30ms,0..5 u] or
+//                   [HP_30/100/300ms u]
 //   compliance      u = tau_d (inverse dynamics on q_d): deflection tau/k; [u], [G, u - G] (gravity
-//                   and motion parts apart) or [u, LP_10ms u, LP_30ms u]
-//   transmission    sin/cos(h N q_internal), h = 1..3 per motor revolution (the motor angle comes
-//                   from the internal encoder: q_d is off by the tracking error times N)
+//                   and motion parts apart), [u, L_30ms,0..1 u] or [u, L_30ms,0..5 u]
+//   transmission    sin/cos(h N q_internal), h = 1..3 per motor revolution, raw or through the
+//                   link's mode on the gear ω²/(s² + 2ζωs + ω²) (f 5..20 Hz, ζ 0.2 / 0.4): above
+//                   that mode the link does not follow the gear's error
 //   resonance       q̈_d through ω²/(s² + 2ζωs + ω²), f 2..40 Hz x ζ {0.02, 0.05, 0.1, 0.3};
 //                   [y, ẏ/ω] (gain and phase)
 //   time_offset     [q̇_d]: the parameter is the offset dt [s] between the streams
-//   payload         [d tau / d m_payload]: the parameter is Δm / k [rad/kg]
+//   payload         all joints at once (one mass acts on every joint it loads): per joint
+//                   u_j = d tau_j / d m_payload, [u_j], [L_30ms,0..3 u_j] or [L_100ms,0..5 u_j]
+//                   with its own parameters per joint (Δm / k_j through joint j's loop)
 //   zero_offset     [1]
 //   thermal_drift   [1, t', t'^2], t' = (t - t_mid) / duration
 //   operating_point [o, o sign(q̇_d)], o = how far |q̇_d| lies beyond the identified speed range
 //                   of the table, relative to it (only with a table that has a speed dimension)
 // The geometric errors of the IMS chain (columns of GapSignals::ims_chain_columns, only with a
-// robot model; the joint-space map -Jb^-1 of a flange pose error, eval/gap_signals.hpp):
+// robot model; the joint-space map -Jb^-1 of a flange pose error, eval/gap_signals.hpp) act on
+// all joints with the same parameters: they are fitted to all joints' gaps at once (stacked), and
+// their joint is the one where their modelled gap is largest:
 //   kinematic_parameters  DH a, alpha, d of one link i = 1..6 (3 parameters, link chosen as the
-//   shape;
-//                         the joint zero offsets are zero_offset)
+//                         shape; the joint zero offsets are zero_offset)
 //   sensor_mounting       the mounting twist of the sensor on the flange: rotation (3),
 //                         translation (3) or both (6)
 //   ims_scale_factor      gyro scale per flange axis (3), isotropic gyro scale (1), isotropic
@@ -70,10 +76,11 @@ inline constexpr int kEffectKindCount = 14;
 const char* to_string(EffectKind kind);
 EffectKind effect_kind_from_index(int index);
 
-// One shape of a candidate: its regressor columns over all samples.
+// One shape of a candidate: its regressor columns over all samples, per joint (an empty matrix:
+// the candidate does not act on that joint; all others have one column per parameter).
 struct CandidateShape {
   std::string label;                         // e.g. "sign(qd), lag 30 ms"
-  Eigen::MatrixXd columns;                   // samples x parameters
+  std::vector<Eigen::MatrixXd> columns;      // [joint]: samples x parameters, or empty
   std::vector<std::string> parameter_names;  // with units, e.g. "l_rad"
 };
 
@@ -85,13 +92,16 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
 
 struct CandidateFit {
   EffectKind kind = EffectKind::kZeroOffset;
+  // The joint whose signals drive the candidate, or (candidates acting on several joints) the
+  // joint where its modelled gap has the most energy.
   std::size_t joint = 0;
+  bool spans_joints = false;  // its columns act on more than one joint
   std::string shape;
   std::vector<std::string> parameter_names;
-  Eigen::VectorXd parameters, sigma;  // 1-sigma (autocorrelation-inflated)
-  Eigen::MatrixXd columns;            // of the chosen shape (kept for combinations)
-  std::vector<double> prediction;     // the candidate's model of the gap, every sample [rad]
-  double training_rms_rad = 0.0;      // residual RMS on the training rows
+  Eigen::VectorXd parameters, sigma;            // 1-sigma (autocorrelation-inflated)
+  std::vector<Eigen::MatrixXd> columns;         // [joint], of the chosen shape (for combinations)
+  std::vector<std::vector<double>> prediction;  // [joint] model of the gap [rad]; empty: none
+  double training_rms_rad = 0.0;                // residual RMS on the training rows
   // The size of the effect in words, e.g. "l = 0.000437 ± 0.000002 rad (1.50 arcmin)".
   std::string size_text;
 };
@@ -106,6 +116,21 @@ struct LinearFit {
 };
 LinearFit fit_columns(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                       const std::vector<bool>& use);
+
+// The same fit over several joints at once: the rows of every joint that has columns are stacked
+// (one parameter vector for all of them), `use` flags the samples (the same on every joint).
+LinearFit fit_joint_columns(const std::vector<Eigen::MatrixXd>& columns,
+                            const std::vector<std::vector<double>>& gap,
+                            const std::vector<bool>& use);
+
+// columns * parameters per joint (empty where the joint has no columns).
+std::vector<std::vector<double>> predict_joint_columns(const std::vector<Eigen::MatrixXd>& columns,
+                                                       const Eigen::VectorXd& parameters);
+
+// The columns of two candidates side by side per joint (zeros where one of them has none).
+std::vector<Eigen::MatrixXd> join_columns(const std::vector<Eigen::MatrixXd>& a,
+                                          const std::vector<Eigen::MatrixXd>& b,
+                                          std::size_t samples);
 
 // Best shape by the 2-fold validation within the training rows (the only shape when there is
 // one), fitted on all training rows; nullopt when the candidate does not apply.

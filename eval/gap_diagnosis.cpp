@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <random>
 
 namespace imscal::eval {
@@ -64,13 +63,16 @@ double heldout_energy(const std::vector<std::vector<double>>& residual, const Ro
   return e;
 }
 
-// Residual of joint j after a joint LS fit of the given columns (training rows).
-std::vector<double> residual_after(const Eigen::MatrixXd& columns, const std::vector<double>& g,
-                                   const std::vector<bool>& training) {
-  const LinearFit f = fit_columns(columns, g, training);
-  const Eigen::VectorXd pred = columns * f.parameters;
-  std::vector<double> r(g.size());
-  for (std::size_t k = 0; k < g.size(); ++k) r[k] = g[k] - pred[Eigen::Index(k)];
+// Residual of every joint after a joint LS fit of the given columns (training rows); joints
+// without columns keep their gap.
+std::vector<std::vector<double>> residual_after(const std::vector<Eigen::MatrixXd>& columns,
+                                                const std::vector<std::vector<double>>& gap,
+                                                const std::vector<bool>& training) {
+  const LinearFit f = fit_joint_columns(columns, gap, training);
+  const auto pred = predict_joint_columns(columns, f.parameters);
+  std::vector<std::vector<double>> r = gap;
+  for (std::size_t j = 0; j < r.size(); ++j)
+    for (std::size_t k = 0; k < pred[j].size(); ++k) r[j][k] -= pred[j][k];
   return r;
 }
 
@@ -137,19 +139,26 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
       auto fit = fit_candidate(effect_kind_from_index(kind), s, j, training);
       if (!fit) continue;
       CandidateResult r;
-      const auto& g = s.gap_rad[j];
-      std::vector<double> d;
-      d.reserve(rows.heldout.size());
-      double ej0 = 0.0, gain = 0.0;
-      for (std::size_t k : rows.heldout) {
-        const double res = g[k] - fit->prediction[k];
-        d.push_back(g[k] * g[k] - res * res);
-        gain += d.back();
-        ej0 += g[k] * g[k];
+      // Per held-out row the reduction of the squared gap summed over the joints it acts on.
+      std::vector<double> d(rows.heldout.size(), 0.0);
+      double gain = 0.0, ej0 = 0.0, joint_gain = 0.0;
+      for (std::size_t jj = 0; jj < s.joint_count(); ++jj) {
+        const auto& p = fit->prediction[jj];
+        if (p.empty()) continue;
+        const auto& g = s.gap_rad[jj];
+        for (std::size_t i = 0; i < rows.heldout.size(); ++i) {
+          const std::size_t k = rows.heldout[i];
+          const double res = g[k] - p[k];
+          const double di = g[k] * g[k] - res * res;
+          d[i] += di;
+          gain += di;
+          if (jj == fit->joint) joint_gain += di;
+        }
       }
+      for (std::size_t k : rows.heldout) ej0 += s.gap_rad[fit->joint][k] * s.gap_rad[fit->joint][k];
       r.shrinkage_percent = shrink(e0 - gain);
       r.joint_shrinkage_percent =
-          ej0 > 0.0 ? 100.0 * (1.0 - std::sqrt(std::max(ej0 - gain, 0.0) / ej0)) : 0.0;
+          ej0 > 0.0 ? 100.0 * (1.0 - std::sqrt(std::max(ej0 - joint_gain, 0.0) / ej0)) : 0.0;
       r.p_value = block_bootstrap_p_value(d, block, o.bootstrap_resamples, seed++);
       r.supported = r.p_value < o.alpha && r.shrinkage_percent >= o.min_shrinkage_percent;
       r.fit = std::move(*fit);
@@ -165,54 +174,50 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
       [&](const CandidateResult& a, const CandidateResult& b) { return score(a) > score(b); });
   out.significant_gap = !out.candidates.empty() && out.candidates.front().supported;
 
-  // Greedy combination of the supported candidates.
+  // Greedy combination of the supported candidates: each step adds the candidate whose columns,
+  // fitted jointly with those already chosen (one stacked LS over the joints they act on), shrink
+  // the held-out gap most. Only the best `combination_pool` supported candidates are tried.
   if (out.significant_gap) {
     std::vector<std::vector<double>> residual = s.gap_rad;
-    std::map<std::size_t, Eigen::MatrixXd> chosen_columns;  // per joint
+    std::vector<Eigen::MatrixXd> chosen_columns(s.joint_count());
+    std::vector<std::size_t> pool;
+    for (std::size_t c = 0; c < out.candidates.size() && int(pool.size()) < o.combination_pool; ++c)
+      if (out.candidates[c].supported) pool.push_back(c);
     std::vector<bool> used(out.candidates.size(), false);
     double energy = e0;
     for (int step = 0; step < o.max_combination; ++step) {
       int best = -1;
       double best_energy = energy;
-      std::vector<double> best_residual;
-      for (std::size_t c = 0; c < out.candidates.size(); ++c) {
-        if (used[c] || !out.candidates[c].supported) continue;
+      std::vector<std::vector<double>> best_residual;
+      std::vector<Eigen::MatrixXd> best_columns;
+      for (std::size_t c : pool) {
+        if (used[c]) continue;
         const CandidateFit& f = out.candidates[c].fit;
-        Eigen::MatrixXd cols = f.columns;
-        if (chosen_columns.count(f.joint)) {
-          const Eigen::MatrixXd& prev = chosen_columns[f.joint];
-          cols.resize(prev.rows(), prev.cols() + f.columns.cols());
-          cols << prev, f.columns;
-        }
-        std::vector<double> r = residual_after(cols, s.gap_rad[f.joint], training);
-        double e = energy;
-        for (std::size_t k : rows.heldout)
-          e += r[k] * r[k] - residual[f.joint][k] * residual[f.joint][k];
+        std::vector<Eigen::MatrixXd> cols =
+            join_columns(chosen_columns, f.columns, s.sample_count());
+        std::vector<std::vector<double>> r = residual_after(cols, s.gap_rad, training);
+        const double e = heldout_energy(r, rows);
         if (e < best_energy) {
           best_energy = e;
           best = int(c);
           best_residual = std::move(r);
+          best_columns = std::move(cols);
         }
       }
       if (best < 0) break;
       const CandidateFit& f = out.candidates[std::size_t(best)].fit;
-      std::vector<double> d;
-      for (std::size_t k : rows.heldout)
-        d.push_back(residual[f.joint][k] * residual[f.joint][k] -
-                    best_residual[k] * best_residual[k]);
+      std::vector<double> d(rows.heldout.size(), 0.0);
+      for (std::size_t j = 0; j < s.joint_count(); ++j)
+        for (std::size_t i = 0; i < rows.heldout.size(); ++i) {
+          const std::size_t k = rows.heldout[i];
+          d[i] += residual[j][k] * residual[j][k] - best_residual[j][k] * best_residual[j][k];
+        }
       const double p = block_bootstrap_p_value(d, block, o.bootstrap_resamples, seed++);
       const double gain_pp = shrink(best_energy) - shrink(energy);
       if (step > 0 && (p >= o.alpha || gain_pp < o.min_combination_gain_percent)) break;
       used[std::size_t(best)] = true;
-      if (chosen_columns.count(f.joint)) {
-        Eigen::MatrixXd prev = chosen_columns[f.joint];
-        Eigen::MatrixXd cols(prev.rows(), prev.cols() + f.columns.cols());
-        cols << prev, f.columns;
-        chosen_columns[f.joint] = cols;
-      } else {
-        chosen_columns[f.joint] = f.columns;
-      }
-      residual[f.joint] = std::move(best_residual);
+      chosen_columns = std::move(best_columns);
+      residual = std::move(best_residual);
       energy = best_energy;
       out.combination.push_back({candidate_label(s, f), shrink(energy), p});
     }
@@ -240,14 +245,21 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
         "the time) and in the {} band ({:.0f} %).",
         out.where.rms_rad, out.where.rms_rad * arcsec, ja.joint, 100.0 * ja.energy_share, ph.label,
         100.0 * ph.energy_share, 100.0 * ph.time_share, band.label, 100.0 * band.energy_share);
+    // Cells outside the identified range, on every joint that runs in them.
     std::vector<std::string> outside;
-    for (const auto& c : ja.by_cell)
-      if (c.outside_identified_range && c.time_share > 0.0)
-        outside.push_back(
-            fmt::format("{} ({:.0f} % of the gap energy)", c.label, 100.0 * c.energy_share));
+    for (const auto& jo : out.where.joints) {
+      double time = 0.0, energy = 0.0;
+      for (const auto& c : jo.by_cell)
+        if (c.outside_identified_range) time += c.time_share, energy += c.energy_share;
+      if (time > 0.0)
+        outside.push_back(fmt::format("{} {:.0f} % of the time ({:.0f} % of its gap energy)",
+                                      jo.joint, 100.0 * time, 100.0 * energy));
+    }
     if (!outside.empty())
-      where += fmt::format(" Operating-point cells outside the identified range: {}.",
-                           fmt::join(outside, ", "));
+      where += fmt::format(
+          " The path runs at operating points outside the identified range (cells of the error "
+          "model not identified from data): {}.",
+          fmt::join(outside, ", "));
   }
   if (!out.significant_gap) {
     out.verdict = fmt::format(

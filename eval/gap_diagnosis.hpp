@@ -29,6 +29,7 @@ struct DiagnosisOptions {
   double min_shrinkage_percent = 5.0;         // below this an effect is not worth modelling
   double min_combination_gain_percent = 2.0;  // further shrinkage a combination step must add
   int max_combination = 3;
+  int combination_pool = 8;       // best supported candidates the greedy combination tries
   std::uint64_t seed = 1;         // of the bootstrap (deterministic reports)
   ModelErrorOptions model_error;  // of the per-joint model-error model
 };

@@ -289,6 +289,7 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
     for (std::size_t k = 0; k < n; ++k)
       g.gap_rad[j][k] =
           real.q_desired_rad[j][k] - real.q_measured_rad[j][k] - sim_joint_error_rad[j][k];
+    g.qd_internal_rad_s.push_back(derivative(real.q_internal_rad[j], g.runs, g.cycle_s));
     g.gear_ratio.push_back(robot.joints[j].drive.gear_ratio);
     g.max_speed_rad_s.push_back(robot.joints[j].max_velocity_rad_s);
   }
@@ -301,6 +302,10 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
   g.torque_nm.assign(nj, std::vector<double>(n));
   g.gravity_torque_nm.assign(nj, std::vector<double>(n));
   g.unit_payload_nm_kg.assign(nj, std::vector<double>(n));
+  g.torque_internal_nm.assign(nj, std::vector<double>(n));
+  std::vector<std::vector<double>> qdd_internal;
+  for (std::size_t j = 0; j < nj; ++j)
+    qdd_internal.push_back(derivative(g.qd_internal_rad_s[j], g.runs, g.cycle_s));
   double current_mass = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     if (real.payload_kg[k] != current_mass) {
@@ -315,11 +320,19 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
       qdd[long(j)] = g.qdd_desired_rad_s2[j][k];
     }
     const calib::JointVector tau = dynamics.inverse_dynamics(q, qd, qdd);
+    calib::JointVector qi, qdi, qddi;
+    for (std::size_t j = 0; j < nj; ++j) {
+      qi[long(j)] = g.q_internal_rad[j][k];
+      qdi[long(j)] = g.qd_internal_rad_s[j][k];
+      qddi[long(j)] = qdd_internal[j][k];
+    }
+    const calib::JointVector tau_internal = dynamics.inverse_dynamics(qi, qdi, qddi);
     const calib::JointVector tau_gravity = dynamics.gravity_torque(q);
     const calib::JointVector tau_unit =
         unit.inverse_dynamics(q, qd, qdd) - bare.inverse_dynamics(q, qd, qdd);
     for (std::size_t j = 0; j < nj; ++j) {
       g.torque_nm[j][k] = tau[long(j)];
+      g.torque_internal_nm[j][k] = tau_internal[long(j)];
       g.gravity_torque_nm[j][k] = tau_gravity[long(j)];
       g.unit_payload_nm_kg[j][k] = tau_unit[long(j)];
     }

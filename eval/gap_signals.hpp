@@ -30,7 +30,13 @@ struct GapSignals {
   std::vector<std::pair<std::size_t, std::size_t>> runs;  // [begin, end) without time gaps
   // [joint][sample]
   std::vector<std::vector<double>> q_desired_rad, qd_desired_rad_s, qdd_desired_rad_s2;
-  std::vector<std::vector<double>> q_internal_rad;      // motor encoder / N of the real run
+  std::vector<std::vector<double>> q_internal_rad;  // motor encoder / N of the real run
+  // Its derivatives (as those of q_desired) and the rigid-body torque of that motion: the drive's
+  // actual motion, which lags q_desired by the tracking error (~1 / kp_position, 80 ms on the
+  // main axes). Friction acts on the motor's own velocity and the gear torque changes sign when
+  // the actual motion's torque does, so these time reversals and torque zero crossings where
+  // q_desired would place them ~0.1 s off. Empty: not known (the candidates then use q_desired).
+  std::vector<std::vector<double>> qd_internal_rad_s, torque_internal_nm;
   std::vector<std::vector<double>> gap_rad;             // real - sim joint error
   std::vector<std::vector<double>> gravity_torque_nm;   // its gravity part G(q_d)
   std::vector<std::vector<double>> torque_nm;           // inverse dynamics on q_d, logged payload

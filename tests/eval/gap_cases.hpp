@@ -6,6 +6,7 @@
 // its own; an elastic gear without its play is then a clean second effect).
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "calib/robot_description.hpp"
 #include "eval/gap_candidates.hpp"
 #include "ident/joint_error_io.hpp"
+#include "ident/parameter_table.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
@@ -26,9 +28,10 @@ namespace imscal::eval::test {
 
 struct WithheldEffect {
   std::string name;  // backlash, coulomb, elastic, transmission, time_offset, zero_offset,
-                     // payload, drift, resonance; errors of the IMS chain: kinematic (DH error of
-                     // link `joint`), mounting, ims_scale, ims_bias (`joint` unused: they spread
-                     // over the joints, Case::chain_joint says where they show most)
+                     // drift, resonance, operating_point; payload (`joint` unused: the mass loads
+                     // every joint); errors of the IMS chain: kinematic (DH error of link
+                     // `joint`), mounting, ims_scale, ims_bias (`joint` unused: they spread over
+                     // the joints; Case::spread_joint says where they show most)
   int joint = 0;
 };
 
@@ -45,11 +48,17 @@ inline EffectKind expected_kind(const std::string& name) {
   if (name == "ims_scale") return EffectKind::kImsScaleFactor;
   if (name == "ims_bias") return EffectKind::kImsBias;
   if (name == "resonance") return EffectKind::kResonance;
+  if (name == "operating_point") return EffectKind::kOperatingPoint;
   return EffectKind::kThermalDrift;
 }
 
 inline bool is_chain_effect(const std::string& name) {
   return name == "kinematic" || name == "mounting" || name == "ims_scale" || name == "ims_bias";
+}
+
+// Effects that act on several joints at once (no source joint): located where they show most.
+inline bool spreads_over_joints(const std::string& name) {
+  return is_chain_effect(name) || name == "payload";
 }
 
 // The joint angles the nominal model's inverse kinematics returns for the flange pose `target`,
@@ -122,7 +131,12 @@ struct GapWorld {
     ident::JointErrorLog real;             // with noise
     ident::JointErrorLog real_noise_free;  // = "the sim re-run with the true effects on"
     std::vector<std::vector<double>> sim_joint_error_rad;
-    int chain_joint = -1;  // joint with the most energy of an injected chain error (-1: none)
+    // The joint where the noise-free gap has the most energy (where an effect that spreads over
+    // the joints shows most).
+    int spread_joint = -1;
+    // The identified error model's operating-point grid ("operating_point" cases): per joint one
+    // speed dimension; cells beyond the identified speed are filled, not identified.
+    std::optional<ident::ParameterTable> table;
   };
 
   // Errors of the IMS chain injected into q_measured: the flange pose the chain would measure
@@ -193,6 +207,35 @@ struct GapWorld {
       }
     return int(std::max_element(energy.begin(), energy.end()) - energy.begin());
   }
+  // One speed dimension per joint: joint `joint` identified up to v_id (the band above filled),
+  // the others identified over their whole range.
+  ident::ParameterTable operating_point_table(int joint, double v_id) const {
+    ident::ParameterTable t;
+    t.robot = robot.name;
+    t.sample_time_s = path.cycle_s;
+    for (int j = 0; j < 6; ++j) {
+      ident::JointParameters jp;
+      jp.name = robot.joints[std::size_t(j)].name;
+      const double top = robot.joints[std::size_t(j)].max_velocity_rad_s;
+      ident::CellParameters identified;
+      identified.bands = {0};
+      if (j == joint) {
+        jp.dimensions.push_back({ident::OperatingQuantity::kSpeed, {0.0, v_id, top}});
+        ident::CellParameters filled;
+        filled.bands = {1};
+        filled.status = ident::CellStatus::kFilled;
+        filled.filled_from = 0;
+        filled.reason = "no identification data at these speeds";
+        jp.cells = {identified, filled};
+      } else {
+        jp.dimensions.push_back({ident::OperatingQuantity::kSpeed, {0.0, top}});
+        jp.cells = {identified};
+      }
+      t.joints.push_back(jp);
+    }
+    return t;
+  }
+
   Case make_case(const std::vector<WithheldEffect>& effects, std::uint64_t seed) const {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> size(0.7, 1.3);
@@ -227,7 +270,7 @@ struct GapWorld {
     ident::JointErrorLog log = log_of(real_plant);
     const std::size_t n = log.sample_count();
     for (const auto& e : effects)
-      if (is_chain_effect(e.name)) c.chain_joint = inject_chain_error(e, rng, log);
+      if (is_chain_effect(e.name)) inject_chain_error(e, rng, log);
     for (const auto& e : effects) {
       auto& qm = log.q_measured_rad[std::size_t(e.joint)];
       if (e.name == "time_offset") {
@@ -270,6 +313,28 @@ struct GapWorld {
           qm[k] += x;
         }
       }
+      if (e.name == "operating_point") {
+        // The error model was identified at speeds up to v_id = 45..65 % of the joint's top
+        // speed in this program (the table's cells above are filled from below); beyond v_id the
+        // real joint error departs from what the model extrapolates: a speed-dependent error
+        // c sign(v) ((|v| - v_id) / v_id)^p (p 1..2, a drag or stiffening the slower runs never
+        // excited; v the link's own velocity), c ~0.2 mrad at the top speed.
+        double v_peak = 0.0;
+        for (const auto& sample : path.samples)
+          v_peak = std::max(v_peak, std::abs(sample.qd_rad_s[e.joint]));
+        const double v_id =
+            (0.45 + 0.2 * std::uniform_real_distribution<double>(0, 1)(rng)) * v_peak;
+        const double p = 1.0 + std::uniform_real_distribution<double>(0, 1)(rng);
+        const double c_size = 2e-4 * size(rng) / std::pow((v_peak - v_id) / v_id, p);
+        const std::vector<double> q = qm;
+        for (std::size_t k = 0; k < n; ++k) {
+          const std::size_t a = k == 0 ? 0 : k - 1, b = std::min(k + 1, n - 1);
+          const double v = (q[b] - q[a]) / (log.time_s[b] - log.time_s[a]);
+          const double excess = std::max(0.0, std::abs(v) - v_id) / v_id;
+          qm[k] -= c_size * (v > 0.0 ? 1.0 : -1.0) * std::pow(excess, p);
+        }
+        c.table = operating_point_table(e.joint, v_id);
+      }
       if (e.name == "drift") {
         const double a = 2e-4 * size(rng), duration = log.time_s.back();
         for (std::size_t k = 0; k < n; ++k) {
@@ -279,6 +344,14 @@ struct GapWorld {
       }
     }
     c.real_noise_free = log;
+    std::vector<double> energy(6, 0.0);
+    for (std::size_t j = 0; j < 6; ++j)
+      for (std::size_t k = 0; k < n; ++k) {
+        const double g =
+            log.q_desired_rad[j][k] - log.q_measured_rad[j][k] - c.sim_joint_error_rad[j][k];
+        energy[j] += g * g;
+      }
+    c.spread_joint = int(std::max_element(energy.begin(), energy.end()) - energy.begin());
     std::normal_distribution<double> white(0.0, 3e-6);
     const double phi = std::exp(-log.cycle_s / 0.05);
     for (auto& qm : log.q_measured_rad) {

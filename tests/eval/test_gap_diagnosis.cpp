@@ -106,7 +106,7 @@ TEST(GapCandidates, BacklashParameterIsRecoveredWithinItsSigma) {
   const std::vector<bool> all(s.sample_count(), true);
   const auto fit = fit_candidate(EffectKind::kBacklash, s, 2, all);
   ASSERT_TRUE(fit.has_value());
-  EXPECT_EQ(fit->shape, "sign(qd_d)");  // the data's own form wins the BIC
+  EXPECT_EQ(fit->shape, "sign(qd)");  // the data's own form wins the validation
   // White noise: sigma is the plain LS sigma, sigma_n / sqrt(n) = 2e-7; 4 sigma covers the draw.
   EXPECT_NEAR(fit->parameters[0], l, 4.0 * fit->sigma[0]);
   EXPECT_NEAR(fit->sigma[0], 2e-5 / std::sqrt(10000.0), 0.2 * 2e-7);

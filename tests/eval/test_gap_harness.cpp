@@ -40,59 +40,85 @@ struct Score {
 
 TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
   const test::GapWorld world;
+  // Every effect of the library on several joints (or, for effects that spread over the joints,
+  // several random sizes and directions), each case its own seed; controls; two-effect cases.
   std::vector<HarnessCase> cases = {
       {{{"backlash", 0}}, 1},
       {{{"backlash", 1}}, 2},
       {{{"backlash", 3}}, 3},
+      {{{"backlash", 2}}, 40},
+      {{{"backlash", 5}}, 41},
       {{{"coulomb", 0}}, 4},
       {{{"coulomb", 2}}, 5},
       {{{"coulomb", 4}}, 6},
+      {{{"coulomb", 1}}, 42},
       {{{"elastic", 1}}, 7},
       {{{"elastic", 2}}, 8},
       {{{"elastic", 4}}, 9},
+      {{{"elastic", 0}}, 43},
       {{{"transmission", 0}}, 10},
       {{{"transmission", 3}}, 11},
+      {{{"transmission", 1}}, 44},
+      {{{"transmission", 5}}, 45},
       {{{"time_offset", 1}}, 12},
       {{{"time_offset", 4}}, 13},
+      {{{"time_offset", 0}}, 46},
       {{{"zero_offset", 2}}, 14},
       {{{"zero_offset", 5}}, 15},
-      {{{"payload", 1}}, 16},
+      {{{"zero_offset", 0}}, 47},
+      {{{"payload", 0}}, 16},
+      {{{"payload", 0}}, 48},
       {{{"drift", 0}}, 17},
       {{{"drift", 3}}, 18},
+      {{{"drift", 5}}, 49},
+      {{{"resonance", 1}}, 35},
+      {{{"resonance", 4}}, 36},
+      {{{"resonance", 2}}, 50},
+      {{{"operating_point", 0}}, 55},
+      {{{"operating_point", 1}}, 56},
+      {{{"operating_point", 2}}, 57},
+      {{{"kinematic", 1}}, 26},
+      {{{"kinematic", 2}}, 27},
+      {{{"kinematic", 4}}, 28},
+      {{{"kinematic", 3}}, 51},
+      {{{"mounting", 0}}, 29},
+      {{{"mounting", 0}}, 30},
+      {{{"mounting", 0}}, 52},
+      {{{"ims_scale", 0}}, 31},
+      {{{"ims_scale", 0}}, 32},
+      {{{"ims_scale", 0}}, 53},
+      {{{"ims_bias", 0}}, 33},
+      {{{"ims_bias", 0}}, 34},
+      {{{"ims_bias", 0}}, 54},
       {{}, 19},
       {{}, 20},
       {{}, 21},
       {{}, 22},
       {{}, 23},
+      {{}, 58},
+      {{}, 59},
+      {{}, 63},
       {{{"backlash", 0}, {"transmission", 3}}, 24},
       {{{"zero_offset", 1}, {"time_offset", 3}}, 25},
-      {{{"kinematic", 1}}, 26},
-      {{{"kinematic", 2}}, 27},
-      {{{"kinematic", 4}}, 28},
-      {{{"mounting", 0}}, 29},
-      {{{"mounting", 0}}, 30},
-      {{{"ims_scale", 0}}, 31},
-      {{{"ims_scale", 0}}, 32},
-      {{{"ims_bias", 0}}, 33},
-      {{{"ims_bias", 0}}, 34},
-      {{{"resonance", 1}}, 35},
-      {{{"resonance", 4}}, 36},
+      {{{"coulomb", 2}, {"backlash", 1}}, 60},
+      {{{"mounting", 0}, {"drift", 1}}, 61},
+      {{{"payload", 0}, {"time_offset", 4}}, 62},
   };
-  if (sanitized())  // one of each family: ~5x fewer plant runs
-    cases = {cases[0],  cases[3],  cases[9],  cases[11], cases[18],
-             cases[23], cases[25], cases[28], cases[34]};
+  if (sanitized())  // seven families (one a two-effect case, one a control): ~8x fewer runs
+    cases = {cases[0], cases[14], cases[23], cases[31], cases[38], cases[47], cases[57]};
 
   std::vector<Score> scores;
   std::map<std::string, std::map<std::string, int>> confusion;
   for (const auto& hc : cases) {
     const auto c = world.make_case(hc.effects, hc.seed);
-    const GapSignals signals = make_gap_signals(c.real, c.sim_joint_error_rad, world.robot);
+    const GapSignals signals =
+        make_gap_signals(c.real, c.sim_joint_error_rad, world.robot, c.table ? &*c.table : nullptr);
     const Diagnosis d = diagnose_gap(signals);
     Score s;
     for (const auto& e : hc.effects)
       s.name +=
           (s.name.empty() ? "" : " + ") +
-          (test::is_chain_effect(e.name)
+          (test::spreads_over_joints(e.name)
                ? (e.name == "kinematic" ? fmt::format("link {} kinematic", e.joint + 1) : e.name)
                : fmt::format("{} {}", world.robot.joints[std::size_t(e.joint)].name, e.name));
     if (s.name.empty()) s.name = "control";
@@ -101,12 +127,13 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
     if (d.significant_gap) {
       const auto& top = d.candidates.front().fit;
       for (const auto& e : hc.effects) {
-        // An error of the IMS chain spreads over the joints: its kind ranked first on any joint
-        // counts, located is the joint where its injected gap has the most energy.
-        const bool chain = test::is_chain_effect(e.name);
-        const int joint = chain ? c.chain_joint : e.joint;
+        // An effect that spreads over the joints (the IMS chain's errors, the payload): its kind
+        // ranked first counts on any joint, located is the joint where the gap has the most
+        // energy. The others: kind and source joint.
+        const bool spread = test::spreads_over_joints(e.name);
+        const int joint = spread ? c.spread_joint : e.joint;
         s.ranked_first |=
-            top.kind == test::expected_kind(e.name) && (chain || int(top.joint) == joint);
+            top.kind == test::expected_kind(e.name) && (spread || int(top.joint) == joint);
         s.joint_located |= int(top.joint) == joint;
       }
       s.predicted = d.combination.empty() ? d.candidates.front().shrinkage_percent
@@ -138,11 +165,11 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
   std::vector<std::string> cols;
   for (int k = 0; k < kEffectKindCount; ++k) cols.push_back(to_string(effect_kind_from_index(k)));
   cols.push_back("none");
-  fmt::print("\nconfusion matrix (rows: withheld, columns: ranked first)\n{:<14}", "");
+  fmt::print("\nconfusion matrix (rows: withheld, columns: ranked first)\n{:<16}", "");
   for (const auto& c : cols) fmt::print("{:>6.6}", c);
   fmt::print("\n");
   for (const auto& [row, counts] : confusion) {
-    fmt::print("{:<14}", row);
+    fmt::print("{:<16}", row);
     for (const auto& c : cols) fmt::print("{:>6}", counts.count(c) ? counts.at(c) : 0);
     fmt::print("\n");
   }
@@ -166,11 +193,17 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
       pct(located, effect_cases), within, effect_cases, pct(within, effect_cases), alarms,
       controls);
 
-  // Goals asserted at the level this library reaches (see the report); the issue's goals are
-  // 90 % / 90 % / ±20 pp / <= 10 % false alarms.
+  // The issue's goals: ranked first >= 90 %, joint located >= 90 %, false alarms <= 10 % of the
+  // controls (met, asserted); predicted shrinkage within ±20 pp of the true one, the goal for
+  // every case: reached in 79 % of them (printed above), asserted with a margin of ~10 pp so
+  // that a regression fails (the misses: backlash, transmission error, payload and a resonance
+  // whose candidates explain less than the truth; see the report of issue 7).
   EXPECT_LE(alarms, controls / 10) << "false alarms on controls";
-  EXPECT_GE(pct(located, effect_cases), 70.0);
-  EXPECT_GE(pct(first, effect_cases), 50.0);
+  EXPECT_GE(pct(first, effect_cases), 90.0);
+  EXPECT_GE(pct(located, effect_cases), 90.0);
+  if (!sanitized()) {  // a figure of the whole set: the subset's few cases say little
+    EXPECT_GE(pct(within, effect_cases), 70.0);
+  }
 }
 
 }  // namespace
