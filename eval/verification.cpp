@@ -264,8 +264,9 @@ IdentifiedTable identify_table(const ident::JointErrorLog& log,
   return out;
 }
 
-ident::IdentificationConfig without_backlash(ident::IdentificationConfig config) {
-  config.options.identify_backlash = false;
+ident::IdentificationConfig with_operating_point_grid(ident::IdentificationConfig config) {
+  config.speed_fraction_bounds = {0.0, 0.2, 0.8, 1.0};
+  config.payload_fraction_bounds = {0.0, 0.5, 1.0};
   return config;
 }
 
@@ -274,6 +275,36 @@ ident::IdentificationConfig single_cell(ident::IdentificationConfig config) {
   config.payload_fraction_bounds = {0.0, 1.0};
   config.extra_dimensions.clear();
   return config;
+}
+
+ident::IdentificationConfig paper_form(ident::IdentificationConfig config) {
+  ident::JointIdentificationOptions& o = config.options;
+  o.form = ident::ArxModelForm::kJointError;
+  o.preview_cycles = 0;
+  o.model_torque_input = o.direction_input = o.torque_sign_input = false;
+  o.identify_backlash = true;
+  return with_operating_point_grid(std::move(config));
+}
+
+std::vector<AblationConfig> ablation_configs(const ident::IdentificationConfig& config) {
+  std::vector<AblationConfig> out{{"paper form", paper_form(config)}};
+  if (config.options.model_torque_input) {
+    AblationConfig a{"without model torque", config};
+    a.config.options.model_torque_input = a.config.options.torque_sign_input = false;
+    out.push_back(std::move(a));
+  }
+  AblationConfig backlash{
+      config.options.identify_backlash ? "without backlash term" : "with backlash term", config};
+  backlash.config.options.identify_backlash = !config.options.identify_backlash;
+  out.push_back(std::move(backlash));
+  const bool one_cell = config.speed_fraction_bounds.size() == 2 &&
+                        config.payload_fraction_bounds.size() == 2 &&
+                        config.extra_dimensions.empty();
+  if (one_cell)
+    out.push_back({"with operating-point grid", with_operating_point_grid(config)});
+  else
+    out.push_back({"single cell", single_cell(config)});
+  return out;
 }
 
 JointFitSummary summarize_fit(const ident::JointIdentification& joint) {

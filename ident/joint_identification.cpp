@@ -231,6 +231,24 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
     out.backlash.reason = "backlash identification disabled";
   }
 
+  // The envelope of the joint error in the data (the supervisor's default tolerances): its
+  // largest magnitude, and its largest rate over 8 ms (central difference over ±2 cycles: the
+  // bandwidth of the precontrol's smoother, whose rate the supervisor watches, with measurement
+  // noise averaged over 4 cycles).
+  for (const auto& [begin, end] : segments) {
+    constexpr std::size_t kHalf = 2;
+    for (std::size_t k = begin; k < end; ++k) {
+      const double e = q_desired[k] - q_measured[k];
+      out.parameters.offset_envelope_rad = std::max(out.parameters.offset_envelope_rad, std::abs(e));
+      if (k < begin + kHalf || k + kHalf >= end) continue;
+      const double rate = ((q_desired[k + kHalf] - q_measured[k + kHalf]) -
+                           (q_desired[k - kHalf] - q_measured[k - kHalf])) /
+                          (2.0 * kHalf * cycle_s);
+      out.parameters.offset_rate_envelope_rad_s =
+          std::max(out.parameters.offset_rate_envelope_rad_s, std::abs(rate));
+    }
+  }
+
   // 2. Estimation and held-out parts of every segment.
   Ranges estimation, held_out;
   const std::size_t block =

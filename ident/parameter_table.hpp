@@ -82,6 +82,11 @@ struct JointParameters {
   std::size_t backlash_lag_samples = 0;  // lag used for the direction of motion
   // Scale of the torque-sign input [N m] (> 0 when the table has that input, else 0).
   double torque_sign_scale_nm = 0.0;
+  // The largest joint error |q_d - q| and its largest rate (over 8 ms) in the identification
+  // data [rad, rad/s]: what the models were identified on. The precontrol's supervisor derives
+  // its default tolerances from them (ident/precontrol.hpp). 0: not known (version 1 tables).
+  double offset_envelope_rad = 0.0;
+  double offset_rate_envelope_rad_s = 0.0;
   std::vector<CellParameters> cells;  // flat (row-major) order of the grid
 
   CellGrid grid() const { return CellGrid(dimensions); }
@@ -95,7 +100,9 @@ struct JointParameters {
            x.backlash_l_sigma_rad == y.backlash_l_sigma_rad &&
            x.backlash_identified == y.backlash_identified &&
            x.backlash_lag_samples == y.backlash_lag_samples &&
-           x.torque_sign_scale_nm == y.torque_sign_scale_nm && x.cells == y.cells;
+           x.torque_sign_scale_nm == y.torque_sign_scale_nm &&
+           x.offset_envelope_rad == y.offset_envelope_rad &&
+           x.offset_rate_envelope_rad_s == y.offset_rate_envelope_rad_s && x.cells == y.cells;
   }
 };
 

@@ -288,7 +288,8 @@ JointParameters read_joint(const Node& n, double sample_time_s, int extra_inputs
   if (extra_inputs < 0)
     n.only_keys({"name", "backlash", "dimensions", "cells"});
   else
-    n.only_keys({"name", "backlash", "torque_sign_scale_nm", "dimensions", "cells"});
+    n.only_keys({"name", "backlash", "torque_sign_scale_nm", "offset_envelope_rad",
+                 "offset_rate_envelope_rad_s", "dimensions", "cells"});
   JointParameters j;
   j.name = n.child("name").string();
   if (j.name.empty()) n.child("name").fail("empty joint name");
@@ -298,6 +299,12 @@ JointParameters read_joint(const Node& n, double sample_time_s, int extra_inputs
       n.child("torque_sign_scale_nm")
           .fail(torque_sign ? "the table has the torque-sign input: the scale must be > 0"
                             : "the table has no torque-sign input: the scale must be 0");
+    for (const auto& [key, value] :
+         {std::pair{"offset_envelope_rad", &j.offset_envelope_rad},
+          std::pair{"offset_rate_envelope_rad_s", &j.offset_rate_envelope_rad_s}}) {
+      *value = n.child(key).number();
+      if (!(*value >= 0.0)) n.child(key).fail("must be >= 0 (0: not known)");
+    }
   }
   const Node bl = n.child("backlash");
   bl.only_keys({"l_rad", "l_sigma_rad", "identified", "lag_samples"});
@@ -351,6 +358,8 @@ std::string parameters_json_text(const ParameterTable& t) {
                         {"identified", j.backlash_identified},
                         {"lag_samples", j.backlash_lag_samples}}},
                       {"torque_sign_scale_nm", j.torque_sign_scale_nm},
+                      {"offset_envelope_rad", j.offset_envelope_rad},
+                      {"offset_rate_envelope_rad_s", j.offset_rate_envelope_rad_s},
                       {"dimensions", dims},
                       {"cells", cells}});
   }

@@ -97,10 +97,16 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
                   std::to_string(T) + " s");
   }
   for (int j = 0; j < kPrecontrolJoints; ++j) {
-    p.options_.offset_tolerance_rad[j] = default_if_zero(options.offset_tolerance_rad[j], 5e-3);
-    p.options_.rate_tolerance_rad_s[j] = default_if_zero(options.rate_tolerance_rad_s[j], 0.5);
-    p.options_.rate_limit_rad_s[j] = default_if_zero(options.rate_limit_rad_s[j], 0.2);
     const JointParameters& source = table.joints[j];
+    const double envelope = kEnvelopeTolerance * source.offset_envelope_rad;
+    const double rate_envelope = kEnvelopeRateTolerance * source.offset_rate_envelope_rad_s;
+    const double rate_limit = kEnvelopeRateLimit * source.offset_rate_envelope_rad_s;
+    p.options_.offset_tolerance_rad[j] =
+        default_if_zero(options.offset_tolerance_rad[j], default_if_zero(envelope, 5e-3));
+    p.options_.rate_tolerance_rad_s[j] =
+        default_if_zero(options.rate_tolerance_rad_s[j], default_if_zero(rate_envelope, 0.5));
+    p.options_.rate_limit_rad_s[j] =
+        default_if_zero(options.rate_limit_rad_s[j], default_if_zero(rate_limit, 0.2));
     JointModel& joint = p.joints_[j];
     const std::string name = "joint " + source.name + ": ";
     if (source.cells.empty() || source.cells.size() > kMaxPrecontrolCells) {

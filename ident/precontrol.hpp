@@ -50,11 +50,20 @@ inline constexpr int kMaxPrecontrolDeadTime = 64;  // d [samples]
 inline constexpr int kMaxPrecontrolCells = 16;     // cells per joint (<= 32: a bit mask)
 inline constexpr int kPrecontrolEventCapacity = 256;
 
+inline constexpr double kEnvelopeTolerance = 1.5;      // offset tolerance / envelope
+inline constexpr double kEnvelopeRateTolerance = 3.0;  // rate tolerance / rate envelope
+inline constexpr double kEnvelopeRateLimit = 4.0;      // output rate limit / rate envelope
+
 struct PrecontrolOptions {
   double caller_cycle_s = 0.002;
-  std::array<double, kPrecontrolJoints> offset_tolerance_rad{};  // 0: 5 mrad default
-  std::array<double, kPrecontrolJoints> rate_tolerance_rad_s{};  // 0: 0.5 rad/s default
-  std::array<double, kPrecontrolJoints> rate_limit_rad_s{};      // 0: 0.2 rad/s default
+  // Per joint; 0 selects the default: from the table's envelope of what the joint's models were
+  // identified on (JointParameters::offset_envelope_rad and _rate_...), tolerance
+  // kEnvelopeTolerance x envelope, rate limit kEnvelopeRateLimit x rate envelope (an offset or a
+  // rate beyond them means the table is applied outside its data); for a table without the
+  // envelope 5 mrad, 0.5 rad/s and 0.2 rad/s. (kEnvelopeRateTolerance for the rate tolerance.)
+  std::array<double, kPrecontrolJoints> offset_tolerance_rad{};
+  std::array<double, kPrecontrolJoints> rate_tolerance_rad_s{};
+  std::array<double, kPrecontrolJoints> rate_limit_rad_s{};
   double smoothing_time_constant_s = 0.004;      // τ of the critically damped smoother
   double fade_out_s = 0.2;                       // deactivation ramp
   double backlash_velocity_scale_rad_s = 0.002;  // v_b of the tanh transition

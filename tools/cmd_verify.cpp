@@ -41,7 +41,7 @@ struct VerifyArgs {
   std::uint64_t seed = 1;
   int look_ahead = eval::VerificationOptions{}.compensation.look_ahead_cycles;
   int inversion_iterations = eval::VerificationOptions{}.compensation.inversion_iterations;
-  double offset_tolerance_rad = 0.02;
+  double offset_tolerance_rad = 0.0;  // 0: from the table's envelope
   bool ablation = true;
   bool force = false;
 };
@@ -276,8 +276,7 @@ void run(const VerifyArgs& args) {
     tables.push_back({"compensated", t.table});
   }
   if (log && args.ablation) {
-    for (const auto& [label, cfg] : {std::pair{"no backlash", eval::without_backlash(*config)},
-                                     std::pair{"single cell", eval::single_cell(*config)}}) {
+    for (const auto& [label, cfg] : eval::ablation_configs(*config)) {
       spdlog::info("verify: ablation table '{}'", label);
       const eval::IdentifiedTable t = eval::identify_table(*log, cfg, source, &torque_model);
       for (const auto& f : t.failed_joints)
@@ -291,7 +290,8 @@ void run(const VerifyArgs& args) {
   options.segment_filter = args.segments;
   options.compensation.look_ahead_cycles = args.look_ahead;
   options.compensation.inversion_iterations = args.inversion_iterations;
-  options.compensation.precontrol.offset_tolerance_rad.fill(args.offset_tolerance_rad);
+  if (args.offset_tolerance_rad > 0.0)
+    options.compensation.precontrol.offset_tolerance_rad.fill(args.offset_tolerance_rad);
   for (const auto& name : args.scenarios) {
     const imscal::sim::Scenario scenario =
         imscal::sim::load_scenario(imscal::sim::resolve_scenario(name));
@@ -330,7 +330,8 @@ imscal::tools::CommandRegistration registration{
                      "cascade stages inverting the loop (eval/closed_loop.hpp; 0: offset added "
                      "once)");
       sub.add_option("--offset-tolerance-rad", args->offset_tolerance_rad,
-                     "supervisor tolerance on |offset| per joint [rad]");
+                     "supervisor tolerance on |offset| per joint [rad] (default: 1.5 x the table's "
+                     "envelope of the identification data)");
       sub.add_flag("!--no-ablation", args->ablation, "skip the ablation tables");
       sub.add_option("--out", args->out, "output folder")->required();
       sub.add_flag("--force", args->force, "Overwrite existing outputs");

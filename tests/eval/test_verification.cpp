@@ -42,7 +42,8 @@ sim::Scenario scenario(const std::string& name) {
 }
 
 struct Tables {
-  IdentifiedTable full, no_backlash, one_cell;
+  IdentifiedTable full;
+  std::vector<std::pair<std::string, IdentifiedTable>> ablation;  // eval::ablation_configs
 };
 
 const Tables& tables() {
@@ -51,21 +52,19 @@ const Tables& tables() {
     const ident::JointErrorLog log =
         simulate_truth_joint_errors(identification, sanitized() ? 60.0 : 1e9);
     const char* config_file = std::getenv("IMSCAL_VERIFY_CONFIG");
-    ident::IdentificationConfig config = ident::load_identification_config(ConfigNode::load_file(
-        config_file ? fs::path(config_file)
-                    : fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-default.yaml"));
-    if (const char* v = std::getenv("IMSCAL_VERIFY_FORM"))
-      config.options.form = ident::arx_model_form_from_string(v);
-    if (const char* v = std::getenv("IMSCAL_VERIFY_PREVIEW"))
-      config.options.preview_cycles = std::atoi(v);
+    const ident::IdentificationConfig config =
+        ident::load_identification_config(ConfigNode::load_file(
+            config_file ? fs::path(config_file)
+                        : fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-default.yaml"));
     const ModelTorqueSource torque_model = scenario_model_torque(identification);
     const std::string source = "simulator truth";
-    Tables out{identify_table(log, config, source, &torque_model),
-               identify_table(log, without_backlash(config), source, &torque_model),
-               identify_table(log, single_cell(config), source, &torque_model)};
-    for (const auto* t : {&out.full, &out.no_backlash, &out.one_cell})
-      for (const auto& failed : t->failed_joints)
-        std::printf("not identified: %s\n", failed.c_str());
+    Tables out{identify_table(log, config, source, &torque_model), {}};
+    for (const auto& a : ablation_configs(config))
+      out.ablation.emplace_back(a.label, identify_table(log, a.config, source, &torque_model));
+    for (const auto& failed : out.full.failed_joints) std::printf("not identified: %s\n", failed.c_str());
+    for (const auto& [label, t] : out.ablation)
+      for (const auto& failed : t.failed_joints)
+        std::printf("%s: not identified: %s\n", label.c_str(), failed.c_str());
     return out;
   }();
   return t;
@@ -109,10 +108,8 @@ VerificationResult run(const std::string& name, const std::string& filter, bool 
   if (const char* v = std::getenv("IMSCAL_VERIFY_RATE_LIMIT_RAD_S"))
     options.compensation.precontrol.rate_limit_rad_s.fill(std::atof(v));
   std::vector<NamedTable> named{{"compensated", tables().full.table}};
-  if (ablation) {
-    named.push_back({"no backlash", tables().no_backlash.table});
-    named.push_back({"single cell", tables().one_cell.table});
-  }
+  if (ablation)
+    for (const auto& [label, t] : tables().ablation) named.push_back({label, t.table});
   const VerificationResult r = verify_scenario(scenario(name), named, options);
   std::printf("%s (%d cycles, segments:", name.c_str(), r.cycles);
   for (const auto& s : r.segments) std::printf(" '%s'", s.c_str());
@@ -139,7 +136,9 @@ TEST(Verification, IdentificationFitPerJoint) {
   if (!sanitized()) {
     EXPECT_TRUE(t.full.failed_joints.empty());
   }
-  for (const auto* table : {&t.full, &t.no_backlash, &t.one_cell}) {
+  std::vector<const IdentifiedTable*> all{&t.full};
+  for (const auto& a : t.ablation) all.push_back(&a.second);
+  for (const IdentifiedTable* table : all) {
     for (const auto& failed : table->failed_joints) {
       const std::string name = failed.substr(0, failed.find(':'));
       for (const auto& joint : table->joints) {
@@ -151,7 +150,7 @@ TEST(Verification, IdentificationFitPerJoint) {
       }
     }
   }
-  for (const auto* table : {&t.full, &t.no_backlash, &t.one_cell}) {
+  for (const IdentifiedTable* table : all) {
     for (const auto& joint : table->joints) {
       // Backlash estimates are bounded (ident::BacklashOptions::max_l_rad = 20 mrad): an absurd
       // width (once 7e3 rad on A5/A6) never reaches a table.
@@ -176,6 +175,9 @@ TEST(Verification, IdentificationFitPerJoint) {
         joint.parameters.name.c_str(), s.simulation_fit_percent, s.joint_error_fit_percent,
         s.validation_rows, joint.parameters.backlash_l_rad * 1e3,
         joint.parameters.backlash_identified ? "identified" : "none");
+    std::printf("    offset envelope of the data: %.2f mrad, %.3f rad/s\n",
+                joint.parameters.offset_envelope_rad * 1e3,
+                joint.parameters.offset_rate_envelope_rad_s);
     std::printf("    backlash: %s; reversals found %zu used %zu, lag %zu\n",
                 joint.backlash.reason.c_str(), std::size_t(joint.backlash.reversals_found),
                 std::size_t(joint.backlash.reversals_used),
