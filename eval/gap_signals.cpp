@@ -207,6 +207,11 @@ std::vector<std::vector<double>> predict_table_joint_errors(const ident::Paramet
   if (table.joints.size() != log.joint_count())
     throw std::invalid_argument("parameter table has " + std::to_string(table.joints.size()) +
                                 " joints, the joint errors " + std::to_string(log.joint_count()));
+  if (table.model_form != ident::TableForm::kForward || !table.extra_inputs.empty())
+    throw std::invalid_argument(
+        "the parameter table is not a single-input forward error model (an inverse-form or "
+        "multi-input table does not predict the joint error from q_d alone); use the forward "
+        "table `imscal identify` writes beside it, forward_parameters.json");
   const auto runs = log.segments();
   const std::size_t n = log.sample_count();
   std::vector<std::vector<double>> out(log.joint_count(), std::vector<double>(n, 0.0));

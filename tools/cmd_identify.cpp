@@ -10,11 +10,16 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <vector>
 
+#include "calib/robot_description.hpp"
 #include "core/atomic_file.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "core/version.hpp"
+#include "eval/model_torque.hpp"
+#include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
 #include "ident/identify_joints.hpp"
 #include "ident/joint_error_io.hpp"
@@ -30,9 +35,33 @@ using nlohmann::json;
 struct IdentifyArgs {
   std::string joint_errors;
   std::string config;
+  std::string robot;  // robot description, for the model torque of multi-input configs
+  std::vector<double> gravity_m_s2{0.0, 0.0, -9.80665};  // in the robot base R
   std::string out;
   bool force = false;
 };
+
+// The model torques of the log's path (eval/model_torque.hpp), when the config's models take
+// them: from the robot description given with --robot, whose name must be the log's robot.
+void attach_model_torques(ident::JointErrorLog& log, const ident::IdentificationConfig& config,
+                          const IdentifyArgs& args) {
+  if (!config.options.model_torque_input) return;
+  if (args.robot.empty())
+    throw imscal::InputError(args.config, 0, "model.model_torque",
+                             "the config's models take the model torque: give the robot "
+                             "description with --robot (e.g. datasets/robots/kr16.yaml)");
+  imscal::eval::ModelTorqueSource model;
+  model.robot = imscal::calib::load_robot_description(args.robot);
+  if (model.robot.name != log.robot)
+    throw imscal::InputError(args.robot, 0, "name",
+                             fmt::format("robot '{}', but {} is of robot '{}'", model.robot.name,
+                                         args.joint_errors, log.robot));
+  model.gravity_in_base_m_s2 =
+      Eigen::Vector3d(args.gravity_m_s2[0], args.gravity_m_s2[1], args.gravity_m_s2[2]);
+  spdlog::info("identify: model torques of {} along the {} path", model.robot.name,
+               imscal::eval::torque_along_measured_path(config.options) ? "measured" : "desired");
+  imscal::eval::attach_model_torques(log, model, config.options);
+}
 
 json number_or_null(double v) {
   return std::isfinite(v) ? json(v) : json(nullptr);
@@ -141,9 +170,10 @@ json joint_report(const ident::JointIdentification& r, double seconds) {
 
 void run(const IdentifyArgs& args) {
   const auto start = std::chrono::steady_clock::now();
-  const ident::JointErrorLog log = ident::read_joint_errors_csv(args.joint_errors);
+  ident::JointErrorLog log = ident::read_joint_errors_csv(args.joint_errors);
   const imscal::ConfigNode config_node = imscal::ConfigNode::load_file(args.config);
   const ident::IdentificationConfig config = ident::load_identification_config(config_node);
+  attach_model_torques(log, config, args);
   if (config.max_speed_rad_s.size() != log.joint_count())
     throw imscal::InputError(
         args.config, config_node.child("joints").child("max_speed_deg_s").line(),
@@ -155,7 +185,7 @@ void run(const IdentifyArgs& args) {
                  report_path = out_dir / "identification_report.json";
   const auto overwrite = args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse;
   if (!args.force)
-    for (const auto& p : {json_path, csv_path, report_path})
+    for (const auto& p : {json_path, csv_path, report_path, out_dir / "forward_parameters.json"})
       if (fs::exists(p))
         throw imscal::InputError(p.string(), 0, "", "output exists; use --force to overwrite it");
   fs::create_directories(out_dir);
@@ -213,8 +243,20 @@ void run(const IdentifyArgs& args) {
       {"sample_time_s", log.cycle_s},
       {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
       {"joints", joints_report}};
+  // An inverse-form table does not predict the joint error from q_d (the gap diagnosis's "sim"):
+  // the paper's forward error model from the same data is written beside it.
+  std::optional<ident::ParameterTable> forward_table;
+  if (config.options.form == ident::ArxModelForm::kInverse) {
+    spdlog::info("identify: the forward error model (paper form) for the gap diagnosis");
+    const ident::IdentificationConfig forward = imscal::eval::paper_form(config);
+    forward_table = ident::parameter_table_header(log, forward, table.source);
+    for (auto& outcome : ident::identify_joints(log, forward))
+      forward_table->joints.push_back(std::move(outcome.result.parameters));
+  }
   // The table last: a reader that sees parameters.json sees a finished run.
   imscal::write_file_atomically(report_path, report.dump(1) + "\n", overwrite);
+  if (forward_table)
+    ident::write_parameters_json(out_dir / "forward_parameters.json", *forward_table, overwrite);
   ident::write_parameters_csv(csv_path, table, overwrite);
   ident::write_parameters_json(json_path, table, overwrite);
   spdlog::info("wrote {}, {}, {}", json_path.string(), csv_path.string(), report_path.string());
@@ -230,6 +272,12 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--config", args->config,
                      "Identification config (datasets/identification/ident-default.yaml)")
           ->required();
+      sub.add_option("--robot", args->robot,
+                     "Robot description (datasets/robots/kr16.yaml): the rigid-body model of the "
+                     "model torque input");
+      sub.add_option("--gravity-m-s2", args->gravity_m_s2,
+                     "Gravity in the robot base R [m/s²] (default 0 0 -9.80665: a level base)")
+          ->expected(3);
       sub.add_option("--out", args->out, "Output folder")->required();
       sub.add_flag("--force", args->force, "Overwrite existing outputs");
       sub.callback([args] { run(*args); });

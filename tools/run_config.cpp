@@ -49,11 +49,12 @@ RunConfig load_run_config(const fs::path& file) {
     config.calibrate = settings;
   }
   if (auto i = root.optional_child("identify")) {
-    i->require_only_keys({"config", "timeout_s"});
+    i->require_only_keys({"config", "robot", "timeout_s"});
     if (!config.joint_errors && !config.calibrate)
       i->fail("an identify section needs joint errors: inputs.joint_errors or a calibrate section");
     IdentifySettings settings;
     settings.config = i->child("config").as_existing_file();
+    if (auto n = i->optional_child("robot")) settings.robot = n->as_existing_file();
     if (auto n = i->optional_child("timeout_s")) settings.timeout_s = positive(*n);
     config.identify = settings;
   } else if (config.joint_errors) {

@@ -17,6 +17,7 @@
 //     timeout_s: 1800
 //   identify:                             # needs joint errors: inputs.joint_errors, or else
 //     config: ../identification/ident-default.yaml    # the calibrate stage's
+//     robot: ../robots/kr16.yaml          # the rigid-body model of the model-torque input
 //     timeout_s: 1800
 //   verify:                               # needs identify: closed loop in the simulator with
 //     scenarios: [seed-line]              # and without the precontrol (shipped names or files)
@@ -45,6 +46,7 @@ struct ValidateSettings {
 
 struct IdentifySettings {
   std::filesystem::path config;
+  std::filesystem::path robot;  // robot description for the model torque (empty: none)
   double timeout_s = 1800.0;
 };
 

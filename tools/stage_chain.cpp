@@ -25,6 +25,14 @@ fs::path table_of(const StageWorkspace& ws) {
   return upstream_file(ws, "identify", "parameters.json");
 }
 
+// The forward error model for the gap diagnosis (its "sim" predicts the joint error from q_d):
+// identify's forward_parameters.json beside an inverse-form table, else the table itself.
+fs::path forward_table_of(const StageWorkspace& ws) {
+  const auto dir = ws.upstream_dir("identify");
+  if (dir && fs::exists(*dir / "forward_parameters.json")) return *dir / "forward_parameters.json";
+  return table_of(ws);
+}
+
 // The joint errors as a stage input: the configured file (with its checksum), or calibrate's.
 void declare_joint_errors(const RunConfig& config, StageInputs& in) {
   if (config.joint_errors)
@@ -91,15 +99,22 @@ std::unique_ptr<Stage> make_identify_stage(const RunConfig& config) {
     StageInputs in;
     declare_joint_errors(config, in);
     in.files.emplace_back("identify_config", config.identify->config);
+    if (!config.identify->robot.empty()) in.files.emplace_back("robot", config.identify->robot);
     in.config = {{"config", config.identify->config.string()},
+                 {"robot", config.identify->robot.string()},
                  {"timeout_s", config.identify->timeout_s}};
     return in;
   };
   spec.arguments = [&config](const StageWorkspace& ws, const fs::path& out) {
     const fs::path joint_errors = joint_errors_of(config, ws);
-    return std::vector<std::string>{"--joint-errors", joint_errors.string(),
-                                    "--config",       config.identify->config.string(),
-                                    "--out",          out.string()};
+    std::vector<std::string> arguments{"--joint-errors", joint_errors.string(),
+                                       "--config",       config.identify->config.string(),
+                                       "--out",          out.string()};
+    if (!config.identify->robot.empty()) {
+      arguments.emplace_back("--robot");
+      arguments.push_back(config.identify->robot.string());
+    }
+    return arguments;
   };
   // `imscal identify` logs "joint A2 (2/6): ..." when it starts a joint.
   spec.progress_of_line = [](const std::string& line) -> std::optional<double> {
@@ -173,10 +188,11 @@ std::unique_ptr<Stage> make_diagnose_stage(const RunConfig& config) {
   };
   spec.arguments = [&config](const StageWorkspace& ws, const fs::path& out) {
     const fs::path joint_errors = joint_errors_of(config, ws);
-    return std::vector<std::string>{
-        "--joint-errors", joint_errors.string(),           "--table",   table_of(ws).string(),
-        "--robot",        config.diagnose->robot.string(), "--figures", "--out",
-        out.string()};
+    return std::vector<std::string>{"--joint-errors", joint_errors.string(),
+                                    "--table",        forward_table_of(ws).string(),
+                                    "--robot",        config.diagnose->robot.string(),
+                                    "--figures",      "--out",
+                                    out.string()};
   };
   spec.success_message = "gap diagnosis written";
   return std::make_unique<SubcommandStage>(std::move(spec));

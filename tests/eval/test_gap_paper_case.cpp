@@ -33,7 +33,7 @@ TEST(GapPaperCase, NamesTheOperatingPointMismatchAndRanksJoint2Backlash) {
                          "scenarios/identification-a2-no-backlash.yaml"),
       sanitized() ? 30.0 : 1e9);
   ident::IdentificationConfig config = ident::load_identification_config(ConfigNode::load_file(
-      fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-default.yaml"));
+      fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-paper.yaml"));
   config.options.form = ident::ArxModelForm::kJointError;  // the forward error model
   // The operating point includes the joint position (the paper's Table 2 extended "to take also
   // into account ... the position of the axes"): bands below -0.5 rad, -0.5..0.5, above 0.5 rad.

@@ -52,16 +52,17 @@ const Tables& tables() {
     const ident::JointErrorLog log =
         simulate_truth_joint_errors(identification, sanitized() ? 60.0 : 1e9);
     const char* config_file = std::getenv("IMSCAL_VERIFY_CONFIG");
-    const ident::IdentificationConfig config =
-        ident::load_identification_config(ConfigNode::load_file(
-            config_file ? fs::path(config_file)
-                        : fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-default.yaml"));
+    const ident::IdentificationConfig config = ident::load_identification_config(
+        ConfigNode::load_file(config_file ? fs::path(config_file)
+                                          : fs::path(IMSCAL_SOURCE_DIR) /
+                                                "datasets/identification/ident-default.yaml"));
     const ModelTorqueSource torque_model = scenario_model_torque(identification);
     const std::string source = "simulator truth";
     Tables out{identify_table(log, config, source, &torque_model), {}};
     for (const auto& a : ablation_configs(config))
       out.ablation.emplace_back(a.label, identify_table(log, a.config, source, &torque_model));
-    for (const auto& failed : out.full.failed_joints) std::printf("not identified: %s\n", failed.c_str());
+    for (const auto& failed : out.full.failed_joints)
+      std::printf("not identified: %s\n", failed.c_str());
     for (const auto& [label, t] : out.ablation)
       for (const auto& failed : t.failed_joints)
         std::printf("%s: not identified: %s\n", label.c_str(), failed.c_str());
@@ -208,18 +209,37 @@ TEST(Verification, SeedLineWithAblation) {
     EXPECT_EQ(c.figures.missed_crossings, 0) << c.label;
   }
   if (!sanitized()) {
-    // What the chain reaches today (Release, 10 cycles, look-ahead 4: compensated 50.3 %, no
-    // backlash 48.2 %, single cell 45.0 %), asserted 5 %-points below to absorb floating-point
-    // differences between compilers (the simulator and the friction draws are deterministic). The
-    // precontrol must stay active through the whole run (it was switched off at cycle 0 by a
-    // garbage A5 table).
-    const double floor_percent[] = {45.0, 40.0, 40.0};
-    for (std::size_t c = 0; c < r.after.size() && c < 3; ++c) {
-      EXPECT_EQ(r.after[c].inactive_cycles, 0u) << r.after[c].label;
-      EXPECT_GE(reduction_percent(before, r.after[c].figures.max_path_deviation_m),
-                floor_percent[c])
-          << r.after[c].label;
+    // What the chain reaches today (Release, 10 cycles, look-ahead 4): the default table (inverse
+    // form with the model torque) 92.8 %; ablation: paper form 49.4 %, without the model torque
+    // 38.0 %, with eq. 3's backlash term 90.2 %, with the operating-point grid 91.5 %. Asserted
+    // 3 %-points below (compiler differences; the simulator and the friction draws are
+    // deterministic), the precontrol active throughout, and each part of the default measured:
+    // the paper's form and the model without the torque stay far behind.
+    EXPECT_EQ(r.after[0].inactive_cycles, 0u);
+    const double compensated = reduction_percent(before, r.after[0].figures.max_path_deviation_m);
+    EXPECT_GE(compensated, 89.8);
+    for (std::size_t c = 1; c < r.after.size(); ++c) {
+      const double reduction = reduction_percent(before, r.after[c].figures.max_path_deviation_m);
+      if (r.after[c].label == "paper form" || r.after[c].label == "without model torque")
+        EXPECT_LT(reduction, compensated - 30.0) << r.after[c].label;
+      else
+        EXPECT_GE(reduction, 85.0) << r.after[c].label;
     }
+    // The repeatability floor: the same table on the plant with its nominal friction (no
+    // run-to-run draw, one cycle): what the model leaves, without what no model of the nominal
+    // robot can predict (the 10 cycles' friction drawn anew, sigma 5 %: RT_p 0.71 mm).
+    VerificationOptions nominal;
+    nominal.cycles = 1;
+    nominal.friction_sigma_fraction = 0.0;
+    nominal.segment_filter = "line";
+    const VerificationResult n =
+        verify_scenario(scenario("seed-line"), {{"compensated", tables().full.table}}, nominal);
+    const double floor_mm = n.after[0].figures.max_path_deviation_m * 1e3;
+    std::printf("seed-line, nominal friction, 1 cycle: %.3f -> %.3f mm (%.1f %%)\n",
+                n.before.figures.max_path_deviation_m * 1e3, floor_mm,
+                reduction_percent(n.before.figures.max_path_deviation_m,
+                                  n.after[0].figures.max_path_deviation_m));
+    EXPECT_LT(n.after[0].figures.max_path_deviation_m, r.after[0].figures.max_path_deviation_m);
   }
   if (assert_goals() && !sanitized()) {
     const double full = reduction_percent(before, r.after[0].figures.max_path_deviation_m);
@@ -231,12 +251,15 @@ TEST(Verification, Iso9283FullVelocity) {
   const VerificationResult r = run("iso9283", "100%", false);
   EXPECT_GT(r.before.figures.max_path_deviation_m, 0.001);
   if (!sanitized()) {
-    // Today the table's prediction exceeds the supervisor's 20 mrad on A3 (cycle ~1285) and the
-    // compensation is faded out; with 50 mrad it stays on longer and makes the path worse
-    // (20.6 mm against 12.7 mm), so the supervisor is doing its job. Asserted: the compensated
-    // run is never worse than the uncompensated one (1 %: the fade-out ramp; measured 0.0 %).
-    EXPECT_LE(r.after[0].figures.max_path_deviation_m,
-              1.01 * r.before.figures.max_path_deviation_m);
+    // What the chain reaches today (Release, 5 cycles): 12.35 -> 2.30 mm (81.3 %), the precontrol
+    // active throughout (its default tolerances come from the identification data's envelope;
+    // the 100 % D 40 mm circle needs A3 offsets of 25 mrad at 0.5 rad/s). The residual sits on
+    // that circle, whose joint accelerations are 3-4x the program's own joint limits and the
+    // identification's (printed by the planner test; tests/sim). Asserted 3 %-points below.
+    EXPECT_EQ(r.after[0].inactive_cycles, 0u);
+    EXPECT_GE(reduction_percent(r.before.figures.max_path_deviation_m,
+                                r.after[0].figures.max_path_deviation_m),
+              78.0);
   }
   if (assert_goals() && !sanitized()) {
     const double full = reduction_percent(r.before.figures.max_path_deviation_m,

@@ -42,7 +42,7 @@ JointErrorLog three_moving_joints_and_one_still() {
 
 IdentificationConfig config_for_four_joints() {
   auto config = load_identification_config(ConfigNode::load_file(
-      std::string(IMSCAL_SOURCE_DIR) + "/datasets/identification/ident-default.yaml"));
+      std::string(IMSCAL_SOURCE_DIR) + "/datasets/identification/ident-paper.yaml"));
   config.max_speed_rad_s.resize(4);
   config.options.grid.na_max = config.options.grid.nb_max = 8;  // a small sweep: a fast test
   return config;

@@ -93,7 +93,9 @@ TEST(ParameterTable, Version1TablesReadAsForwardModelsWithoutPreview) {
        {"model_form", "preview_cycles", "extra_inputs", "direction_speed_scale_rad_s"})
     j.erase(key);
   for (auto& joint : j["joints"]) {
-    joint.erase("torque_sign_scale_nm");
+    for (const char* key :
+         {"torque_sign_scale_nm", "offset_envelope_rad", "offset_rate_envelope_rad_s"})
+      joint.erase(key);
     for (auto& cell : joint["cells"]) {
       cell.erase("nx");
       cell.erase("c");

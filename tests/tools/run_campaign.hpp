@@ -53,10 +53,10 @@ inline std::filesystem::path write_campaign(const std::filesystem::path& dir,
   ident::write_joint_errors_csv(dir / "joint_errors.csv", log);
 
   std::string config =
-      read_file_text(fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-default.yaml");
+      read_file_text(fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-paper.yaml");
   const auto replace = [&](const std::string& from, const std::string& to) {
     const auto at = config.find(from);
-    if (at == std::string::npos) throw std::runtime_error("ident-default.yaml lacks " + from);
+    if (at == std::string::npos) throw std::runtime_error("ident-paper.yaml lacks " + from);
     config.replace(at, from.size(), to);
   };
   replace("max_speed_deg_s: [156, 156, 156, 330, 330, 615]", "max_speed_deg_s: [60, 60]");

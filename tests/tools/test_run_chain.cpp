@@ -42,6 +42,8 @@ TEST_F(RunChain, IdentifyVerifyDiagnoseAndReport) {
                            "identify:\n"
                            "  config: " IMSCAL_SOURCE_DIR
                            "/datasets/identification/ident-default.yaml\n"
+                           "  robot: " IMSCAL_SOURCE_DIR
+                           "/datasets/robots/kr16.yaml\n"
                            "verify:\n"
                            "  scenarios: [seed-line]\n"
                            "  cycles: 2\n"
