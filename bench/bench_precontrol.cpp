@@ -19,17 +19,22 @@ namespace {
 
 using namespace imscal::ident;
 
-ParameterTable order_32_table() {
+// with_inputs: every cell also takes the three further inputs of the default identification
+// (model torque and direction with 32 coefficients each, the torque's sign with one).
+ParameterTable order_32_table(bool with_inputs) {
   std::mt19937_64 rng(32);
   ParameterTable t;
   t.robot = "kr16";
   t.sample_time_s = 0.002;
+  if (with_inputs)
+    t.extra_inputs = {TableInput::kModelTorque, TableInput::kDirection, TableInput::kTorqueSign};
   for (int j = 0; j < 6; ++j) {
     JointParameters joint;
     joint.name = std::string(1, 'A').append(std::to_string(j + 1));
     joint.dimensions = {CellDimension{OperatingQuantity::kSpeed, {0.0, 0.5, 1.5, 3.0}},
                         CellDimension{OperatingQuantity::kPayload, {0.0, 8.0, 16.0}}};
     joint.backlash_l_rad = 1e-4;
+    if (with_inputs) joint.torque_sign_scale_nm = 1.0;
     for (int c = 0; c < 6; ++c) {
       CellParameters cell;
       cell.bands = {c / 2, c % 2};
@@ -39,6 +44,11 @@ ParameterTable order_32_table() {
       const double a_sum = 1.0 + a.sum();
       cell.a.assign(a.data(), a.data() + a.size());
       cell.b.assign(32, a_sum / 32.0);  // static gain 1
+      if (with_inputs) {
+        cell.structure.extra_inputs = 3;
+        cell.structure.nx = {32, 32, 1};
+        cell.c.assign(65, 1e-7);  // a small response to torque, direction and side
+      }
       joint.cells.push_back(cell);
     }
     t.joints.push_back(joint);
@@ -46,12 +56,23 @@ ParameterTable order_32_table() {
   return t;
 }
 
+// The torque-fed cycle where the runtime has one (the all-cells reference has none and is only
+// timed without further inputs).
+template <class Runtime>
+PrecontrolOutput cycle_with_torque(Runtime& runtime, const std::array<double, 6>& q, double payload,
+                                   const std::array<double, 6>& torque, std::uint64_t k) {
+  if constexpr (requires { runtime.cycle(q, payload, torque, k); })
+    return runtime.cycle(q, payload, torque, k);
+  else
+    return runtime.cycle(q, payload, k);
+}
+
 // Times each of kCycles consecutive cycles of `precontrol` (Precontrol or the all-cells
 // reference, same interface) and reports median, 99.9th percentile and maximum in ns, and the
 // fraction of cycles that ended active (the supervisor must not switch the work off).
 template <class Runtime>
-void time_cycles(benchmark::State& state) {
-  const ParameterTable table = order_32_table();
+void time_cycles(benchmark::State& state, bool with_inputs) {
+  const ParameterTable table = order_32_table(with_inputs);
   PrecontrolOptions options;
   options.offset_tolerance_rad.fill(1.0);  // keep it active: measure the full work
   options.rate_tolerance_rad_s.fill(1e9);
@@ -63,14 +84,18 @@ void time_cycles(benchmark::State& state) {
   }
   constexpr int kCycles = 1000000;
   std::vector<double> ns(kCycles);
-  std::array<double, 6> q{};
+  std::array<double, 6> q{}, torque{};
   int active = 0;
   for (auto _ : state) {
     for (int k = 0; k < kCycles; ++k) {
       const double t = k * 0.002;
       for (int j = 0; j < 6; ++j) q[j] = 0.8 * std::sin(0.5 * t + j);  // sweeps the speed cells
+      for (int j = 0; j < 6; ++j) torque[j] = 100.0 * std::sin(0.5 * t + j);  // N m
+      const double payload = 8.0 + 6.0 * std::sin(0.01 * t);
       const auto begin = std::chrono::steady_clock::now();
-      const PrecontrolOutput out = precontrol.cycle(q, 8.0 + 6.0 * std::sin(0.01 * t), k);
+      const PrecontrolOutput out = with_inputs
+                                       ? cycle_with_torque(precontrol, q, payload, torque, k)
+                                       : precontrol.cycle(q, payload, k);
       const auto end = std::chrono::steady_clock::now();
       benchmark::DoNotOptimize(out);
       active += out.state == PrecontrolState::kActive;
@@ -85,14 +110,23 @@ void time_cycles(benchmark::State& state) {
 }
 
 void BM_PrecontrolCycle6JointsOrder32(benchmark::State& state) {
-  time_cycles<Precontrol>(state);
+  time_cycles<Precontrol>(state, false);
 }
 BENCHMARK(BM_PrecontrolCycle6JointsOrder32)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// The same table with the default identification's three further inputs in every cell (the
+// model torque fed by the caller): the heaviest table the default config can produce per cell.
+void BM_PrecontrolCycle6JointsOrder32FurtherInputs(benchmark::State& state) {
+  time_cycles<Precontrol>(state, true);
+}
+BENCHMARK(BM_PrecontrolCycle6JointsOrder32FurtherInputs)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 // The same with the runtime as it was before issue 6's speed work (every cell runs every cycle):
 // the before/after comparison in one run, on the same machine load.
 void BM_AllCellsReferenceCycle6JointsOrder32(benchmark::State& state) {
-  time_cycles<imscal::test_support::AllCellsPrecontrol>(state);
+  time_cycles<imscal::test_support::AllCellsPrecontrol>(state, false);
 }
 BENCHMARK(BM_AllCellsReferenceCycle6JointsOrder32)->Unit(benchmark::kMillisecond)->Iterations(1);
 
