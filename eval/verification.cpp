@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "calib/forward_kinematics.hpp"
+#include "eval/ims_measured_path.hpp"
 #include "eval/iso9283_path.hpp"
 #include "eval/path_deviation.hpp"
 #include "ident/identify_joints.hpp"
@@ -389,7 +390,15 @@ VerificationResult verify_scenario(const sim::Scenario& scenario,
   const sim::PlantConfig base = scenario_plant(scenario, robot);
   std::mt19937_64 rng(options.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
-  std::vector<std::vector<std::vector<PathPose>>> cycles(tables.size() + 1);
+  // Per case and cycle: the attained path as measured, and the true one.
+  std::vector<std::vector<std::vector<PathPose>>> cycles(tables.size() + 1),
+      true_cycles(tables.size() + 1);
+  // The standstill at the start of the run: the IMS chain's first rest.
+  double standstill_s = 0.0;
+  for (const auto& sample : path.samples) {
+    if (sample.qd_rad_s.norm() != 0.0 || sample.qdd_rad_s2.norm() != 0.0) break;
+    standstill_s = sample.t_s;
+  }
   for (int j = 0; j < options.cycles; ++j) {
     sim::PlantConfig config = base;
     for (auto& joint : config.robot.joints) {
@@ -398,9 +407,21 @@ VerificationResult verify_scenario(const sim::Scenario& scenario,
       joint.drive.coulomb_nm *= factor;
       joint.drive.viscous_nm_s_per_rad *= factor;
     }
-    cycles[0].push_back(attained_path(robot, sim::simulate_plant(config, path, T)));
-    for (std::size_t c = 0; c < commands.size(); ++c) {
-      cycles[c + 1].push_back(attained_path(robot, sim::simulate_plant(config, commands[c], T)));
+    for (std::size_t c = 0; c <= commands.size(); ++c) {
+      const sim::DesiredJointPath& command = c == 0 ? path : commands[c - 1];
+      const sim::PlantLog plant = sim::simulate_plant(config, command, T);
+      true_cycles[c].push_back(attained_path(robot, plant));
+      if (!options.measure_with_ims) {
+        cycles[c].push_back(true_cycles[c].back());
+        continue;
+      }
+      const ImsJointMeasurement m = measure_joints_with_ims(
+          scenario, robot, command, plant, standstill_s, options.ims_seed + std::uint64_t(j));
+      std::vector<double> t;
+      std::vector<calib::JointVector> q;
+      for (std::size_t k = 0; k < m.q_rad.size(); ++k)
+        if (m.valid[k]) t.push_back(plant.samples[k].t_s), q.push_back(m.q_rad[k]);
+      cycles[c].push_back(flange_path(robot, t, q));
     }
   }
 
@@ -409,6 +430,9 @@ VerificationResult verify_scenario(const sim::Scenario& scenario,
     vc.label = label;
     vc.figures =
         path_figures(evaluated, path.segments, desired, cycles[index], options, &vc.series);
+    vc.true_figures = options.measure_with_ims ? path_figures(evaluated, path.segments, desired,
+                                                              true_cycles[index], options, nullptr)
+                                               : vc.figures;
     for (double& t : vc.series.t_s) t += t0;  // back to the scenario's clock
     return vc;
   };

@@ -15,9 +15,10 @@
 // first of them (if the robot is at rest there; the plant starts balanced at rest, so this is
 // the same as having arrived and settled) to lead_out_s after the last, to save time.
 //
-// The attained path is the flange's, by forward kinematics of the link-side joint angles the
-// plant reached (what a perfect IMS chain would measure; the IMS chain of `imscal calibrate`
-// can replace it once it exists).
+// The attained path is the flange's, as the IMS chain measures it (VerificationOptions::
+// measure_with_ims: the plant's run recorded by the scenario's simulated IMS, mechanized,
+// smoothed, through the frames and the inverse kinematics), and by forward kinematics of the
+// link-side joint angles the plant reached (the truth, VerificationCase::true_figures).
 //
 // Identification from simulator truth: joint errors q_d - q_link of a scenario's run, one sample
 // per controller cycle (a stand-in for the IMS chain's joint_errors.csv), and the parameter
@@ -117,6 +118,12 @@ struct VerificationOptions {
     c.look_ahead_cycles = 4;
     return c;
   }();
+  // The attained path as the paper measures it: recorded by the scenario's simulated IMS and
+  // taken through the chain (eval/ims_measured_path.hpp; sensor draws seeded per cycle from
+  // ims_seed, the same for a cycle's uncompensated and compensated runs). false: the plant's
+  // true link-side path (a perfect measurement).
+  bool measure_with_ims = true;
+  std::uint64_t ims_seed = 1;
   int calculation_points = 200;      // ISO 9283 calculation points per segment
   double iso_time_window_s = 0.25;   // a crossing counts within this time of its point
   double deviation_window_s = 0.25;  // path deviation: desired path within this time
@@ -149,8 +156,9 @@ struct PlotSeries {
 };
 
 struct VerificationCase {
-  std::string label;  // "uncompensated" or the table's label
-  PathFigures figures;
+  std::string label;         // "uncompensated" or the table's label
+  PathFigures figures;       // of the attained path as measured (by the IMS chain when enabled)
+  PathFigures true_figures;  // of the plant's true link-side path (equal without the IMS chain)
   PlotSeries series;
   std::vector<ident::PrecontrolEvent> events;  // precontrol events (compensated cases)
   std::size_t inactive_cycles = 0;             // cycles with the precontrol not active

@@ -63,6 +63,39 @@ std::vector<Eigen::Isometry3d> flange_poses(const calib::RobotDescription& robot
   return poses;
 }
 
+ImsRecording record_ims(const Scenario& scenario, const calib::RobotDescription& robot,
+                        const ims::SensorSpec& spec, const PlantLog& plant,
+                        const Eigen::Isometry3d& T_W_R, const Eigen::Isometry3d& T_H_S,
+                        std::mt19937_64& rng) {
+  const ims::EarthModel earth(scenario.site);
+  const std::vector<Eigen::Isometry3d> T_R_H = flange_poses(robot, plant);
+  std::vector<ims::PoseSample> poses(T_R_H.size());
+  for (std::size_t k = 0; k < T_R_H.size(); ++k) {
+    const Eigen::Isometry3d T_W_S = T_W_R * T_R_H[k] * T_H_S;
+    poses[k] = {plant.samples[k].t_s, T_W_S.translation(),
+                Eigen::Quaterniond(T_W_S.linear()).normalized()};
+  }
+  const ims::SplineTrajectory trajectory(poses);
+  const ims::ImuSeries ideal =
+      ims::synthesize_ideal_increments(trajectory, earth, scenario.imu_rate_hz);
+  ImsRecording out;
+  out.sensor_errors = ims::draw_sensor_errors(spec, rng);
+  out.imu_raw = ims::corrupt(ideal, out.sensor_errors, spec, rng());
+  // Truth at the start of the first interval and at every sample, then both on the IMS clock.
+  const double offset = scenario.imu_clock_offset_s;
+  auto truth_at = [&](double t_robot) {
+    const ims::KinematicState state = trajectory.at(t_robot);
+    return ims::NavState{t_robot + offset, state.q_W_S, state.v_W, state.p_W};
+  };
+  out.sensor_truth.reserve(ideal.samples.size() + 1);
+  out.sensor_truth.push_back(truth_at(trajectory.begin_s()));
+  for (const ims::ImuSample& sample : ideal.samples)
+    out.sensor_truth.push_back(truth_at(sample.t_s));
+  for (ims::ImuSample& sample : out.imu_raw.samples) sample.t_s += offset;
+  out.imu_raw.site = scenario.site;
+  return out;
+}
+
 SimulationResult run_simulation(const Scenario& scenario, std::uint64_t seed,
                                 const SimulationProgress& progress, double max_duration_s) {
   auto report = [&](const char* stage, double fraction) {
@@ -94,32 +127,11 @@ SimulationResult run_simulation(const Scenario& scenario, std::uint64_t seed,
 
   // The IMS frame S in W at every plant sample, interpolated by a spline for the synthesis.
   report("ims", 0.0);
-  const std::vector<Eigen::Isometry3d> T_R_H = flange_poses(result.robot, result.plant);
-  std::vector<ims::PoseSample> poses(T_R_H.size());
-  for (std::size_t k = 0; k < T_R_H.size(); ++k) {
-    const Eigen::Isometry3d T_W_S = result.T_W_R * T_R_H[k] * result.T_H_S;
-    poses[k] = {result.plant.samples[k].t_s, T_W_S.translation(),
-                Eigen::Quaterniond(T_W_S.linear()).normalized()};
-  }
-  const ims::SplineTrajectory trajectory(poses);
-  const ims::ImuSeries ideal =
-      ims::synthesize_ideal_increments(trajectory, earth, scenario.imu_rate_hz);
-  report("ims", 0.7);
-
-  result.sensor_errors = ims::draw_sensor_errors(result.sensor_spec, rng);
-  result.imu_raw = ims::corrupt(ideal, result.sensor_errors, result.sensor_spec, rng());
-  // Truth at the start of the first interval and at every sample, then both on the IMS clock.
-  auto truth_at = [&](double t_robot) {
-    const ims::KinematicState state = trajectory.at(t_robot);
-    return ims::NavState{t_robot + result.imu_clock_offset_s, state.q_W_S, state.v_W, state.p_W};
-  };
-  result.sensor_truth.reserve(ideal.samples.size() + 1);
-  result.sensor_truth.push_back(truth_at(trajectory.begin_s()));
-  for (const ims::ImuSample& sample : ideal.samples) {
-    result.sensor_truth.push_back(truth_at(sample.t_s));
-  }
-  for (ims::ImuSample& sample : result.imu_raw.samples) sample.t_s += result.imu_clock_offset_s;
-  result.imu_raw.site = scenario.site;
+  ImsRecording recording = record_ims(scenario, result.robot, result.sensor_spec, result.plant,
+                                      result.T_W_R, result.T_H_S, rng);
+  result.sensor_errors = std::move(recording.sensor_errors);
+  result.imu_raw = std::move(recording.imu_raw);
+  result.sensor_truth = std::move(recording.sensor_truth);
   result.imu_raw.metadata = {{"sensor", result.sensor_spec.name},
                              {"scenario", scenario.name},
                              {"seed", std::to_string(seed)},

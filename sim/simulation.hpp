@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <functional>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "calib/robot_description.hpp"
@@ -38,6 +39,20 @@ using SimulationProgress = std::function<void(const char* stage, double fraction
 SimulationResult run_simulation(const Scenario& scenario, std::uint64_t seed,
                                 const SimulationProgress& progress = {},
                                 double max_duration_s = std::numeric_limits<double>::infinity());
+
+// What the scenario's IMS records of a plant run: the link-side flange motion carried through the
+// mount T_H_S into W (base T_W_R), synthesised at the scenario's rate with the Earth model of its
+// site, corrupted by sensor errors drawn from `spec` and noise seeded from `rng` (in that order);
+// time stamps on the IMS clock (robot clock + the scenario's offset).
+struct ImsRecording {
+  ims::SensorErrorModel sensor_errors;
+  ims::ImuSeries imu_raw;
+  std::vector<ims::NavState> sensor_truth;  // S in W at the start and every sample, IMS clock
+};
+ImsRecording record_ims(const Scenario& scenario, const calib::RobotDescription& robot,
+                        const ims::SensorSpec& spec, const PlantLog& plant,
+                        const Eigen::Isometry3d& T_W_R, const Eigen::Isometry3d& T_H_S,
+                        std::mt19937_64& rng);
 
 // The link-side flange pose T_R_H at every plant sample (robot clock).
 std::vector<Eigen::Isometry3d> flange_poses(const calib::RobotDescription& robot,

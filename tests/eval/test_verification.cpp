@@ -80,18 +80,23 @@ int inversion_iterations() {
   return v ? std::atoi(v) : VerificationOptions{}.compensation.inversion_iterations;
 }
 
-void print_case(const VerificationCase& c, const PathFigures& before) {
+void print_case(const VerificationCase& c, const PathFigures& before,
+                const PathFigures& before_true) {
   const PathFigures& f = c.figures;
   constexpr double mm = 1e3, deg = 180.0 / M_PI;
   std::printf(
       "  %-16s max dev %7.3f mm (%6.1f %%)  AT_p %7.3f  RT_p %6.3f mm  AT_abc %.4f %.4f %.4f "
       "RT_abc %.4f %.4f %.4f deg  CO %6.3f mm  AV %+6.2f %%  RV %5.2f %%  FV %6.4f m/s  "
-      "(inactive cycles %zu, events %zu)\n",
+      "(inactive cycles %zu, events %zu)\n"
+      "  %-16s   true path: max dev %7.3f mm (%6.1f %%)  AT_p %7.3f  RT_p %6.3f mm\n",
       c.label.c_str(), f.max_path_deviation_m * mm,
       reduction_percent(before.max_path_deviation_m, f.max_path_deviation_m), f.AT_p_m * mm,
       f.RT_p_m * mm, f.AT_abc_rad[0] * deg, f.AT_abc_rad[1] * deg, f.AT_abc_rad[2] * deg,
       f.RT_abc_rad[0] * deg, f.RT_abc_rad[1] * deg, f.RT_abc_rad[2] * deg, f.CO_m * mm,
-      f.AV_percent, f.RV_percent, f.FV_m_s, c.inactive_cycles, c.events.size());
+      f.AV_percent, f.RV_percent, f.FV_m_s, c.inactive_cycles, c.events.size(), "",
+      c.true_figures.max_path_deviation_m * mm,
+      reduction_percent(before_true.max_path_deviation_m, c.true_figures.max_path_deviation_m),
+      c.true_figures.AT_p_m * mm, c.true_figures.RT_p_m * mm);
 }
 
 VerificationResult run(const std::string& name, const std::string& filter, bool ablation) {
@@ -116,9 +121,9 @@ VerificationResult run(const std::string& name, const std::string& filter, bool 
   for (const auto& s : r.segments) std::printf(" '%s'", s.c_str());
   std::printf(", look-ahead %d cycles, inversion iterations %d)\n",
               options.compensation.look_ahead_cycles, options.compensation.inversion_iterations);
-  print_case(r.before, r.before.figures);
+  print_case(r.before, r.before.figures, r.before.true_figures);
   for (const auto& c : r.after) {
-    print_case(c, r.before.figures);
+    print_case(c, r.before.figures, r.before.true_figures);
     for (std::size_t i = 0; i < c.events.size() && i < 5; ++i) {
       std::printf("    precontrol event: cycle %llu joint %d %s (%g)\n",
                   static_cast<unsigned long long>(c.events[i].cycle), int(c.events[i].joint),
