@@ -107,7 +107,8 @@ SimulationResult run_simulation(const Scenario& scenario, std::uint64_t seed,
   report("ims", 0.7);
 
   result.sensor_errors = ims::draw_sensor_errors(result.sensor_spec, rng);
-  result.imu_raw = ims::corrupt(ideal, result.sensor_errors, result.sensor_spec, rng());
+  result.imu_raw =
+      ims::corrupt(ideal, result.sensor_errors, result.sensor_spec, rng(), &result.imu_in_run_bias);
   // Truth at the start of the first interval and at every sample, then both on the IMS clock.
   auto truth_at = [&](double t_robot) {
     const ims::KinematicState state = trajectory.at(t_robot);
@@ -119,6 +120,7 @@ SimulationResult run_simulation(const Scenario& scenario, std::uint64_t seed,
     result.sensor_truth.push_back(truth_at(sample.t_s));
   }
   for (ims::ImuSample& sample : result.imu_raw.samples) sample.t_s += result.imu_clock_offset_s;
+  for (double& t : result.imu_in_run_bias.t_s) t += result.imu_clock_offset_s;
   result.imu_raw.site = scenario.site;
   result.imu_raw.metadata = {{"sensor", result.sensor_spec.name},
                              {"scenario", scenario.name},

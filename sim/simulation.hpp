@@ -9,6 +9,7 @@
 
 #include "calib/robot_description.hpp"
 #include "ims/imu_data.hpp"
+#include "ims/imu_noise.hpp"
 #include "ims/nav_state.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
@@ -27,7 +28,10 @@ struct SimulationResult {
   Eigen::Isometry3d T_H_S = Eigen::Isometry3d::Identity();  // IMS on the flange (as drawn)
   double imu_clock_offset_s = 0.0;                          // t_IMS = t_robot + offset
   ims::SensorErrorModel sensor_errors;                      // drawn from the spec
-  ims::ImuSeries imu_raw;                                   // what the IMS records, IMS clock
+  // The in-run part of the biases the record carries (beside sensor_errors' turn-on biases),
+  // at the IMS samples, IMS clock.
+  ims::InRunBias imu_in_run_bias;
+  ims::ImuSeries imu_raw;                   // what the IMS records, IMS clock
   std::vector<ims::NavState> sensor_truth;  // S in W at the start and every IMS sample, IMS clock
 };
 
