@@ -173,6 +173,8 @@ ImuNoiseModel imu_noise_model(const ims::SensorSpec& spec, const PriorConfig& pr
   m.acc_noise_density_m_s_per_sqrt_s = spec.acc.white_noise_density;
   m.gyro_bias_sigma_rad_s = priors.gyro_bias_sigma_rad_s.value_or(bias_sigma(spec.gyro));
   m.acc_bias_sigma_m_s2 = priors.acc_bias_sigma_m_s2.value_or(bias_sigma(spec.acc));
+  for (const auto& term : spec.acc.bias_instability)
+    m.acc_bias_drift_psd += 2.0 * term.sigma * term.sigma / term.correlation_time_s;
   m.gyro_quantization_rad = spec.gyro.quantization_lsb;
   m.acc_quantization_m_s = spec.acc.quantization_lsb;
   return m;

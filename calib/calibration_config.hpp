@@ -10,7 +10,7 @@
 //   robot: ../robots/kr16.yaml
 //   unit_calibration: unit.yaml                   # the IMS unit's lab calibration (optional)
 //   payload: {mass_kg: 0.0, com_mm: [0, 0, 0]}    # in the tool frame T
-//   rests: {min_duration_s: 2.0, trim_s: 0.5, max_joint_spread_deg: 0.00057,
+//   rests: {min_duration_s: 2.0, trim_s: 0.5, max_joint_spread_deg: 0.0172,
 //           settle_tolerance_deg: 0, detector_threshold_sigmas: 5.0}
 //   time_offset: {max_abs_offset_s: 0.5}
 //   bundle: {estimate_time_offset: true, estimate_scale_factors: false, huber_scale_sigma: 3,
@@ -42,8 +42,9 @@ struct PayloadConfig {
 struct RestConfig {
   double min_duration_s = 2.0;  // shorter rests are not used
   double trim_s = 0.5;          // cut at both ends of every detected rest
-  // Largest spread of the robot's joint readings over a rest (the robot must be still) [rad].
-  double max_joint_spread_rad = 1e-5;  // a few encoder counts
+  // Largest spread of the robot's joint readings over a rest [rad]: the arm may still creep
+  // (the bundle models that from the readings, RestObservation::q_creep_*), but not move.
+  double max_joint_spread_rad = 3e-4;
   // Rests are used from where the joint readings have settled within this of their final value
   // (calib/rest_poses.hpp) [rad]; 0: not checked.
   double settle_tolerance_rad = 0.0;
@@ -87,6 +88,7 @@ CalibrationConfig load_calibration_config(const std::filesystem::path& file);
 
 // The bundle's noise model from the sensor spec and the priors: white-noise densities from the
 // spec; bias sigmas from the priors, or else sqrt(turn-on^2 + sum of bias-instability sigma^2);
+// the accelerometer bias's drift PSD from the spec's bias instability (sum of 2 sigma^2 / tau);
 // quantisation LSBs from the spec.
 ImuNoiseModel imu_noise_model(const ims::SensorSpec& spec, const PriorConfig& priors);
 

@@ -1,5 +1,6 @@
 // The frame-and-bias bundle (calib/frame_calibration.hpp). Design decisions:
-//  - Unknowns: q_W_R, q_S_H (quaternions, left perturbation), p_S_H, b_g, b_a, dt, optional
+//  - Unknowns: q_W_R, q_S_H (quaternions, left perturbation), p_S_H, b_g, b_a (per rest when it
+//    drifts, ImuNoiseModel::acc_bias_drift_psd), dt with the link share, optional
 //    scale factors, dq_i per rest (joints with prior sigma 0 held by a SubsetManifold). W's
 //    origin is the sensor at the first rest: p_W_R is derived (never a parameter), and the
 //    motion residuals only use position differences, so it needs no residual of its own.
@@ -45,8 +46,11 @@ struct Parameters {
   double q_S_H[4] = {0, 0, 0, 1};
   double p_S_H[3] = {0, 0, 0};
   double b_g[3] = {0, 0, 0};
-  double b_a[3] = {0, 0, 0};
+  // Accelerometer bias per rest (one shared block without drift: b_a_blocks all point to it).
+  std::vector<std::array<double, 3>> b_a;
+  std::vector<double*> b_a_blocks;
   double dt[1] = {0};
+  double link_share[1] = {0};
   double s_g[3] = {0, 0, 0};
   double s_a[3] = {0, 0, 0};
   double m_w[6] = {0, 0, 0, 0, 0, 0};  // 1 - k_w (estimate_deflection_scale)
@@ -63,7 +67,7 @@ struct Parameters {
   ImuBiases biases() const {
     ImuBiases b;
     b.gyro_rad_s = Eigen::Map<const Eigen::Vector3d>(b_g);
-    b.acc_m_s2 = Eigen::Map<const Eigen::Vector3d>(b_a);
+    b.acc_m_s2 = Eigen::Map<const Eigen::Vector3d>(b_a_blocks.front());
     return b;
   }
   // dq_i plus the scaled wind-up and play of rest i.
@@ -79,14 +83,47 @@ void set_quaternion(double* q, const Eigen::Matrix3d& R) {
   out = quaternion;
 }
 
-// omega_H(t) on a uniform robot-time grid, from the joint readings (central differences).
+// The sensor's velocity in R at joint angles q and rates q_dot, for the sensor at p_H_S [m/s].
+Eigen::Vector3d sensor_velocity_R(const KinematicModel& model, const JointVector& q,
+                                  const JointVector& q_dot, const Eigen::Vector3d& p_H_S) {
+  const Jacobian J = geometric_jacobian(model, q);
+  const Eigen::Vector3d omega_R = J.bottomRows<3>() * q_dot;
+  const Eigen::Matrix3d R_R_H = forward_kinematics<double>(model, q).linear();
+  return J.topRows<3>() * q_dot + omega_R.cross(R_R_H * p_H_S);
+}
+
+// What a rest's creep (RestObservation::q_creep_*, q_rate_*) means for the sensor.
+struct RestCreep {
+  Eigen::Vector3d mean_rate_H = Eigen::Vector3d::Zero();          // [rad/s]
+  Eigen::Vector3d mean_acceleration_R = Eigen::Vector3d::Zero();  // [m/s^2]
+  Eigen::Vector3d velocity_begin_R = Eigen::Vector3d::Zero();     // [m/s]
+  Eigen::Vector3d velocity_end_R = Eigen::Vector3d::Zero();
+};
+
+RestCreep rest_creep(const KinematicModel& model, const RestObservation& rest, double duration_s,
+                     const Eigen::Vector3d& p_H_S) {
+  RestCreep c;
+  const JointVector q_begin = rest.q_link_rad + rest.q_creep_begin_rad;
+  const JointVector q_end = rest.q_link_rad + rest.q_creep_end_rad;
+  const Eigen::Matrix3d R_begin = forward_kinematics<double>(model, q_begin).linear();
+  const Eigen::Matrix3d R_end = forward_kinematics<double>(model, q_end).linear();
+  c.mean_rate_H =
+      ims::quat_log<double>(Eigen::Quaterniond(R_begin.transpose() * R_end)) / duration_s;
+  c.velocity_begin_R = sensor_velocity_R(model, q_begin, rest.q_rate_begin_rad_s, p_H_S);
+  c.velocity_end_R = sensor_velocity_R(model, q_end, rest.q_rate_end_rad_s, p_H_S);
+  c.mean_acceleration_R = (c.velocity_end_R - c.velocity_begin_R) / duration_s;
+  return c;
+}
+
+// omega_H(t) and lag_H(t) (calib/frame_residuals.hpp, RateResidual) on a uniform robot-time
+// grid, from the joint readings (central differences).
 struct FlangeRateGrid {
   double t0_s = 0.0;
   double step_s = 1.0;
-  std::vector<double> values;  // 3 per node
-  std::unique_ptr<ceres::Grid1D<double, 3>> grid;
+  std::vector<double> values;  // 6 per node
+  std::unique_ptr<ceres::Grid1D<double, 6>> grid;
   std::unique_ptr<RateResidual::Interpolator> interpolator;
-  double t_end_s() const { return t0_s + step_s * static_cast<double>(values.size() / 3 - 1); }
+  double t_end_s() const { return t0_s + step_s * static_cast<double>(values.size() / 6 - 1); }
 };
 
 std::unique_ptr<FlangeRateGrid> make_flange_rate_grid(const KinematicModel& model,
@@ -120,18 +157,37 @@ std::unique_ptr<FlangeRateGrid> make_flange_rate_grid(const KinematicModel& mode
         (t - robot.t_robot_s[j]) / (robot.t_robot_s[j + 1] - robot.t_robot_s[j]), 0.0, 1.0);
     q[k] = (1.0 - a) * robot.q_rad[j] + a * robot.q_rad[j + 1];
   }
-  out->values.assign(3 * nodes, 0.0);
+  out->values.assign(6 * nodes, 0.0);
   for (std::size_t k = 0; k < nodes; ++k) {
     const std::size_t lo = k == 0 ? 0 : k - 1;
     const std::size_t hi = k + 1 == nodes ? k : k + 1;
     const JointVector q_dot = (q[hi] - q[lo]) / (out->step_s * static_cast<double>(hi - lo));
-    const Eigen::Vector3d omega_R = geometric_jacobian(model, q[k]).bottomRows<3>() * q_dot;
-    const Eigen::Vector3d omega_H =
-        forward_kinematics<double>(model, q[k]).linear().transpose() * omega_R;
-    for (int c = 0; c < 3; ++c) out->values[3 * k + c] = omega_H[c];
+    // Second difference at the interior nodes (0 at the ends).
+    const JointVector q_ddot =
+        hi - lo == 2 ? JointVector((q[hi] - 2.0 * q[k] + q[lo]) / (out->step_s * out->step_s))
+                     : JointVector::Zero();
+    // omega_H of joint angles q and rates q_dot: R_H_R J_rotation(q) q_dot.
+    const auto flange_rate = [&](const JointVector& angles, const JointVector& rates) {
+      const Eigen::Matrix3d R_H_R = forward_kinematics<double>(model, angles).linear().transpose();
+      return Eigen::Vector3d(R_H_R * (geometric_jacobian(model, angles).bottomRows<3>() * rates));
+    };
+    const Eigen::Vector3d omega_H = flange_rate(q[k], q_dot);
+    // What the readings add when they lead the link angles by lag_j: q + lag q_dot is read
+    // (first order in the lags: tens of microseconds).
+    const JointVector& lag = robot.link_lag_per_share_s;
+    const Eigen::Vector3d lag_H =
+        lag.cwiseAbs().maxCoeff() > 0.0
+            ? Eigen::Vector3d(
+                  flange_rate(q[k] + lag.cwiseProduct(q_dot), q_dot + lag.cwiseProduct(q_ddot)) -
+                  omega_H)
+            : Eigen::Vector3d::Zero();
+    for (int c = 0; c < 3; ++c) {
+      out->values[6 * k + c] = omega_H[c];
+      out->values[6 * k + 3 + c] = lag_H[c];
+    }
   }
   out->grid =
-      std::make_unique<ceres::Grid1D<double, 3>>(out->values.data(), 0, static_cast<int>(nodes));
+      std::make_unique<ceres::Grid1D<double, 6>>(out->values.data(), 0, static_cast<int>(nodes));
   out->interpolator = std::make_unique<RateResidual::Interpolator>(*out->grid);
   return out;
 }
@@ -249,6 +305,10 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
   Eigen::Map<Eigen::Vector3d>(x.p_S_H) = init.T_S_H.translation();
   x.dt[0] = init.time_offset_s;
   x.dq.assign(rests.size(), std::array<double, 6>{0, 0, 0, 0, 0, 0});
+  const bool acc_bias_drifts = input.noise.acc_bias_drift_psd > 0.0;
+  x.b_a.assign(acc_bias_drifts ? rests.size() : 1, std::array<double, 3>{0, 0, 0});
+  for (std::size_t i = 0; i < rests.size(); ++i)
+    x.b_a_blocks.push_back(x.b_a[acc_bias_drifts ? i : 0].data());
   x.rests = &input.rests;
   // Deflection scales: per joint, only where some rest has a modelled wind-up / play.
   JointVector windup_inverse_sigma = JointVector::Zero(), play_inverse_sigma = JointVector::Zero();
@@ -296,6 +356,11 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
     }
   }
   const bool time_offset_observed = options.estimate_time_offset && !rate_windows.empty();
+  // The link share with dt, where the robot file gives the lags and the prior allows it.
+  const bool link_share_estimated = time_offset_observed && options.estimate_link_share &&
+                                    options.link_share_prior_sigma > 0.0 &&
+                                    input.robot.link_lag_per_share_s.cwiseAbs().maxCoeff() > 0.0;
+  if (link_share_estimated) x.link_share[0] = options.link_share_prior_mean;
 
   FrameCalibrationResult result;
   result.initial_T_R_W = init.T_R_W;
@@ -330,7 +395,17 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
     problem.AddParameterBlock(x.q_S_H, 4, new ceres::EigenQuaternionManifold);
     problem.AddParameterBlock(x.p_S_H, 3);
     problem.AddParameterBlock(x.b_g, 3);
-    problem.AddParameterBlock(x.b_a, 3);
+    for (auto& b : x.b_a) problem.AddParameterBlock(b.data(), 3);
+    for (std::size_t i = 0; acc_bias_drifts && i + 1 < rests.size(); ++i) {
+      // Between the rests' mid-times.
+      const double gap_s = 0.5 * (rests[i + 1].begin_s + rests[i + 1].end_s) -
+                           0.5 * (rests[i].begin_s + rests[i].end_s);
+      BiasDriftResidual drift;
+      drift.inverse_sigma = 1.0 / std::sqrt(input.noise.acc_bias_drift_psd * gap_s);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<BiasDriftResidual, 3, 3, 3>(new BiasDriftResidual(drift)),
+          nullptr, x.b_a_blocks[i], x.b_a_blocks[i + 1]);
+    }
     problem.AddParameterBlock(x.s_g, 3);
     problem.AddParameterBlock(x.s_a, 3);
     problem.AddParameterBlock(x.m_w, 6);
@@ -390,6 +465,13 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
         p_abs[i] = p - first + input.first_rest_position_W_m;
       }
     }
+    std::vector<RestCreep> creep(rests.size());
+    {
+      const Eigen::Vector3d p_H_S =
+          -(x.R_S_H().transpose() * Eigen::Map<const Eigen::Vector3d>(x.p_S_H));
+      for (std::size_t i = 0; i < rests.size(); ++i)
+        creep[i] = rest_creep(input.kinematics, input.rests[i], rests[i].duration_s(), p_H_S);
+    }
     stage.rest_functors.clear();
     for (std::size_t i = 0; i < rests.size(); ++i) {
       RestResidual f;
@@ -401,15 +483,21 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
       f.mean_force = rests[i].mean_specific_force_m_s2;
       f.earth_rate_W = earth.earth_rate_W();
       f.gravity_W = earth.gravity_W(p_abs[i]);
+      f.creep_rate_H = creep[i].mean_rate_H;
+      f.creep_acceleration_R = creep[i].mean_acceleration_R;
       const RestSigmas sig = rest_sigmas(input.noise, rests[i].duration_s());
-      f.rate_sigma = sig.rate_rad_s;
-      f.force_sigma = sig.force_m_s2;
+      // The creep as the joint readings see it is good to a fraction (transmission error, the
+      // friction's share at the gear output).
+      f.rate_sigma =
+          std::hypot(sig.rate_rad_s, options.creep_model_fraction * creep[i].mean_rate_H.norm());
+      f.force_sigma = std::hypot(
+          sig.force_m_s2, options.creep_model_fraction * creep[i].mean_acceleration_R.norm());
       stage.rest_functors.push_back(f);
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<RestResidual, 6, 4, 4, 6, 3, 3, 3, 3, 6, 6>(
               new RestResidual(f)),
           new ceres::HuberLoss(options.huber_scale_sigma * std::sqrt(6.0)), x.q_W_R, x.q_S_H,
-          x.dq[i].data(), x.b_g, x.b_a, x.s_g, x.s_a, x.m_w, x.m_p);
+          x.dq[i].data(), x.b_g, x.b_a_blocks[i], x.s_g, x.s_a, x.m_w, x.m_p);
     }
     stage.motion_functors.clear();
     stage.motion_covariance_factor.clear();
@@ -419,6 +507,10 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
       f.preintegration = &stage.motions[i];
       f.q_i = input.rests[i].q_link_rad;
       f.q_j = input.rests[i + 1].q_link_rad;
+      f.creep_i = input.rests[i].q_creep_end_rad;
+      f.creep_j = input.rests[i + 1].q_creep_begin_rad;
+      f.velocity_start_R = creep[i].velocity_end_R;
+      f.velocity_end_R = creep[i + 1].velocity_begin_R;
       f.windup_i = input.rests[i].q_windup_rad;
       f.play_i = input.rests[i].q_play_rad;
       f.windup_j = input.rests[i + 1].q_windup_rad;
@@ -426,29 +518,59 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
       f.earth_rate_W = earth.earth_rate_W();
       f.gravity_start_W = earth.gravity_W(p_abs[i]);
       f.gravity_gradient_W = earth.gravity_gradient_W();
-      const Eigen::Matrix<double, 9, 9> cov = motion_covariance(
+      Eigen::Matrix<double, 9, 9> cov = motion_covariance(
           input.noise, stage.motions[i].duration_s(), rests[i].mean_specific_force_m_s2);
+      // The creep velocities at the ends are good to the same fraction.
+      const double creep_velocity =
+          options.creep_model_fraction *
+          std::hypot(creep[i].velocity_end_R.norm(), creep[i + 1].velocity_begin_R.norm());
+      const double creep_position = options.creep_model_fraction * creep[i].velocity_end_R.norm() *
+                                    stage.motions[i].duration_s();
+      for (int k = 0; k < 3; ++k) {
+        cov(3 + k, 3 + k) += creep_velocity * creep_velocity;
+        cov(6 + k, 6 + k) += creep_position * creep_position;
+      }
       f.whitening = whitening_matrix(cov);
       stage.motion_covariance_factor.push_back(
           Eigen::LLT<Eigen::Matrix<double, 9, 9>>(cov).matrixL());
       stage.motion_functors.push_back(f);
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<MotionResidual, 9, 4, 4, 3, 6, 6, 3, 3, 6, 6>(
-              new MotionResidual(f)),
-          new ceres::HuberLoss(options.huber_scale_sigma * 3.0), x.q_W_R, x.q_S_H, x.p_S_H,
-          x.dq[i].data(), x.dq[i + 1].data(), x.b_g, x.b_a, x.m_w, x.m_p);
+      if (acc_bias_drifts) {
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<MotionResidual, 9, 4, 4, 3, 6, 6, 3, 3, 3, 6, 6>(
+                new MotionResidual(f)),
+            new ceres::HuberLoss(options.huber_scale_sigma * 3.0), x.q_W_R, x.q_S_H, x.p_S_H,
+            x.dq[i].data(), x.dq[i + 1].data(), x.b_g, x.b_a_blocks[i], x.b_a_blocks[i + 1], x.m_w,
+            x.m_p);
+      } else {
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<MotionResidualConstantBias, 9, 4, 4, 3, 6, 6, 3, 3, 6,
+                                            6>(new MotionResidualConstantBias{f}),
+            new ceres::HuberLoss(options.huber_scale_sigma * 3.0), x.q_W_R, x.q_S_H, x.p_S_H,
+            x.dq[i].data(), x.dq[i + 1].data(), x.b_g, x.b_a_blocks[i], x.m_w, x.m_p);
+      }
     }
     stage.rate_functors.clear();
     if (!rate_windows.empty()) {
       problem.AddParameterBlock(x.dt, 1);
+      problem.AddParameterBlock(x.link_share, 1);
       for (const RateWindow& w : rate_windows) {
         const RateResidual f = make_rate_functor(w);
         stage.rate_functors.push_back(f);
         problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<RateResidual, 3, 1>(new RateResidual(f)),
-            new ceres::HuberLoss(options.huber_scale_sigma * std::sqrt(3.0)), x.dt);
+            new ceres::AutoDiffCostFunction<RateResidual, 3, 1, 1>(new RateResidual(f)),
+            new ceres::HuberLoss(options.huber_scale_sigma * std::sqrt(3.0)), x.dt, x.link_share);
       }
       if (!options.estimate_time_offset) problem.SetParameterBlockConstant(x.dt);
+      if (link_share_estimated) {
+        LinkSharePriorResidual prior;
+        prior.mean = options.link_share_prior_mean;
+        prior.inverse_sigma = 1.0 / options.link_share_prior_sigma;
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LinkSharePriorResidual, 1, 1>(
+                                     new LinkSharePriorResidual(prior)),
+                                 nullptr, x.link_share);
+      } else {
+        problem.SetParameterBlockConstant(x.link_share);
+      }
     }
     ceres::Solver::Options solver;
     solver.linear_solver_type = options.sparse ? ceres::SPARSE_NORMAL_CHOLESKY : ceres::DENSE_QR;
@@ -469,7 +591,7 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
     for (const RateWindow& w : rate_windows) {
       const RateResidual f = make_rate_functor(w);
       double r[3];
-      f(x.dt, r);
+      f(x.dt, x.link_share, r);
       for (double v : r) sum_sq += (v * f.sigma) * (v * f.sigma);
     }
     const double rms = std::sqrt(sum_sq / (3.0 * static_cast<double>(rate_windows.size())));
@@ -496,9 +618,11 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
     result.T_R_W = T_W_R.inverse();
   }
   result.biases = x.biases();
+  for (const double* b : x.b_a_blocks) result.acc_bias_at_rests_m_s2.emplace_back(b[0], b[1], b[2]);
   result.gyro_scale_factor = Eigen::Map<const Eigen::Vector3d>(x.s_g);
   result.acc_scale_factor = Eigen::Map<const Eigen::Vector3d>(x.s_a);
   result.time_offset_s = x.dt[0];
+  if (link_share_estimated) result.link_share = x.link_share[0];
   for (int k = 0; k < kJointCount; ++k) {
     result.windup_scale[k] = 1.0 - x.m_w[k];
     result.play_scale[k] = 1.0 - x.m_p[k];
@@ -513,11 +637,12 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
                      first.summary.IsSolutionUsable();
 
   // Covariance.
-  std::vector<CovarianceBlock> blocks = {{"R_W_R", x.q_W_R, 3, 2.0, {"east", "north", "up"}},
-                                         {"R_S_H", x.q_S_H, 3, 2.0, {"x", "y", "z"}},
-                                         {"p_S_H", x.p_S_H, 3, 1.0, {"x", "y", "z"}},
-                                         {"gyro_bias", x.b_g, 3, 1.0, {"x", "y", "z"}},
-                                         {"acc_bias", x.b_a, 3, 1.0, {"x", "y", "z"}}};
+  std::vector<CovarianceBlock> blocks = {
+      {"R_W_R", x.q_W_R, 3, 2.0, {"east", "north", "up"}},
+      {"R_S_H", x.q_S_H, 3, 2.0, {"x", "y", "z"}},
+      {"p_S_H", x.p_S_H, 3, 1.0, {"x", "y", "z"}},
+      {"gyro_bias", x.b_g, 3, 1.0, {"x", "y", "z"}},
+      {"acc_bias", x.b_a_blocks.front(), 3, 1.0, {"x", "y", "z"}}};
   int offset_dt = -1;
   if (time_offset_observed) {
     offset_dt = 15;
@@ -546,6 +671,7 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
   if (play_estimated)
     blocks.push_back(
         {"play_scale_deviation", x.m_p, static_cast<int>(play_names.size()), 1.0, play_names});
+  if (link_share_estimated) blocks.push_back({"link_share", x.link_share, 1, 1.0, {"s"}});
   const FrameCovariance cov = compute_frame_covariance(problem, blocks);
   result.parameter_names = cov.parameter_names;
   result.covariance = cov.covariance;
@@ -629,6 +755,18 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
            Eigen::Map<const Eigen::VectorXd>(values.data(), Eigen::Index(values.size())),
            Eigen::Map<const Eigen::VectorXd>(sigmas.data(), Eigen::Index(sigmas.size()))});
     }
+    const auto share = std::find(cov.parameter_names.begin(), cov.parameter_names.end(),
+                                 std::string("link_share.s"));
+    if (share != cov.parameter_names.end()) {
+      const auto i = Eigen::Index(share - cov.parameter_names.begin());
+      result.link_share_sigma = std::sqrt(std::max(0.0, cov.covariance(i, i)));
+      result.estimates.push_back(
+          {"link_share (of the drives' viscous friction, at the gear output)",
+           "1",
+           {"s"},
+           Eigen::VectorXd::Constant(1, result.link_share),
+           Eigen::VectorXd::Constant(1, result.link_share_sigma)});
+    }
   }
   std::vector<Eigen::Matrix3d> flange_rotations;
   for (std::size_t i = 0; i + 1 < rests.size(); ++i) {
@@ -642,7 +780,8 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
   for (std::size_t i = 0; i < rests.size(); ++i) {
     const RestResidual& f = stage.rest_functors[i];
     Eigen::Matrix<double, 6, 1> r;
-    f(x.q_W_R, x.q_S_H, x.dq[i].data(), x.b_g, x.b_a, x.s_g, x.s_a, x.m_w, x.m_p, r.data());
+    f(x.q_W_R, x.q_S_H, x.dq[i].data(), x.b_g, x.b_a_blocks[i], x.s_g, x.s_a, x.m_w, x.m_p,
+      r.data());
     PoseResidual p;
     p.label = input.rests[i].label;
     p.normalised = std::sqrt(r.squaredNorm() / 6.0);
@@ -659,8 +798,8 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
   for (std::size_t i = 0; i + 1 < rests.size(); ++i) {
     const MotionResidual& f = stage.motion_functors[i];
     Eigen::Matrix<double, 9, 1> r;
-    f(x.q_W_R, x.q_S_H, x.p_S_H, x.dq[i].data(), x.dq[i + 1].data(), x.b_g, x.b_a, x.m_w, x.m_p,
-      r.data());
+    f(x.q_W_R, x.q_S_H, x.p_S_H, x.dq[i].data(), x.dq[i + 1].data(), x.b_g, x.b_a_blocks[i],
+      x.b_a_blocks[i + 1], x.m_w, x.m_p, r.data());
     const Eigen::Matrix<double, 9, 1> raw = stage.motion_covariance_factor[i] * r;
     PoseResidual p;
     p.label = fmt::format("{} -> {}", input.rests[i].label, input.rests[i + 1].label);

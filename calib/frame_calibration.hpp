@@ -6,15 +6,22 @@
 //
 // Measurements (W Earth-fixed ENU, gravity g_W(p) and Earth rate Omega from ims::EarthModel):
 //  - rest pose i (robot still over [begin_ims_s, end_ims_s]): the mean specific force equals
-//    -R_S_W g_W + b_a, the mean angular rate R_S_W Omega + b_g, with
+//    -R_S_W g_W + b_a,i, the mean angular rate R_S_W Omega + b_g, with
 //    R_W_S_i = R_W_R R_R_H(q_i + dq_i) R_H_S from the forward kinematics of the rest pose's
 //    link-side joint angles q_i plus a per-pose joint deviation dq_i (backlash play, unmodelled
 //    deflection; prior N(0, q_link_sigma_rad));
 //  - motion i -> i+1: the IMU preintegration (calib/imu_preintegration.hpp, bias Jacobians,
 //    Earth rate, Coriolis) from rest i at zero velocity must arrive at rest i+1 with zero
-//    velocity, the attitude and the position of the forward kinematics;
+//    velocity, the attitude and the position of the forward kinematics (accelerometer bias: the
+//    mean of b_a,i and b_a,i+1);
+//  - the accelerometer bias drifts between rests as a random walk (ImuNoiseModel::
+//    acc_bias_drift_psd; one constant b_a when it is 0);
 //  - during motion: the gyro rate minus bias minus Earth rate equals R_S_H omega_H(t_ims - dt),
 //    omega_H from the robot's joint readings (this is what makes the time offset dt observable).
+//    The readings are motor-side: the link lags them by the gear deflection that the friction at
+//    the gear output causes, s c_j / k_j per joint for a share s of the viscous friction c_j
+//    acting there (stiffness k_j; 15-75 us on the KR 16 at s = 0.1). That lag looks like a clock
+//    offset, so s is estimated with dt (it differs per joint, dt does not): omega_H - s lag_H.
 //
 // Convention for the origin of W (the IMS senses no absolute position): W's origin is the
 // sensor's position at the first rest pose, so the translation of T_R_W is not a free
@@ -23,8 +30,10 @@
 //
 // Observability: the heading of R in W (rotation of T_R_W about the vertical) is seen only
 // through the Earth rate (gyrocompassing): its 1-sigma is about
-// ARW / (|Omega| cos(latitude) sqrt(total time)), e.g. ~0.06 deg for a 0.002 deg/sqrt(h) gyro
-// over 2 minutes. The covariance reports it as it is; the observability report names it.
+// k ARW / (|Omega| cos(latitude) sqrt(total rest time)), k = 1.45 with the gyro bias estimated
+// from the same 8 mounting poses (tests/calib/test_heading_observability.cpp), e.g. 0.064 deg
+// for a 0.002 deg/sqrt(h) gyro over 4 minutes of rest; 0.005 deg takes ~11 h. The covariance
+// reports it as it is; the observability report names it.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <string>
@@ -49,12 +58,27 @@ struct RestObservation {
   // FrameCalibrationOptions::estimate_deflection_scale the bundle scales both per joint.
   JointVector q_windup_rad = JointVector::Zero();  // gear wind-up tau_g / k
   JointVector q_play_rad = JointVector::Zero();    // backlash play taken up, (b / 2) sign(tau_g)
+  // Creep: a still-commanded arm may still move slowly after a move (the joint controllers
+  // settle through friction; 1e-5..1e-4 rad over a rest on the elastic KR 16). The joint readings
+  // at the window's begin and end minus q_link_rad's reading (the mean), and the joint rates
+  // there [rad], [rad/s]: the gear deflection does not change measurably during such creep, so
+  // the link moves by the same amounts (calib/rest_poses.cpp fills them from the robot log;
+  // zero: the robot is still). The bundle uses them for the mean rate and acceleration over the
+  // rest and for the poses and velocities at the ends of the motions.
+  JointVector q_creep_begin_rad = JointVector::Zero();
+  JointVector q_creep_end_rad = JointVector::Zero();
+  JointVector q_rate_begin_rad_s = JointVector::Zero();
+  JointVector q_rate_end_rad_s = JointVector::Zero();
 };
 
 // The robot's joint readings, for the flange rate during motion (time offset) [robot clock].
 struct RobotJointSeries {
   std::vector<double> t_robot_s;
   std::vector<JointVector> q_rad;  // internal (motor-side) readings are fine: rates only
+  // Per joint, c_j / k_j: how far the link lags the reading if all of the drive's viscous
+  // friction acted at the gear output [s] (robot_joint_series(log, robot) fills it from the
+  // robot file). Zero: the readings are taken as link rates (no link share estimated).
+  JointVector link_lag_per_share_s = JointVector::Zero();
 };
 
 // The sensor's stochastic model (white noise densities and bias priors).
@@ -63,6 +87,13 @@ struct ImuNoiseModel {
   double acc_noise_density_m_s_per_sqrt_s = 0.0;   // velocity random walk
   double gyro_bias_sigma_rad_s = 0.0;              // prior 1-sigma of the (constant) gyro bias
   double acc_bias_sigma_m_s2 = 0.0;                // prior 1-sigma of the accelerometer bias
+  // Power spectral density of the accelerometer bias's in-run drift, modelled as a random walk
+  // between the rests: each rest has its own bias, b_(i+1) - b_i ~ N(0, psd dt_i) per axis (the
+  // spec's Gauss-Markov terms: sum of 2 sigma^2 / tau; 10 ug over 600 s drifts by 1.6 ug in 8 s
+  // and 5.5 ug over 110 s, against 0.4 ug of white noise in all the rests of a campaign)
+  // [(m/s^2)^2 / s]. 0: one constant bias. The gyro bias stays constant: its drift (0.0008 deg/h
+  // over 2 min for a navigation-grade unit) is far below what the rests resolve.
+  double acc_bias_drift_psd = 0.0;
   // Floors added in quadrature to the motion residuals' sigmas: unmodelled effects of the
   // preintegration (vibration, second-order terms) [rad], [m/s], [m].
   double rotation_floor_rad = 1e-7;
@@ -101,6 +132,11 @@ struct FrameCalibrationOptions {
   // torques that change from pose to pose (wind-up) and the tilt of loaded joints (play).
   bool estimate_deflection_scale = true;
   double deflection_scale_sigma = 1.0;
+  // How well the joint readings describe a creeping arm's motion at the rests
+  // (RestObservation::q_creep_*): their sigma as a fraction of the creep's mean rate,
+  // acceleration and end velocities (the gears' transmission error: up to A N ~ 1 % of the
+  // motor's motion for 10 arcsec at N = 160; the friction's share at the gear output) [1].
+  double creep_model_fraction = 0.02;
   // Robust loss on the per-pose and per-motion residual blocks (Huber, in units of sigma).
   double huber_scale_sigma = 3.0;
   // A pose or motion whose normalised residual (sqrt of its chi-square / dof) exceeds this is
@@ -111,6 +147,12 @@ struct FrameCalibrationOptions {
   // min_rate_rad_s.
   double rate_window_s = 0.02;
   double min_rate_rad_s = 0.05;
+  // The link share s of the drives' viscous friction (see the measurements above), estimated
+  // with dt when RobotJointSeries::link_lag_per_share_s is set; prior N(mean, sigma): anywhere
+  // in [0, 1] (all at the motor .. all at the gear output).
+  bool estimate_link_share = true;
+  double link_share_prior_mean = 0.5;
+  double link_share_prior_sigma = 0.5;
   int max_iterations = 100;
   // Ceres linear solver: SPARSE_NORMAL_CHOLESKY (SuiteSparse) for the sparse per-pose blocks.
   bool sparse = true;
@@ -145,10 +187,17 @@ struct PoseResidual {
 struct FrameCalibrationResult {
   Eigen::Isometry3d T_R_W = Eigen::Isometry3d::Identity();  // W origin: see convention above
   Eigen::Isometry3d T_S_H = Eigen::Isometry3d::Identity();
+  // The gyro bias and the accelerometer bias at the first rest (where a smoothing of the record
+  // starts); the covariance's acc_bias is that of the first rest too.
   ImuBiases biases;
+  std::vector<Eigen::Vector3d> acc_bias_at_rests_m_s2;  // per rest (all equal without drift)
   Eigen::Vector3d gyro_scale_factor = Eigen::Vector3d::Zero();  // dimensionless (1e-6 = 1 ppm)
   Eigen::Vector3d acc_scale_factor = Eigen::Vector3d::Zero();
   double time_offset_s = 0.0;  // t_ims = t_robot + time_offset_s
+  // The link share of the drives' viscous friction seen in the rate windows, with its 1-sigma
+  // (0 and 0 where not estimated).
+  double link_share = 0.0;
+  double link_share_sigma = 0.0;
   // Per rest: the estimated link angle minus RestObservation::q_link_rad (dq_i plus the scaled
   // wind-up and play, see estimate_deflection_scale) [rad].
   std::vector<JointVector> joint_deviation_rad;

@@ -54,7 +54,10 @@ Matrix3T<T> rest_attitude(const KinematicModel& model, const JointVector& q, con
 }
 
 // Rest pose: mean rate and specific force over the rest against
-//   rate = (I + diag(s_g)) R_S_W Omega_W + b_g,   force = (I + diag(s_a)) (-R_S_W g_W) + b_a.
+//   rate = (I + diag(s_g)) (R_S_W Omega_W + R_S_H w_creep) + b_g,
+//   force = (I + diag(s_a)) R_S_W (R_W_R a_creep - g_W) + b_a,
+// with the creeping arm's mean flange rate w_creep (in H) and mean acceleration a_creep (in R)
+// over the rest (zero when the arm is still).
 // Residual (6): whitened (measured - model); sigmas per component.
 struct RestResidual {
   const KinematicModel* model = nullptr;
@@ -65,6 +68,10 @@ struct RestResidual {
   Eigen::Vector3d mean_force = Eigen::Vector3d::Zero();
   Eigen::Vector3d earth_rate_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d gravity_W = Eigen::Vector3d::Zero();
+  // The arm's creep over the rest (RestObservation::q_creep_*): mean flange rate in H [rad/s]
+  // and mean acceleration of the sensor in R [m/s^2]; zero when still.
+  Eigen::Vector3d creep_rate_H = Eigen::Vector3d::Zero();
+  Eigen::Vector3d creep_acceleration_R = Eigen::Vector3d::Zero();
   double rate_sigma = 1.0;   // [rad/s]
   double force_sigma = 1.0;  // [m/s^2]
 
@@ -74,8 +81,11 @@ struct RestResidual {
     const Eigen::Matrix<T, 6, 1> deviation = rest_deviation<T>(dq, m_w, m_p, windup, play);
     const Matrix3T<T> R_S_W =
         rest_attitude<T>(*model, q, q_W_R, q_S_H, deviation.data()).transpose();
-    const Vector3T<T> rate_true = R_S_W * earth_rate_W.cast<T>();
-    const Vector3T<T> force_true = -(R_S_W * gravity_W.cast<T>());
+    const Matrix3T<T> R_W_R = Eigen::Map<const Eigen::Quaternion<T>>(q_W_R).toRotationMatrix();
+    const Matrix3T<T> R_S_H = Eigen::Map<const Eigen::Quaternion<T>>(q_S_H).toRotationMatrix();
+    const Vector3T<T> rate_true = R_S_W * earth_rate_W.cast<T>() + R_S_H * creep_rate_H.cast<T>();
+    const Vector3T<T> force_true =
+        R_S_W * (R_W_R * creep_acceleration_R.cast<T>() - gravity_W.cast<T>());
     for (int k = 0; k < 3; ++k) {
       const T rate_model = (T(1) + s_g[k]) * rate_true[k] + b_g[k];
       const T force_model = (T(1) + s_a[k]) * force_true[k] + b_a[k];
@@ -97,6 +107,11 @@ struct MotionResidual {
   const ImuPreintegration* preintegration = nullptr;
   JointVector q_i = JointVector::Zero();
   JointVector q_j = JointVector::Zero();
+  // Where the creeping arm is at the motion's ends (rest i's end, rest j's begin) relative to
+  // the rests' mean readings [rad], and the sensor's velocity there in R [m/s] (zero: still).
+  JointVector creep_i = JointVector::Zero(), creep_j = JointVector::Zero();
+  Eigen::Vector3d velocity_start_R = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_end_R = Eigen::Vector3d::Zero();
   JointVector windup_i = JointVector::Zero(), play_i = JointVector::Zero();
   JointVector windup_j = JointVector::Zero(), play_j = JointVector::Zero();
   Eigen::Vector3d earth_rate_W = Eigen::Vector3d::Zero();
@@ -104,24 +119,33 @@ struct MotionResidual {
   Eigen::Matrix3d gravity_gradient_W = Eigen::Matrix3d::Zero();
   Eigen::Matrix<double, 9, 9> whitening = Eigen::Matrix<double, 9, 9>::Identity();
 
+  // b_a_i, b_a_j: the accelerometer biases of rests i and j (the same block without drift); the
+  // motion uses their mean.
   template <typename T>
   bool operator()(const T* q_W_R, const T* q_S_H, const T* p_S_H, const T* dq_i, const T* dq_j,
-                  const T* b_g, const T* b_a, const T* m_w, const T* m_p, T* residual) const {
+                  const T* b_g, const T* b_a_i, const T* b_a_j, const T* m_w, const T* m_p,
+                  T* residual) const {
     const ImuPreintegration& pre = *preintegration;
     const Eigen::Matrix<T, 6, 1> deviation_i = rest_deviation<T>(dq_i, m_w, m_p, windup_i, play_i);
     const Eigen::Matrix<T, 6, 1> deviation_j = rest_deviation<T>(dq_j, m_w, m_p, windup_j, play_j);
     Vector3T<T> p_R_S_i, p_R_S_j;
+    const JointVector q_start = q_i + creep_i, q_end = q_j + creep_j;
     const Matrix3T<T> R_i =
-        rest_attitude<T>(*model, q_i, q_W_R, q_S_H, deviation_i.data(), &p_R_S_i, p_S_H);
+        rest_attitude<T>(*model, q_start, q_W_R, q_S_H, deviation_i.data(), &p_R_S_i, p_S_H);
     const Matrix3T<T> R_j =
-        rest_attitude<T>(*model, q_j, q_W_R, q_S_H, deviation_j.data(), &p_R_S_j, p_S_H);
+        rest_attitude<T>(*model, q_end, q_W_R, q_S_H, deviation_j.data(), &p_R_S_j, p_S_H);
     const Matrix3T<T> R_W_R = Eigen::Map<const Eigen::Quaternion<T>>(q_W_R).toRotationMatrix();
     const Vector3T<T> dp_model = R_W_R * (p_R_S_j - p_R_S_i);
+    // Start and end velocities of a creeping arm (the Coriolis term of v_start, 2 Omega x v T^2
+    // / 2 ~ 1e-7 m for 1e-4 m/s over 3 s, is left out).
+    const Vector3T<T> v_start = R_W_R * velocity_start_R.cast<T>();
+    const Vector3T<T> v_end = R_W_R * velocity_end_R.cast<T>();
 
     const Vector3T<T> dbg =
         Eigen::Map<const Vector3T<T>>(b_g) - pre.linearisation().gyro_rad_s.cast<T>();
-    const Vector3T<T> dba =
-        Eigen::Map<const Vector3T<T>>(b_a) - pre.linearisation().acc_m_s2.cast<T>();
+    const Vector3T<T> b_a =
+        T(0.5) * (Eigen::Map<const Vector3T<T>>(b_a_i) + Eigen::Map<const Vector3T<T>>(b_a_j));
+    const Vector3T<T> dba = b_a - pre.linearisation().acc_m_s2.cast<T>();
     const ImuBiases zero_offset = pre.linearisation();
     std::array<Vector3T<T>, ImuPreintegration::kMomentCount> w;
     for (int m = 0; m < ImuPreintegration::kMomentCount; ++m) {
@@ -161,8 +185,8 @@ struct MotionResidual {
     const Vector3T<T> rotation_W = ims::quat_log<T>(Eigen::Quaternion<T>(R_error));
     Eigen::Matrix<T, 9, 1> raw;
     raw.template segment<3>(0) = R_i.transpose() * rotation_W;
-    raw.template segment<3>(3) = R_i.transpose() * v;
-    raw.template segment<3>(6) = R_i.transpose() * (dp - dp_model);
+    raw.template segment<3>(3) = R_i.transpose() * (v + v_start - v_end);
+    raw.template segment<3>(6) = R_i.transpose() * (dp + v_start * duration - dp_model);
     Eigen::Map<Eigen::Matrix<T, 9, 1>> out(residual);
     out = whitening.cast<T>() * raw;
     return true;
@@ -178,7 +202,10 @@ struct MotionResidual {
 // the rests and motions determine far better.
 // Residual (3): whitened by `sigma` [rad/s].
 struct RateResidual {
-  using Interpolator = ceres::CubicInterpolator<ceres::Grid1D<double, 3>>;
+  // Per grid node: omega_H (3) from the joint readings and lag_H (3) = sum_j lag_j z_j qdd_j in H,
+  // the rate the link falls behind per unit of the link share of friction (see
+  // RobotJointSeries::link_lag_per_share_s).
+  using Interpolator = ceres::CubicInterpolator<ceres::Grid1D<double, 6>>;
   const Interpolator* omega_H = nullptr;
   double grid_t0_s = 0.0;  // robot time of node 0
   double grid_step_s = 1.0;
@@ -188,18 +215,51 @@ struct RateResidual {
   Eigen::Vector3d offset_S = Eigen::Vector3d::Zero();  // b_g + Earth rate in S [rad/s]
   double sigma = 1.0;
 
+  // dt [s]; share [1]: the link share of the drives' viscous friction (link rate =
+  // omega_H - share lag_H).
   template <typename T>
-  bool operator()(const T* dt, T* residual) const {
+  bool operator()(const T* dt, const T* share, T* residual) const {
     Vector3T<T> sum = Vector3T<T>::Zero();
     for (const double t : mid_times_ims_s) {
       const T x = (T(t) - dt[0] - T(grid_t0_s)) / T(grid_step_s);
-      T value[3];
+      T value[6];
       omega_H->Evaluate(x, value);
-      sum += Vector3T<T>(value[0], value[1], value[2]);
+      for (int k = 0; k < 3; ++k) sum[k] += value[k] - share[0] * value[3 + k];
     }
     const Vector3T<T> mean_H = sum / T(static_cast<double>(mid_times_ims_s.size()));
     const Vector3T<T> model = R_S_H.cast<T>() * mean_H + offset_S.cast<T>();
     for (int k = 0; k < 3; ++k) residual[k] = (T(mean_rate[k]) - model[k]) / T(sigma);
+    return true;
+  }
+};
+
+// MotionResidual with one constant accelerometer bias (Ceres refuses a block passed twice).
+struct MotionResidualConstantBias {
+  MotionResidual motion;
+  template <typename T>
+  bool operator()(const T* q_W_R, const T* q_S_H, const T* p_S_H, const T* dq_i, const T* dq_j,
+                  const T* b_g, const T* b_a, const T* m_w, const T* m_p, T* residual) const {
+    return motion(q_W_R, q_S_H, p_S_H, dq_i, dq_j, b_g, b_a, b_a, m_w, m_p, residual);
+  }
+};
+
+// Random walk of the accelerometer bias from one rest to the next: (b_j - b_i) / sigma.
+struct BiasDriftResidual {
+  double inverse_sigma = 1.0;  // 1 / sqrt(psd dt) [s^2/m]
+  template <typename T>
+  bool operator()(const T* b_i, const T* b_j, T* residual) const {
+    for (int k = 0; k < 3; ++k) residual[k] = (b_j[k] - b_i[k]) * T(inverse_sigma);
+    return true;
+  }
+};
+
+// Prior N(mean, sigma) of the link share of the drives' viscous friction.
+struct LinkSharePriorResidual {
+  double mean = 0.5;
+  double inverse_sigma = 2.0;
+  template <typename T>
+  bool operator()(const T* share, T* residual) const {
+    residual[0] = (share[0] - T(mean)) * T(inverse_sigma);
     return true;
   }
 };

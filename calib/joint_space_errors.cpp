@@ -2,15 +2,46 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "calib/forward_kinematics.hpp"
 #include "calib/inverse_kinematics.hpp"
+#include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
 #include "ims/earth_model.hpp"
 
 namespace imscal::calib {
+
+namespace {
+
+// 1-sigma of the joint angles from the sensor pose's sigmas (attitude phi in W, position in W;
+// taken as independent) through the flange twist in R and the inverse Jacobian.
+JointVector joint_sigma(const KinematicModel& kinematics, const JointVector& q,
+                        const Eigen::Matrix<double, 9, 1>& sigma_W, const Eigen::Matrix3d& R_R_W,
+                        const Eigen::Vector3d& r_S_H_W) {
+  if (sigma_W.isZero(0.0)) return JointVector::Zero();
+  // (phi_W, dp_W) -> (dp_H in R, phi in R): dp_H = R_R_W (dp + phi x r), phi_R = R_R_W phi.
+  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix3d minus_skew_r;
+  minus_skew_r << 0, r_S_H_W.z(), -r_S_H_W.y(), -r_S_H_W.z(), 0, r_S_H_W.x(), r_S_H_W.y(),
+      -r_S_H_W.x(), 0;
+  A.block<3, 3>(0, 0) = R_R_W * minus_skew_r;
+  A.block<3, 3>(0, 3) = R_R_W;
+  A.block<3, 3>(3, 0) = R_R_W;
+  Eigen::Matrix<double, 6, 1> variance;
+  variance << sigma_W.head<3>().cwiseAbs2(), sigma_W.tail<3>().cwiseAbs2();
+  const Eigen::Matrix<double, 6, 6> twist = A * variance.asDiagonal() * A.transpose();
+  const Jacobian J = geometric_jacobian(kinematics, q);
+  const Eigen::FullPivLU<Jacobian> lu(J);
+  if (!lu.isInvertible()) return JointVector::Constant(std::numeric_limits<double>::infinity());
+  const Jacobian J_inverse = lu.inverse();
+  return (J_inverse * twist * J_inverse.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
+}
+
+}  // namespace
 
 bool interpolate_sensor_pose(const std::vector<ims::SmoothedState>& states, double t_ims_s,
                              Eigen::Isometry3d& T_W_S) {
@@ -68,6 +99,15 @@ JointSpaceErrors joint_errors_along(const std::vector<ims::SmoothedState>& traje
     out.q_desired_rad.push_back(sample.q_desired_rad);
     out.q_measured_rad.push_back(solution.q);
     out.q_internal_rad.push_back(sample.q_internal_rad);
+    // The smoother's sigmas at the nearest state.
+    const double t_ims = sample.t_s + frames.time_offset_s;
+    auto nearest =
+        std::lower_bound(trajectory.begin(), trajectory.end(), t_ims,
+                         [](const ims::SmoothedState& s, double t) { return s.state.t_s < t; });
+    if (nearest == trajectory.end()) --nearest;
+    const Eigen::Vector3d r_S_H_W = T_W_S.linear() * frames.T_S_H.translation();  // S to H in W
+    out.q_measured_sigma_rad.push_back(
+        joint_sigma(kinematics, solution.q, nearest->sigma, frames.T_R_W.linear(), r_S_H_W));
   }
   return out;
 }
@@ -118,7 +158,15 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   zupt.initial_gyro_bias_rad_s = input.frames.biases.gyro_rad_s;
   zupt.initial_acc_bias_m_s2 = input.frames.biases.acc_m_s2;
   const ims::EarthModel earth(input.site);
-  ims::ZuptSmootherResult smoothed = ims::smooth_with_zupt(cut, earth, initial, sigma0, zupt);
+  ims::SmootherAids aids;
+  if (options.encoder_stillness || options.creep_velocity_updates) {
+    const EncoderMotion motion = encoder_motion(*input.log, input.kinematics, T_W_R,
+                                                input.frames.T_S_H.inverse().translation(),
+                                                input.frames.time_offset_s, options.encoder);
+    if (options.encoder_stillness) aids.still = motion.still;
+    if (options.creep_velocity_updates) aids.velocity = motion.creep_velocity;
+  }
+  ims::ZuptSmootherResult smoothed = ims::smooth_with_zupt(cut, earth, initial, sigma0, zupt, aids);
 
   // The initial state belongs to the trajectory too (the start of the first increment).
   ims::SmoothedState first;

@@ -3,12 +3,17 @@
 //   W_T_S(t)   the sensor's trajectory by zero-velocity-aided smoothing (ims/zupt_smoother.hpp),
 //              started at the first rest pose with R_W_S0 = R_W_R R_R_H(q_0) R_H_S and
 //              p_W_S0 = T_W_R T_R_H(q_0) p_H_S (whatever the origin of W in T_R_W is: with the
-//              convention of calib/frame_calibration.hpp it is 0), biases from the frames;
+//              convention of calib/frame_calibration.hpp it is 0), biases from the frames; the
+//              robot's readings at commanded standstill say where it is really still and how it
+//              creeps (calib/encoder_motion.hpp): rests only there, velocity updates while it
+//              creeps (never during commanded motion, where the gears deflect);
 //   T_R_H(t)   = T_R_W W_T_S(t + dt) T_S_H at every robot sample (t robot clock, t + dt IMS clock;
 //              the smoothed poses interpolated between IMS samples: linear position, slerp);
 //   q_measured inverse kinematics (calib/inverse_kinematics.hpp) in the configuration of the
 //              robot's own reading at that sample, the 2*pi branch nearest to it;
-//   dq         = q_desired - q_measured per joint (the robot's internal reading beside it).
+//   dq         = q_desired - q_measured per joint (the robot's internal reading beside it),
+//              with the 1-sigma the smoother's own sigmas give it (position and attitude of
+//              W_T_S through the inverse Jacobian, their correlations left out).
 //
 // The result holds the columns of joint_errors.csv (ident/joint_error_io.hpp, datasets/FORMAT.md
 // section 10: t_s, payload_kg, q_desired, q_measured, q_internal); calib may not use ident, so
@@ -20,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "calib/encoder_motion.hpp"
 #include "calib/frame_calibration.hpp"
 #include "calib/imu_preintegration.hpp"
 #include "calib/robot_description.hpp"
@@ -66,6 +72,11 @@ struct JointSpaceOptions {
   // IMS path moves A4 and A6 by ~e / |sin A5| in opposite directions (1e-4 rad at 0.05 gives
   // 2 mrad; at 1e-4, a whole radian). 0.05: ~2.9 deg around A5 = 0.
   double min_wrist_sin = 0.05;
+  // The robot's readings at commanded standstill: rests only where they are still, velocity
+  // updates while the arm creeps (calib/encoder_motion.hpp). Off: the IMS's own rests only.
+  bool encoder_stillness = true;
+  bool creep_velocity_updates = true;
+  EncoderMotionOptions encoder;
 };
 
 // One row per kept robot sample (the joint_errors.csv columns) [robot clock, SI].
@@ -77,6 +88,8 @@ struct JointSpaceErrors {
   std::vector<JointVector> q_desired_rad;
   std::vector<JointVector> q_measured_rad;  // from the IMS chain
   std::vector<JointVector> q_internal_rad;
+  // 1-sigma of q_measured from the smoother's sigmas (zero along a trajectory without them).
+  std::vector<JointVector> q_measured_sigma_rad;
   std::size_t outside_record = 0;  // robot samples without IMS data (before/after the record)
   std::size_t ik_failures = 0;     // robot samples whose inverse kinematics failed
   std::size_t near_wrist_singularity = 0;  // left out: |sin A5| < JointSpaceOptions::min_wrist_sin

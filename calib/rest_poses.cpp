@@ -127,7 +127,39 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
         correct_static_deflection(*input.robot, payload.mass_kg > 0.0 ? &payload : nullptr,
                                   detail.q_internal_mean_rad, options.deflection);
 
+    // The readings and rates at the two ends: a line through the samples within creep_fit_s.
+    const auto end_fit = [&](double t_robot, JointVector& q, JointVector& rate) {
+      double s_t = 0.0, s_tt = 0.0;
+      JointVector s_q = JointVector::Zero(), s_tq = JointVector::Zero();
+      int n = 0;
+      for (auto it = first; it != last; ++it) {
+        const double t = it->t_s - t_robot;
+        if (std::abs(t) > options.creep_fit_s) continue;
+        s_t += t;
+        s_tt += t * t;
+        s_q += it->q_internal_rad;
+        s_tq += t * it->q_internal_rad;
+        ++n;
+      }
+      const double det = n * s_tt - s_t * s_t;
+      if (n < 2 || !(det > 0.0)) {
+        q = detail.q_internal_mean_rad;
+        rate.setZero();
+        return;
+      }
+      rate = (n * s_tq - s_t * s_q) / det;
+      q = (s_q - rate * s_t) / n;
+    };
+    JointVector q_begin, q_end, rate_begin, rate_end;
+    end_fit(rest_begin - input.time_offset_s, q_begin, rate_begin);
+    end_fit(end - input.time_offset_s, q_end, rate_end);
+
     RestObservation rest;
+    rest.q_creep_begin_rad = q_begin - detail.q_internal_mean_rad;
+    rest.q_creep_end_rad = q_end - detail.q_internal_mean_rad;
+    rest.q_rate_begin_rad_s = rate_begin;
+    rest.q_rate_end_rad_s = rate_end;
+
     rest.label = fmt::format("rest {} at {:.1f} s", result.rests.size() + 1, begin);
     rest.begin_ims_s = rest_begin;
     rest.end_ims_s = end;
@@ -148,6 +180,16 @@ RobotJointSeries robot_joint_series(const RobotLog& log) {
   for (const RobotLogSample& s : log.samples) {
     series.t_robot_s.push_back(s.t_s);
     series.q_rad.push_back(s.q_internal_rad);
+  }
+  return series;
+}
+
+RobotJointSeries robot_joint_series(const RobotLog& log, const RobotDescription& robot) {
+  RobotJointSeries series = robot_joint_series(log);
+  for (int j = 0; j < kJointCount; ++j) {
+    const DriveParameters& drive = robot.joints[j].drive;
+    if (drive.stiffness_nm_per_rad > 0.0)
+      series.link_lag_per_share_s[j] = drive.viscous_nm_s_per_rad / drive.stiffness_nm_per_rad;
   }
   return series;
 }

@@ -52,8 +52,14 @@ ImsJointMeasurement measure_joints_with_ims(const sim::Scenario& scenario,
   input.kinematics = robot.kinematics;
   input.frames.T_R_W = T_W_R.inverse();
   input.frames.T_S_H = T_H_S.inverse();
+  // The biases as the record carries them at its start (turn-on plus in-run part: what a
+  // calibration at the rest before the run estimates); the smoother follows their drift.
   input.frames.biases.gyro_rad_s = recording.sensor_errors.gyro.bias;
   input.frames.biases.acc_m_s2 = recording.sensor_errors.acc.bias;
+  if (!recording.in_run_bias.t_s.empty()) {
+    input.frames.biases.gyro_rad_s += recording.in_run_bias.gyro_rad_s.front();
+    input.frames.biases.acc_m_s2 += recording.in_run_bias.acc_m_s2.front();
+  }
   input.frames.time_offset_s = scenario.imu_clock_offset_s;
   // The plant starts at rest: the first lead-in is the smoother's first rest, its pose the
   // forward kinematics of the link angles there (a rest pose whose deflection the frame

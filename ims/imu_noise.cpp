@@ -52,6 +52,7 @@ class TriadNoise {
 
   // Output increment for the ideal increment over dt.
   Eigen::Vector3d step(const Eigen::Vector3d& ideal, double dt) {
+    in_run_mean_.setZero();
     Eigen::Vector3d raw = errors_.apply(ideal, dt);
     const double white_sigma = spec_.white_noise_density * std::sqrt(dt);
     for (int i = 0; i < 3; ++i) raw[i] += white_sigma * normal_.next();
@@ -63,6 +64,7 @@ class TriadNoise {
       const Eigen::Vector3d before = gm_state_[j];
       for (int i = 0; i < 3; ++i) gm_state_[j][i] = rho * before[i] + drive * normal_.next();
       raw += 0.5 * (before + gm_state_[j]) * dt;
+      in_run_mean_ += 0.5 * (before + gm_state_[j]);
     }
     if (spec_.range > 0.0) {
       const double limit = spec_.range * dt;
@@ -79,12 +81,16 @@ class TriadNoise {
     return raw;
   }
 
+  // The in-run bias over the last step's interval (sum of the Gauss-Markov terms' means).
+  const Eigen::Vector3d& in_run_mean() const { return in_run_mean_; }
+
  private:
   const TriadSpec& spec_;
   const TriadErrors& errors_;
   NormalDraws& normal_;
   std::vector<Eigen::Vector3d> gm_state_;
   Eigen::Vector3d residual_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d in_run_mean_ = Eigen::Vector3d::Zero();
 };
 }  // namespace
 
@@ -97,7 +103,7 @@ SensorErrorModel draw_sensor_errors(const SensorSpec& spec, std::mt19937_64& rng
 }
 
 ImuSeries corrupt(const ImuSeries& ideal, const SensorErrorModel& errors, const SensorSpec& spec,
-                  std::uint64_t seed) {
+                  std::uint64_t seed, InRunBias* in_run) {
   std::mt19937_64 rng(seed);
   NormalDraws normal(rng);
   TriadNoise gyro(spec.gyro, errors.gyro, normal);
@@ -114,6 +120,11 @@ ImuSeries corrupt(const ImuSeries& ideal, const SensorErrorModel& errors, const 
     ImuSample& s = out.samples[k];
     s.gyro = gyro.step(ideal.samples[k].gyro * to_increment, dt) / to_increment;
     s.acc = acc.step(ideal.samples[k].acc * to_increment, dt) / to_increment;
+    if (in_run != nullptr) {
+      in_run->t_s.push_back(s.t_s);
+      in_run->gyro_rad_s.push_back(gyro.in_run_mean());
+      in_run->acc_m_s2.push_back(acc.in_run_mean());
+    }
   }
   return out;
 }

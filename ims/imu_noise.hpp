@@ -15,11 +15,17 @@
 // Rate series are treated as increments rate * dt and divided by dt again (white noise then has
 // sigma N / sqrt(dt), the band-limited rate noise, and the LSB of a rate is LSB / dt).
 //
+// The in-run part (the sum of the Gauss-Markov terms, mean over each interval) can be handed
+// back: it is part of the truth, since the bias a record shows drifts away from the turn-on
+// bias by ~sigma sqrt(2 T / tau) over T seconds (5.5 ug over 110 s for 10 ug, 600 s).
+//
 // Determinism: normal draws are made by the polar method on std::mt19937_64 (fully specified
 // by the standard), so a seed gives the same numbers with any standard library; same seed and
 // same input give bit-identical output on the same platform.
+#include <Eigen/Core>
 #include <cstdint>
 #include <random>
+#include <vector>
 
 #include "ims/imu_data.hpp"
 #include "ims/sensor_error_model.hpp"
@@ -43,10 +49,19 @@ class NormalDraws {
 // independent zero-mean normal with the spec's sigma.
 SensorErrorModel draw_sensor_errors(const SensorSpec& spec, std::mt19937_64& rng);
 
+// The in-run bias of each triad over every sample's interval (the same time stamps as the
+// series), beside the constant turn-on bias of the SensorErrorModel.
+struct InRunBias {
+  std::vector<double> t_s;
+  std::vector<Eigen::Vector3d> gyro_rad_s;
+  std::vector<Eigen::Vector3d> acc_m_s2;
+};
+
 // The ideal series (increments or rates) as the unit described by `errors` and `spec` would
 // output it. Uses spec only for the noise, bias instability, quantisation and range (the
-// deterministic errors are those in `errors`).
+// deterministic errors are those in `errors`). in_run (may be null): receives the in-run bias;
+// the draws, and so the output, are the same either way.
 ImuSeries corrupt(const ImuSeries& ideal, const SensorErrorModel& errors, const SensorSpec& spec,
-                  std::uint64_t seed);
+                  std::uint64_t seed, InRunBias* in_run = nullptr);
 
 }  // namespace imscal::ims

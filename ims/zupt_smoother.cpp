@@ -218,17 +218,55 @@ std::vector<SmoothedState> apply_smoothed_errors(const std::vector<NavState>& no
   return states;
 }
 
+// Keeps only the rest samples inside the still intervals (sorted) and redoes the runs.
+void restrict_rests(const ImuSeries& imu, const std::vector<TimeInterval>& still,
+                    RestDetection& rest) {
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < imu.samples.size(); ++i) {
+    const double t = imu.samples[i].t_s;
+    while (j < still.size() && still[j].end_s < t) ++j;
+    if (j >= still.size() || t < still[j].begin_s) rest.at_rest[i] = false;
+  }
+  rest.intervals.clear();
+  for (std::size_t i = 0; i < rest.at_rest.size();) {
+    if (!rest.at_rest[i]) {
+      ++i;
+      continue;
+    }
+    std::size_t last = i;
+    while (last + 1 < rest.at_rest.size() && rest.at_rest[last + 1]) ++last;
+    rest.intervals.push_back({i, last, imu.samples[i].t_s, imu.samples[last].t_s});
+    i = last + 1;
+  }
+}
+
+// The aid's velocity at t, linearly between the two samples around it (at most max_gap_s apart).
+bool aid_velocity_at(const SmootherAids& aids, double t, std::size_t& cursor, Eigen::Vector3d& v,
+                     double& sigma) {
+  const std::vector<VelocitySample>& series = aids.velocity;
+  while (cursor + 1 < series.size() && series[cursor + 1].t_s < t) ++cursor;
+  if (cursor + 1 >= series.size() || series[cursor].t_s > t) return false;
+  const VelocitySample& a = series[cursor];
+  const VelocitySample& b = series[cursor + 1];
+  if (b.t_s - a.t_s > aids.max_velocity_gap_s || !(b.t_s > a.t_s)) return false;
+  const double f = (t - a.t_s) / (b.t_s - a.t_s);
+  v = (1.0 - f) * a.v_W + f * b.v_W;
+  sigma = std::max(a.sigma_m_s, b.sigma_m_s);
+  return sigma > 0.0;
+}
+
 }  // namespace
 
 ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& earth,
                                     const NavState& initial,
                                     const Eigen::Matrix<double, 9, 1>& initial_sigma,
-                                    const ZuptOptions& options) {
+                                    const ZuptOptions& options, const SmootherAids& aids) {
   check_options(imu, options);
   const std::size_t n = imu.samples.size();
   ZuptSmootherResult result;
 
-  const RestDetection rest = detect_rest(imu, earth, rest_options_of(options));
+  RestDetection rest = detect_rest(imu, earth, rest_options_of(options));
+  if (aids.still) restrict_rests(imu, *aids.still, rest);
   result.summary.rest_intervals = rest.intervals;
 
   const ErrorProcessNoise noise = process_noise_of(options);
@@ -268,15 +306,18 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
   ErrorLinearisation point;
   point.earth_rate_W = earth.earth_rate_W();
   point.gravity_gradient_W = earth.gravity_gradient_W();
-  UpdateTally zupt_tally, zaru_tally;
+  UpdateTally zupt_tally, zaru_tally, aid_tally;
+  std::size_t aid_cursor = 0;
   // Zero angular rate over a whole rest: sums of the raw gyro increments, time and attitude.
   Eigen::Vector3d rest_raw_dtheta = Eigen::Vector3d::Zero();
   Eigen::Matrix3d rest_sum_R = Eigen::Matrix3d::Zero();
   double rest_time = 0.0;
+  // The nominal velocity carries the quantisation residual of the summed increments.
+  const double velocity_quantisation_variance =
+      options.acc_quantization_lsb_m_s * options.acc_quantization_lsb_m_s / 12.0;
   const double zero_velocity_variance =
       options.zero_velocity_sigma_m_s * options.zero_velocity_sigma_m_s +
-      // the nominal velocity carries the quantisation residual of the summed increments
-      options.acc_quantization_lsb_m_s * options.acc_quantization_lsb_m_s / 12.0;
+      velocity_quantisation_variance;
 
   for (std::size_t k = 1; k <= epoch_count; ++k) {
     const std::size_t begin = (k - 1) * samples_per_epoch;
@@ -328,6 +369,17 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
       update(x, P, -state.v_W, H, zero_velocity_variance * Eigen::Matrix3d::Identity(), gate,
              zupt_tally);
     }
+    Eigen::Vector3d aid_v;
+    double aid_sigma = 0.0;
+    if (!epoch_zero_velocity[k] &&
+        aid_velocity_at(aids, strapdown.state().t_s, aid_cursor, aid_v, aid_sigma)) {
+      // An outside velocity: z = v_aid - v_estimate = dv + noise.
+      Matrix3x15 H = Matrix3x15::Zero();
+      H.block<3, 3>(0, kVelocity).setIdentity();
+      update(x, P, aid_v - strapdown.state().v_W, H,
+             (aid_sigma * aid_sigma + velocity_quantisation_variance) * Eigen::Matrix3d::Identity(),
+             options.innovation_gate_chi2, aid_tally);
+    }
     if (epoch_in_rest_interior[k]) {
       rest_raw_dtheta += sum_raw_dtheta;
       rest_sum_R += sum_R;
@@ -368,6 +420,7 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
   }
   result.summary.zero_velocity = zupt_tally.statistics();
   result.summary.zero_angular_rate = zaru_tally.statistics();
+  result.summary.velocity_aid = aid_tally.statistics();
   result.summary.propagation_steps = epoch_count;
 
   const SmoothedErrors smoothed = rts_backward_pass(epochs);

@@ -14,6 +14,9 @@
 //    Updates whose normalised innovation squared exceeds the gate are rejected. The estimate is
 //    fed back into the nominal state and the bias estimates after every update (closed loop),
 //    so the error stays small and the linear model holds.
+//    With SmootherAids (ims/smoother_aids.hpp): the rests only where the aid says the sensor is
+//    still, and velocity measurements v_W = v_aid + noise(sigma) at the propagation instants
+//    the aid covers (gated like the zero-velocity updates).
 // 3. Backward pass: Rauch-Tung-Striebel on the error state, with the filter's stored covariances
 //    and transitions; the smoothed errors are applied to the nominal trajectory, interpolated
 //    linearly between propagation instants.
@@ -30,6 +33,7 @@
 #include "ims/imu_data.hpp"
 #include "ims/nav_state.hpp"
 #include "ims/rest_detector.hpp"
+#include "ims/smoother_aids.hpp"
 #include "ims/zupt_options.hpp"
 
 namespace imscal::ims {
@@ -62,6 +66,7 @@ struct ZuptSummary {
   std::vector<RestInterval> rest_intervals;
   InnovationStatistics zero_velocity;
   InnovationStatistics zero_angular_rate;
+  InnovationStatistics velocity_aid;  // SmootherAids::velocity
   std::size_t propagation_steps = 0;
 };
 
@@ -77,6 +82,6 @@ struct ZuptSmootherResult {
 ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& earth,
                                     const NavState& initial,
                                     const Eigen::Matrix<double, 9, 1>& initial_sigma,
-                                    const ZuptOptions& options);
+                                    const ZuptOptions& options, const SmootherAids& aids = {});
 
 }  // namespace imscal::ims

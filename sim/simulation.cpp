@@ -80,7 +80,7 @@ ImsRecording record_ims(const Scenario& scenario, const calib::RobotDescription&
       ims::synthesize_ideal_increments(trajectory, earth, scenario.imu_rate_hz);
   ImsRecording out;
   out.sensor_errors = ims::draw_sensor_errors(spec, rng);
-  out.imu_raw = ims::corrupt(ideal, out.sensor_errors, spec, rng());
+  out.imu_raw = ims::corrupt(ideal, out.sensor_errors, spec, rng(), &out.in_run_bias);
   // Truth at the start of the first interval and at every sample, then both on the IMS clock.
   const double offset = scenario.imu_clock_offset_s;
   auto truth_at = [&](double t_robot) {
@@ -92,6 +92,7 @@ ImsRecording record_ims(const Scenario& scenario, const calib::RobotDescription&
   for (const ims::ImuSample& sample : ideal.samples)
     out.sensor_truth.push_back(truth_at(sample.t_s));
   for (ims::ImuSample& sample : out.imu_raw.samples) sample.t_s += offset;
+  for (double& t : out.in_run_bias.t_s) t += offset;
   out.imu_raw.site = scenario.site;
   return out;
 }
@@ -132,6 +133,7 @@ SimulationResult run_simulation(const Scenario& scenario, std::uint64_t seed,
   result.sensor_errors = std::move(recording.sensor_errors);
   result.imu_raw = std::move(recording.imu_raw);
   result.sensor_truth = std::move(recording.sensor_truth);
+  result.imu_in_run_bias = std::move(recording.in_run_bias);
   result.imu_raw.metadata = {{"sensor", result.sensor_spec.name},
                              {"scenario", scenario.name},
                              {"seed", std::to_string(seed)},

@@ -10,6 +10,7 @@
 
 #include "calib/robot_description.hpp"
 #include "ims/imu_data.hpp"
+#include "ims/imu_noise.hpp"
 #include "ims/nav_state.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
@@ -28,7 +29,10 @@ struct SimulationResult {
   Eigen::Isometry3d T_H_S = Eigen::Isometry3d::Identity();  // IMS on the flange (as drawn)
   double imu_clock_offset_s = 0.0;                          // t_IMS = t_robot + offset
   ims::SensorErrorModel sensor_errors;                      // drawn from the spec
-  ims::ImuSeries imu_raw;                                   // what the IMS records, IMS clock
+  // The in-run part of the biases the record carries (beside sensor_errors' turn-on biases),
+  // at the IMS samples, IMS clock.
+  ims::InRunBias imu_in_run_bias;
+  ims::ImuSeries imu_raw;                   // what the IMS records, IMS clock
   std::vector<ims::NavState> sensor_truth;  // S in W at the start and every IMS sample, IMS clock
 };
 
@@ -48,6 +52,7 @@ struct ImsRecording {
   ims::SensorErrorModel sensor_errors;
   ims::ImuSeries imu_raw;
   std::vector<ims::NavState> sensor_truth;  // S in W at the start and every sample, IMS clock
+  ims::InRunBias in_run_bias;               // the biases as they drift in the record, IMS clock
 };
 ImsRecording record_ims(const Scenario& scenario, const calib::RobotDescription& robot,
                         const ims::SensorSpec& spec, const PlantLog& plant,

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -68,6 +69,36 @@ std::string flange_csv(const SimulationResult& r) {
   return text;
 }
 
+// The biases the record carries, turn-on + in-run, every `every_s` of the IMS clock (the in-run
+// part changes over minutes; its mean over the sample interval at the stamp).
+std::string imu_bias_csv(const SimulationResult& r, double every_s) {
+  constexpr double kDegPerHourPerRadPerSecond = 180.0 / M_PI * 3600.0;
+  constexpr double kMicroGPerMeterPerSecond2 = 1e6 / 9.80665;
+  std::string text =
+      "# imscal-truth-imu-bias: 1\n"
+      "t_s,gyro_bias_x_deg_h,gyro_bias_y_deg_h,gyro_bias_z_deg_h,acc_bias_x_ug,acc_bias_y_ug,"
+      "acc_bias_z_ug\n";
+  const ims::InRunBias& in_run = r.imu_in_run_bias;
+  double next = -std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < in_run.t_s.size(); ++k) {
+    if (in_run.t_s[k] < next) continue;
+    next = in_run.t_s[k] + every_s - 1e-9;
+    csv::append_shortest(text, in_run.t_s[k]);
+    const Eigen::Vector3d gyro = r.sensor_errors.gyro.bias + in_run.gyro_rad_s[k];
+    const Eigen::Vector3d acc = r.sensor_errors.acc.bias + in_run.acc_m_s2[k];
+    for (int i = 0; i < 3; ++i) {
+      text += ',';
+      csv::append_shortest(text, gyro[i] * kDegPerHourPerRadPerSecond);
+    }
+    for (int i = 0; i < 3; ++i) {
+      text += ',';
+      csv::append_shortest(text, acc[i] * kMicroGPerMeterPerSecond2);
+    }
+    text += '\n';
+  }
+  return text;
+}
+
 std::string segments_csv(const DesiredJointPath& path) {
   static const char* kKinds[] = {"rest", "ptp", "lin", "circ"};
   std::string text = "kind,begin_s,end_s,label\n";
@@ -118,8 +149,8 @@ std::vector<fs::path> simulation_outputs(const Scenario& scenario) {
   return {"imu." + scenario.imu_format, "robot.csv",
           "truth/joints.csv",           "truth/flange_poses.csv",
           "truth/trajectory.csv",       "truth/frames.json",
-          "truth/sensor_errors.yaml",   "truth/segments.csv",
-          "truth/scenario.yaml"};
+          "truth/sensor_errors.yaml",   "truth/imu_bias.csv",
+          "truth/segments.csv",         "truth/scenario.yaml"};
 }
 
 calib::RobotLog make_robot_log(const SimulationResult& result) {
@@ -155,6 +186,7 @@ void write_simulation(const fs::path& folder, const Scenario& scenario, std::uin
                         fmt::format("# Drawn errors of the simulated IMS '{}', seed {}\n",
                                     result.sensor_spec.name, seed) +
                             ims::to_yaml(result.sensor_errors));
+  write_file_atomically(out.staged("truth/imu_bias.csv"), imu_bias_csv(result, 0.1));
   write_file_atomically(out.staged("truth/segments.csv"), segments_csv(result.path));
   write_file_atomically(out.staged("truth/scenario.yaml"), scenario_yaml(scenario, seed, result));
   out.commit();

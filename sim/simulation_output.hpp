@@ -7,6 +7,7 @@
 //   DIR/truth/trajectory.csv       S in W at the IMS samples (IMS clock)
 //   DIR/truth/frames.json          T_R_W, T_S_H (and inverses), clock offset, site
 //   DIR/truth/sensor_errors.yaml   the IMS's drawn deterministic errors
+//   DIR/truth/imu_bias.csv         the biases the record carries (turn-on + in-run), every 0.1 s
 //   DIR/truth/segments.csv         the program's segments (robot clock)
 //   DIR/truth/scenario.yaml        the scenario file as used, with the seed and the drawn values
 // All or nothing (core/output_folder.hpp); existing outputs are refused unless overwrite allows.

@@ -369,7 +369,9 @@ void run(const CalibrateArgs& args) {
   frame_input.site = *in.imu.site;
   frame_input.kinematics = in.robot.kinematics;
   frame_input.rests = rests.rests;
-  frame_input.robot = calib::robot_joint_series(in.log);
+  // With the robot description: the link-side friction lag of each drive (c / k) that the
+  // bundle estimates with the clock offset (calib/frame_calibration.hpp).
+  frame_input.robot = calib::robot_joint_series(in.log, in.robot);
   frame_input.noise = calib::imu_noise_model(in.spec, config.priors);
   frame_input.time_offset_initial_s = dt0.offset_s;
   frame_input.source = args.imu;

@@ -42,6 +42,19 @@ struct FrameScene {
   Eigen::Isometry3d T_R_W() const { return T_W_R.inverse(); }
 };
 
+// Poses of datasets/programs/mounting.yaml (a subset): rotations about all flange axes [rad].
+inline std::vector<calib::JointVector> mounting_poses() {
+  const auto deg = [](double a1, double a2, double a3, double a4, double a5, double a6) {
+    calib::JointVector q;
+    q << a1, a2, a3, a4, a5, a6;
+    return calib::JointVector(q * M_PI / 180.0);
+  };
+  return {deg(0, -90, 90, 0, 45, 0),        deg(0, -90, 90, 0, 45, 90),
+          deg(0, -90, 90, 0, -45, 0),       deg(0, -90, 90, 90, 45, 0),
+          deg(30, -80, 100, 0, 90, 0),      deg(-30, -100, 80, 45, 100, 45),
+          deg(45, -60, 110, -120, 60, 180), deg(10, -90, 90, 0, 45, 0)};
+}
+
 // Quintic joint moves between rests; every pose is held rest_s, moves take move_s.
 inline void make_kinematic_motion(FrameScene& scene, const std::vector<calib::JointVector>& poses,
                                   double rest_s, double move_s, double step_s = 0.001) {

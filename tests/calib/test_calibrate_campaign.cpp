@@ -8,9 +8,12 @@
 //
 // Reported per scenario: rests found, seeds calibrated or refused, the worst rotation/translation
 // errors of T_S_H, the worst tilt (roll/pitch) and translation of T_R_W, and the heading,
-// biases and time offset in units of their reported sigma. Goal of issue 4: 0.005 deg / 0.05 mm,
-// the rest within 3 sigma. Asserted is what the chain meets (see the comments at the asserts);
-// the figures are printed for the report.
+// biases and time offset in units of their reported sigma (worst, and the share of all of them
+// within 1/2/3 sigma: 68/95/99.7 % if the sigmas are honest). The accelerometer bias is compared
+// with the bias the record carries over the first rest (turn-on plus the unit's in-run drift,
+// ims::corrupt's InRunBias): the bundle models that drift and reports the first rest's bias.
+// Goal of issue 4: 0.005 deg / 0.05 mm, the rest within 3 sigma. Asserted is what the chain
+// meets (see the comments at the asserts); the figures are printed for the report.
 //
 // Three scenarios: `mounting` as shipped (every plant effect), `mounting-rigid` (rigid drives)
 // and `mounting` with the backlash off (a scratch copy), which shows what the other effects
@@ -62,6 +65,8 @@ struct SeedOutcome {
   double S_H_rotation_deg = 0.0, S_H_translation_mm = 0.0;
   double R_W_tilt_deg = 0.0, R_W_translation_mm = 0.0;
   double heading_sigmas = 0.0, gyro_bias_sigmas = 0.0, acc_bias_sigmas = 0.0, dt_sigmas = 0.0;
+  std::vector<double> normalised_errors;  // |error| / sigma: heading, gyro and acc bias, dt
+  double link_share = 0.0;
   std::size_t outliers = 0;
 };
 
@@ -72,13 +77,16 @@ double sigma_of(const FrameCalibrationResult& r, const std::string& name) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-// Largest |error_k| / sigma_k of a 3-vector whose sigmas are named prefix.x/y/z.
+// Largest |error_k| / sigma_k of a 3-vector whose sigmas are named prefix.x/y/z; each one is
+// also appended to `all`.
 double worst_sigmas(const FrameCalibrationResult& r, const std::string& prefix,
-                    const Eigen::Vector3d& error) {
+                    const Eigen::Vector3d& error, std::vector<double>& all) {
   double worst = 0.0;
   const char* axes[3] = {"x", "y", "z"};
-  for (int k = 0; k < 3; ++k)
-    worst = std::max(worst, std::abs(error[k]) / sigma_of(r, prefix + "." + axes[k]));
+  for (int k = 0; k < 3; ++k) {
+    all.push_back(std::abs(error[k]) / sigma_of(r, prefix + "." + axes[k]));
+    worst = std::max(worst, all.back());
+  }
   return worst;
 }
 
@@ -117,7 +125,8 @@ SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult&
   const ims::ImuSeries ideal =
       ims::synthesize_ideal_increments(trajectory, earth, scenario.imu_rate_hz);
   const ims::SensorErrorModel errors = ims::draw_sensor_errors(base.sensor_spec, rng);
-  ims::ImuSeries imu = ims::corrupt(ideal, errors, base.sensor_spec, rng());
+  ims::InRunBias in_run;  // on the ideal series' (robot) clock
+  ims::ImuSeries imu = ims::corrupt(ideal, errors, base.sensor_spec, rng(), &in_run);
   for (auto& s : imu.samples) s.t_s += scenario.imu_clock_offset_s;
   imu.site = scenario.site;
   if (unit_calibration) {
@@ -159,7 +168,7 @@ SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult&
     in.site = scenario.site;
     in.kinematics = base.robot.kinematics;
     in.rests = rests.rests;
-    in.robot = robot_joint_series(log);
+    in.robot = robot_joint_series(log, base.robot);
     in.noise = imu_noise_model(base.sensor_spec, config.priors);
     in.time_offset_initial_s = dt0.offset_s;
     in.source = "campaign";
@@ -181,6 +190,7 @@ SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult&
         ims::quat_log<double>(Eigen::Quaterniond(R_W_R * T_W_R.linear().transpose()));
     o.R_W_tilt_deg = rotation_error_W.head<2>().norm() / kDeg;
     o.heading_sigmas = std::abs(rotation_error_W.z()) / sigma_of(r, "R_W_R.up");
+    o.normalised_errors.push_back(o.heading_sigmas);
     // The true link angles at the middle of the first rest (robot clock).
     const double t_first = 0.5 * (in.rests.front().begin_ims_s + in.rests.front().end_ims_s) -
                            scenario.imu_clock_offset_s;
@@ -189,10 +199,26 @@ SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult&
     const Eigen::Isometry3d T_R_W_true = frame_calibration_truth_convention(
         T_W_R.inverse(), T_S_H_true, base.robot.kinematics, base.plant.samples[k].q_link_rad);
     o.R_W_translation_mm = (r.T_R_W.translation() - T_R_W_true.translation()).norm() * 1e3;
-    o.gyro_bias_sigmas = worst_sigmas(r, "gyro_bias", r.biases.gyro_rad_s - errors.gyro.bias);
-    o.acc_bias_sigmas = worst_sigmas(r, "acc_bias", r.biases.acc_m_s2 - errors.acc.bias);
+    // The gyro's in-run drift (0.003 deg/h over an hour) is far below the gyro bias's sigma:
+    // its turn-on bias is the truth. The accelerometer's: the mean over the first rest.
+    o.gyro_bias_sigmas =
+        worst_sigmas(r, "gyro_bias", r.biases.gyro_rad_s - errors.gyro.bias, o.normalised_errors);
+    Eigen::Vector3d in_run_acc = Eigen::Vector3d::Zero();
+    int in_run_count = 0;
+    for (std::size_t s = 0; s < in_run.t_s.size(); ++s) {
+      const double t_ims = in_run.t_s[s] + scenario.imu_clock_offset_s;
+      if (t_ims > in.rests.front().begin_ims_s && t_ims <= in.rests.front().end_ims_s) {
+        in_run_acc += in_run.acc_m_s2[s];
+        ++in_run_count;
+      }
+    }
+    const Eigen::Vector3d acc_bias_true = errors.acc.bias + in_run_acc / std::max(in_run_count, 1);
+    o.acc_bias_sigmas =
+        worst_sigmas(r, "acc_bias", r.biases.acc_m_s2 - acc_bias_true, o.normalised_errors);
     o.dt_sigmas =
         std::abs(r.time_offset_s - scenario.imu_clock_offset_s) / sigma_of(r, "time_offset.dt");
+    o.normalised_errors.push_back(o.dt_sigmas);
+    o.link_share = r.link_share;
   } catch (const InputError& e) {
     o.refusal = e.what();
   }
@@ -206,6 +232,9 @@ struct CampaignFigures {
   double S_H_rotation_deg = 0.0, S_H_translation_mm = 0.0, R_W_tilt_deg = 0.0,
          R_W_translation_mm = 0.0, heading_sigmas = 0.0, gyro_bias_sigmas = 0.0,
          acc_bias_sigmas = 0.0, dt_sigmas = 0.0;
+  // Shares of all normalised errors (heading, biases, dt of every seed) within 1, 2, 3 sigma.
+  double within_1 = 0.0, within_2 = 0.0, within_3 = 0.0;
+  double mean_link_share = 0.0;
   std::size_t worst_outliers = 0;
   std::string first_refusal;
 };
@@ -242,7 +271,14 @@ CampaignFigures run_campaign(const fs::path& scenario_file, const std::string& l
 
   CampaignFigures f;
   f.seeds = seeds;
+  std::size_t normalised = 0;
   for (const auto& o : outcomes) {
+    for (double z : o.normalised_errors) {
+      f.within_1 += z <= 1.0;
+      f.within_2 += z <= 2.0;
+      f.within_3 += z <= 3.0;
+      ++normalised;
+    }
     f.min_rests = std::min(f.min_rests, o.rests);
     f.max_rests = std::max(f.max_rests, o.rests);
     f.worst_initial_dt_ms = std::max(f.worst_initial_dt_ms, std::abs(o.initial_dt_error_s) * 1e3);
@@ -261,7 +297,14 @@ CampaignFigures run_campaign(const fs::path& scenario_file, const std::string& l
     f.acc_bias_sigmas = std::max(f.acc_bias_sigmas, o.acc_bias_sigmas);
     f.dt_sigmas = std::max(f.dt_sigmas, o.dt_sigmas);
     f.worst_outliers = std::max(f.worst_outliers, o.outliers);
+    f.mean_link_share += o.link_share;
   }
+  if (normalised > 0) {
+    f.within_1 /= double(normalised);
+    f.within_2 /= double(normalised);
+    f.within_3 /= double(normalised);
+  }
+  if (f.calibrated > 0) f.mean_link_share /= double(f.calibrated);
   std::printf(
       "campaign %s: %zu seeds, rests found %zu..%zu, calibrated %zu, converged %zu, worst "
       "initial dt error %.3f ms\n",
@@ -271,10 +314,12 @@ CampaignFigures run_campaign(const fs::path& scenario_file, const std::string& l
     std::printf(
         "campaign %s worst: T_S_H %.5f deg %.4f mm | T_R_W tilt %.5f deg, translation %.4f mm | "
         "heading %.2f sigma | gyro bias %.2f sigma | acc bias %.2f sigma | dt %.2f sigma | "
-        "outlier blocks %zu (goal 0.005 deg, 0.05 mm, 3 sigma)\n",
+        "outlier blocks %zu (goal 0.005 deg, 0.05 mm, 3 sigma)\n"
+        "campaign %s sigmas: heading, biases and dt within 1/2/3 sigma %.2f / %.2f / %.2f "
+        "(honest: 0.68 / 0.95 / 0.997); link share of the viscous friction %.3f (mean)\n",
         label.c_str(), f.S_H_rotation_deg, f.S_H_translation_mm, f.R_W_tilt_deg,
         f.R_W_translation_mm, f.heading_sigmas, f.gyro_bias_sigmas, f.acc_bias_sigmas, f.dt_sigmas,
-        f.worst_outliers);
+        f.worst_outliers, label.c_str(), f.within_1, f.within_2, f.within_3, f.mean_link_share);
   if (!f.first_refusal.empty())
     std::printf("campaign %s first refusal: %s\n", label.c_str(), f.first_refusal.c_str());
   return f;
@@ -286,14 +331,23 @@ TEST(CalibrateCampaign, MountingScenarioAsShipped) {
   // Met: the initial clock offset from the cross-correlation of rate magnitudes, within 1 ms of
   // the simulated 12.3 ms (the robot cycle is 2 ms; the correlation peak is sub-sample).
   EXPECT_LT(f.worst_initial_dt_ms, 1.0);
-  // Met: no confident wrong answer. With every effect on, the unloaded joints (A1, A4, A6) float
-  // inside their backlash at rest (the link drifts by 0.3-1.9 mrad over a rest in
-  // truth/joints.csv), so the IMS sees no standstill and the rests are refused; every seed is
-  // either refused with the reason, or calibrated and converged.
+  // Met: every seed finds its rests (13-14 of 14; before the bundle modelled the joint
+  // controllers' creep at the rests, the readings' 1e-5 rad stillness limit left 2-4 and 21 of
+  // 50 seeds were refused) and converges from the automatic initial values.
+  EXPECT_EQ(f.calibrated, f.seeds);
   EXPECT_EQ(f.calibrated, f.converged);
-  if (f.calibrated < f.seeds) {
-    EXPECT_FALSE(f.first_refusal.empty());
-  }
+  if (sanitized()) return;  // 60 s, 7 rests: the figures below are those of the full record
+  // Measured (worst of 50): T_S_H 0.0055 deg / 0.109 mm, T_R_W tilt 0.0099 deg, dt 0.95 sigma.
+  // NOT honest: heading, biases and dt within 1/2/3 sigma 0.25 / 0.40 / 0.53, heading up to 7.4
+  // and the gyro bias up to 11 sigma, 11 of 27 blocks outliers. The cause: links whose gears
+  // carry (almost) no load slide inside their backlash at rest where the encoders cannot see it
+  // (A5 of poses 5 and 6 by 6e-4 rad over the rest in truth/joints.csv, the motor still): the
+  // plant's smooth Coulomb law has no static friction to hold them. Asserted (2x margin on the
+  // measured worst) so that the chain does not fall back behind what it reaches here.
+  EXPECT_LT(f.S_H_rotation_deg, 0.011);
+  EXPECT_LT(f.S_H_translation_mm, 0.22);
+  EXPECT_LT(f.R_W_tilt_deg, 0.02);
+  EXPECT_LT(f.dt_sigmas, 3.0);
 }
 
 TEST(CalibrateCampaign, MountingRigid) {
@@ -311,20 +365,27 @@ TEST(CalibrateCampaign, MountingRigid) {
   EXPECT_EQ(f.calibrated, f.seeds);
   EXPECT_EQ(f.calibrated, f.converged);
   if (sanitized()) return;  // 60 s, 7 rests: the figures below are those of the full record
-  // Measured over the 10 seeds (worst): T_S_H 0.0024 deg / 0.034 mm, T_R_W tilt 0.0048 deg,
-  // translation 0.094 mm, heading 1.6 sigma, gyro bias 2.2 sigma, dt 2.6 sigma, no outlier
-  // block. Asserted: issue 4's goals where met (T_S_H 0.005 deg / 0.05 mm; 3 sigma), the tilt
-  // at 0.01 deg (met at 0.0048 with little margin) and the T_R_W translation at 0.2 mm (not met:
-  // the A1/A4/A6 play priors and the deflection scales cost precision). Not asserted: the
-  // accelerometer bias (97 sigma against the drawn turn-on bias: the unit's 10 ug in-run bias
-  // instability moves the bias the record sees; the truth does not carry it).
+  // Measured over the 10 seeds (worst): T_S_H 0.0019 deg / 0.030 mm, T_R_W tilt 0.0052 deg,
+  // translation 0.088 mm, heading 2.4 sigma, gyro bias 1.8 sigma, acc bias 2.8 sigma, dt 1.7
+  // sigma, no outlier block; heading, biases and dt within 1/2/3 sigma 0.66 / 0.95 / 1.00. The
+  // accelerometer bias is that of the first rest (the unit's in-run drift, 10 ug over 600 s,
+  // moves it by ~5 ug over the record: against the turn-on bias alone it was 97 sigma off, and
+  // 18 sigma against the first rest's bias while the bundle took the bias as constant).
+  // Asserted: issue 4's goals where met (T_S_H 0.005 deg / 0.05 mm; 3 sigma), the share within
+  // 1 and 2 sigma with room for 80 draws (0.55, 0.85), the tilt at 0.01 deg (met at 0.0052 with
+  // little margin) and the T_R_W translation at 0.2 mm (not met: the unloaded A1's play prior,
+  // b / sqrt(12) = 8e-5 rad at the first rest, is 0.09 mm there, and no IMS measurement tells
+  // A1's angle from the heading of the base).
   EXPECT_LT(f.S_H_rotation_deg, 0.005);
   EXPECT_LT(f.S_H_translation_mm, 0.05);
   EXPECT_LT(f.R_W_tilt_deg, 0.01);
   EXPECT_LT(f.R_W_translation_mm, 0.2);
   EXPECT_LT(f.heading_sigmas, 3.0);
   EXPECT_LT(f.gyro_bias_sigmas, 3.0);
+  EXPECT_LT(f.acc_bias_sigmas, 3.0);
   EXPECT_LT(f.dt_sigmas, 3.0);
+  EXPECT_GT(f.within_1, 0.55);
+  EXPECT_GT(f.within_2, 0.85);
   EXPECT_EQ(f.worst_outliers, 0u);
 }
 
@@ -346,27 +407,36 @@ TEST_F(CalibrateCampaignScratch, MountingWithoutBacklash) {
   replace("backlash: true", "backlash: false");
   std::ofstream(dir_ / "mounting-no-backlash.yaml") << text;
   // 10 seeds (the brief's 50 are spent on the shipped scenario; this one shows what limits the
-  // rest of the chain). The elastic drives still creep by 2e-5..8e-5 rad over a rest after a
-  // move, above the default 1e-5 rad stillness limit of the joint readings: 1e-4 rad here (the
-  // settling check stays off: the creep never comes within 3e-7 rad, 3 rests were left). The unit's
-  // lab calibration is applied (as for `rigid`).
-  const CampaignFigures f =
-      run_campaign(dir_ / "mounting-no-backlash.yaml", "no-backlash", 10, 1e-4);
+  // rest of the chain). The elastic drives still creep after every move (up to 1.5e-4 rad over
+  // a rest; the joint controllers settle through friction), the bundle models that creep from
+  // the joint readings (RestObservation::q_creep_*). The unit's lab calibration is applied (as
+  // for `rigid`); the shipped rest options.
+  const CampaignFigures f = run_campaign(dir_ / "mounting-no-backlash.yaml", "no-backlash", 10);
   EXPECT_LT(f.worst_initial_dt_ms, 1.0);  // as above
-  // Met: every seed finds >= 3 rests (14) and converges from the automatic initial values, and
-  // the time offset lies within 3 sigma of the truth (measured 0.8 sigma at worst). Measured
-  // (worst of 10): T_S_H 0.0040 deg / 0.117 mm, T_R_W tilt 0.0044 deg, translation 0.165 mm,
-  // heading 8.5 sigma, gyro bias 3.8 sigma, acc bias 74 sigma, up to 16 of 27 outlier blocks
-  // (before the deflection scales and the unit calibration: 0.027 deg / 1.5 mm, tilt 0.083 deg,
-  // biases 16 / 83 sigma). Asserted with ~2x margin on the Release figures; what is left: the
-  // creep at the rests (not settled), the gear's transmission error, the in-run bias drift.
+  // Met: every seed finds >= 3 rests (13-14) and converges from the automatic initial values,
+  // and the time offset lies within 3 sigma of the truth. The time offset is estimated with the
+  // share of the drives' viscous friction at the gear output (the link lags the motor-side
+  // readings by share * c / k, which looks like a clock offset: with the plant's 0.1 of it the
+  // offset alone came out 0.047 ms = 3.2 sigma off; estimated share 0.15 +- 0.05, dt 0.84 sigma).
   EXPECT_EQ(f.calibrated, f.seeds);
   EXPECT_EQ(f.calibrated, f.converged);
   EXPECT_LT(f.dt_sigmas, 3.0);
   if (sanitized()) return;
-  EXPECT_LT(f.S_H_rotation_deg, 0.01);
-  EXPECT_LT(f.S_H_translation_mm, 0.25);
+  // Measured (worst of 10): T_S_H 0.0023 deg / 0.043 mm, T_R_W tilt 0.0051 deg, translation
+  // 0.121 mm, heading 2.1 sigma, gyro bias 1.6 sigma, acc bias 3.1 sigma, dt 0.84 sigma, no
+  // outlier block; within 1/2/3 sigma 0.79 / 0.95 / 0.99. Before the creep and the bias drift
+  // were modelled: T_S_H 0.0043 deg / 0.108 mm, heading 6.2, gyro bias 4.9, acc bias 77 sigma,
+  // 15 of 27 blocks outliers. Asserted: issue 4's goals for T_S_H and the 3-sigma bounds where
+  // met, the sigma shares as for `rigid`, the tilt at 0.01 deg; the T_R_W translation is not
+  // met (0.12 mm, the unloaded A1's play prior at the first rest, see `rigid`).
+  EXPECT_LT(f.S_H_rotation_deg, 0.005);
+  EXPECT_LT(f.S_H_translation_mm, 0.05);
   EXPECT_LT(f.R_W_tilt_deg, 0.01);
+  EXPECT_LT(f.heading_sigmas, 3.0);
+  EXPECT_LT(f.gyro_bias_sigmas, 3.0);
+  EXPECT_GT(f.within_1, 0.55);
+  EXPECT_GT(f.within_2, 0.85);
+  EXPECT_EQ(f.worst_outliers, 0u);
 }
 
 }  // namespace

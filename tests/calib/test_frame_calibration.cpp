@@ -64,19 +64,7 @@ RobotDescription kr16() {
                                 "kr16.yaml");
 }
 
-JointVector joints_deg(double a1, double a2, double a3, double a4, double a5, double a6) {
-  JointVector q;
-  q << a1, a2, a3, a4, a5, a6;
-  return q * kDeg;
-}
-
-// Poses of datasets/programs/mounting.yaml (a subset): rotations about all flange axes.
-std::vector<JointVector> mounting_poses() {
-  return {joints_deg(0, -90, 90, 0, 45, 0),        joints_deg(0, -90, 90, 0, 45, 90),
-          joints_deg(0, -90, 90, 0, -45, 0),       joints_deg(0, -90, 90, 90, 45, 0),
-          joints_deg(30, -80, 100, 0, 90, 0),      joints_deg(-30, -100, 80, 45, 100, 45),
-          joints_deg(45, -60, 110, -120, 60, 180), joints_deg(10, -90, 90, 0, 45, 0)};
-}
+using test_support::mounting_poses;
 
 TEST(FrameCalibration, NoiseFreeRecordGivesTheFramesBack) {
   const RobotDescription robot = kr16();

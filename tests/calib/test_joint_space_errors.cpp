@@ -2,7 +2,19 @@
 // the simulated `seed-line` run (the paper's test path, KR 16 with every drive effect, 5 kg,
 // navigation-grade IMS), with the TRUE frames, biases and clock offset of the simulation (this
 // isolates the joint-space step from the frame calibration), the joint errors recovered from the
-// IMS match the simulator's true link-side errors q_desired - q_link.
+// IMS match the simulator's true link-side errors q_desired - q_link. Goal of issue 4: 0.01 mrad
+// RMS on the lines.
+//
+// What limits it, measured here: after every move the simulated arm does not come to rest. Its
+// joint controllers work the remaining position error (up to 4e-3 rad on A3) off through the
+// friction for seconds (joint rates 1e-4..5e-3 rad/s, the flange moves by millimetres during the
+// 3 s and 1 s "rests"), and its links ring against the motors for ~1 s. The IMS alone takes much
+// of that creep for rest; the chain now asks the robot's readings during commanded standstill
+// where the arm is really still and how it creeps (calib/encoder_motion.hpp). Each stop then
+// leaves the trajectory ~50 um less certain (the unaided second after it, and the creep known
+// only to ~1 % through the gears' transmission error), which is 0.1-0.3 mrad at the lines: the
+// smoother's own sigma says so too. On an arm that rests between the moves the same chain reaches
+// the IMS's noise floor (second test below).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,7 +28,10 @@
 #include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "ims/imu_noise.hpp"
+#include "ims/imu_synthesis.hpp"
 #include "ims/sensor_error_model.hpp"
+#include "ims/spline_trajectory.hpp"
 #include "ims/zupt_options.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulation.hpp"
@@ -27,27 +42,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The simulator lets a link whose gear carries no gravity torque (A1 always, A4 and A6 in these
-// poses) rattle freely inside its backlash at standstill (no link-side friction or damping in
-// the gap): the flange then never rests (gyros ~1e-3 rad/s, flange ~1e-3 m/s), which no rest
-// detector or zero-velocity update can accept. Until the plant damps the gap, these tests run
-// seed-line with the play of those three joints closed; every other effect stays on.
-sim::Scenario seed_line_without_rattling() {
-  sim::Scenario scenario =
-      sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "scenarios" / "seed-line.yaml");
-  scenario.effects = ConfigNode::load_string(
-                         "effects:\n"
-                         "  all: {motor_inertia: true, elastic_gear: true, gear_damping: true,\n"
-                         "        backlash: true, coulomb_friction: true, viscous_friction: true,\n"
-                         "        transmission_error: true}\n"
-                         "  transmission_error: {amplitude_arcsec: 10, harmonic_per_motor_rev: 1,\n"
-                         "                       phase_deg: 0}\n"
-                         "  A1: {backlash: false}\n"
-                         "  A4: {backlash: false}\n"
-                         "  A6: {backlash: false}\n",
-                         "seed-line effects without rattling")
-                         .child("effects");
-  return scenario;
+// The shipped seed-line scenario, whose play of the joints that carry (almost) no gravity torque
+// (A1 always, A4 and A6 in these poses) is closed: without static friction in the simulated play
+// those links slide inside it at standstill (A4 by 2.2e-4 rad over the initial rest, the flange
+// turning at 1.6e-4 rad/s at its start, against an Earth rate of 7.3e-5 rad/s), so the record
+// would have no still start to align on. Every other effect is on.
+sim::Scenario seed_line_scenario() {
+  return sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "scenarios" /
+                            "seed-line.yaml");
 }
 
 bool sanitized() {
@@ -56,24 +58,78 @@ bool sanitized() {
 
 struct SimRun {
   sim::Scenario scenario;
-  sim::SimulationResult sim;
+  sim::SimulationResult sim;  // plant.samples: the truth (link angles) at a fixed interval
   RobotLog log;
-  ims::ImuSeries imu;  // scale factors and misalignments removed (the unit's calibration)
+  ims::ImuSeries imu;                       // the unit's scale and axes corrected
+  std::vector<ims::NavState> sensor_truth;  // as sim.sensor_truth (IMS clock)
 };
+
+// Error correction as in the chain: the unit's scale factors and misalignments are known from its
+// own calibration; the biases stay (the frames carry them).
+ims::ImuSeries unit_corrected(const ims::ImuSeries& raw, ims::SensorErrorModel unit) {
+  unit.gyro.bias.setZero();
+  unit.acc.bias.setZero();
+  return ims::correct(raw, unit);
+}
 
 const SimRun& seed_line() {
   static const SimRun run = [] {
     SimRun r;
-    r.scenario = seed_line_without_rattling();
+    r.scenario = seed_line_scenario();
     // Sanitized builds: up to the end of the first line and into the 1 s pause.
     r.sim = sim::run_simulation(r.scenario, r.scenario.seed, {}, sanitized() ? 15.0 : 1e9);
     r.log = sim::make_robot_log(r.sim);
-    // Error correction as in the chain: the unit's scale factors and misalignments are known
-    // from its own calibration; the biases stay (the frames carry them).
-    ims::SensorErrorModel unit = r.sim.sensor_errors;
-    unit.gyro.bias.setZero();
-    unit.acc.bias.setZero();
-    r.imu = ims::correct(r.sim.imu_raw, unit);
+    r.imu = unit_corrected(r.sim.imu_raw, r.sim.sensor_errors);
+    r.sensor_truth = r.sim.sensor_truth;
+    return r;
+  }();
+  return run;
+}
+
+// The same program on an arm that does what it is told (link angles = desired angles = its
+// readings, every 2 ms): it rests exactly when the program says so. The same IMS unit, noise
+// drawn from the same seed.
+const SimRun& ideal_seed_line() {
+  static const SimRun run = [] {
+    const SimRun& plant = seed_line();
+    SimRun r;
+    r.scenario = plant.scenario;
+    r.sim = plant.sim;
+    r.sim.plant.samples.clear();
+    for (const sim::DesiredJointSample& d : r.sim.path.samples) {
+      sim::PlantSample sample;
+      sample.t_s = d.t_s;
+      sample.q_link_rad = sample.q_motor_rad = d.q_rad;
+      sample.qd_link_rad_s = d.qd_rad_s;
+      r.sim.plant.samples.push_back(sample);
+    }
+    r.log = sim::make_robot_log(r.sim);
+    const std::vector<Eigen::Isometry3d> T_R_H = sim::flange_poses(r.sim.robot, r.sim.plant);
+    std::vector<ims::PoseSample> poses(T_R_H.size());
+    for (std::size_t k = 0; k < T_R_H.size(); ++k) {
+      const Eigen::Isometry3d T_W_S = r.sim.T_W_R * T_R_H[k] * r.sim.T_H_S;
+      poses[k] = {r.sim.plant.samples[k].t_s, T_W_S.translation(),
+                  Eigen::Quaterniond(T_W_S.linear()).normalized()};
+    }
+    const ims::SplineTrajectory trajectory(poses);
+    const ims::EarthModel earth(r.scenario.site);
+    const ims::ImuSeries ideal =
+        ims::synthesize_ideal_increments(trajectory, earth, r.scenario.imu_rate_hz);
+    r.sim.imu_in_run_bias = {};
+    ims::ImuSeries raw = ims::corrupt(ideal, r.sim.sensor_errors, r.sim.sensor_spec,
+                                      r.scenario.seed, &r.sim.imu_in_run_bias);
+    const double offset = r.sim.imu_clock_offset_s;
+    for (ims::ImuSample& sample : raw.samples) sample.t_s += offset;
+    for (double& t : r.sim.imu_in_run_bias.t_s) t += offset;
+    raw.site = r.scenario.site;
+    r.imu = unit_corrected(raw, r.sim.sensor_errors);
+    const auto truth_at = [&](double t_robot) {
+      const ims::KinematicState state = trajectory.at(t_robot);
+      return ims::NavState{t_robot + offset, state.q_W_S, state.v_W, state.p_W};
+    };
+    r.sensor_truth.push_back(truth_at(trajectory.begin_s()));
+    for (const ims::ImuSample& sample : ideal.samples)
+      r.sensor_truth.push_back(truth_at(sample.t_s));
     return r;
   }();
   return run;
@@ -87,11 +143,14 @@ JointSpaceInput true_input(const SimRun& run) {
   input.kinematics = run.sim.robot.kinematics;
   input.frames.T_R_W = run.sim.T_W_R.inverse();
   input.frames.T_S_H = run.sim.T_H_S.inverse();
-  input.frames.biases.gyro_rad_s = run.sim.sensor_errors.gyro.bias;
-  input.frames.biases.acc_m_s2 = run.sim.sensor_errors.acc.bias;
+  // The biases the record carries at its start: turn-on plus in-run part.
+  input.frames.biases.gyro_rad_s =
+      run.sim.sensor_errors.gyro.bias + run.sim.imu_in_run_bias.gyro_rad_s.front();
+  input.frames.biases.acc_m_s2 =
+      run.sim.sensor_errors.acc.bias + run.sim.imu_in_run_bias.acc_m_s2.front();
   input.frames.time_offset_s = run.sim.imu_clock_offset_s;
   // The first rest starts with the record; its link-side angles from the simulator.
-  input.first_rest.begin_ims_s = run.sim.sensor_truth.front().t_s;
+  input.first_rest.begin_ims_s = run.sensor_truth.front().t_s;
   input.first_rest.end_ims_s = input.first_rest.begin_ims_s + 5.0;
   input.first_rest.q_link_rad = run.sim.plant.samples.front().q_link_rad;
   input.zupt = ims::zupt_options_from_spec(run.sim.sensor_spec);
@@ -99,13 +158,18 @@ JointSpaceInput true_input(const SimRun& run) {
   return input;
 }
 
-// Per-joint RMS of (q_measured - q_link) at the robot samples, over the samples for which
-// `keep(t_robot)` holds [rad].
+// Per-joint RMS over the samples for which `keep(t_robot)` holds of (q_measured - q_link), and of
+// the smoother's sigma of q_measured [rad].
+struct JointRms {
+  JointVector error = JointVector::Zero();
+  JointVector sigma = JointVector::Zero();
+  int count = 0;
+};
+
 template <typename Keep>
-JointVector rms_error(const SimRun& run, const JointSpaceErrors& errors, Keep keep, int* count) {
+JointRms rms_error(const SimRun& run, const JointSpaceErrors& errors, Keep keep) {
   const double plant_interval = run.sim.plant.samples[1].t_s - run.sim.plant.samples[0].t_s;
-  JointVector sum = JointVector::Zero();
-  *count = 0;
+  JointRms out;
   for (std::size_t k = 0; k < errors.t_s.size(); ++k) {
     if (!keep(errors.t_s[k])) continue;
     const auto index = static_cast<std::size_t>(std::llround(errors.t_s[k] / plant_interval));
@@ -114,10 +178,20 @@ JointVector rms_error(const SimRun& run, const JointSpaceErrors& errors, Keep ke
     // Delta q from the IMS minus the true Delta q = q_link - q_measured.
     const JointVector difference = (errors.q_desired_rad[k] - errors.q_measured_rad[k]) -
                                    (errors.q_desired_rad[k] - truth.q_link_rad);
-    sum += difference.cwiseAbs2();
-    ++*count;
+    out.error += difference.cwiseAbs2();
+    out.sigma += errors.q_measured_sigma_rad[k].cwiseAbs2();
+    ++out.count;
   }
-  return (sum / std::max(*count, 1)).cwiseSqrt();
+  out.error = (out.error / std::max(out.count, 1)).cwiseSqrt();
+  out.sigma = (out.sigma / std::max(out.count, 1)).cwiseSqrt();
+  return out;
+}
+
+// Whether robot time t lies on one of the program's linear segments (the lines).
+bool on_line(const SimRun& run, double t) {
+  for (const sim::PathSegment& s : run.sim.path.segments)
+    if (s.kind == sim::SegmentKind::kLinear && t >= s.begin_s && t <= s.end_s) return true;
+  return false;
 }
 
 void print(const char* what, const JointVector& rms, int count) {
@@ -126,65 +200,59 @@ void print(const char* what, const JointVector& rms, int count) {
   std::printf("  mrad RMS (%d samples)\n", count);
 }
 
+// The smoothed sensor trajectory against the truth (both on the IMS clock, same samples: the
+// record starts with the first rest) [m].
+double worst_position_error(const SimRun& run, const JointSpaceErrors& errors, double* at_s) {
+  double worst = 0.0;
+  for (std::size_t k = 0; k < errors.trajectory.size() && k < run.sensor_truth.size(); ++k) {
+    const ims::NavState& e = errors.trajectory[k].state;
+    const ims::NavState& t = run.sensor_truth[k];
+    EXPECT_NEAR(e.t_s, t.t_s, 1e-9);
+    if ((e.p_W - t.p_W).norm() > worst) *at_s = e.t_s;
+    worst = std::max(worst, (e.p_W - t.p_W).norm());
+  }
+  return worst;
+}
+
+void print_smoother(const JointSpaceErrors& errors) {
+  const ims::ZuptSummary& s = errors.smoother;
+  std::printf(
+      "zero-velocity updates: %zu accepted, %zu rejected, mean NIS %.2f; velocity updates from "
+      "the readings while creeping: %zu accepted, %zu rejected, mean NIS %.2f; rests %zu\n",
+      s.zero_velocity.accepted, s.zero_velocity.rejected, s.zero_velocity.mean_nis,
+      s.velocity_aid.accepted, s.velocity_aid.rejected, s.velocity_aid.mean_nis,
+      s.rest_intervals.size());
+  for (const auto& r : s.rest_intervals)
+    std::printf("rest used %.3f .. %.3f s\n", r.begin_s, r.end_s);
+}
+
 TEST(JointSpaceErrors, MatchTheSimulatorsLinkSideErrorsOnSeedLine) {
   const SimRun& run = seed_line();
   const JointSpaceErrors errors = joint_space_errors(true_input(run));
-  std::printf("zero-velocity updates: %zu accepted, %zu rejected, mean NIS %.2f; rests %zu\n",
-              errors.smoother.zero_velocity.accepted, errors.smoother.zero_velocity.rejected,
-              errors.smoother.zero_velocity.mean_nis, errors.smoother.rest_intervals.size());
+  print_smoother(errors);
   std::printf("robot samples: %zu kept, %zu outside the IMS record, %zu IK failures %s\n",
               errors.t_s.size(), errors.outside_record, errors.ik_failures,
               errors.first_ik_failure.c_str());
-  for (const auto& r : errors.smoother.rest_intervals) {
-    std::printf("IMS rest detected %.3f .. %.3f s\n", r.begin_s, r.end_s);
-  }
-  // The smoothed sensor trajectory against the simulator's (both on the IMS clock, same
-  // samples: the record starts with the first rest).
-  double worst_position = 0.0, worst_attitude = 0.0, worst_at = 0.0;
-  for (std::size_t k = 0; k < errors.trajectory.size() && k < run.sim.sensor_truth.size(); ++k) {
-    const ims::NavState& e = errors.trajectory[k].state;
-    const ims::NavState& t = run.sim.sensor_truth[k];
-    EXPECT_NEAR(e.t_s, t.t_s, 1e-9);
-    if ((e.p_W - t.p_W).norm() > worst_position) worst_at = e.t_s;
-    worst_position = std::max(worst_position, (e.p_W - t.p_W).norm());
-    worst_attitude = std::max(worst_attitude, e.q_W_S.angularDistance(t.q_W_S));
-  }
-  std::printf(
-      "smoothed W_T_S vs truth: max position error %.4f mm (at %.2f s), attitude %.2f urad\n",
-      worst_position * 1e3, worst_at, worst_attitude * 1e6);
+  double worst_at = 0.0;
+  const double worst_position = worst_position_error(run, errors, &worst_at);
+  std::printf("smoothed W_T_S vs truth: max position error %.4f mm (at %.2f s)\n",
+              worst_position * 1e3, worst_at);
   EXPECT_EQ(errors.ik_failures, 0u);
   // The IMS clock runs 12.3 ms ahead: only the robot's last few samples lack IMS data... and
   // the record starts with the first rest, so at most the offset's worth is missing.
   EXPECT_LE(errors.outside_record, 10u);
   ASSERT_GT(errors.t_s.size(), run.log.samples.size() - 10);
 
-  int count = 0;
-  const JointVector all = rms_error(
-      run, errors, [](double) { return true; }, &count);
-  print("seed-line, whole record:", all, count);
-  std::vector<sim::PathSegment> lines;
-  for (const sim::PathSegment& s : run.sim.path.segments) {
-    if (s.kind == sim::SegmentKind::kLinear) lines.push_back(s);
-  }
-  int line_count = 0;
-  const JointVector on_lines = rms_error(
-      run, errors,
-      [&](double t) {
-        for (const sim::PathSegment& s : lines) {
-          if (t >= s.begin_s && t <= s.end_s) return true;
-        }
-        return false;
-      },
-      &line_count);
-  print("seed-line, on the two lines:", on_lines, line_count);
+  const JointRms all = rms_error(run, errors, [](double) { return true; });
+  print("seed-line, whole record:", all.error, all.count);
+  const JointRms lines = rms_error(run, errors, [&](double t) { return on_line(run, t); });
+  print("seed-line, on the two lines:", lines.error, lines.count);
+  print("  the smoother's own sigma there:", lines.sigma, lines.count);
   // The size of what is measured, for scale: the true joint errors' RMS on the lines.
   JointVector true_sq = JointVector::Zero();
   int true_count = 0;
   for (std::size_t k = 0; k < errors.t_s.size(); ++k) {
-    bool on_line = false;
-    for (const sim::PathSegment& s : lines)
-      on_line |= errors.t_s[k] >= s.begin_s && errors.t_s[k] <= s.end_s;
-    if (!on_line) continue;
+    if (!on_line(run, errors.t_s[k])) continue;
     const auto index = static_cast<std::size_t>(std::llround(errors.t_s[k] / 0.001));
     true_sq += (errors.q_desired_rad[k] - run.sim.plant.samples.at(index).q_link_rad).cwiseAbs2();
     ++true_count;
@@ -193,18 +261,78 @@ TEST(JointSpaceErrors, MatchTheSimulatorsLinkSideErrorsOnSeedLine) {
         true_count);
   // The initial rest (robot clock < 6 s), where the IMS sees a true standstill and the
   // zero-velocity updates hold the trajectory: the issue's 0.01 mrad RMS per joint holds.
-  int rest_count = 0;
-  const JointVector initial_rest = rms_error(
-      run, errors, [](double t) { return t < 5.9; }, &rest_count);
-  print("seed-line, initial rest (ZUPT-aided):", initial_rest, rest_count);
-  for (int i = 0; i < kJointCount; ++i) EXPECT_LT(initial_rest(i), 1e-5) << "joint A" << i + 1;
-  // Issue 4 asks for 0.01 mrad RMS over the run. NOT MET on the simulated seed-line: after every
-  // move the plant creeps (joint rates 1e-4..1e-3 rad/s for seconds: the slow position loop
-  // working through friction), so the IMS finds no rest after the approach except two short
-  // ones and the trajectory drifts by millimetres (printed above). The figures are printed; the
-  // bound below only guards against a gross failure of the chain (IK branch, clock, frames),
-  // which shows as errors of 0.1 rad and more.
-  for (int i = 0; i < kJointCount; ++i) EXPECT_LT(all(i), 0.05) << "joint A" << i + 1;
+  const JointRms initial_rest = rms_error(run, errors, [](double t) { return t < 5.9; });
+  print("seed-line, initial rest (ZUPT-aided):", initial_rest.error, initial_rest.count);
+  for (int i = 0; i < kJointCount; ++i)
+    EXPECT_LT(initial_rest.error(i), 1e-5) << "joint A" << i + 1;
+
+  // As before this change, for comparison: the IMS's own rests, no readings.
+  JointSpaceOptions ims_only;
+  ims_only.encoder_stillness = false;
+  ims_only.creep_velocity_updates = false;
+  const JointSpaceErrors without = joint_space_errors(true_input(run), ims_only);
+  double without_at = 0.0;
+  const double without_position = worst_position_error(run, without, &without_at);
+  const JointRms without_lines = rms_error(run, without, [&](double t) { return on_line(run, t); });
+  std::printf("IMS's own rests only (%zu): max position error %.4f mm (at %.2f s)\n",
+              without.smoother.rest_intervals.size(), without_position * 1e3, without_at);
+  print("  on the two lines:", without_lines.error, without_lines.count);
+
+  // Issue 4 asks for 0.01 mrad RMS on the lines: NOT MET here (see the top of the file).
+  // Measured (Release): max position error 0.091 mm (IMS's own rests: 8.0 mm); on the lines A1
+  // 0.014, A2 0.115, A3 0.163, A4 0.001, A5 0.054, A6 0.013 mrad RMS (IMS's own rests: 0.18,
+  // 1.36, 5.71, 0.001, 4.37, 0.18), the smoother's sigma 0.051, 0.162, 0.305, 0.001, 0.164,
+  // 0.055 mrad. Asserted: the chain without gross failure (IK branch, clock, frames: errors of
+  // 0.1 rad and more); then what it reaches with ~1.5x margin, that the readings beat the IMS's
+  // own rests by 10x in position, and that the errors stay within 1.5x the smoother's sigma on
+  // every joint (it reports what it knows).
+  for (int i = 0; i < kJointCount; ++i) EXPECT_LT(all.error(i), 0.05) << "joint A" << i + 1;
+  if (sanitized()) return;  // 15 s only: the figures below are those of the whole run
+  EXPECT_LT(worst_position, 0.15e-3);
+  EXPECT_LT(worst_position * 10.0, without_position);
+  const JointVector reached = (JointVector() << 0.03, 0.18, 0.26, 0.003, 0.09, 0.03).finished();
+  for (int i = 0; i < kJointCount; ++i) {
+    EXPECT_LT(lines.error(i), reached(i) * 1e-3) << "joint A" << i + 1;
+    EXPECT_LT(lines.error(i), 1.5 * lines.sigma(i)) << "joint A" << i + 1;
+  }
+}
+
+TEST(JointSpaceErrors, OnAnArmThatRestsTheChainReachesTheImsNoiseFloor) {
+  // The same program and IMS on an arm without creep or ringing: rests are rests, and each line
+  // starts and ends with zero-velocity updates. White accelerometer noise q (2.2 ug/sqrt(Hz)),
+  // double integrated over a line of T = 2.2 s pinned at both ends, leaves q sqrt(T^3 / 12) =
+  // 21 um at most; but nothing pins the position between the rests, so each of the three moves
+  // adds its own (the smoother's position sigma: 16, then 27, then 36 um per axis), and the
+  // lines lie at 91-95 % of the arm's reach, where the elbow is nearly stretched: there a
+  // micrometre of flange position is 3-4 urad of A2/A3 (the inverse Jacobian).
+  const SimRun& run = ideal_seed_line();
+  const JointSpaceErrors errors = joint_space_errors(true_input(run));
+  print_smoother(errors);
+  double worst_at = 0.0;
+  const double worst_position = worst_position_error(run, errors, &worst_at);
+  std::printf("ideal arm: max position error %.4f mm (at %.2f s)\n", worst_position * 1e3,
+              worst_at);
+  const JointRms lines = rms_error(run, errors, [&](double t) { return on_line(run, t); });
+  print("ideal arm, on the two lines:", lines.error, lines.count);
+  print("  the smoother's own sigma there:", lines.sigma, lines.count);
+  EXPECT_EQ(errors.ik_failures, 0u);
+  if (sanitized()) return;  // 15 s only: the figures below are those of the whole run
+  // Measured (Release): max position error 0.072 mm; on the lines A1 0.029, A2 0.057, A3 0.124,
+  // A4 0.004, A5 0.069, A6 0.028 mrad RMS against the smoother's sigma 0.018, 0.055, 0.103,
+  // 0.001, 0.056, 0.027 (five other noise seeds of the unit: A3 0.061..0.212 mrad). So even on
+  // an arm that rests, 0.01 mrad on the lines is below what this IMS resolves on this path (its
+  // floor is ~0.1 mrad on A3, ~0.05 on A2 and A5); the wrist's A1/A4/A6 come within 0.03.
+  // Asserted: the four rests are found (initial, before the line, pause, final), what is
+  // reached with ~1.5x margin, and the errors within 2x the smoother's sigma (+ 3 urad: A4's
+  // sigma is 1.4 urad) on every joint.
+  EXPECT_EQ(errors.smoother.rest_intervals.size(), 4u);
+  const JointVector reached =
+      (JointVector() << 0.045, 0.085, 0.19, 0.0065, 0.105, 0.042).finished();
+  for (int i = 0; i < kJointCount; ++i) {
+    EXPECT_LT(lines.error(i), reached(i) * 1e-3) << "joint A" << i + 1;
+    EXPECT_LT(lines.error(i), 2.0 * lines.sigma(i) + 3e-6) << "joint A" << i + 1;
+  }
+  EXPECT_LT(worst_position, 0.11e-3);
 }
 
 TEST(JointSpaceErrors, TheJointSpaceStepIsExactAlongTheTrueTrajectory) {
@@ -218,12 +346,10 @@ TEST(JointSpaceErrors, TheJointSpaceStepIsExactAlongTheTrueTrajectory) {
   const JointSpaceErrors errors =
       joint_errors_along(truth, run.log, input.kinematics, input.frames);
   EXPECT_EQ(errors.ik_failures, 0u);
-  int count = 0;
-  const JointVector all = rms_error(
-      run, errors, [](double) { return true; }, &count);
-  print("seed-line, true sensor trajectory:", all, count);
+  const JointRms all = rms_error(run, errors, [](double) { return true; });
+  print("seed-line, true sensor trajectory:", all.error, all.count);
   // 1 um of interpolation error over a ~1 m lever: 1e-6 rad; the issue's goal is 1e-5 rad.
-  for (int i = 0; i < kJointCount; ++i) EXPECT_LT(all(i), 1e-6) << "joint A" << i + 1;
+  for (int i = 0; i < kJointCount; ++i) EXPECT_LT(all.error(i), 1e-6) << "joint A" << i + 1;
 }
 
 // A wrist move through A5 = 0 (axes 4 and 6 align), measured with a constant flange orientation

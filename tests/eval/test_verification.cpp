@@ -105,6 +105,9 @@ VerificationResult run(const std::string& name, const std::string& filter, bool 
   options.cycles = sanitized() ? 2 : (ablation ? 10 : 5);
   if (const char* n = std::getenv("IMSCAL_VERIFY_CYCLES")) options.cycles = std::atoi(n);
   options.segment_filter = filter;
+  // Under the sanitizers the attained paths are the plant's own (the IMS chain's measurement of
+  // a run has its own test there: tests/eval/test_ims_measured_path.cpp).
+  options.measure_with_ims = !sanitized();
   options.compensation.look_ahead_cycles = look_ahead();
   options.compensation.inversion_iterations = inversion_iterations();
   if (const char* v = std::getenv("IMSCAL_VERIFY_OFFSET_TOLERANCE_RAD"))
@@ -214,22 +217,32 @@ TEST(Verification, SeedLineWithAblation) {
     EXPECT_EQ(c.figures.missed_crossings, 0) << c.label;
   }
   if (!sanitized()) {
-    // What the chain reaches today (Release, 10 cycles, look-ahead 4): the default table (inverse
-    // form with the model torque) 92.8 %; ablation: paper form 49.4 %, without the model torque
-    // 38.0 %, with eq. 3's backlash term 90.2 %, with the operating-point grid 91.5 %. Asserted
-    // 3 %-points below (compiler differences; the simulator and the friction draws are
-    // deterministic), the precontrol active throughout, and each part of the default measured:
-    // the paper's form and the model without the torque stay far behind.
+    // What the chain reaches today (Release, 10 cycles, look-ahead 4), as the IMS chain measures
+    // the attained path: 13.14 -> 1.23 mm (90.7 %); on the plant's true path 12.47 -> 0.93 mm
+    // (92.5 %). Ablation on the true path: paper form 49.4 %, without the model torque 39.0 %,
+    // with eq. 3's backlash term 89.8 %, with the operating-point grid 91.2 %. Asserted 3
+    // %-points below (compiler differences; the simulator and every draw are deterministic), the
+    // precontrol active throughout, and each part of the default measured: the paper's form and
+    // the model without the torque stay far behind.
     EXPECT_EQ(r.after[0].inactive_cycles, 0u);
-    const double compensated = reduction_percent(before, r.after[0].figures.max_path_deviation_m);
-    EXPECT_GE(compensated, 89.8);
+    EXPECT_GE(reduction_percent(before, r.after[0].figures.max_path_deviation_m), 87.7);
+    const double before_true = r.before.true_figures.max_path_deviation_m;
+    const double compensated =
+        reduction_percent(before_true, r.after[0].true_figures.max_path_deviation_m);
+    EXPECT_GE(compensated, 89.5);
     for (std::size_t c = 1; c < r.after.size(); ++c) {
-      const double reduction = reduction_percent(before, r.after[c].figures.max_path_deviation_m);
+      const double reduction =
+          reduction_percent(before_true, r.after[c].true_figures.max_path_deviation_m);
       if (r.after[c].label == "paper form" || r.after[c].label == "without model torque")
         EXPECT_LT(reduction, compensated - 30.0) << r.after[c].label;
       else
         EXPECT_GE(reduction, 85.0) << r.after[c].label;
     }
+    // The IMS chain measures the path to a fraction of the compensated deviation: the measured
+    // and true maximum deviations differ by < 0.5 mm (measured 0.29 mm).
+    EXPECT_LT(std::abs(r.after[0].figures.max_path_deviation_m -
+                       r.after[0].true_figures.max_path_deviation_m),
+              0.5e-3);
     // The repeatability floor: the same table on the plant with its nominal friction (no
     // run-to-run draw, one cycle): what the model leaves, without what no model of the nominal
     // robot can predict (the 10 cycles' friction drawn anew, sigma 5 %: RT_p 0.71 mm).

@@ -178,6 +178,45 @@ TEST(ImuNoise, DeterministicBySeed) {
   EXPECT_NE(a.samples[10].gyro, c.samples[10].gyro);
 }
 
+TEST(ImuNoise, InRunBiasIsWhatTheRecordCarriesBesideTheTurnOnBias) {
+  // Only bias instability (two Gauss-Markov terms per triad) and a turn-on bias: every output
+  // increment is then (turn-on + in-run bias) * dt exactly (to rounding), and handing back the
+  // in-run part changes no draw.
+  SensorSpec spec;
+  spec.gyro.bias_instability = {{1e-6, 50.0}, {2e-6, 500.0}};
+  spec.acc.bias_instability = {{1e-4, 20.0}, {5e-5, 600.0}};
+  SensorErrorModel errors;
+  errors.gyro.bias = Eigen::Vector3d(3e-6, -1e-6, 2e-6);
+  errors.acc.bias = Eigen::Vector3d(2e-4, 1e-4, -3e-4);
+  const double dt = 0.01;
+  const ImuSeries ideal = zero_increments(20000, dt);  // 200 s
+  InRunBias in_run;
+  const ImuSeries with = corrupt(ideal, errors, spec, 5, &in_run);
+  const ImuSeries without = corrupt(ideal, errors, spec, 5);
+  ASSERT_EQ(in_run.t_s.size(), ideal.samples.size());
+  EXPECT_EQ(std::memcmp(with.samples.data(), without.samples.data(),
+                        with.samples.size() * sizeof(ImuSample)),
+            0);
+  double worst_gyro = 0.0, worst_acc = 0.0, spread_acc = 0.0;
+  for (std::size_t k = 0; k < ideal.samples.size(); ++k) {
+    EXPECT_EQ(in_run.t_s[k], with.samples[k].t_s);
+    worst_gyro =
+        std::max(worst_gyro, (with.samples[k].gyro / dt - errors.gyro.bias - in_run.gyro_rad_s[k])
+                                 .cwiseAbs()
+                                 .maxCoeff());
+    worst_acc = std::max(
+        worst_acc,
+        (with.samples[k].acc / dt - errors.acc.bias - in_run.acc_m_s2[k]).cwiseAbs().maxCoeff());
+    spread_acc =
+        std::max(spread_acc, (in_run.acc_m_s2[k] - in_run.acc_m_s2.front()).cwiseAbs().maxCoeff());
+  }
+  // Rounding of a ~1e-6 increment divided by 0.01 s: ~1e-20 / 1e-2.
+  EXPECT_LT(worst_gyro, 1e-15);
+  EXPECT_LT(worst_acc, 1e-13);
+  // And it is not a constant: the 20 s term (1e-4 sigma) wanders by ~its sigma over 200 s.
+  EXPECT_GT(spread_acc, 5e-5);
+}
+
 TEST(ImuNoise, DrawnErrorsFollowTheSpec) {
   SensorSpec spec;
   spec.gyro.turn_on_bias_sigma = 1e-5;

@@ -271,6 +271,61 @@ TEST(ZuptSmoother, GateRejectsZeroVelocityAtConstantVelocity) {
   EXPECT_NEAR(last.p_W.x(), velocity_W.x() * last.t_s, 5e-4);
 }
 
+TEST(ZuptSmoother, OutsideAidsTellCreepFromRest) {
+  // A sensor at rest for 1 s that then creeps at 0.5 mm/s without turning for 2 s (a robot's
+  // joint controllers after a move): the IMS's rest detector takes all 3 s for rest, and below
+  // the gate's 1 mm/s the zero-velocity updates are taken too, pinning the trajectory ~1 mm off.
+  // With outside aids (ims/smoother_aids.hpp) saying it is still only in the first second and
+  // giving its velocity (the truth, 1e-5 m/s sigma) after it, the smoother follows the creep.
+  const ims::EarthModel earth(kSite);
+  const Quaterniond q_W_S = ims::quat_exp(Vector3d(0.01, 0.02, -0.4));
+  const Vector3d velocity_W(0.0, 5e-4, 0.0);
+  const double start_s = 1.0;
+  auto series = static_record(earth, q_W_S, 3.0, Vector3d::Zero(), Vector3d::Zero(), 7);
+  const Eigen::Matrix3d R_S_W = q_W_S.toRotationMatrix().transpose();
+  const Vector3d coriolis_S = R_S_W * (2.0 * earth.earth_rate_W().cross(velocity_W));
+  bool started = false;
+  for (auto& s : series.samples) {
+    if (s.t_s <= start_s) continue;
+    s.acc += coriolis_S * series.nominal_dt_s;
+    if (!started) s.acc += R_S_W * velocity_W;  // the step to the creep velocity
+    started = true;
+  }
+  const Vector9d sigma0 =
+      (Vector9d() << Vector3d::Constant(1e-6), Vector3d::Constant(1e-5), Vector3d::Constant(1e-6))
+          .finished();
+  ims::NavState initial;
+  initial.q_W_S = q_W_S;
+  const auto final_error = [&](const ims::ZuptSmootherResult& r) {
+    const ims::NavState& last = r.states.back().state;
+    return std::abs(last.p_W.y() - velocity_W.y() * (last.t_s - start_s));
+  };
+  const auto fooled =
+      ims::smooth_with_zupt(series, earth, initial, sigma0, white_noise_only_options());
+  ims::SmootherAids aids;
+  aids.still = std::vector<ims::TimeInterval>{{0.0, start_s}};
+  for (int k = 101; k <= 300; ++k) aids.velocity.push_back({0.01 * k, velocity_W, 1e-5});
+  const auto aided =
+      ims::smooth_with_zupt(series, earth, initial, sigma0, white_noise_only_options(), aids);
+  std::printf(
+      "creep 0.5 mm/s for 2 s: final position error %.1f um taken for rest, %.1f um "
+      "aided\n",
+      final_error(fooled) * 1e6, final_error(aided) * 1e6);
+  EXPECT_GT(fooled.summary.zero_velocity.accepted, 250u);
+  // Aided: zero-velocity updates only in the still second (one per 10 ms), velocity updates at
+  // every update instant the aid covers after it.
+  ASSERT_EQ(aided.summary.rest_intervals.size(), 1u);
+  EXPECT_LE(aided.summary.rest_intervals.front().end_s, start_s);
+  EXPECT_LE(aided.summary.zero_velocity.accepted, 100u);
+  EXPECT_GE(aided.summary.velocity_aid.accepted, 195u);
+  EXPECT_EQ(aided.summary.velocity_aid.rejected, 0u);
+  // Taken for rest the creep is lost: ~1 mm (0.5 mm/s over 2 s). Aided: the velocity noise of
+  // the aid (1e-5 m/s, independent every 10 ms: 1e-5 sqrt(2 s * 0.01 s) ~ 1.4 um) and the
+  // accelerometer's white noise between the updates; bound 20 um.
+  EXPECT_GT(final_error(fooled), 0.5e-3);
+  EXPECT_LT(final_error(aided), 20e-6);
+}
+
 struct RunFigures {
   double position_rms_mm = 0.0;
   double attitude_rms_deg = 0.0;

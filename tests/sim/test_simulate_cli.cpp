@@ -44,7 +44,7 @@ TEST_F(SimulateCli, WritesConsistentFilesAndTheSameBytesForTheSameSeed) {
             0);
   for (const char* file : {"imu.csv", "robot.csv", "truth/joints.csv", "truth/flange_poses.csv",
                            "truth/trajectory.csv", "truth/frames.json", "truth/sensor_errors.yaml",
-                           "truth/segments.csv", "truth/scenario.yaml"}) {
+                           "truth/imu_bias.csv", "truth/segments.csv", "truth/scenario.yaml"}) {
     SCOPED_TRACE(file);
     ASSERT_TRUE(fs::is_regular_file(a / file));
     EXPECT_EQ(read(a / file), read(b / file));  // same seed, same bytes
@@ -79,6 +79,16 @@ TEST_F(SimulateCli, WritesConsistentFilesAndTheSameBytesForTheSameSeed) {
   for (int k = 0; k < 500; ++k) dv += imu.samples[k].acc;
   const ims::EarthModel earth({48.78232, 9.18162, 245.4});
   EXPECT_NEAR(dv.norm() / 0.5, earth.normal_gravity_magnitude(), 1e-3);
+  // The biases the record carries: every 0.1 s of the IMS clock from its first sample on; the
+  // navigation-grade accelerometer's in-run part (10 ug over 600 s) keeps them within a few
+  // tens of ug of the turn-on bias (25 ug sigma) over a few seconds.
+  const NumericTable bias = read_numeric_table(a / "truth/imu_bias.csv");
+  ASSERT_GT(bias.rows(), 10u);
+  EXPECT_NEAR(bias.at(0, 0), imu.samples.front().t_s, 1e-12);
+  EXPECT_NEAR(bias.at(1, 0) - bias.at(0, 0), 0.1, 1e-9);
+  EXPECT_NEAR(bias.at(bias.rows() - 1, 0), imu.samples.back().t_s, 0.1);
+  for (std::size_t r = 0; r < bias.rows(); r += bias.rows() / 10)
+    EXPECT_LT(std::abs(bias.at(r, bias.column("acc_bias_z_ug"))), 200.0);
 
   // The truth trajectory of S in W is the flange truth through the frames: check 20 instants.
   const nlohmann::json frames = nlohmann::json::parse(read(a / "truth/frames.json"));
