@@ -236,6 +236,46 @@ ModelTorqueSource scenario_model_torque(const sim::Scenario& scenario) {
   return model;
 }
 
+ident::JointErrorLog simulate_ims_joint_errors(const sim::Scenario& scenario, std::uint64_t seed,
+                                               double max_duration_s) {
+  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
+  sim::DesiredJointPath path =
+      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
+  while (path.samples.size() > 2 && path.samples.back().t_s > max_duration_s) {
+    path.samples.pop_back();
+  }
+  const sim::PlantLog plant =
+      sim::simulate_plant(scenario_plant(scenario, robot), path, path.cycle_s);
+  double standstill_s = 0.0;  // the program's initial rest: the chain's first rest
+  for (const auto& sample : path.samples) {
+    if (sample.qd_rad_s.norm() != 0.0 || sample.qdd_rad_s2.norm() != 0.0) break;
+    standstill_s = sample.t_s;
+  }
+  const ImsJointMeasurement m =
+      measure_joints_with_ims(scenario, robot, path, plant, standstill_s, seed);
+  ident::JointErrorLog log;
+  log.robot = robot.name;
+  log.cycle_s = path.cycle_s;
+  log.source = fmt::format("IMS chain (simulated navigation-grade IMS, seed {}) of scenario {}",
+                           seed, scenario.name);
+  for (const auto& joint : robot.joints) log.joint_names.push_back(joint.name);
+  log.q_desired_rad.assign(calib::kJointCount, {});
+  log.q_measured_rad.assign(calib::kJointCount, {});
+  log.q_internal_rad.assign(calib::kJointCount, {});
+  for (std::size_t k = 0; k < std::min(path.samples.size(), plant.samples.size()); ++k) {
+    if (!m.valid[k]) continue;
+    log.time_s.push_back(path.samples[k].t_s);
+    log.payload_kg.push_back(payload_mass(path, path.samples[k]));
+    for (int j = 0; j < calib::kJointCount; ++j) {
+      log.q_desired_rad[std::size_t(j)].push_back(path.samples[k].q_rad[j]);
+      log.q_measured_rad[std::size_t(j)].push_back(m.q_rad[k][j]);
+      log.q_internal_rad[std::size_t(j)].push_back(plant.samples[k].q_motor_rad[j]);
+    }
+  }
+  ident::split_at_gaps(log);
+  return log;
+}
+
 IdentifiedTable identify_table(const ident::JointErrorLog& log,
                                const ident::IdentificationConfig& config,
                                const std::string& source_file,

@@ -45,6 +45,15 @@ namespace imscal::eval {
 ident::JointErrorLog simulate_truth_joint_errors(
     const sim::Scenario& scenario, double max_duration_s = std::numeric_limits<double>::infinity());
 
+// The same run measured as the paper measures it: the plant's link-side motion recorded by the
+// scenario's simulated IMS and taken through the chain (eval/ims_measured_path.hpp), q_measured
+// the IMS's joint angles (samples the chain could not measure are left out: the log then has
+// gaps), q_internal the encoders. seed: the sensor's draw. The joint_errors.csv `imscal
+// calibrate` writes, with the frames known (their calibration: issue 4's figures).
+ident::JointErrorLog simulate_ims_joint_errors(
+    const sim::Scenario& scenario, std::uint64_t seed = 1,
+    double max_duration_s = std::numeric_limits<double>::infinity());
+
 struct IdentifiedTable {
   ident::ParameterTable table;
   std::vector<ident::JointIdentification> joints;  // reports (chosen orders, fits, backlash)

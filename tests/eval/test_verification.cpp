@@ -218,14 +218,14 @@ TEST(Verification, SeedLineWithAblation) {
   }
   if (!sanitized()) {
     // What the chain reaches today (Release, 10 cycles, look-ahead 4), as the IMS chain measures
-    // the attained path: 13.14 -> 1.23 mm (90.7 %); on the plant's true path 12.47 -> 0.93 mm
-    // (92.5 %). Ablation on the true path: paper form 49.4 %, without the model torque 39.0 %,
-    // with eq. 3's backlash term 89.8 %, with the operating-point grid 91.2 %. Asserted 3
+    // the attained path: 13.14 -> 1.27 mm (90.3 %); on the plant's true path 12.47 -> 0.91 mm
+    // (92.7 %). Ablation on the true path: paper form 49.0 %, without the model torque 42.0 %,
+    // with eq. 3's backlash term 90.1 %, with the operating-point grid 91.4 %. Asserted 3
     // %-points below (compiler differences; the simulator and every draw are deterministic), the
     // precontrol active throughout, and each part of the default measured: the paper's form and
     // the model without the torque stay far behind.
     EXPECT_EQ(r.after[0].inactive_cycles, 0u);
-    EXPECT_GE(reduction_percent(before, r.after[0].figures.max_path_deviation_m), 87.7);
+    EXPECT_GE(reduction_percent(before, r.after[0].figures.max_path_deviation_m), 87.3);
     const double before_true = r.before.true_figures.max_path_deviation_m;
     const double compensated =
         reduction_percent(before_true, r.after[0].true_figures.max_path_deviation_m);
@@ -239,7 +239,7 @@ TEST(Verification, SeedLineWithAblation) {
         EXPECT_GE(reduction, 85.0) << r.after[c].label;
     }
     // The IMS chain measures the path to a fraction of the compensated deviation: the measured
-    // and true maximum deviations differ by < 0.5 mm (measured 0.29 mm).
+    // and true maximum deviations differ by < 0.5 mm (measured 0.36 mm).
     EXPECT_LT(std::abs(r.after[0].figures.max_path_deviation_m -
                        r.after[0].true_figures.max_path_deviation_m),
               0.5e-3);
@@ -388,6 +388,76 @@ TEST(Verification, TrueJointErrorAsOffsetBound) {
   if (!sanitized()) {
     EXPECT_LT(inverted, 0.5 * b);
   }
+}
+
+}  // namespace
+}  // namespace imscal::eval
+
+namespace imscal::eval {
+namespace {
+
+// Issues 5 and 6 the way the paper works: the identification runs MEASURED by the IMS chain (the
+// simulated navigation-grade IMS, mechanized, smoothed, through the frames and the inverse
+// kinematics; eval/ims_measured_path.hpp), not the simulator's truth; the default table
+// identified from them; the held-out fits and the verification on seed-line.
+TEST(Verification, IdentifiedFromTheImsChain) {
+  if (sanitized()) GTEST_SKIP() << "3 min of plant and IMS: Release only";
+  const sim::Scenario identification = scenario("identification");
+  const ident::JointErrorLog measured = simulate_ims_joint_errors(identification, 1);
+  const ident::JointErrorLog truth = simulate_truth_joint_errors(identification);
+  // The measurement's own error on the joint errors (the same plant run: deterministic).
+  std::size_t k_truth = 0;
+  calib::JointVector sq_error = calib::JointVector::Zero(), sq_signal = sq_error;
+  for (std::size_t k = 0; k < measured.sample_count(); ++k) {
+    while (truth.time_s[k_truth] < measured.time_s[k] - 1e-9) ++k_truth;
+    for (int j = 0; j < 6; ++j) {
+      const double e_true = truth.q_desired_rad[std::size_t(j)][k_truth] -
+                            truth.q_measured_rad[std::size_t(j)][k_truth];
+      const double e_ims =
+          measured.q_desired_rad[std::size_t(j)][k] - measured.q_measured_rad[std::size_t(j)][k];
+      sq_error(j) += (e_ims - e_true) * (e_ims - e_true);
+      sq_signal(j) += e_true * e_true;
+    }
+  }
+  std::printf(
+      "identification measured by the IMS chain: %zu of %zu samples; joint error RMS "
+      "(true | measurement error) [mrad]:",
+      measured.sample_count(), truth.sample_count());
+  for (int j = 0; j < 6; ++j)
+    std::printf(" A%d %.3f | %.3f", j + 1,
+                std::sqrt(sq_signal(j) / double(measured.sample_count())) * 1e3,
+                std::sqrt(sq_error(j) / double(measured.sample_count())) * 1e3);
+  std::printf("\n");
+
+  const ident::IdentificationConfig config =
+      ident::load_identification_config(ConfigNode::load_file(
+          fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-default.yaml"));
+  const ModelTorqueSource torque_model = scenario_model_torque(identification);
+  const IdentifiedTable table = identify_table(measured, config, "IMS chain", &torque_model);
+  EXPECT_TRUE(table.failed_joints.empty());
+  for (const auto& joint : table.joints) {
+    const JointFitSummary s = summarize_fit(joint);
+    std::printf(
+        "%s (from the IMS chain): held-out simulation fit %.3f %%, joint-error fit %.1f %%\n",
+        joint.parameters.name.c_str(), s.simulation_fit_percent, s.joint_error_fit_percent);
+  }
+  VerificationOptions options;
+  options.cycles = 5;
+  options.segment_filter = "line";
+  const VerificationResult r =
+      verify_scenario(scenario("seed-line"), {{"from the IMS chain", table.table}}, options);
+  std::printf("seed-line with the table identified from the IMS chain (%d cycles):\n", r.cycles);
+  print_case(r.before, r.before.figures, r.before.true_figures);
+  print_case(r.after[0], r.before.figures, r.before.true_figures);
+  EXPECT_EQ(r.after[0].inactive_cycles, 0u);
+  // Measured: 92.7 % as the IMS chain sees the path, 93.2 % on the true path (5 cycles);
+  // asserted 3 %-points below, as above.
+  EXPECT_GE(reduction_percent(r.before.figures.max_path_deviation_m,
+                              r.after[0].figures.max_path_deviation_m),
+            89.7);
+  EXPECT_GE(reduction_percent(r.before.true_figures.max_path_deviation_m,
+                              r.after[0].true_figures.max_path_deviation_m),
+            90.2);
 }
 
 }  // namespace
