@@ -7,10 +7,13 @@
 #include <filesystem>
 #include <memory>
 #include <sstream>
+#include <vector>
 
+#include "calib/robot_description.hpp"
 #include "calib/robot_log.hpp"
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "eval/model_torque.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "ident/precontrol.hpp"
 #include "tools/command_registry.hpp"
@@ -20,9 +23,39 @@ namespace ident = imscal::ident;
 
 struct CompensateArgs {
   std::string table, robot_log, out;
-  double offset_tolerance_rad = 0.0;  // 0: the precontrol's default
+  std::string robot;  // robot description, for tables whose models take the model torque
+  std::vector<double> gravity_m_s2{0.0, 0.0, -9.80665};  // in the robot base R
+  double offset_tolerance_rad = 0.0;                     // 0: the precontrol's default
   bool force = false;
 };
+
+// The joint torques of the robot's rigid-body model along the log's desired path
+// ([joint][sample]; eval/model_torque.hpp), for a table whose models take them.
+std::vector<std::vector<double>> model_torques(const CompensateArgs& args,
+                                               const imscal::calib::RobotLog& log) {
+  if (args.robot.empty())
+    throw imscal::InputError(args.table, 0, "extra_inputs",
+                             "the table's models take the model torque: give the robot "
+                             "description with --robot (e.g. datasets/robots/kr16.yaml)");
+  imscal::eval::ModelTorqueSource model;
+  model.robot = imscal::calib::load_robot_description(args.robot);
+  if (model.robot.name != log.robot_name)
+    throw imscal::InputError(args.robot, 0, "name",
+                             fmt::format("robot '{}', but {} is of robot '{}'", model.robot.name,
+                                         args.robot_log, log.robot_name));
+  model.gravity_in_base_m_s2 =
+      Eigen::Vector3d(args.gravity_m_s2[0], args.gravity_m_s2[1], args.gravity_m_s2[2]);
+  const std::size_t n = log.samples.size();
+  std::vector<std::vector<double>> q(imscal::calib::kJointCount, std::vector<double>(n));
+  std::vector<double> payload(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    payload[k] = log.samples[k].payload_kg;
+    for (int j = 0; j < imscal::calib::kJointCount; ++j)
+      q[std::size_t(j)][k] = log.samples[k].q_desired_rad[j];
+  }
+  const std::vector<std::pair<std::size_t, std::size_t>> whole{{0, n}};
+  return imscal::eval::model_torques_along(model, log.cycle_s, q, payload, whole);
+}
 
 const char* state_name(ident::PrecontrolState s) {
   switch (s) {
@@ -59,13 +92,25 @@ void run(const CompensateArgs& args) {
   csv << "\n";
   std::array<ident::PrecontrolEvent, ident::kPrecontrolEventCapacity> events{};
   std::size_t active = 0, event_count = 0;
+  const std::vector<std::vector<double>> torque = precontrol->needs_model_torque()
+                                                      ? model_torques(args, log)
+                                                      : std::vector<std::vector<double>>{};
+  // An inverse-form table is fed the desired path preview_cycles ahead (the interpolator's
+  // look-ahead online; the log's later samples here, the last one held).
+  const auto preview = static_cast<std::size_t>(table.preview_cycles);
   for (std::size_t k = 0; k < log.samples.size(); ++k) {
     const auto& s = log.samples[k];
-    std::array<double, ident::kPrecontrolJoints> q{};
-    for (int j = 0; j < ident::kPrecontrolJoints; ++j) q[std::size_t(j)] = s.q_desired_rad[j];
+    const std::size_t ahead = std::min(log.samples.size() - 1, k + preview);
+    std::array<double, ident::kPrecontrolJoints> q{}, tau{};
+    for (int j = 0; j < ident::kPrecontrolJoints; ++j) {
+      q[std::size_t(j)] = log.samples[ahead].q_desired_rad[j];
+      if (!torque.empty()) tau[std::size_t(j)] = torque[std::size_t(j)][ahead];
+    }
     // Cycle numbers from the time stamps: a lost cycle in the log reaches the supervisor.
     const auto cycle = static_cast<std::uint64_t>(std::llround(s.t_s / log.cycle_s));
-    const ident::PrecontrolOutput out = precontrol->cycle(q, s.payload_kg, cycle);
+    const ident::PrecontrolOutput out =
+        torque.empty() ? precontrol->cycle(q, log.samples[ahead].payload_kg, cycle)
+                       : precontrol->cycle(q, log.samples[ahead].payload_kg, tau, cycle);
     active += out.state == ident::PrecontrolState::kActive;
     csv << fmt::format("{},{},{}", s.t_s, state_name(out.state), out.outside_table ? 1 : 0);
     for (double o : out.offset_rad) csv << fmt::format(",{}", o);
@@ -94,6 +139,12 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--table", args->table, "parameters.json (imscal identify)")->required();
       sub.add_option("--robot-log", args->robot_log, "robot.csv (desired joints, payload)")
           ->required();
+      sub.add_option("--robot", args->robot,
+                     "Robot description (datasets/robots/kr16.yaml): the model torque of tables "
+                     "with that input");
+      sub.add_option("--gravity-m-s2", args->gravity_m_s2,
+                     "Gravity in the robot base R [m/s²] (default 0 0 -9.80665: a level base)")
+          ->expected(3);
       sub.add_option("--out", args->out, "offsets.csv")->required();
       sub.add_option("--offset-tolerance-rad", args->offset_tolerance_rad,
                      "supervisor tolerance on |offset| per joint [rad] (default 0.005)");
