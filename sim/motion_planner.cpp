@@ -1,6 +1,7 @@
 #include "sim/motion_planner.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "calib/inverse_kinematics.hpp"
 #include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
+#include "sim/cartesian_timing.hpp"
 #include "sim/motion_profile.hpp"
 
 namespace imscal::sim {
@@ -41,6 +44,23 @@ struct FlangeMotion {
   Vector6d acceleration = Vector6d::Zero();  // [a; w_dot] in R
 };
 
+// A LIN/CIRC move without its timing: the flange origin's path p(s), s in [0, length] [m], and
+// the orientation law R(s) = R0 exp(s / length theta [k]) (rotation_vector = theta k, in R0's
+// axes).
+struct CartesianPath {
+  double length = 0.0;
+  std::function<PathPoint(double)> geometry;
+  Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d rotation_vector = Eigen::Vector3d::Zero();
+
+  Eigen::Matrix3d rotation(double s) const;
+};
+
+// Joint angles and their planned rates in one cycle.
+struct JointState {
+  JointVector q, qd, qdd;
+};
+
 class Planner {
  public:
   Planner(const calib::RobotDescription& robot, const MotionProgram& program)
@@ -60,8 +80,20 @@ class Planner {
   void plan_rest(const ProgramStep& step);
   void plan_ptp(const ProgramStep& step);
   void plan_cartesian(const ProgramStep& step);
+  CartesianPath cartesian_path(const ProgramStep& step) const;
+  std::vector<JointState> sample_cartesian(const ProgramStep& step, const CartesianPath& path,
+                                           const MotionProfile& profile) const;
+  JointLimits joint_limits(const ProgramStep& step) const;
+  JointLimitUse limit_use(const JointLimits& limits, const std::vector<JointState>& samples) const;
+  JointPathDerivatives joint_path_derivatives(const CartesianPath& path,
+                                              const MotionProfile& profile,
+                                              const std::vector<JointState>& samples) const;
+  void log_slowed(const ProgramStep& step, const CartesianTiming& timing, double duration_s) const;
+  std::string joint_name(int i) const {
+    return i < 0 ? std::string("none") : robot_.joints[static_cast<std::size_t>(i)].name;
+  }
   JointVector solve_pose(const ProgramStep& step, const Eigen::Isometry3d& pose) const;
-  MotionProfile path_profile(const ProgramStep& step, double length) const;
+  MotionProfile path_profile(ProfileKind kind, double length, const ProfileLimits& limits) const;
   long cycles_for(double duration) const {
     return static_cast<long>(std::ceil(duration / cycle_ - 1e-9));
   }
@@ -204,28 +236,35 @@ void Planner::plan_ptp(const ProgramStep& step) {
   path_.samples.back().q_rad = target;
 }
 
-MotionProfile Planner::path_profile(const ProgramStep& step, double length) const {
-  const ProfileLimits limits{step.path.velocity_m_s, step.path.acceleration_m_s2,
-                             step.path.jerk_m_s3};
-  const MotionProfile raw = MotionProfile::plan(step.profile, length, limits);
+MotionProfile Planner::path_profile(ProfileKind kind, double length,
+                                    const ProfileLimits& limits) const {
+  const MotionProfile raw = MotionProfile::plan(kind, length, limits);
   return raw.stretched_to(static_cast<double>(cycles_for(raw.duration())) * cycle_);
 }
 
-void Planner::plan_cartesian(const ProgramStep& step) {
+Eigen::Matrix3d CartesianPath::rotation(double s) const {
+  const double sigma = s / length;
+  return R0 * Eigen::AngleAxisd(sigma * rotation_vector.norm(),
+                                rotation_vector.norm() > 0.0
+                                    ? Eigen::Vector3d(rotation_vector.normalized())
+                                    : Eigen::Vector3d::UnitZ())
+                  .toRotationMatrix();
+}
+
+CartesianPath Planner::cartesian_path(const ProgramStep& step) const {
   const Eigen::Isometry3d start = calib::forward_kinematics<double>(robot_.kinematics, q_);
   const Eigen::Vector3d p0 = start.translation();
-  const Eigen::Matrix3d R0 = start.linear();
+  CartesianPath path;
+  path.R0 = start.linear();
 
   // The geometric path p(s), s in [0, length].
-  double length = 0.0;
-  std::function<PathPoint(double)> geometry;
   if (step.kind == ProgramStepKind::kLinear) {
     const Eigen::Vector3d p1 =
         step.target_is_offset ? Eigen::Vector3d(p0 + step.target_m) : step.target_m;
-    length = (p1 - p0).norm();
-    if (length < 1e-9) fail(step, "a line of zero length (use ptp to only turn the flange)");
-    const Eigen::Vector3d u = (p1 - p0) / length;
-    geometry = [p0, u](double s) { return PathPoint{p0 + s * u, u, Eigen::Vector3d::Zero()}; };
+    path.length = (p1 - p0).norm();
+    if (path.length < 1e-9) fail(step, "a line of zero length (use ptp to only turn the flange)");
+    const Eigen::Vector3d u = (p1 - p0) / path.length;
+    path.geometry = [p0, u](double s) { return PathPoint{p0 + s * u, u, Eigen::Vector3d::Zero()}; };
   } else {
     Eigen::Vector3d centre, normal;
     double radius = 0.0, angle = 0.0;
@@ -263,10 +302,10 @@ void Planner::plan_cartesian(const ProgramStep& step) {
                          off_radius * 1e3));
       }
     }
-    length = radius * angle;
+    path.length = radius * angle;
     const Eigen::Vector3d e1 = (p0 - centre - (p0 - centre).dot(normal) * normal).normalized();
     const Eigen::Vector3d e2 = normal.cross(e1);
-    geometry = [centre, e1, e2, radius](double s) {
+    path.geometry = [centre, e1, e2, radius](double s) {
       const double phi = s / radius;
       const Eigen::Vector3d radial = std::cos(phi) * e1 + std::sin(phi) * e2;
       const Eigen::Vector3d tangent = -std::sin(phi) * e1 + std::cos(phi) * e2;
@@ -275,45 +314,35 @@ void Planner::plan_cartesian(const ProgramStep& step) {
   }
 
   // Orientation: R(sigma) = R0 exp(sigma theta [k]), sigma = s / length.
-  Eigen::Vector3d rotation_vector = Eigen::Vector3d::Zero();  // theta k, in the axes of R0
   if (step.orientation == OrientationMode::kSlerp) {
-    const Eigen::AngleAxisd turn(R0.transpose() * (*step.target_rotation));
-    rotation_vector = turn.angle() * turn.axis();
+    const Eigen::AngleAxisd turn(path.R0.transpose() * (*step.target_rotation));
+    path.rotation_vector = turn.angle() * turn.axis();
   }
+  return path;
+}
 
-  // The target first: a clear refusal if it is out of reach, before any sampling.
-  Eigen::Isometry3d end_pose = Eigen::Isometry3d::Identity();
-  end_pose.translation() = geometry(length).p;
-  end_pose.linear() = R0 * Eigen::AngleAxisd(rotation_vector.norm(),
-                                             rotation_vector.norm() > 0.0
-                                                 ? Eigen::Vector3d(rotation_vector.normalized())
-                                                 : Eigen::Vector3d::UnitZ())
-                               .toRotationMatrix();
-  solve_pose(step, end_pose);
-
-  const MotionProfile profile = path_profile(step, length);
+std::vector<JointState> Planner::sample_cartesian(const ProgramStep& step,
+                                                  const CartesianPath& path,
+                                                  const MotionProfile& profile) const {
   const long cycles = cycles_for(profile.duration() - 1e-12);
+  const double length = path.length;
   calib::IkOptions options;
   options.singularity_tolerance = kSingularityTolerance;
   JointVector q_prev = q_;
-  const SegmentKind kind =
-      step.kind == ProgramStepKind::kLinear ? SegmentKind::kLinear : SegmentKind::kCircular;
-  emit(step, kind, cycles, [&](double t, JointVector& q, JointVector& qd, JointVector& qdd) {
+  std::vector<JointState> out(static_cast<std::size_t>(cycles));
+  for (long k = 1; k <= cycles; ++k) {
+    const double t = static_cast<double>(k) * cycle_;
+    JointState& j = out[static_cast<std::size_t>(k - 1)];
     const ProfileState s = profile.at(t);
-    const PathPoint point = geometry(s.position);
-    const double sigma = s.position / length;
+    const PathPoint point = path.geometry(s.position);
     FlangeMotion m;
     m.pose.translation() = point.p;
-    m.pose.linear() = R0 * Eigen::AngleAxisd(sigma * rotation_vector.norm(),
-                                             rotation_vector.norm() > 0.0
-                                                 ? Eigen::Vector3d(rotation_vector.normalized())
-                                                 : Eigen::Vector3d::UnitZ())
-                               .toRotationMatrix();
+    m.pose.linear() = path.rotation(s.position);
     m.twist.head<3>() = point.dp_ds * s.velocity;
-    m.twist.tail<3>() = R0 * rotation_vector * (s.velocity / length);
+    m.twist.tail<3>() = path.R0 * path.rotation_vector * (s.velocity / length);
     m.acceleration.head<3>() =
         point.d2p_ds2 * s.velocity * s.velocity + point.dp_ds * s.acceleration;
-    m.acceleration.tail<3>() = R0 * rotation_vector * (s.acceleration / length);
+    m.acceleration.tail<3>() = path.R0 * path.rotation_vector * (s.acceleration / length);
 
     options.q_near = q_prev;
     const calib::IkResult ik = ik_.solve(m.pose, ik_.configuration_of(q_prev), options);
@@ -327,29 +356,162 @@ void Planner::plan_cartesian(const ProgramStep& step) {
                              t, s.position * 1e3, point.p.x() * 1e3, point.p.y() * 1e3,
                              point.p.z() * 1e3, calib::to_string(ik.status), ik.reason));
     }
-    q = ik.q;
-    const calib::Jacobian J = calib::geometric_jacobian(robot_.kinematics, q);
+    j.q = ik.q;
+    const calib::Jacobian J = calib::geometric_jacobian(robot_.kinematics, j.q);
     const Eigen::PartialPivLU<calib::Jacobian> lu(J);
-    qd = lu.solve(m.twist);
-    qdd = lu.solve(m.acceleration - jacobian_rate_times_joint_rate(robot_.kinematics, q, qd));
+    j.qd = lu.solve(m.twist);
+    j.qdd = lu.solve(m.acceleration - jacobian_rate_times_joint_rate(robot_.kinematics, j.q, j.qd));
     for (int i = 0; i < kJointCount; ++i) {
       const double v_max = robot_.joints[i].max_velocity_rad_s;
-      if (std::abs(qd(i)) > v_max * (1.0 + kLimitSlack)) {
+      if (std::abs(j.qd(i)) > v_max * (1.0 + kLimitSlack)) {
         fail(step, fmt::format("at {:.3f} s ({:.1f} mm along the path): joint {} would turn at "
                                "{:.1f} deg/s, above its max velocity {:.1f} deg/s",
-                               t, s.position * 1e3, robot_.joints[i].name, qd(i) * kRadToDeg,
+                               t, s.position * 1e3, robot_.joints[i].name, j.qd(i) * kRadToDeg,
                                v_max * kRadToDeg));
       }
       // Between two samples a joint moves at most v_max * cycle; far more means IK jumped.
-      if (std::abs(q(i) - q_prev(i)) > 2.0 * v_max * cycle_ + 1e-9) {
+      if (std::abs(j.q(i) - q_prev(i)) > 2.0 * v_max * cycle_ + 1e-9) {
         fail(step, fmt::format("at {:.3f} s: joint {} jumps by {:.3f} deg in one cycle (IK "
                                "branch change)",
-                               t, robot_.joints[i].name, (q(i) - q_prev(i)) * kRadToDeg));
+                               t, robot_.joints[i].name, (j.q(i) - q_prev(i)) * kRadToDeg));
       }
     }
-    q_prev = q;
-  });
+    q_prev = j.q;
+  }
   // The segment ends at rest: the profile's end state has zero rates.
+  return out;
+}
+
+JointLimits Planner::joint_limits(const ProgramStep& step) const {
+  JointLimits limits;
+  limits.acceleration_rad_s2 = program_.max_acceleration_rad_s2;
+  if (step.profile == ProfileKind::kJerkLimited) limits.jerk_rad_s3 = program_.max_jerk_rad_s3;
+  return limits;
+}
+
+JointLimitUse Planner::limit_use(const JointLimits& limits,
+                                 const std::vector<JointState>& samples) const {
+  JointLimitMeter meter(limits, cycle_, path_.samples.back().qdd_rad_s2);
+  for (const JointState& j : samples) meter.add(j.qdd);
+  return meter.use();
+}
+
+// q'(s) = J^-1 [dp/ds; R0 theta k / length] and q''(s) = J^-1 ([d2p/ds2; 0] - J_dot(q, q') q') at
+// the start and at every sample of a timing (q_ddot = q'' s_dot^2 + q' s_ddot,
+// sim/cartesian_timing.hpp).
+JointPathDerivatives Planner::joint_path_derivatives(const CartesianPath& path,
+                                                     const MotionProfile& profile,
+                                                     const std::vector<JointState>& samples) const {
+  const Eigen::Vector3d w_per_s = path.R0 * path.rotation_vector / path.length;
+  JointPathDerivatives out;
+  auto add = [&](double s, const JointVector& q) {
+    const PathPoint point = path.geometry(s);
+    const Eigen::PartialPivLU<calib::Jacobian> lu(calib::geometric_jacobian(robot_.kinematics, q));
+    Vector6d twist, curvature = Vector6d::Zero();
+    twist << point.dp_ds, w_per_s;
+    const JointVector dq = lu.solve(twist);
+    curvature.head<3>() = point.d2p_ds2;
+    out.add(s, dq, lu.solve(curvature - jacobian_rate_times_joint_rate(robot_.kinematics, q, dq)));
+  };
+  add(0.0, q_);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    add(profile.at(static_cast<double>(k + 1) * cycle_).position, samples[k].q);
+  }
+  return out;
+}
+
+void Planner::plan_cartesian(const ProgramStep& step) {
+  const CartesianPath path = cartesian_path(step);
+  // The target first: a clear refusal if it is out of reach, before any sampling.
+  Eigen::Isometry3d end_pose = Eigen::Isometry3d::Identity();
+  end_pose.translation() = path.geometry(path.length).p;
+  end_pose.linear() = path.rotation(path.length);
+  solve_pose(step, end_pose);
+
+  CartesianTiming timing;
+  timing.programmed = {step.path.velocity_m_s, step.path.acceleration_m_s2, step.path.jerk_m_s3};
+  MotionProfile profile = path_profile(step.profile, path.length, timing.programmed);
+  std::vector<JointState> samples = sample_cartesian(step, path, profile);
+  const JointLimits limits = joint_limits(step);
+  timing.programmed_use = limit_use(limits, samples);
+  timing.programmed_peak_velocity_m_s = profile.peak_velocity();
+  timing.programmed_duration_s = static_cast<double>(samples.size()) * cycle_;
+  timing.planned = timing.programmed;
+  timing.planned_use = timing.programmed_use;
+  timing.planned_peak_velocity_m_s = timing.programmed_peak_velocity_m_s;
+  if (timing.programmed_use.ratio() > 1.0 + kJointLimitTolerance) {
+    // Judge candidate timings without IK, on the joint path of the programmed samples.
+    const JointPathDerivatives derivatives = joint_path_derivatives(path, profile, samples);
+    TimingJudge judge;
+    judge.duration = [&](const ProfileLimits& l) {
+      return path_profile(step.profile, path.length, l).duration();
+    };
+    judge.within = [&](const ProfileLimits& l) {
+      const MotionProfile candidate = path_profile(step.profile, path.length, l);
+      JointLimitMeter meter(limits, cycle_, path_.samples.back().qdd_rad_s2);
+      const long cycles = cycles_for(candidate.duration() - 1e-12);
+      std::size_t cursor = 0;
+      for (long k = 1; k <= cycles; ++k) {
+        const ProfileState state = candidate.at(static_cast<double>(k) * cycle_);
+        meter.add(derivatives.acceleration(state, cursor));
+        if (meter.use().ratio() > 1.0) return false;
+      }
+      return true;
+    };
+    TimingChoice choice = choose_timing(timing.programmed, timing.programmed_use, judge);
+    // The chosen timing sampled by IK and checked exactly; a remaining excess (interpolation
+    // error) removed by a further uniform slow-down, exact for the continuous motion.
+    int round = 0;
+    for (;; ++round) {
+      profile = path_profile(step.profile, path.length, choice.limits);
+      samples = sample_cartesian(step, path, profile);
+      timing.planned_use = limit_use(limits, samples);
+      if (timing.planned_use.ratio() <= 1.0 + kJointLimitTolerance) break;
+      if (round == 10) {
+        throw std::logic_error(fmt::format("planner: '{}' stays above the joint limits ({:.9f})",
+                                           step.label, timing.planned_use.ratio()));
+      }
+      choice.speed_factor *= std::max(std::sqrt(timing.planned_use.acceleration_ratio),
+                                      std::cbrt(timing.planned_use.jerk_ratio));
+      choice.limits = slowed_limits(timing.programmed, choice.speed_factor, choice.ramp_factor);
+    }
+    timing.planned = choice.limits;
+    timing.planned_peak_velocity_m_s = profile.peak_velocity();
+    timing.slowed = true;
+    spdlog::debug(
+        "planner: '{}': timing chosen after {} trials, {} corrections: k {:.6f}, m {:.6f}",
+        step.label, choice.trials, round, choice.speed_factor, choice.ramp_factor);
+    log_slowed(step, timing, static_cast<double>(samples.size()) * cycle_);
+  }
+  const long cycles = static_cast<long>(samples.size());
+  emit(step, step.kind == ProgramStepKind::kLinear ? SegmentKind::kLinear : SegmentKind::kCircular,
+       cycles, [&](double t, JointVector& q, JointVector& qd, JointVector& qdd) {
+         const JointState& j = samples[static_cast<std::size_t>(std::lround(t / cycle_) - 1)];
+         q = j.q;
+         qd = j.qd;
+         qdd = j.qdd;
+       });
+  path_.segments.back().timing = timing;
+}
+
+void Planner::log_slowed(const ProgramStep& step, const CartesianTiming& timing,
+                         double duration_s) const {
+  const JointLimitUse& before = timing.programmed_use;
+  const JointLimitUse& after = timing.planned_use;
+  spdlog::info(
+      "planner: segments[{}] '{}' slowed to {:.0f} % of its programmed speed by {}'s {} limit: "
+      "peak path speed {:.3f} -> {:.3f} m/s, duration {:.3f} -> {:.3f} s; profile limits {:.3f} -> "
+      "{:.3f} m/s, {:.2f} -> {:.2f} m/s^2, {:.1f} -> {:.1f} m/s^3; largest joint acceleration "
+      "{:.2f} ({}) -> {:.2f} ({}) of its limit, jerk {:.2f} ({}) -> {:.2f} ({})",
+      step.index, step.label,
+      100.0 * timing.planned_peak_velocity_m_s / timing.programmed_peak_velocity_m_s,
+      joint_name(after.joint()), after.jerk_binds() ? "jerk" : "acceleration",
+      timing.programmed_peak_velocity_m_s, timing.planned_peak_velocity_m_s,
+      timing.programmed_duration_s, duration_s, timing.programmed.velocity, timing.planned.velocity,
+      timing.programmed.acceleration, timing.planned.acceleration, timing.programmed.jerk,
+      timing.planned.jerk, before.acceleration_ratio, joint_name(before.acceleration_joint),
+      after.acceleration_ratio, joint_name(after.acceleration_joint), before.jerk_ratio,
+      joint_name(before.jerk_joint), after.jerk_ratio, joint_name(after.jerk_joint));
 }
 
 DesiredJointPath Planner::run() {

@@ -17,6 +17,12 @@
 //   sample), joint rates from the Cartesian twist, q_dot = J^-1 [v; w], and accelerations
 //   q_ddot = J^-1 ([a; w_dot] - J_dot q_dot), J_dot q_dot in closed form
 //   (jacobian_rate_times_joint_rate): exact up to rounding, no finite differences.
+//   Joint limits: a LIN/CIRC move whose programmed timing would take a joint beyond its
+//   acceleration limit (or, jerk_limited, its jerk limit per cycle; both from the program) by
+//   more than kJointLimitTolerance is slowed, as a controller does: same path and orientation
+//   law, a slower profile (sim/cartesian_timing.hpp: longer ramps where they suffice, a lower
+//   path speed where not). Logged (info) and recorded in PathSegment::timing (programmed and
+//   planned limits, speeds and joint use); a move within the limits keeps its timing bit for bit.
 // - Refusals: InputError(program file, line of the segment, "segments[i] 'label'", problem with
 //   the joint and the value) when a target is unreachable or outside the joint limits, a
 //   Cartesian move comes within kSingularityTolerance of a singularity, a joint would exceed its

@@ -17,6 +17,7 @@
 #include "sim/motion_planner.hpp"
 #include "sim/motion_profile.hpp"
 #include "sim/motion_program.hpp"
+#include "tests/sim/joint_limit_use.hpp"
 
 namespace imscal::sim {
 namespace {
@@ -42,6 +43,12 @@ joint_jerk_deg_s3: [2000, 2000, 2500, 6000, 6000, 9000]
 MotionProgram program(const std::string& segments) {
   return parse_motion_program(
       ConfigNode::load_string(std::string(kHeader) + "segments:\n" + segments, "test.yaml"));
+}
+
+// kHeader's joint limits.
+const MotionProgram& header_program() {
+  static const MotionProgram p = program("  - rest: {duration_s: 1}\n");
+  return p;
 }
 
 Eigen::Isometry3d fk(const JointVector& q) {
@@ -149,16 +156,28 @@ TEST(MotionPlanner, JacobianRateTimesJointRateMatchesFiniteDifference) {
 }
 
 // Checks a Cartesian segment: positions through FK on the geometry (distance function),
-// orientation, path speed from J qd against the profile, qd and qdd against finite differences.
+// orientation, path speed from J qd against the profile, qd and qdd against finite differences,
+// the joints within the program's acceleration and jerk limits.
 template <typename Distance, typename Orientation>
 void check_cartesian(const DesiredJointPath& path, const PathSegment& seg, double length,
-                     const ProfileLimits& limits, Distance distance_to_path,
+                     const ProfileLimits& programmed, Distance distance_to_path,
                      Orientation expected_rotation) {
   const auto [first, last] = range(path, seg);
-  // The planned profile, recomputed: the arc-length profile over `length`, stretched to the
-  // segment's duration.
+  // The planned profile, recomputed: the arc-length profile over `length` with the limits the
+  // planner chose (the programmed ones unless a joint limit made it slow the segment down),
+  // stretched to the segment's duration.
+  ASSERT_TRUE(seg.timing.has_value());
+  EXPECT_EQ(seg.timing->programmed.velocity, programmed.velocity);
+  EXPECT_EQ(seg.timing->programmed.acceleration, programmed.acceleration);
+  EXPECT_EQ(seg.timing->programmed.jerk, programmed.jerk);
+  const ProfileLimits limits = seg.timing->planned;
   const MotionProfile profile = MotionProfile::plan(ProfileKind::kJerkLimited, length, limits)
                                     .stretched_to(seg.end_s - seg.begin_s);
+  // Within the joint limits of kHeader (the planner's tolerance: 1e-6).
+  const MeasuredLimitUse use = measured_limit_use(
+      path, seg, header_program().max_acceleration_rad_s2, header_program().max_jerk_rad_s3);
+  EXPECT_LE(use.acceleration, 1.0 + kJointLimitTolerance);
+  EXPECT_LE(use.jerk, 1.0 + kJointLimitTolerance);
   double peak_speed = 0.0;
   for (std::size_t k = first; k <= last; ++k) {
     const DesiredJointSample& s = path.samples[k];
