@@ -14,7 +14,7 @@ namespace imscal::eval {
 
 ImsJointMeasurement measure_joints_with_ims(const sim::Scenario& scenario,
                                             const calib::RobotDescription& robot,
-                                            const sim::DesiredJointPath& command,
+                                            const sim::DesiredJointPath& desired,
                                             const sim::PlantLog& plant, double lead_in_s,
                                             std::uint64_t seed) {
   // The measurement setup: the scenario's base and nominal mount, its IMS and clock offset.
@@ -31,17 +31,17 @@ ImsJointMeasurement measure_joints_with_ims(const sim::Scenario& scenario,
   unit.acc.bias.setZero();
   const ims::ImuSeries imu = ims::correct(recording.imu_raw, unit);
 
-  // The controller's log of the run: what it was commanded, what its encoders read.
+  // The controller's log of the run: its desired angles, what its encoders read.
   calib::RobotLog log;
   log.robot_name = robot.name;
-  log.cycle_s = command.cycle_s;
-  const std::size_t n = std::min(command.samples.size(), plant.samples.size());
+  log.cycle_s = desired.cycle_s;
+  const std::size_t n = std::min(desired.samples.size(), plant.samples.size());
   for (std::size_t k = 0; k < n; ++k) {
-    const sim::DesiredJointSample& c = command.samples[k];
+    const sim::DesiredJointSample& c = desired.samples[k];
     log.samples.push_back({c.t_s,
-                           command.payloads.empty()
+                           desired.payloads.empty()
                                ? 0.0
-                               : command.payloads[std::size_t(c.payload_index)].body.mass_kg,
+                               : desired.payloads[std::size_t(c.payload_index)].body.mass_kg,
                            c.q_rad, plant.samples[k].q_motor_rad});
   }
 
@@ -77,7 +77,7 @@ ImsJointMeasurement measure_joints_with_ims(const sim::Scenario& scenario,
   out.smoother = errors.smoother;
   const double t0 = plant.samples.front().t_s;
   for (std::size_t i = 0; i < errors.t_s.size(); ++i) {
-    const auto k = static_cast<std::size_t>(std::llround((errors.t_s[i] - t0) / command.cycle_s));
+    const auto k = static_cast<std::size_t>(std::llround((errors.t_s[i] - t0) / desired.cycle_s));
     if (k >= out.q_rad.size()) continue;
     out.q_rad[k] = errors.q_measured_rad[i];
     out.valid[k] = true;

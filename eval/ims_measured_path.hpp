@@ -26,13 +26,14 @@ struct ImsJointMeasurement {
   ims::ZuptSummary smoother;
 };
 
-// command: what the controller was given (the robot log's desired angles); plant: its run, one
+// desired: the interpolator's desired angles (the robot log's q_desired, without a precontrol's
+// offsets: the chain finds the program's standstills there); plant: its run, one
 // sample per controller cycle, starting at rest (its first lead_in_s are the smoother's first
 // rest). seed: the sensor errors' and noise's draw. Throws InputError (from the chain) when the
 // record cannot be used.
 ImsJointMeasurement measure_joints_with_ims(const sim::Scenario& scenario,
                                             const calib::RobotDescription& robot,
-                                            const sim::DesiredJointPath& command,
+                                            const sim::DesiredJointPath& desired,
                                             const sim::PlantLog& plant, double lead_in_s,
                                             std::uint64_t seed);
 

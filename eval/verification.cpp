@@ -455,8 +455,10 @@ VerificationResult verify_scenario(const sim::Scenario& scenario,
         cycles[c].push_back(true_cycles[c].back());
         continue;
       }
+      // The controller's log holds the interpolator's desired angles (the offset is added after
+      // it): the chain finds the program's standstills there.
       const ImsJointMeasurement m = measure_joints_with_ims(
-          scenario, robot, command, plant, standstill_s, options.ims_seed + std::uint64_t(j));
+          scenario, robot, path, plant, standstill_s, options.ims_seed + std::uint64_t(j));
       std::vector<double> t;
       std::vector<calib::JointVector> q;
       for (std::size_t k = 0; k < m.q_rad.size(); ++k)
