@@ -133,28 +133,25 @@ class Precontrol {
   // Histories are rings stored twice (each value written at i and i + ring): the newest-first
   // window of any length up to the ring size is then contiguous, so the model's dot products
   // run over plain arrays (vectorised) without index wrapping.
-  // The model's sums (ident/arx_step_kernel.hpp) run over max(na, nb) padded to a multiple
-  // of kArxStepLanes with zero coefficients: no remainder loop, no branch (the reads past na, nb
-  // stay inside the rings and are multiplied by 0).
+  // The model's sums (ident/arx_step_kernel.hpp) each run over their own length (na, nb, nx_e)
+  // padded to a multiple of kArxStepLanes with zero coefficients: no remainder loop (the reads
+  // past na, nb, nx_e stay inside the rings and are multiplied by 0).
+  static_assert(kMaxPrecontrolOrder <= kArxStepMaxTerms);
   static_assert(kMaxPrecontrolOrder % kArxStepLanes == 0);
-  static constexpr int kInputRing = 128;  // power of two >= d + terms
+  static constexpr int kInputRing = 128;  // power of two >= d + longest sum
   static_assert(kInputRing >= kMaxPrecontrolOrder + kMaxPrecontrolDeadTime);
   static constexpr int kOutputRing = kMaxPrecontrolOrder;  // q̂ history
   static_assert((kOutputRing & (kOutputRing - 1)) == 0);
   static constexpr int kSpeedRing = 128;  // > the largest backlash lag accepted [cycles]
-  struct CellModel {
-    int na = 0, nb = 0, d = 0, nx = 0;
-    int terms = 0;  // max(na, nb, nx) rounded up to kArxStepLanes: the length of every sum
-    std::array<double, kMaxPrecontrolOrder> a{};  // a_1..a_na, then zeros
-    std::array<double, kMaxPrecontrolOrder> b{};  // b_0..b_{nb-1}, then zeros
-    // Further inputs' coefficients c_e,0..c_e,nx-1, then zeros.
-    std::array<std::array<double, kMaxPrecontrolOrder>, kArxStepMaxExtras> c{};
-    std::array<double, 2 * kOutputRing> y{};  // q̂ history, newest at y[y_pos]
-    int y_pos = 0;
+  struct OutputHistory {
+    std::array<double, 2 * kOutputRing> y{};  // q̂ history, newest at y[pos]
+    int pos = 0;
   };
   struct JointModel {
     int cells = 0;
-    std::array<CellModel, kMaxPrecontrolCells> cell{};
+    // Per cell its model (contiguous: the kernel runs over all of them) and its own q̂ history.
+    std::array<ArxCellCoefficients, kMaxPrecontrolCells> model{};
+    std::array<OutputHistory, kMaxPrecontrolCells> output_history{};
     // Blending grid: per dimension the quantity and cell centres.
     int dims = 0;
     std::array<OperatingQuantity, 4> quantity{};
