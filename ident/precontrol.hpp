@@ -17,8 +17,15 @@
 //      companion form of an order-32 model (|a_i| up to ~1e8) that transient reached 2.3 rad in
 //      bench/bench_precontrol.cpp's table within a few cycles, so "only the blended cells" was
 //      rejected. The cycle is made fast instead by the padded SIMD sums of
-//      ident/arx_step_kernel.hpp (same outputs as before within a few ulp:
-//      tests/ident/test_precontrol.cpp compares with the all-cells reference);
+//      ident/arx_step_kernel.hpp, each over its own length (a one-tap input costs one block of
+//      8 products, not max(na, nb, nx) of them), with the same outputs as before within a few
+//      ulp (tests/ident/test_precontrol*.cpp compare with the all-cells reference). Measured and
+//      not taken (bench/bench_precontrol.cpp's 6-cell grid with the further inputs, kernel alone):
+//      the input sums of all cells of a joint as one matrix-vector product over the shared
+//      histories (cells in the SIMD lanes) saved ~13 % of the kernel (~6 % of the cycle), at the
+//      price of coefficient matrices sized for the largest table accepted (16 cells, 64 taps,
+//      dead times up to 64 apart: ~380 kB more state) and a second code path for one-cell
+//      tables; 8-wide AVX-512 registers saved nothing (the sums are not bound by their width);
 //   3. the backlash term of eq. 3, l · tanh(q̇_d(k - lag) / v_b) with the table's lag: ±l when
 //      moving, a smooth transition through zero velocity instead of a jump at reversals (no
 //      chattering);
