@@ -1,8 +1,11 @@
 // One precontrol cycle (ident/precontrol.hpp) for 6 joints with order-32 ARX models (na = nb =
 // 32, dead time 2) in a 3 x 2 operating-point table (joint speed x payload) with blending and a
-// backlash term: the time of each of 10^6 consecutive cycles is measured (steady_clock around
-// the call, ~20 ns of its own), and the median and the 99.9th percentile are reported. Goal:
-// 99.9th percentile < 2 us (the cycle is 2 ms).
+// backlash term, and the same table with the default identification's three further inputs in
+// every cell: the time of each of 10^6 consecutive cycles is measured (steady_clock around the
+// call, ~20 ns of its own), and the median, the 99.9th percentile and the maximum are reported.
+// Goal: 99.9th percentile < 2 us (the cycle is 2 ms). Each case also runs on the all-cells
+// reference (tests/support/reference_precontrol.hpp) in the same process: the machine is shared,
+// so compare the runtime with the reference of the same run rather than with older figures.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -56,27 +59,20 @@ ParameterTable order_32_table(bool with_inputs) {
   return t;
 }
 
-// The torque-fed cycle where the runtime has one (the all-cells reference has none and is only
-// timed without further inputs).
-template <class Runtime>
-PrecontrolOutput cycle_with_torque(Runtime& runtime, const std::array<double, 6>& q, double payload,
-                                   const std::array<double, 6>& torque, std::uint64_t k) {
-  if constexpr (requires { runtime.cycle(q, payload, torque, k); })
-    return runtime.cycle(q, payload, torque, k);
-  else
-    return runtime.cycle(q, payload, k);
-}
-
 // Times each of kCycles consecutive cycles of `precontrol` (Precontrol or the all-cells
-// reference, same interface) and reports median, 99.9th percentile and maximum in ns, and the
-// fraction of cycles that ended active (the supervisor must not switch the work off).
+// reference, same interface) and reports median, 99th and 99.9th percentile and maximum in ns,
+// the cycles slower than the goal and those slower than 20 us (per 10^6), and the fraction of
+// cycles that ended active (the supervisor must not switch the work off). A cycle of 20 us or
+// more was preempted (the work is < 2 us): on a shared machine these and the cycles hit by an
+// interrupt or by a neighbour's cache traffic number some 10^2..10^3 per 10^6, so the 99.9th
+// percentile is the machine's as much as the cycle's once `over_2us` nears 1000.
 template <class Runtime>
 void time_cycles(benchmark::State& state, bool with_inputs) {
   const ParameterTable table = order_32_table(with_inputs);
   PrecontrolOptions options;
   options.offset_tolerance_rad.fill(1.0);  // keep it active: measure the full work
   options.rate_tolerance_rad_s.fill(1e9);
-  static Runtime precontrol;  // ~300 kB of fixed state: not on the stack
+  static Runtime precontrol;  // ~420 kB of fixed state: not on the stack
   std::string why;
   if (!Runtime::create(table, "kr16", options, &precontrol, &why)) {
     state.SkipWithError(why.c_str());
@@ -93,9 +89,8 @@ void time_cycles(benchmark::State& state, bool with_inputs) {
       for (int j = 0; j < 6; ++j) torque[j] = 100.0 * std::sin(0.5 * t + j);  // N m
       const double payload = 8.0 + 6.0 * std::sin(0.01 * t);
       const auto begin = std::chrono::steady_clock::now();
-      const PrecontrolOutput out = with_inputs
-                                       ? cycle_with_torque(precontrol, q, payload, torque, k)
-                                       : precontrol.cycle(q, payload, k);
+      const PrecontrolOutput out =
+          with_inputs ? precontrol.cycle(q, payload, torque, k) : precontrol.cycle(q, payload, k);
       const auto end = std::chrono::steady_clock::now();
       benchmark::DoNotOptimize(out);
       active += out.state == PrecontrolState::kActive;
@@ -103,9 +98,15 @@ void time_cycles(benchmark::State& state, bool with_inputs) {
     }
   }
   std::sort(ns.begin(), ns.end());
+  auto slower_than = [&](double limit_ns) {
+    return double(ns.end() - std::upper_bound(ns.begin(), ns.end(), limit_ns));
+  };
   state.counters["median_ns"] = ns[kCycles / 2];
+  state.counters["p99_ns"] = ns[static_cast<std::size_t>(kCycles * 0.99)];
   state.counters["p99.9_ns"] = ns[static_cast<std::size_t>(kCycles * 0.999)];
   state.counters["max_ns"] = ns.back();
+  state.counters["over_2us"] = slower_than(2000.0);
+  state.counters["over_20us"] = slower_than(20000.0);
   state.counters["active"] = double(active) / kCycles;
 }
 
@@ -129,6 +130,13 @@ void BM_AllCellsReferenceCycle6JointsOrder32(benchmark::State& state) {
   time_cycles<imscal::test_support::AllCellsPrecontrol>(state, false);
 }
 BENCHMARK(BM_AllCellsReferenceCycle6JointsOrder32)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+void BM_AllCellsReferenceCycle6JointsOrder32FurtherInputs(benchmark::State& state) {
+  time_cycles<imscal::test_support::AllCellsPrecontrol>(state, true);
+}
+BENCHMARK(BM_AllCellsReferenceCycle6JointsOrder32FurtherInputs)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 }  // namespace
 

@@ -14,67 +14,73 @@ double reduce(const double* sum) noexcept {
   return (s0 + s2) + (s1 + s3);
 }
 
-void steps_sse2(const ArxStepInput* models, int count, double* output) noexcept {
-  for (int c = 0; c < count; ++c) {
-    const ArxStepInput& m = models[c];
-    __m128d in0 = _mm_setzero_pd(), in1 = in0, in2 = in0, in3 = in0;
-    __m128d out0 = in0, out1 = in0, out2 = in0, out3 = in0;
-    for (int i = 0; i < m.terms; i += kArxStepLanes) {
-      const double *b = m.b + i, *u = m.u_delayed + i, *a = m.a + i, *y = m.y_past + i;
-      in0 = _mm_add_pd(in0, _mm_mul_pd(_mm_loadu_pd(b), _mm_loadu_pd(u)));
-      in1 = _mm_add_pd(in1, _mm_mul_pd(_mm_loadu_pd(b + 2), _mm_loadu_pd(u + 2)));
-      in2 = _mm_add_pd(in2, _mm_mul_pd(_mm_loadu_pd(b + 4), _mm_loadu_pd(u + 4)));
-      in3 = _mm_add_pd(in3, _mm_mul_pd(_mm_loadu_pd(b + 6), _mm_loadu_pd(u + 6)));
-      out0 = _mm_add_pd(out0, _mm_mul_pd(_mm_loadu_pd(a), _mm_loadu_pd(y)));
-      out1 = _mm_add_pd(out1, _mm_mul_pd(_mm_loadu_pd(a + 2), _mm_loadu_pd(y + 2)));
-      out2 = _mm_add_pd(out2, _mm_mul_pd(_mm_loadu_pd(a + 4), _mm_loadu_pd(y + 4)));
-      out3 = _mm_add_pd(out3, _mm_mul_pd(_mm_loadu_pd(a + 6), _mm_loadu_pd(y + 6)));
-    }
-    for (int e = 0; e < m.extra_count; ++e) {
-      for (int i = 0; i < m.terms; i += kArxStepLanes) {
-        const double *c = m.c[e] + i, *x = m.x_delayed[e] + i;
-        in0 = _mm_add_pd(in0, _mm_mul_pd(_mm_loadu_pd(c), _mm_loadu_pd(x)));
-        in1 = _mm_add_pd(in1, _mm_mul_pd(_mm_loadu_pd(c + 2), _mm_loadu_pd(x + 2)));
-        in2 = _mm_add_pd(in2, _mm_mul_pd(_mm_loadu_pd(c + 4), _mm_loadu_pd(x + 4)));
-        in3 = _mm_add_pd(in3, _mm_mul_pd(_mm_loadu_pd(c + 6), _mm_loadu_pd(x + 6)));
-      }
-    }
-    alignas(16) double in[8], out[8];
-    _mm_store_pd(in, in0), _mm_store_pd(in + 2, in1), _mm_store_pd(in + 4, in2);
-    _mm_store_pd(in + 6, in3);
-    _mm_store_pd(out, out0), _mm_store_pd(out + 2, out1), _mm_store_pd(out + 4, out2);
-    _mm_store_pd(out + 6, out3);
-    output[c] = reduce(in) - reduce(out);
+// sum[l] += Σ_{i ≡ l mod 8, i < terms} coefficient[i] v[i], the 8 partial sums held in 4 SSE2
+// registers.
+inline void add_sse2(__m128d (&sum)[4], const double* coefficient, const double* v,
+                     int terms) noexcept {
+  for (int i = 0; i < terms; i += kArxStepLanes) {
+    const double *k = coefficient + i, *x = v + i;
+    sum[0] = _mm_add_pd(sum[0], _mm_mul_pd(_mm_loadu_pd(k), _mm_loadu_pd(x)));
+    sum[1] = _mm_add_pd(sum[1], _mm_mul_pd(_mm_loadu_pd(k + 2), _mm_loadu_pd(x + 2)));
+    sum[2] = _mm_add_pd(sum[2], _mm_mul_pd(_mm_loadu_pd(k + 4), _mm_loadu_pd(x + 4)));
+    sum[3] = _mm_add_pd(sum[3], _mm_mul_pd(_mm_loadu_pd(k + 6), _mm_loadu_pd(x + 6)));
   }
 }
 
-__attribute__((target("avx"))) void steps_avx(const ArxStepInput* models, int count,
+inline double reduce_sse2(const __m128d (&sum)[4]) noexcept {
+  alignas(16) double lane[8];
+  for (int r = 0; r < 4; ++r) _mm_store_pd(lane + 2 * r, sum[r]);
+  return reduce(lane);
+}
+
+void steps_sse2(const ArxCellCoefficients* cells, const double* const* y_past, int count,
+                const ArxInputWindows& inputs, double* output) noexcept {
+  for (int c = 0; c < count; ++c) {
+    const ArxCellCoefficients& m = cells[c];
+    __m128d in[4] = {_mm_setzero_pd(), _mm_setzero_pd(), _mm_setzero_pd(), _mm_setzero_pd()};
+    __m128d out[4] = {in[0], in[0], in[0], in[0]};
+    add_sse2(in, m.b.data(), inputs.u + m.dead_time, m.b_terms);
+    for (int e = 0; e < inputs.extra_count; ++e)
+      add_sse2(in, m.c[e].data(), inputs.x[e] + m.dead_time, m.c_terms[e]);
+    add_sse2(out, m.a.data(), y_past[c], m.a_terms);
+    output[c] = reduce_sse2(in) - reduce_sse2(out);
+  }
+}
+
+// The same 8 partial sums in 2 AVX registers.
+__attribute__((target("avx"))) inline void add_avx(__m256d (&sum)[2], const double* coefficient,
+                                                   const double* v, int terms) noexcept {
+  for (int i = 0; i < terms; i += kArxStepLanes) {
+    const double *k = coefficient + i, *x = v + i;
+    sum[0] = _mm256_add_pd(sum[0], _mm256_mul_pd(_mm256_loadu_pd(k), _mm256_loadu_pd(x)));
+    sum[1] = _mm256_add_pd(sum[1], _mm256_mul_pd(_mm256_loadu_pd(k + 4), _mm256_loadu_pd(x + 4)));
+  }
+}
+
+__attribute__((target("avx"))) inline double reduce_avx(const __m256d (&sum)[2]) noexcept {
+  alignas(32) double lane[8];
+  _mm256_store_pd(lane, sum[0]), _mm256_store_pd(lane + 4, sum[1]);
+  return reduce(lane);
+}
+
+__attribute__((target("avx"))) void steps_avx(const ArxCellCoefficients* cells,
+                                              const double* const* y_past, int count,
+                                              const ArxInputWindows& inputs,
                                               double* output) noexcept {
-  alignas(32) double in[8], out[8];
   for (int c = 0; c < count; ++c) {
-    const ArxStepInput& m = models[c];
-    __m256d in0 = _mm256_setzero_pd(), in1 = in0, out0 = in0, out1 = in0;
-    for (int i = 0; i < m.terms; i += kArxStepLanes) {
-      const double *b = m.b + i, *u = m.u_delayed + i, *a = m.a + i, *y = m.y_past + i;
-      in0 = _mm256_add_pd(in0, _mm256_mul_pd(_mm256_loadu_pd(b), _mm256_loadu_pd(u)));
-      in1 = _mm256_add_pd(in1, _mm256_mul_pd(_mm256_loadu_pd(b + 4), _mm256_loadu_pd(u + 4)));
-      out0 = _mm256_add_pd(out0, _mm256_mul_pd(_mm256_loadu_pd(a), _mm256_loadu_pd(y)));
-      out1 = _mm256_add_pd(out1, _mm256_mul_pd(_mm256_loadu_pd(a + 4), _mm256_loadu_pd(y + 4)));
-    }
-    for (int e = 0; e < m.extra_count; ++e) {
-      for (int i = 0; i < m.terms; i += kArxStepLanes) {
-        const double *c = m.c[e] + i, *x = m.x_delayed[e] + i;
-        in0 = _mm256_add_pd(in0, _mm256_mul_pd(_mm256_loadu_pd(c), _mm256_loadu_pd(x)));
-        in1 = _mm256_add_pd(in1, _mm256_mul_pd(_mm256_loadu_pd(c + 4), _mm256_loadu_pd(x + 4)));
-      }
-    }
-    _mm256_store_pd(in, in0), _mm256_store_pd(in + 4, in1);
-    _mm256_store_pd(out, out0), _mm256_store_pd(out + 4, out1);
-    output[c] = reduce(in) - reduce(out);
+    const ArxCellCoefficients& m = cells[c];
+    __m256d in[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
+    __m256d out[2] = {in[0], in[0]};
+    add_avx(in, m.b.data(), inputs.u + m.dead_time, m.b_terms);
+    for (int e = 0; e < inputs.extra_count; ++e)
+      add_avx(in, m.c[e].data(), inputs.x[e] + m.dead_time, m.c_terms[e]);
+    add_avx(out, m.a.data(), y_past[c], m.a_terms);
+    output[c] = reduce_avx(in) - reduce_avx(out);
   }
 }
 
-using StepsKernel = void (*)(const ArxStepInput*, int, double*) noexcept;
+using StepsKernel = void (*)(const ArxCellCoefficients*, const double* const*, int,
+                             const ArxInputWindows&, double*) noexcept;
 
 StepsKernel choose_kernel() noexcept {
   __builtin_cpu_init();
@@ -86,8 +92,9 @@ const StepsKernel kKernel = choose_kernel();
 
 }  // namespace
 
-void arx_free_run_steps(const ArxStepInput* models, int count, double* output) noexcept {
-  kKernel(models, count, output);
+void arx_free_run_steps(const ArxCellCoefficients* cells, const double* const* y_past, int count,
+                        const ArxInputWindows& inputs, double* output) noexcept {
+  kKernel(cells, y_past, count, inputs, output);
 }
 
 const char* arx_step_kernel_name() noexcept {

@@ -22,9 +22,11 @@ inline constexpr int kMaxCellDimensions = 4;
 inline constexpr int kMaxBlendCorners = 1 << kMaxCellDimensions;
 
 struct CellBlend {
-  int count = 0;                                  // corners with a weight (1 .. 2^D)
-  std::array<int, kMaxBlendCorners> cell{};       // flat cell index of each corner
-  std::array<double, kMaxBlendCorners> weight{};  // sums to 1
+  int count = 0;  // corners with a weight (1 .. 2^D)
+  // Only the first `count` entries are set: zeroing all of them cost the precontrol's cycle
+  // ~30 ns per joint (a `rep stos` of 200 bytes), for entries nobody reads.
+  std::array<int, kMaxBlendCorners> cell;       // flat cell index of each corner
+  std::array<double, kMaxBlendCorners> weight;  // sums to 1
 };
 
 // centres[d]: the cell centres of dimension d (strictly increasing, at least one);

@@ -142,30 +142,37 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
       return refuse(name + "the torque-sign input needs a scale > 0");
     for (int k = 0; k < joint.cells; ++k) {
       const CellParameters& cell = source.cells[k];
-      CellModel& model = joint.cell[k];
-      model.na = cell.structure.na;
-      model.nb = cell.structure.nb;
-      model.d = cell.structure.dead_time;
-      if (cell.structure.extra_inputs != p.extra_count_ ||
-          cell.c.size() != std::size_t(cell.structure.extra_coefficient_count())) {
+      ArxCellCoefficients& model = joint.model[k];
+      const ArxStructure& structure = cell.structure;
+      if (structure.extra_inputs != p.extra_count_ ||
+          cell.c.size() != std::size_t(structure.extra_coefficient_count())) {
         return refuse(name + "cell " + std::to_string(k) + ": " +
-                      std::to_string(cell.structure.extra_inputs) +
+                      std::to_string(structure.extra_inputs) +
                       " further inputs, the table declares " + std::to_string(p.extra_count_));
       }
-      model.nx = cell.structure.max_nx();
-      if (model.na < 0 || model.na > kMaxPrecontrolOrder || model.nb < 1 ||
-          model.nb > kMaxPrecontrolOrder || model.d < 0 || model.d > kMaxPrecontrolDeadTime ||
-          model.nx > kMaxPrecontrolOrder || static_cast<int>(cell.a.size()) != model.na ||
-          static_cast<int>(cell.b.size()) != model.nb) {
+      bool in_range = structure.na >= 0 && structure.na <= kMaxPrecontrolOrder &&
+                      structure.nb >= 1 && structure.nb <= kMaxPrecontrolOrder &&
+                      structure.dead_time >= 0 && structure.dead_time <= kMaxPrecontrolDeadTime &&
+                      static_cast<int>(cell.a.size()) == structure.na &&
+                      static_cast<int>(cell.b.size()) == structure.nb;
+      for (int e = 0; e < p.extra_count_; ++e) {
+        const int nx = structure.nx[std::size_t(e)];
+        in_range = in_range && nx >= 1 && nx <= kMaxPrecontrolOrder;
+      }
+      if (!in_range) {
         return refuse(name + "cell " + std::to_string(k) + ": order or dead time out of range");
       }
-      model.terms = round_up(std::max({model.na, model.nb, model.nx}), kArxStepLanes);
-      for (int i = 0; i < model.na; ++i) model.a[i] = cell.a[i];
-      for (int i = 0; i < model.nb; ++i) model.b[i] = cell.b[i];
+      // Each sum over its own length (zeros past na, nb, nx_e up to the next kArxStepLanes).
+      model.dead_time = structure.dead_time;
+      model.a_terms = round_up(structure.na, kArxStepLanes);
+      model.b_terms = round_up(structure.nb, kArxStepLanes);
+      std::copy(cell.a.begin(), cell.a.end(), model.a.begin());
+      std::copy(cell.b.begin(), cell.b.end(), model.b.begin());
       for (int e = 0; e < p.extra_count_; ++e) {
-        model.c[e].fill(0.0);  // beyond nx[e]: zeros, so every sum runs over `terms` entries
-        for (int i = 0; i < cell.structure.nx[std::size_t(e)]; ++i)
-          model.c[e][i] = cell.c[std::size_t(cell.structure.extra_offset(e) + i)];
+        const int nx = structure.nx[std::size_t(e)];
+        model.c_terms[std::size_t(e)] = round_up(nx, kArxStepLanes);
+        for (int i = 0; i < nx; ++i)
+          model.c[e][i] = cell.c[std::size_t(structure.extra_offset(e) + i)];
       }
       auto all_finite = [](const std::vector<double>& v) {
         return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
@@ -222,15 +229,16 @@ void Precontrol::restart_models(const std::array<double, kPrecontrolJoints>& q,
     const std::array<double, kArxStepMaxExtras> x = extra_values(joint, 0.0, torque[j]);
     for (int e = 0; e < extra_count_; ++e) joint.x[e].fill(x[e]);
     for (int k = 0; k < joint.cells; ++k) {
-      CellModel& m = joint.cell[k];
+      const ArxCellCoefficients& m = joint.model[k];
+      // Over the sums' lengths: the entries past na, nb, nx_e are zeros.
       double a1 = 1.0, b1 = 0.0, steady_extra = 0.0;
-      for (int i = 0; i < m.na; ++i) a1 += m.a[i];
-      for (int i = 0; i < m.nb; ++i) b1 += m.b[i];
+      for (int i = 0; i < m.a_terms; ++i) a1 += m.a[i];
+      for (int i = 0; i < m.b_terms; ++i) b1 += m.b[i];
       for (int e = 0; e < extra_count_; ++e)
-        for (int i = 0; i < m.nx; ++i) steady_extra += m.c[e][i] * x[e];
+        for (int i = 0; i < m.c_terms[e]; ++i) steady_extra += m.c[e][i] * x[e];
       // Near an integrator (A(1) ~ 0) the steady state is not defined: start at q_d.
       const double steady = std::abs(a1) > 1e-9 ? (b1 * q[j] + steady_extra) / a1 : q[j];
-      m.y.fill(steady);
+      joint.output_history[k].y.fill(steady);
     }
     joint.last_error = joint.previous_error = 0.0;
     joint.smooth = joint.output;
@@ -277,22 +285,21 @@ void Precontrol::model_step(JointModel& joint, double q_desired, double speed, d
                                       std::span<const double>(point.data(), joint.dims));
   // Every cell model advances, in or out of the blend: a cell entering the blend needs its own
   // free-run state (see the header); the blend weights pick their errors.
-  std::array<ArxStepInput, kMaxPrecontrolCells> step;
+  ArxInputWindows windows;
+  windows.u = u;
+  windows.extra_count = extra_count_;
+  for (int e = 0; e < extra_count_; ++e) windows.x[e] = joint.x[e].data() + joint.u_pos;
+  std::array<const double*, kMaxPrecontrolCells> y_past;  // only the first `cells` are set
   for (int c = 0; c < joint.cells; ++c) {
-    const CellModel& m = joint.cell[c];
-    step[c] = ArxStepInput{m.b.data(), u + m.d, m.a.data(), m.y.data() + m.y_pos, m.terms};
-    step[c].extra_count = extra_count_;
-    for (int e = 0; e < extra_count_; ++e) {
-      step[c].c[e] = m.c[e].data();
-      step[c].x_delayed[e] = joint.x[e].data() + joint.u_pos + m.d;
-    }
+    const OutputHistory& h = joint.output_history[c];
+    y_past[c] = h.y.data() + h.pos;
   }
   std::array<double, kMaxPrecontrolCells> y, error;
-  arx_free_run_steps(step.data(), joint.cells, y.data());
+  arx_free_run_steps(joint.model.data(), y_past.data(), joint.cells, windows, y.data());
   for (int c = 0; c < joint.cells; ++c) {
-    CellModel& m = joint.cell[c];
-    push_newest(m.y, m.y_pos, kOutputRing, y[c]);
-    error[c] = u[m.d] - y[c];
+    OutputHistory& h = joint.output_history[c];
+    push_newest(h.y, h.pos, kOutputRing, y[c]);
+    error[c] = u[joint.model[c].dead_time] - y[c];
   }
   double blended = 0.0;
   for (int i = 0; i < blend.count; ++i) blended += blend.weight[i] * error[blend.cell[i]];

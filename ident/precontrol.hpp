@@ -17,8 +17,15 @@
 //      companion form of an order-32 model (|a_i| up to ~1e8) that transient reached 2.3 rad in
 //      bench/bench_precontrol.cpp's table within a few cycles, so "only the blended cells" was
 //      rejected. The cycle is made fast instead by the padded SIMD sums of
-//      ident/arx_step_kernel.hpp (same outputs as before within a few ulp:
-//      tests/ident/test_precontrol.cpp compares with the all-cells reference);
+//      ident/arx_step_kernel.hpp, each over its own length (a one-tap input costs one block of
+//      8 products, not max(na, nb, nx) of them), with the same outputs as before within a few
+//      ulp (tests/ident/test_precontrol*.cpp compare with the all-cells reference). Measured and
+//      not taken (bench/bench_precontrol.cpp's 6-cell grid with the further inputs, kernel alone):
+//      the input sums of all cells of a joint as one matrix-vector product over the shared
+//      histories (cells in the SIMD lanes) saved ~13 % of the kernel (~6 % of the cycle), at the
+//      price of coefficient matrices sized for the largest table accepted (16 cells, 64 taps,
+//      dead times up to 64 apart: ~380 kB more state) and a second code path for one-cell
+//      tables; 8-wide AVX-512 registers saved nothing (the sums are not bound by their width);
 //   3. the backlash term of eq. 3, l · tanh(q̇_d(k - lag) / v_b) with the table's lag: ±l when
 //      moving, a smooth transition through zero velocity instead of a jump at reversals (no
 //      chattering);
@@ -133,28 +140,25 @@ class Precontrol {
   // Histories are rings stored twice (each value written at i and i + ring): the newest-first
   // window of any length up to the ring size is then contiguous, so the model's dot products
   // run over plain arrays (vectorised) without index wrapping.
-  // The model's sums (ident/arx_step_kernel.hpp) run over max(na, nb) padded to a multiple
-  // of kArxStepLanes with zero coefficients: no remainder loop, no branch (the reads past na, nb
-  // stay inside the rings and are multiplied by 0).
+  // The model's sums (ident/arx_step_kernel.hpp) each run over their own length (na, nb, nx_e)
+  // padded to a multiple of kArxStepLanes with zero coefficients: no remainder loop (the reads
+  // past na, nb, nx_e stay inside the rings and are multiplied by 0).
+  static_assert(kMaxPrecontrolOrder <= kArxStepMaxTerms);
   static_assert(kMaxPrecontrolOrder % kArxStepLanes == 0);
-  static constexpr int kInputRing = 128;  // power of two >= d + terms
+  static constexpr int kInputRing = 128;  // power of two >= d + longest sum
   static_assert(kInputRing >= kMaxPrecontrolOrder + kMaxPrecontrolDeadTime);
   static constexpr int kOutputRing = kMaxPrecontrolOrder;  // q̂ history
   static_assert((kOutputRing & (kOutputRing - 1)) == 0);
   static constexpr int kSpeedRing = 128;  // > the largest backlash lag accepted [cycles]
-  struct CellModel {
-    int na = 0, nb = 0, d = 0, nx = 0;
-    int terms = 0;  // max(na, nb, nx) rounded up to kArxStepLanes: the length of every sum
-    std::array<double, kMaxPrecontrolOrder> a{};  // a_1..a_na, then zeros
-    std::array<double, kMaxPrecontrolOrder> b{};  // b_0..b_{nb-1}, then zeros
-    // Further inputs' coefficients c_e,0..c_e,nx-1, then zeros.
-    std::array<std::array<double, kMaxPrecontrolOrder>, kArxStepMaxExtras> c{};
-    std::array<double, 2 * kOutputRing> y{};  // q̂ history, newest at y[y_pos]
-    int y_pos = 0;
+  struct OutputHistory {
+    std::array<double, 2 * kOutputRing> y{};  // q̂ history, newest at y[pos]
+    int pos = 0;
   };
   struct JointModel {
     int cells = 0;
-    std::array<CellModel, kMaxPrecontrolCells> cell{};
+    // Per cell its model (contiguous: the kernel runs over all of them) and its own q̂ history.
+    std::array<ArxCellCoefficients, kMaxPrecontrolCells> model{};
+    std::array<OutputHistory, kMaxPrecontrolCells> output_history{};
     // Blending grid: per dimension the quantity and cell centres.
     int dims = 0;
     std::array<OperatingQuantity, 4> quantity{};

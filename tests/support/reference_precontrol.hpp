@@ -1,9 +1,15 @@
 #pragma once
 // The precontrol cycle as it was before the speed work of issue 6 (ident/precontrol.* at commit
-// ef0e005): every cell's ARX model advances in every cycle, whether or not it is in the blend.
-// Kept verbatim (renamed) as the reference that the faster runtime is compared with: by
-// tests/ident/test_precontrol.cpp (same offsets within a stated tolerance) and by
-// bench/bench_precontrol.cpp (before/after cycle times in the same run). Not for production use.
+// ef0e005): every cell's ARX model advances in every cycle, whether or not it is in the blend,
+// each sum an Eigen dot product over exactly its own coefficients. Kept (renamed) as the reference
+// that the faster runtime is compared with: by tests/ident/test_precontrol*.cpp (same offsets
+// within a stated tolerance) and by bench/bench_precontrol.cpp (before/after cycle times in the
+// same run). Not for production use.
+// Extended since by the further inputs of the multi-input models as ident/precontrol.hpp defines
+// them (commit 29523ed: model torque from the caller, direction tanh(q̇ / scale), torque sign
+// tanh(torque / joint scale); started at the steady state of the pose's torque; lost cycles
+// bridged with the last torque), written here again from that definition: Σ_j c_e,j x_e(k-d-j)
+// over the nx_e coefficients of input e, in the runtime's table order.
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
@@ -52,7 +58,17 @@ class AllCellsPrecontrol {
 
   // One control cycle. cycle_counter: the caller's cycle number (consecutive normally).
   PrecontrolOutput cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
-                         double payload_kg, std::uint64_t cycle_counter) noexcept;
+                         double payload_kg, std::uint64_t cycle_counter) noexcept {
+    return run_cycle(q_desired_rad, payload_kg, nullptr, cycle_counter);
+  }
+  // The same with the model torques [N m], for tables with further inputs.
+  PrecontrolOutput cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
+                         double payload_kg,
+                         const std::array<double, kPrecontrolJoints>& model_torque_nm,
+                         std::uint64_t cycle_counter) noexcept {
+    return run_cycle(q_desired_rad, payload_kg, &model_torque_nm, cycle_counter);
+  }
+  bool needs_model_torque() const noexcept { return torque_input_ >= 0; }
 
   // Explicit re-activation after a deactivation: the models restart from the current desired
   // values (at rest: zero error) and the offsets rise smoothly from zero.
@@ -71,10 +87,13 @@ class AllCellsPrecontrol {
   static constexpr int kInputRing = 128;  // power of two >= nb + d
   static_assert(kInputRing >= kMaxPrecontrolOrder + kMaxPrecontrolDeadTime);
   static constexpr int kSpeedRing = 128;  // > the largest backlash lag accepted [cycles]
+  static constexpr int kMaxExtras = kMaxExtraInputs;
   struct CellModel {
     int na = 0, nb = 0, d = 0;
+    std::array<int, kMaxExtras> nx{};
     std::array<double, kMaxPrecontrolOrder> a{};
     std::array<double, kMaxPrecontrolOrder> b{};
+    std::array<std::array<double, kMaxPrecontrolOrder>, kMaxExtras> c{};  // input after input
     std::array<double, 2 * kMaxPrecontrolOrder> y{};  // q̂ history, newest at y[y_pos]
     int y_pos = 0;
   };
@@ -88,6 +107,7 @@ class AllCellsPrecontrol {
     std::array<int, 4> centre_count{};
     std::array<double, 4> lower{}, upper{};  // grid bounds (outside: event)
     double backlash_l_rad = 0.0;
+    double torque_sign_scale_nm = 0.0;
     // The identification's direction of motion is the desired velocity `backlash_lag` cycles
     // earlier (ident/backlash_identification.hpp): a ring of past speeds [rad/s].
     int backlash_lag = 0;
@@ -96,6 +116,7 @@ class AllCellsPrecontrol {
     // Input history q_d(k), q_d(k-1), ... (ring), newest at u_head.
     std::array<double, 2 * kInputRing> u{};  // q_d history, newest at u[u_pos]
     int u_pos = 0;
+    std::array<std::array<double, 2 * kInputRing>, kMaxExtras> x{};  // x_e history, newest at u_pos
     double last_error = 0.0;      // blended Δq̂ of the last model step
     double previous_error = 0.0;  // the one before (for output interpolation at T/m cycles)
     double smooth = 0.0, smooth_rate = 0.0;  // smoother state
@@ -103,8 +124,15 @@ class AllCellsPrecontrol {
   };
 
   void model_step(JointModel& joint, double q_desired, double speed, double acceleration,
-                  double payload, bool& outside) noexcept;
-  void restart_models(const std::array<double, kPrecontrolJoints>& q_desired) noexcept;
+                  double payload, double torque, bool& outside) noexcept;
+  std::array<double, kMaxExtras> extra_values(const JointModel& joint, double speed,
+                                              double torque) const noexcept;
+  void restart_models(const std::array<double, kPrecontrolJoints>& q_desired,
+                      const std::array<double, kPrecontrolJoints>& torque) noexcept;
+  PrecontrolOutput run_cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
+                             double payload_kg,
+                             const std::array<double, kPrecontrolJoints>* model_torque_nm,
+                             std::uint64_t cycle_counter) noexcept;
   void deactivate(std::uint64_t cycle, int joint, PrecontrolCause cause, double value) noexcept;
   void log(std::uint64_t cycle, int joint, PrecontrolCause cause, double value) noexcept;
 
@@ -116,6 +144,10 @@ class AllCellsPrecontrol {
   std::array<JointModel, kPrecontrolJoints> joints_{};
   std::array<double, kPrecontrolJoints> last_q_{};
   std::array<double, kPrecontrolJoints> last_speed_{};
+  std::array<double, kPrecontrolJoints> last_torque_{};
+  int extra_count_ = 0;
+  int torque_input_ = -1, direction_input_ = -1, torque_sign_input_ = -1;  // -1: none
+  double direction_scale_ = 0.01;                                          // [rad/s]
   double last_payload_ = 0.0;
   bool started_ = false;
   std::uint64_t last_cycle_ = 0;
@@ -144,6 +176,16 @@ inline bool AllCellsPrecontrol::create(const ParameterTable& table, const std::s
   AllCellsPrecontrol p;
   p.options_ = options;
   p.model_sample_s_ = T;
+  if (table.extra_inputs.size() > std::size_t(kMaxExtras)) return refuse("too many inputs");
+  p.extra_count_ = static_cast<int>(table.extra_inputs.size());
+  for (int e = 0; e < p.extra_count_; ++e) {
+    const TableInput input = table.extra_inputs[std::size_t(e)];
+    if (input == TableInput::kModelTorque) p.torque_input_ = e;
+    if (input == TableInput::kDirection) p.direction_input_ = e;
+    if (input == TableInput::kTorqueSign) p.torque_sign_input_ = e;
+  }
+  if (p.torque_sign_input_ >= 0 && p.torque_input_ < 0) return refuse("sign without torque");
+  p.direction_scale_ = table.direction_speed_scale_rad_s;
   const double up = c / T, down = T / c;
   if (std::abs(up - std::round(up)) < 1e-9 * up && std::round(up) >= 1 && std::round(up) <= 8) {
     p.steps_per_call_ = static_cast<int>(std::round(up));
@@ -190,6 +232,7 @@ inline bool AllCellsPrecontrol::create(const ParameterTable& table, const std::s
                     " samples exceeds the supported " + std::to_string(kSpeedRing - 1));
     }
     joint.backlash_lag = static_cast<int>(source.backlash_lag_samples);
+    joint.torque_sign_scale_nm = source.torque_sign_scale_nm;
     for (int k = 0; k < joint.cells; ++k) {
       const CellParameters& cell = source.cells[k];
       CellModel& model = joint.cell[k];
@@ -204,9 +247,20 @@ inline bool AllCellsPrecontrol::create(const ParameterTable& table, const std::s
       }
       for (int i = 0; i < model.na; ++i) model.a[i] = cell.a[i];
       for (int i = 0; i < model.nb; ++i) model.b[i] = cell.b[i];
-      const bool finite =
-          std::all_of(cell.a.begin(), cell.a.end(), [](double v) { return std::isfinite(v); }) &&
-          std::all_of(cell.b.begin(), cell.b.end(), [](double v) { return std::isfinite(v); });
+      if (cell.structure.extra_inputs != p.extra_count_ ||
+          cell.c.size() != std::size_t(cell.structure.extra_coefficient_count())) {
+        return refuse(name + "further inputs differ from the table's");
+      }
+      for (int e = 0; e < p.extra_count_; ++e) {
+        model.nx[e] = cell.structure.nx[std::size_t(e)];
+        if (model.nx[e] < 1 || model.nx[e] > kMaxPrecontrolOrder) return refuse(name + "bad nx");
+        for (int i = 0; i < model.nx[e]; ++i)
+          model.c[e][i] = cell.c[std::size_t(cell.structure.extra_offset(e) + i)];
+      }
+      auto finite_values = [](const std::vector<double>& v) {
+        return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+      };
+      const bool finite = finite_values(cell.a) && finite_values(cell.b) && finite_values(cell.c);
       if (!finite) return refuse(name + "cell " + std::to_string(k) + ": NaN/Inf parameter");
     }
   }
@@ -234,19 +288,35 @@ inline int AllCellsPrecontrol::read_events(PrecontrolEvent* out, int capacity) n
   return n;
 }
 
+inline std::array<double, AllCellsPrecontrol::kMaxExtras> AllCellsPrecontrol::extra_values(
+    const JointModel& joint, double speed, double torque) const noexcept {
+  std::array<double, kMaxExtras> value{};
+  if (torque_input_ >= 0) value[torque_input_] = torque;
+  if (direction_input_ >= 0) value[direction_input_] = std::tanh(speed / direction_scale_);
+  if (torque_sign_input_ >= 0)
+    value[torque_sign_input_] = std::tanh(torque / joint.torque_sign_scale_nm);
+  return value;
+}
+
 inline void AllCellsPrecontrol::restart_models(
-    const std::array<double, kPrecontrolJoints>& q) noexcept {
-  // At rest the robot stands where it was told: past inputs all equal q_d, every model at its
-  // steady state B(1) q_d / A(1) (q_d itself near an integrator, A(1) ~ 0).
+    const std::array<double, kPrecontrolJoints>& q,
+    const std::array<double, kPrecontrolJoints>& torque) noexcept {
+  // At rest the robot stands where it was told: past inputs all equal q_d (and the pose's
+  // torque, direction 0), every model at its steady state (B(1) q_d + Σ_e C_e(1) x_e) / A(1)
+  // (q_d itself near an integrator, A(1) ~ 0).
   for (int j = 0; j < kPrecontrolJoints; ++j) {
     JointModel& joint = joints_[j];
     joint.u.fill(q[j]);
+    const std::array<double, kMaxExtras> x = extra_values(joint, 0.0, torque[j]);
+    for (int e = 0; e < extra_count_; ++e) joint.x[e].fill(x[e]);
     for (int k = 0; k < joint.cells; ++k) {
       CellModel& m = joint.cell[k];
-      double a1 = 1.0, b1 = 0.0;
+      double a1 = 1.0, b1 = 0.0, extra = 0.0;
       for (int i = 0; i < m.na; ++i) a1 += m.a[i];
       for (int i = 0; i < m.nb; ++i) b1 += m.b[i];
-      m.y.fill(std::abs(a1) > 1e-9 ? b1 * q[j] / a1 : q[j]);
+      for (int e = 0; e < extra_count_; ++e)
+        for (int i = 0; i < m.nx[e]; ++i) extra += m.c[e][i] * x[e];
+      m.y.fill(std::abs(a1) > 1e-9 ? (b1 * q[j] + extra) / a1 : q[j]);
     }
     joint.last_error = joint.previous_error = 0.0;
     joint.smooth = joint.output;
@@ -255,14 +325,20 @@ inline void AllCellsPrecontrol::restart_models(
     joint.speed_history.fill(0.0);
   }
   last_q_ = q;
+  last_torque_ = torque;
   call_phase_ = 0;
 }
 
 inline void AllCellsPrecontrol::model_step(JointModel& joint, double q_desired, double speed,
-                                           double acceleration, double payload,
+                                           double acceleration, double payload, double torque,
                                            bool& outside) noexcept {
   push_newest(joint.u, joint.u_pos, kInputRing, q_desired);
   const double* u = joint.u.data() + joint.u_pos;  // u[i] = q_d(k - i)
+  const std::array<double, kMaxExtras> x_now = extra_values(joint, speed, torque);
+  for (int e = 0; e < extra_count_; ++e) {
+    joint.x[e][joint.u_pos] = x_now[e];
+    joint.x[e][joint.u_pos + kInputRing] = x_now[e];
+  }
 
   std::array<double, 4> point{};
   std::array<std::span<const double>, 4> centres{};
@@ -292,7 +368,10 @@ inline void AllCellsPrecontrol::model_step(JointModel& joint, double q_desired, 
   for (int c = 0; c < joint.cells; ++c) {
     CellModel& m = joint.cell[c];
     const double* y_past = m.y.data() + m.y_pos;  // y_past[i] = q̂(k - 1 - i)
-    const double y = dot(m.b.data(), u + m.d, m.nb) - dot(m.a.data(), y_past, m.na);
+    double input = dot(m.b.data(), u + m.d, m.nb);
+    for (int e = 0; e < extra_count_; ++e)
+      input += dot(m.c[e].data(), joint.x[e].data() + joint.u_pos + m.d, m.nx[e]);
+    const double y = input - dot(m.a.data(), y_past, m.na);
     push_newest(m.y, m.y_pos, kOutputRing, y);
     error[c] = u[m.d] - y;
   }
@@ -314,31 +393,41 @@ inline void AllCellsPrecontrol::deactivate(std::uint64_t cycle, int joint, Preco
 inline void AllCellsPrecontrol::reactivate() noexcept {
   log(last_cycle_, -1, PrecontrolCause::kReactivated, 0.0);
   state_ = PrecontrolState::kActive;
-  if (started_) restart_models(last_q_);
+  if (started_) restart_models(last_q_, last_torque_);
 }
 
-inline PrecontrolOutput AllCellsPrecontrol::cycle(
+inline PrecontrolOutput AllCellsPrecontrol::run_cycle(
     const std::array<double, kPrecontrolJoints>& q_desired_rad, double payload_kg,
+    const std::array<double, kPrecontrolJoints>* model_torque_nm,
     std::uint64_t cycle_counter) noexcept {
   const double dt = options_.caller_cycle_s;
   PrecontrolOutput out;
   bool valid = std::isfinite(payload_kg);
   for (double q : q_desired_rad) valid = valid && std::isfinite(q);
-  if (!valid) {
+  std::array<double, kPrecontrolJoints> torque{};
+  if (model_torque_nm != nullptr) {
+    torque = *model_torque_nm;
+    for (double t : torque) valid = valid && std::isfinite(t);
+  }
+  if (needs_model_torque() && model_torque_nm == nullptr) {
+    if (state_ == PrecontrolState::kActive)
+      deactivate(cycle_counter, -1, PrecontrolCause::kMissingTorque, 0.0);
+    valid = false;
+  } else if (!valid) {
     deactivate(cycle_counter, -1, PrecontrolCause::kInvalidInput, 0.0);
   } else if (!started_) {
-    restart_models(q_desired_rad);
+    restart_models(q_desired_rad, torque);
     started_ = true;
   } else if (cycle_counter != last_cycle_ + 1) {
     const double lost = static_cast<double>(cycle_counter - last_cycle_) - 1.0;
     if (cycle_counter <= last_cycle_ || lost > options_.max_lost_cycles) {
       deactivate(cycle_counter, -1, PrecontrolCause::kLostCycles, lost);
-      restart_models(q_desired_rad);
+      restart_models(q_desired_rad, torque);
     } else {  // bridge: the model sees the last input held over the lost cycles
       bool ignored = false;
       for (int k = 0; k < static_cast<int>(lost) * steps_per_call_; ++k) {
         for (int j = 0; j < kPrecontrolJoints; ++j) {
-          model_step(joints_[j], last_q_[j], 0.0, 0.0, last_payload_, ignored);
+          model_step(joints_[j], last_q_[j], 0.0, 0.0, last_payload_, last_torque_[j], ignored);
         }
       }
     }
@@ -358,7 +447,7 @@ inline PrecontrolOutput AllCellsPrecontrol::cycle(
         for (int s = 1; s <= steps_per_call_; ++s) {
           const double f = static_cast<double>(s) / steps_per_call_;
           model_step(joint, last_q_[j] + f * (q_desired_rad[j] - last_q_[j]), speed, acceleration,
-                     payload_kg, outside);
+                     payload_kg, last_torque_[j] + f * (torque[j] - last_torque_[j]), outside);
         }
       }
       const double phase =
@@ -397,6 +486,7 @@ inline PrecontrolOutput AllCellsPrecontrol::cycle(
   }
   if (valid) {
     last_q_ = q_desired_rad;  // also while inactive: a re-activation restarts from here
+    last_torque_ = torque;
     last_payload_ = payload_kg;
   }
 
