@@ -239,7 +239,8 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
     constexpr std::size_t kHalf = 2;
     for (std::size_t k = begin; k < end; ++k) {
       const double e = q_desired[k] - q_measured[k];
-      out.parameters.offset_envelope_rad = std::max(out.parameters.offset_envelope_rad, std::abs(e));
+      out.parameters.offset_envelope_rad =
+          std::max(out.parameters.offset_envelope_rad, std::abs(e));
       if (k < begin + kHalf || k + kHalf >= end) continue;
       const double rate = ((q_desired[k + kHalf] - q_measured[k + kHalf]) -
                            (q_desired[k - kHalf] - q_measured[k - kHalf])) /
