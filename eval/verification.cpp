@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <stdexcept>
 
@@ -197,36 +198,84 @@ Eigen::Matrix<double, 8, 1> pose_row(const PathPose& p) {
 
 }  // namespace
 
-ident::JointErrorLog simulate_truth_joint_errors(const sim::Scenario& scenario,
-                                                 double max_duration_s) {
-  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
-  sim::DesiredJointPath path =
-      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
-  while (path.samples.size() > 2 && path.samples.back().t_s > max_duration_s) {
-    path.samples.pop_back();
+namespace {
+
+// The scenario's program (cut at max_duration_s), its plant run and the robot.
+struct ScenarioRun {
+  calib::RobotDescription robot;
+  sim::DesiredJointPath path;
+  sim::PlantLog plant;
+};
+
+ScenarioRun run_scenario(const sim::Scenario& scenario, double max_duration_s) {
+  ScenarioRun run;
+  run.robot = calib::load_robot_description(scenario.robot_file);
+  run.path = sim::plan_motion(run.robot, sim::load_motion_program(scenario.program_file));
+  while (run.path.samples.size() > 2 && run.path.samples.back().t_s > max_duration_s) {
+    run.path.samples.pop_back();
   }
-  const sim::PlantLog plant =
-      sim::simulate_plant(scenario_plant(scenario, robot), path, path.cycle_s);
+  run.plant = sim::simulate_plant(scenario_plant(scenario, run.robot), run.path, run.path.cycle_s);
+  return run;
+}
+
+// The joint-error log of a run, one sample per controller cycle: q_d, the measured angles where
+// measured[k] holds a value (gaps elsewhere) and the encoders (q_internal = motor angle / N).
+ident::JointErrorLog joint_error_log(const ScenarioRun& run,
+                                     const std::vector<std::optional<calib::JointVector>>& measured,
+                                     std::string source) {
   ident::JointErrorLog log;
-  log.robot = robot.name;
-  log.cycle_s = path.cycle_s;
-  log.source =
-      fmt::format("simulator truth (q_measured = link-side angles) of scenario {}", scenario.name);
-  for (const auto& joint : robot.joints) log.joint_names.push_back(joint.name);
+  log.robot = run.robot.name;
+  log.cycle_s = run.path.cycle_s;
+  log.source = std::move(source);
+  for (const auto& joint : run.robot.joints) log.joint_names.push_back(joint.name);
   log.q_desired_rad.assign(calib::kJointCount, {});
   log.q_measured_rad.assign(calib::kJointCount, {});
   log.q_internal_rad.assign(calib::kJointCount, {});
-  const std::size_t n = std::min(path.samples.size(), plant.samples.size());
-  for (std::size_t k = 0; k < n; ++k) {
-    log.time_s.push_back(path.samples[k].t_s);
-    log.payload_kg.push_back(payload_mass(path, path.samples[k]));
+  for (std::size_t k = 0; k < measured.size(); ++k) {
+    if (!measured[k]) continue;
+    log.time_s.push_back(run.path.samples[k].t_s);
+    log.payload_kg.push_back(payload_mass(run.path, run.path.samples[k]));
     for (int j = 0; j < calib::kJointCount; ++j) {
-      log.q_desired_rad[std::size_t(j)].push_back(path.samples[k].q_rad[j]);
-      log.q_measured_rad[std::size_t(j)].push_back(plant.samples[k].q_link_rad[j]);
-      log.q_internal_rad[std::size_t(j)].push_back(plant.samples[k].q_motor_rad[j]);
+      log.q_desired_rad[std::size_t(j)].push_back(run.path.samples[k].q_rad[j]);
+      log.q_measured_rad[std::size_t(j)].push_back((*measured[k])[j]);
+      log.q_internal_rad[std::size_t(j)].push_back(run.plant.samples[k].q_motor_rad[j]);
     }
   }
+  ident::split_at_gaps(log);
   return log;
+}
+
+}  // namespace
+
+ident::JointErrorLog simulate_truth_joint_errors(const sim::Scenario& scenario,
+                                                 double max_duration_s) {
+  const ScenarioRun run = run_scenario(scenario, max_duration_s);
+  std::vector<std::optional<calib::JointVector>> link(
+      std::min(run.path.samples.size(), run.plant.samples.size()));
+  for (std::size_t k = 0; k < link.size(); ++k) link[k] = run.plant.samples[k].q_link_rad;
+  return joint_error_log(
+      run, link,
+      fmt::format("simulator truth (q_measured = link-side angles) of scenario {}", scenario.name));
+}
+
+ident::JointErrorLog simulate_ims_joint_errors(const sim::Scenario& scenario, std::uint64_t seed,
+                                               double max_duration_s) {
+  const ScenarioRun run = run_scenario(scenario, max_duration_s);
+  double standstill_s = 0.0;  // the program's initial rest: the chain's first rest
+  for (const auto& sample : run.path.samples) {
+    if (sample.qd_rad_s.norm() != 0.0 || sample.qdd_rad_s2.norm() != 0.0) break;
+    standstill_s = sample.t_s;
+  }
+  const ImsJointMeasurement m =
+      measure_joints_with_ims(scenario, run.robot, run.path, run.plant, standstill_s, seed);
+  std::vector<std::optional<calib::JointVector>> ims(
+      std::min(run.path.samples.size(), run.plant.samples.size()));
+  for (std::size_t k = 0; k < ims.size(); ++k)
+    if (m.valid[k]) ims[k] = m.q_rad[k];
+  return joint_error_log(
+      run, ims,
+      fmt::format("IMS chain (simulated navigation-grade IMS, seed {}) of scenario {}", seed,
+                  scenario.name));
 }
 
 ModelTorqueSource scenario_model_torque(const sim::Scenario& scenario) {
@@ -234,46 +283,6 @@ ModelTorqueSource scenario_model_torque(const sim::Scenario& scenario) {
   model.robot = calib::load_robot_description(scenario.robot_file);
   model.gravity_in_base_m_s2 = scenario_plant(scenario, model.robot).gravity_in_base_m_s2;
   return model;
-}
-
-ident::JointErrorLog simulate_ims_joint_errors(const sim::Scenario& scenario, std::uint64_t seed,
-                                               double max_duration_s) {
-  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
-  sim::DesiredJointPath path =
-      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
-  while (path.samples.size() > 2 && path.samples.back().t_s > max_duration_s) {
-    path.samples.pop_back();
-  }
-  const sim::PlantLog plant =
-      sim::simulate_plant(scenario_plant(scenario, robot), path, path.cycle_s);
-  double standstill_s = 0.0;  // the program's initial rest: the chain's first rest
-  for (const auto& sample : path.samples) {
-    if (sample.qd_rad_s.norm() != 0.0 || sample.qdd_rad_s2.norm() != 0.0) break;
-    standstill_s = sample.t_s;
-  }
-  const ImsJointMeasurement m =
-      measure_joints_with_ims(scenario, robot, path, plant, standstill_s, seed);
-  ident::JointErrorLog log;
-  log.robot = robot.name;
-  log.cycle_s = path.cycle_s;
-  log.source = fmt::format("IMS chain (simulated navigation-grade IMS, seed {}) of scenario {}",
-                           seed, scenario.name);
-  for (const auto& joint : robot.joints) log.joint_names.push_back(joint.name);
-  log.q_desired_rad.assign(calib::kJointCount, {});
-  log.q_measured_rad.assign(calib::kJointCount, {});
-  log.q_internal_rad.assign(calib::kJointCount, {});
-  for (std::size_t k = 0; k < std::min(path.samples.size(), plant.samples.size()); ++k) {
-    if (!m.valid[k]) continue;
-    log.time_s.push_back(path.samples[k].t_s);
-    log.payload_kg.push_back(payload_mass(path, path.samples[k]));
-    for (int j = 0; j < calib::kJointCount; ++j) {
-      log.q_desired_rad[std::size_t(j)].push_back(path.samples[k].q_rad[j]);
-      log.q_measured_rad[std::size_t(j)].push_back(m.q_rad[k][j]);
-      log.q_internal_rad[std::size_t(j)].push_back(plant.samples[k].q_motor_rad[j]);
-    }
-  }
-  ident::split_at_gaps(log);
-  return log;
 }
 
 IdentifiedTable identify_table(const ident::JointErrorLog& log,

@@ -9,7 +9,6 @@
 #include <sstream>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "calib/robot_log.hpp"
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
@@ -17,15 +16,15 @@
 #include "ident/parameter_table_io.hpp"
 #include "ident/precontrol.hpp"
 #include "tools/command_registry.hpp"
+#include "tools/model_torque_option.hpp"
 
 namespace {
 namespace ident = imscal::ident;
 
 struct CompensateArgs {
   std::string table, robot_log, out;
-  std::string robot;  // robot description, for tables whose models take the model torque
-  std::vector<double> gravity_m_s2{0.0, 0.0, -9.80665};  // in the robot base R
-  double offset_tolerance_rad = 0.0;                     // 0: the precontrol's default
+  imscal::tools::ModelTorqueOption model_torque;  // for tables with the model-torque input
+  double offset_tolerance_rad = 0.0;              // 0: the precontrol's default
   bool force = false;
 };
 
@@ -33,18 +32,8 @@ struct CompensateArgs {
 // ([joint][sample]; eval/model_torque.hpp), for a table whose models take them.
 std::vector<std::vector<double>> model_torques(const CompensateArgs& args,
                                                const imscal::calib::RobotLog& log) {
-  if (args.robot.empty())
-    throw imscal::InputError(args.table, 0, "extra_inputs",
-                             "the table's models take the model torque: give the robot "
-                             "description with --robot (e.g. datasets/robots/kr16.yaml)");
-  imscal::eval::ModelTorqueSource model;
-  model.robot = imscal::calib::load_robot_description(args.robot);
-  if (model.robot.name != log.robot_name)
-    throw imscal::InputError(args.robot, 0, "name",
-                             fmt::format("robot '{}', but {} is of robot '{}'", model.robot.name,
-                                         args.robot_log, log.robot_name));
-  model.gravity_in_base_m_s2 =
-      Eigen::Vector3d(args.gravity_m_s2[0], args.gravity_m_s2[1], args.gravity_m_s2[2]);
+  const imscal::eval::ModelTorqueSource model =
+      args.model_torque.source(log.robot_name, args.robot_log, args.table, "extra_inputs");
   const std::size_t n = log.samples.size();
   std::vector<std::vector<double>> q(imscal::calib::kJointCount, std::vector<double>(n));
   std::vector<double> payload(n);
@@ -139,12 +128,7 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--table", args->table, "parameters.json (imscal identify)")->required();
       sub.add_option("--robot-log", args->robot_log, "robot.csv (desired joints, payload)")
           ->required();
-      sub.add_option("--robot", args->robot,
-                     "Robot description (datasets/robots/kr16.yaml): the model torque of tables "
-                     "with that input");
-      sub.add_option("--gravity-m-s2", args->gravity_m_s2,
-                     "Gravity in the robot base R [m/s²] (default 0 0 -9.80665: a level base)")
-          ->expected(3);
+      args->model_torque.add_to(sub);
       sub.add_option("--out", args->out, "offsets.csv")->required();
       sub.add_option("--offset-tolerance-rad", args->offset_tolerance_rad,
                      "supervisor tolerance on |offset| per joint [rad] (default 0.005)");

@@ -13,7 +13,6 @@
 #include <optional>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "core/atomic_file.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
@@ -26,6 +25,7 @@
 #include "ident/joint_identification.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "tools/command_registry.hpp"
+#include "tools/model_torque_option.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -35,29 +35,18 @@ using nlohmann::json;
 struct IdentifyArgs {
   std::string joint_errors;
   std::string config;
-  std::string robot;  // robot description, for the model torque of multi-input configs
-  std::vector<double> gravity_m_s2{0.0, 0.0, -9.80665};  // in the robot base R
+  imscal::tools::ModelTorqueOption model_torque;  // for configs with the model-torque input
   std::string out;
   bool force = false;
 };
 
 // The model torques of the log's path (eval/model_torque.hpp), when the config's models take
-// them: from the robot description given with --robot, whose name must be the log's robot.
+// them.
 void attach_model_torques(ident::JointErrorLog& log, const ident::IdentificationConfig& config,
                           const IdentifyArgs& args) {
   if (!config.options.model_torque_input) return;
-  if (args.robot.empty())
-    throw imscal::InputError(args.config, 0, "model.model_torque",
-                             "the config's models take the model torque: give the robot "
-                             "description with --robot (e.g. datasets/robots/kr16.yaml)");
-  imscal::eval::ModelTorqueSource model;
-  model.robot = imscal::calib::load_robot_description(args.robot);
-  if (model.robot.name != log.robot)
-    throw imscal::InputError(args.robot, 0, "name",
-                             fmt::format("robot '{}', but {} is of robot '{}'", model.robot.name,
-                                         args.joint_errors, log.robot));
-  model.gravity_in_base_m_s2 =
-      Eigen::Vector3d(args.gravity_m_s2[0], args.gravity_m_s2[1], args.gravity_m_s2[2]);
+  const imscal::eval::ModelTorqueSource model =
+      args.model_torque.source(log.robot, args.joint_errors, args.config, "model.model_torque");
   spdlog::info("identify: model torques of {} along the {} path", model.robot.name,
                imscal::eval::torque_along_measured_path(config.options) ? "measured" : "desired");
   imscal::eval::attach_model_torques(log, model, config.options);
@@ -272,12 +261,7 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--config", args->config,
                      "Identification config (datasets/identification/ident-default.yaml)")
           ->required();
-      sub.add_option("--robot", args->robot,
-                     "Robot description (datasets/robots/kr16.yaml): the rigid-body model of the "
-                     "model torque input");
-      sub.add_option("--gravity-m-s2", args->gravity_m_s2,
-                     "Gravity in the robot base R [m/s²] (default 0 0 -9.80665: a level base)")
-          ->expected(3);
+      args->model_torque.add_to(sub);
       sub.add_option("--out", args->out, "Output folder")->required();
       sub.add_flag("--force", args->force, "Overwrite existing outputs");
       sub.callback([args] { run(*args); });

@@ -1,0 +1,38 @@
+#include "tools/model_torque_option.hpp"
+
+#include <fmt/format.h>
+
+#include "calib/robot_description.hpp"
+#include "core/input_error.hpp"
+
+namespace imscal::tools {
+
+void ModelTorqueOption::add_to(CLI::App& command) {
+  command.add_option("--robot", robot,
+                     "Robot description (datasets/robots/kr16.yaml): the rigid-body model of the "
+                     "model-torque input");
+  command
+      .add_option("--gravity-m-s2", gravity_m_s2,
+                  "Gravity in the robot base R [m/s²] (default 0 0 -9.80665: a level base)")
+      ->expected(3);
+}
+
+eval::ModelTorqueSource ModelTorqueOption::source(const std::string& data_robot,
+                                                  const std::string& data_file,
+                                                  const std::string& needed_by_file,
+                                                  const std::string& needed_by_field) const {
+  if (robot.empty())
+    throw InputError(needed_by_file, 0, needed_by_field,
+                     "the models take the model torque: give the robot description with --robot "
+                     "(e.g. datasets/robots/kr16.yaml)");
+  eval::ModelTorqueSource model;
+  model.robot = calib::load_robot_description(robot);
+  if (model.robot.name != data_robot)
+    throw InputError(robot, 0, "name",
+                     fmt::format("robot '{}', but {} is of robot '{}'", model.robot.name, data_file,
+                                 data_robot));
+  model.gravity_in_base_m_s2 = Eigen::Vector3d(gravity_m_s2[0], gravity_m_s2[1], gravity_m_s2[2]);
+  return model;
+}
+
+}  // namespace imscal::tools
