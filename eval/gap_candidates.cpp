@@ -330,7 +330,10 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
           "d tau / d m / k on every loaded joint", 1,
           [&](std::size_t j) { return std::vector<Column>{to_column(s.unit_payload_nm_kg[j])}; },
           ""));
-      for (const auto& [tl, order] : {std::pair{0.03, 4}, std::pair{0.1, 6}}) {
+      for (const auto& [tl_s, order_taps] : {std::pair{0.03, 4}, std::pair{0.1, 6}}) {
+        // Copies: clang 14 cannot capture structured bindings in a lambda.
+        const double tl = tl_s;
+        const int order = order_taps;
         const int ms = int(std::lround(1000.0 * tl));
         out.push_back(per_joint(
             fmt::format("d tau / d m through Laguerre {} ms x{} on every loaded joint", ms, order),
