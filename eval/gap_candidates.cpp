@@ -9,94 +9,17 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "eval/gap_coupling.hpp"
+#include "eval/gap_filters.hpp"
+#include "eval/gap_validation.hpp"
+
 namespace imscal::eval {
 namespace {
-
-using Column = Eigen::VectorXd;
-
-Column to_column(const std::vector<double>& v) {
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), Eigen::Index(v.size()));
-}
-
-// First-order lag y' = (u - y) / tau, exact discretisation, restarted at every run from u.
-Column lag(const Column& u, double tau_s, const GapSignals& s) {
-  Column y(u.size());
-  const double a = std::exp(-s.cycle_s / tau_s);
-  for (const auto& [b, e] : s.runs) {
-    double state = e > b ? u[Eigen::Index(b)] : 0.0;
-    for (std::size_t k = b; k < e; ++k) {
-      state = a * state + (1.0 - a) * u[Eigen::Index(k)];
-      y[Eigen::Index(k)] = state;
-    }
-  }
-  return y;
-}
-
-// Lightly damped second-order response ω²/(s² + 2ζωs + ω²) to u (semi-implicit Euler with 8
-// substeps per cycle: stable and accurate to < 1 % up to 40 Hz at 2 ms), and its rate / ω.
-std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta,
-                                       const GapSignals& s) {
-  const double w = 2.0 * M_PI * f_hz;
-  const int sub = 8;
-  const double h = s.cycle_s / sub;
-  Column y(u.size()), r(u.size());
-  for (const auto& [b, e] : s.runs) {
-    double p = e > b ? u[Eigen::Index(b)] : 0.0, v = 0.0;  // at rest in its first input
-    for (std::size_t k = b; k < e; ++k) {
-      const double x = u[Eigen::Index(k)];
-      for (int i = 0; i < sub; ++i) {
-        v += h * (w * w * (x - p) - 2.0 * zeta * w * v);
-        p += h * v;
-      }
-      y[Eigen::Index(k)] = p;
-      r[Eigen::Index(k)] = v / w;
-    }
-  }
-  return {y, r};
-}
-
-// Discrete Laguerre filters of u with time scale tau (pole a = exp(-T / tau)):
-// L_0 = sqrt(1 - a²) / (1 - a z^-1), L_i = L_{i-1} (z^-1 - a) / (1 - a z^-1): an orthonormal
-// basis of stable linear responses, so a few columns follow a closed loop's reaction to u without
-// knowing its poles. Each run starts in the steady state of its first input.
-std::vector<Column> laguerre(const Column& u, double tau_s, int order, const GapSignals& s) {
-  const double a = std::exp(-s.cycle_s / tau_s), g0 = std::sqrt(1.0 - a * a);
-  std::vector<Column> out(std::size_t(order), Column(u.size()));
-  for (const auto& [b, e] : s.runs) {
-    if (e <= b) continue;
-    const double u0 = u[Eigen::Index(b)];
-    std::vector<double> y(std::size_t(order), g0 / (1.0 - a) * u0);
-    std::vector<double> x_previous = y;  // each stage's previous input
-    x_previous[0] = u0;
-    for (std::size_t k = b; k < e; ++k) {
-      double x = u[Eigen::Index(k)];
-      for (int i = 0; i < order; ++i) {
-        double& yi = y[std::size_t(i)];
-        const double next = i == 0 ? a * yi + g0 * x : a * yi + x_previous[std::size_t(i)] - a * x;
-        x_previous[std::size_t(i)] = x;
-        yi = next;
-        out[std::size_t(i)][Eigen::Index(k)] = next;
-        x = next;
-      }
-    }
-  }
-  return out;
-}
-
-Eigen::MatrixXd matrix_of(const std::vector<Column>& cols) {
-  Eigen::MatrixXd m(cols.empty() ? 0 : cols[0].size(), Eigen::Index(cols.size()));
-  for (std::size_t i = 0; i < cols.size(); ++i) m.col(Eigen::Index(i)) = cols[i];
-  return m;
-}
 
 std::vector<std::string> numbered(const std::string& stem, int count) {
   std::vector<std::string> names;
   for (int i = 0; i < count; ++i) names.push_back(fmt::format("{}{}_rad", stem, i));
   return names;
-}
-
-double rms_of(const Column& c) {
-  return c.size() ? std::sqrt(c.squaredNorm() / double(c.size())) : 0.0;
 }
 
 // Velocity scale of the smooth sign of the desired velocity [rad/s]: 0.3 deg/s, well below any
@@ -202,34 +125,66 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
   std::vector<CandidateShape> out;
   switch (kind) {
     case EffectKind::kBacklash: {
+      // The paper's eq. 3: the sign of the velocity (smooth, no memory).
       const Column sv = (qd_actual / kSignVelocityScale).array().tanh().matrix();
       out.push_back(local("sign(qd)", {sv}, {"l_rad"}));
       out.push_back(local("sign(qd) + lag 30 ms", {sv, lag(sv, 0.03, s)}, {"l_rad", "l_lag_rad"}));
-      // The gear torque must change sign for the play to show as anything but a constant
-      // offset: with less than 5 % of the samples on the minority side, no torque-sign shape.
+      // The flank the link rests on: a relay with memory of the sign of the gear torque (the link
+      // crosses the play when the torque the gear must pass changes sign, and stays on its flank
+      // while the torque is small). That torque is the rigid-body torque of the drive's actual
+      // motion plus the friction at the link (an unknown share of the joint's friction, which on
+      // light wrist axes outweighs their inertia torques): z = tau / RMS(tau) + c tanh(qd / v_s),
+      // c = 0 (torque only), 0.03 .. 3, or the velocity alone; thresholds 2 or 10 % of the
+      // torque's RMS. The link lands on the other flank with the gear's and the loop's dynamics:
+      // [r] or [r, Laguerre 10, 30 or 100 ms x4 of r].
+      const double tau_rms = std::max(rms_of(tau_actual), 1e-12);
+      // The smooth sign of the torque without memory (the link also starts across the play on
+      // short torque dips that do not reach the other flank): scales 1, 5, 20 % of its RMS, raw or
+      // with Laguerre 10, 30 or 100 ms x4; only when at least 5 % of the samples lie on the
+      // torque's minority side (otherwise it is the one-flank offset below).
       std::size_t positive = 0;
       for (Eigen::Index k = 0; k < n; ++k) positive += tau_actual[k] > 0.0;
       const double minority = double(std::min<std::size_t>(positive, std::size_t(n) - positive));
-      if (minority >= 0.05 * double(n)) {
-        // The torque's zero crossing is blurred by the unknown load model: scales 1, 5, 20 % of
-        // its RMS. The link crosses the play and lands with the gear's own dynamics: Laguerre
-        // bases of 10, 30 and 100 ms.
+      if (minority >= 0.05 * double(n))
         for (double fraction : {0.01, 0.05, 0.2}) {
-          const double tau_scale = std::max(fraction * rms_of(tau_actual), 1e-9);
-          const Column st = (tau_actual / tau_scale).array().tanh().matrix();
-          const int percent = int(std::lround(100.0 * fraction));
-          out.push_back(
-              local(fmt::format("sign(tau) at {} % of its RMS", percent), {st}, {"l_rad"}));
+          const Column st = (tau_actual / (fraction * tau_rms)).array().tanh().matrix();
+          const std::string label =
+              fmt::format("sign(tau) at {:.0f} % of its RMS", 100.0 * fraction);
+          out.push_back(local(label, {st}, {"l_rad"}));
           for (double tl : {0.01, 0.03, 0.1}) {
             std::vector<Column> cols = laguerre(st, tl, 4, s);
             cols.insert(cols.begin(), st);
             const int ms = int(std::lround(1000.0 * tl));
             std::vector<std::string> names = numbered(fmt::format("laguerre{}ms_", ms), 4);
             names.insert(names.begin(), "l_rad");
-            out.push_back(
-                local(fmt::format("sign(tau) at {} % of its RMS + Laguerre {} ms x4", percent, ms),
-                      cols, names));
+            out.push_back(local(fmt::format("{} + Laguerre {} ms x4", label, ms), cols, names));
           }
+        }
+      std::vector<std::pair<std::string, Column>> relays;
+      for (double h : {0.02, 0.1})
+        relays.emplace_back(fmt::format("sign(tau), hold below {:.0f} % of its RMS", 100.0 * h),
+                            relay(tau_actual / tau_rms, h, s));
+      for (double c : {0.03, 0.1, 0.3, 1.0, 3.0})
+        relays.emplace_back(fmt::format("sign(tau + {:.2f} RMS(tau) sign(qd)), hold below 2 %", c),
+                            relay(tau_actual / tau_rms + c * sv, 0.02, s));
+      relays.emplace_back("sign(qd), held at rest", relay(qd_actual, kSignVelocityScale, s));
+      bool one_flank_added = false;
+      for (const auto& [label, r] : relays) {
+        // A relay that never switches: the gear torque keeps its sign, the link stays on one
+        // flank and the play shows as a constant offset of half its width (one shape for all).
+        if (r.maxCoeff() == r.minCoeff()) {
+          if (!one_flank_added) out.push_back(local(kOneFlankShape, {r}, {"l_rad"}));
+          one_flank_added = true;
+          continue;
+        }
+        out.push_back(local(label, {r}, {"l_rad"}));
+        for (double tl : {0.01, 0.03, 0.1}) {
+          std::vector<Column> cols = laguerre(r, tl, 4, s);
+          cols.insert(cols.begin(), r);
+          const int ms = int(std::lround(1000.0 * tl));
+          std::vector<std::string> names = numbered(fmt::format("laguerre{}ms_", ms), 4);
+          names.insert(names.begin(), "l_rad");
+          out.push_back(local(fmt::format("{} + Laguerre {} ms x4", label, ms), cols, names));
         }
       }
       break;
@@ -269,30 +224,79 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
       break;
     }
     case EffectKind::kTransmissionError: {
+      // te(theta) = A sin(h N theta + phi) between motor and link, theta the motor angle / N: the
+      // link follows it below the closed loop's bandwidth and not above the link's mode, and the
+      // motor feels it as a torque ripple te'(theta) tau_g (the virtual work of the gear): the
+      // joint's error is a linear response to sin, cos (and tau sin, tau cos) of h N theta, whose
+      // frequency h N qd sweeps through those modes. Raw, or through Laguerre bases of 3, 10 or
+      // 30 ms (the response without knowing the loop's poles), with the ripple through 100 ms.
       const Column q = to_column(s.q_internal_rad[joint]);
       const double n_gear = s.gear_ratio[joint];
+      const Column tau_d = to_column(s.torque_nm[joint]);
+      const double tau_d_rms = std::max(rms_of(tau_d), 1e-12);
+      const auto through = [&](const std::vector<Column>& inputs, double tl, int order,
+                               const std::vector<std::string>& stems) {
+        std::vector<Column> cols;
+        std::vector<std::string> names;
+        const int ms = int(std::lround(1000.0 * tl));
+        for (std::size_t i = 0; i < inputs.size(); ++i) {
+          for (auto& c : laguerre(inputs[i], tl, order, s)) cols.push_back(std::move(c));
+          for (auto& nm : numbered(fmt::format("{}_laguerre{}ms_", stems[i], ms), order))
+            names.push_back(std::move(nm));
+        }
+        return std::pair{cols, names};
+      };
       for (int h = 1; h <= 3; ++h) {
         const Column phase = double(h) * n_gear * q;
         const Column sn = phase.array().sin().matrix(), cs = phase.array().cos().matrix();
         out.push_back(local(fmt::format("harmonic {} of the motor angle", h), {sn, cs},
                             {"sin_rad", "cos_rad"}));
-        for (double f : {5.0, 8.0, 11.0, 15.0, 20.0})
-          for (double zeta : {0.2, 0.4}) {
-            const Column ys = second_order(sn, f, zeta, s).first;
-            const Column yc = second_order(cs, f, zeta, s).first;
-            out.push_back(local(fmt::format("harmonic {} of the motor angle through a {:.0f} Hz "
-                                            "mode, damping {:.1f}",
-                                            h, f, zeta),
-                                {ys, yc}, {"sin_rad", "cos_rad"}));
-          }
+        for (const auto& [tl, order] :
+             {std::pair{0.003, 3}, std::pair{0.003, 4}, std::pair{0.01, 4}, std::pair{0.03, 4}}) {
+          auto [cols, names] = through({sn, cs}, tl, order, {"sin", "cos"});
+          out.push_back(local(fmt::format("harmonic {} of the motor angle through Laguerre {:.0f} "
+                                          "ms x{}",
+                                          h, 1000.0 * tl, order),
+                              cols, names));
+        }
+        // The ripple torque through the loop's slower response (its PI integrates it): tau_d (the
+        // desired motion's torque: the actual one carries the ripple's own oscillation).
+        const Column ts = tau_d.cwiseProduct(sn) / tau_d_rms;
+        const Column tc = tau_d.cwiseProduct(cs) / tau_d_rms;
+        {
+          auto [cols, names] = through({sn, cs}, 0.01, 3, {"sin", "cos"});
+          auto [rc, rn] = through({ts, tc}, 0.1, 3, {"tau_sin", "tau_cos"});
+          cols.insert(cols.end(), rc.begin(), rc.end());
+          names.insert(names.end(), rn.begin(), rn.end());
+          out.push_back(
+              local(fmt::format("harmonic {} of the motor angle through Laguerre 10 ms x3 "
+                                "and its torque ripple through Laguerre 100 ms x3",
+                                h),
+                    cols, names));
+        }
+        {
+          auto [cols, names] = through({sn, cs}, 0.003, 3, {"sin", "cos"});
+          auto [mc, mn] = through({sn, cs}, 0.03, 3, {"sin", "cos"});
+          auto [rc, rn] = through({ts, tc}, 0.1, 3, {"tau_sin", "tau_cos"});
+          cols.insert(cols.end(), mc.begin(), mc.end());
+          cols.insert(cols.end(), rc.begin(), rc.end());
+          names.insert(names.end(), mn.begin(), mn.end());
+          names.insert(names.end(), rn.begin(), rn.end());
+          out.push_back(
+              local(fmt::format("harmonic {} of the motor angle through Laguerre 3 and 30 "
+                                "ms x3 and its torque ripple through Laguerre 100 ms x3",
+                                h),
+                    cols, names));
+        }
       }
       break;
     }
     case EffectKind::kResonance: {
-      for (double f : {2.0, 3.0, 4.5, 6.5, 9.0, 12.0, 15.0, 20.0, 27.0, 36.0})
-        for (double zeta : {0.02, 0.05, 0.1, 0.3}) {
+      // A lightly damped mode is only fitted where its frequency is: 2..40 Hz in steps of 10 %.
+      for (double f = 2.0; f < 41.0; f *= 1.1)
+        for (double zeta : {0.02, 0.04, 0.07, 0.12, 0.3}) {
           auto [y, r] = second_order(qdd, f, zeta, s);
-          out.push_back(local(fmt::format("mode {:.1f} Hz, damping {:.2f}", f, zeta), {y, r},
+          out.push_back(local(fmt::format("mode {:.2f} Hz, damping {:.2f}", f, zeta), {y, r},
                               {"gain_rad_s2_per_rad_s2", "quadrature"}));
         }
       break;
@@ -304,6 +308,13 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
       if (joint != 0) break;  // one candidate for all joints, as the IMS chain's errors below
       // Every joint the payload loads (d tau / d m above 1e-6 N m/kg), each with its own
       // parameters: the same mass error acts on each through that joint's own compliance and loop.
+      // The unit-payload torque along the drive's actual motion where known (the mass loads the
+      // arm as it moves), else along q_d.
+      const auto unit_torque = [&](std::size_t j) {
+        const bool internal = j < s.unit_payload_internal_nm_kg.size() &&
+                              s.unit_payload_internal_nm_kg[j].size() == std::size_t(n);
+        return to_column(internal ? s.unit_payload_internal_nm_kg[j] : s.unit_payload_nm_kg[j]);
+      };
       std::vector<std::size_t> loaded;
       for (std::size_t j = 0; j < nj; ++j)
         if (rms_of(to_column(s.unit_payload_nm_kg[j])) > 1e-6) loaded.push_back(j);
@@ -328,21 +339,27 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
       };
       out.push_back(per_joint(
           "d tau / d m / k on every loaded joint", 1,
-          [&](std::size_t j) { return std::vector<Column>{to_column(s.unit_payload_nm_kg[j])}; },
-          ""));
-      for (const auto& [tl_s, order_taps] : {std::pair{0.03, 4}, std::pair{0.1, 6}}) {
-        // Copies: clang 14 cannot capture structured bindings in a lambda.
-        const double tl = tl_s;
-        const int order = order_taps;
+          [&](std::size_t j) { return std::vector<Column>{unit_torque(j)}; }, ""));
+      for (const auto& [scale, count] : {std::pair{0.03, 4}, std::pair{0.1, 6}}) {
+        // Plain copies: clang 14 does not let a lambda capture structured bindings.
+        const double tl = scale;
+        const int order = count;
         const int ms = int(std::lround(1000.0 * tl));
         out.push_back(per_joint(
             fmt::format("d tau / d m through Laguerre {} ms x{} on every loaded joint", ms, order),
-            order,
-            [&](std::size_t j) {
-              return laguerre(to_column(s.unit_payload_nm_kg[j]), tl, order, s);
-            },
+            order, [&](std::size_t j) { return laguerre(unit_torque(j), tl, order, s); },
             fmt::format("laguerre{}ms_", ms)));
       }
+      // Both time scales: the loop's fast reaction to the inertia part and its slow one (the PI
+      // working off the static part).
+      out.push_back(per_joint(
+          "d tau / d m through Laguerre 30 ms x4 + 100 ms x6 on every loaded joint", 10,
+          [&](std::size_t j) {
+            std::vector<Column> cols = laguerre(unit_torque(j), 0.03, 4, s);
+            for (auto& c : laguerre(unit_torque(j), 0.1, 6, s)) cols.push_back(std::move(c));
+            return cols;
+          },
+          "laguerre30ms100ms_"));
       break;
     }
     case EffectKind::kZeroOffset:
@@ -536,32 +553,6 @@ std::vector<bool> repeat(const std::vector<bool>& use, std::size_t times) {
   return out;
 }
 
-// Sum of squared residuals on the rows `check` of the LS fit of columns to y on the rows `fit`
-// (parameters only: no sigma needed to choose a shape).
-double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
-                      const std::vector<Eigen::Index>& fit,
-                      const std::vector<Eigen::Index>& check) {
-  const Eigen::Index p = columns.cols();
-  Eigen::MatrixXd x(Eigen::Index(fit.size()), p);
-  Eigen::VectorXd b(x.rows());
-  for (std::size_t i = 0; i < fit.size(); ++i) {
-    x.row(Eigen::Index(i)) = columns.row(fit[i]);
-    b[Eigen::Index(i)] = y[std::size_t(fit[i])];
-  }
-  Eigen::VectorXd scale(p);
-  for (Eigen::Index c = 0; c < p; ++c) {
-    scale[c] = x.col(c).norm() > 0.0 ? x.col(c).norm() : 1.0;
-    x.col(c) /= scale[c];
-  }
-  const Eigen::VectorXd theta = x.colPivHouseholderQr().solve(b).cwiseQuotient(scale);
-  double sse = 0.0;
-  for (Eigen::Index k : check) {
-    const double r = y[std::size_t(k)] - columns.row(k).dot(theta);
-    sse += r * r;
-  }
-  return sse;
-}
-
 // Relative margin within which the shape with fewer parameters wins the validation.
 constexpr double kShapeParsimony = 0.01;
 
@@ -613,30 +604,116 @@ std::vector<Eigen::MatrixXd> join_columns(const std::vector<Eigen::MatrixXd>& a,
   return out;
 }
 
+namespace {
+
+constexpr double kArcsecPerRad = 180.0 / M_PI * 3600.0;
+
+// Half the step of a backlash's modelled gap between the two flanks: the medians of its own
+// joint's modelled gap where the shape's first column (the flank) is positive and negative,
+// half their difference (the Laguerre columns' landing transients left aside; samples between
+// the flanks, where a smooth sign is near zero, left out). One flank only: the modelled offset.
+double half_play(const CandidateFit& c, const CandidateShape& sh) {
+  const Eigen::MatrixXd& cols = sh.columns[c.joint];
+  std::vector<double> up, down;
+  for (Eigen::Index k = 0; k < cols.rows(); ++k) {
+    if (std::abs(cols(k, 0)) < 0.5) continue;  // between the flanks (a smooth sign near zero)
+    (cols(k, 0) > 0.0 ? up : down).push_back(c.prediction[c.joint][std::size_t(k)]);
+  }
+  const auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  if (up.empty() || down.empty()) return median(up.empty() ? down : up);
+  return 0.5 * (median(up) - median(down));
+}
+
+// The size of the effect in words: the first parameter with its sigma (all of them for the IMS
+// chain's few geometric parameters), in the effect's own terms where it has them.
+std::string size_in_words(const CandidateFit& c, const CandidateShape& sh, double own_rms) {
+  std::string first =
+      fmt::format("{} = {:.4g} ± {:.2g}", c.parameter_names[0], c.parameters[0], c.sigma[0]);
+  switch (c.kind) {
+    case EffectKind::kGearCompliance:
+      if (c.parameters[0] != 0.0)
+        first += fmt::format(" (stiffness {:.3g} N m/rad)", 1.0 / c.parameters[0]);
+      break;
+    case EffectKind::kBacklash: {
+      const double l = half_play(c, sh);
+      if (sh.label == kOneFlankShape)
+        first = fmt::format(
+            "a constant offset of {:.3g} rad ({:.2f} arcsec): half the play if all of it is the "
+            "play (full play {:.2f} arcsec)",
+            l, l * kArcsecPerRad, 2.0 * std::abs(l) * kArcsecPerRad);
+      else
+        first = fmt::format("half play {:.3g} rad ({:.2f} arcsec, full play {:.2f} arcsec)", l,
+                            l * kArcsecPerRad, 2.0 * std::abs(l) * kArcsecPerRad);
+      break;
+    }
+    case EffectKind::kTransmissionError: {
+      const double a = sh.parameter_names.size() == 2 ? std::hypot(c.parameters[0], c.parameters[1])
+                                                      : std::sqrt(2.0) * own_rms;
+      first = fmt::format("amplitude {:.3g} rad ({:.2f} arcsec){}", a, a * kArcsecPerRad,
+                          sh.parameter_names.size() == 2 ? "" : " at the link (sqrt 2 x RMS)");
+      break;
+    }
+    case EffectKind::kTimeOffset:
+      first += " s";
+      break;
+    case EffectKind::kSensorMounting:
+    case EffectKind::kKinematicParameters:
+    case EffectKind::kImsScaleFactor:
+    case EffectKind::kImsBias: {
+      std::vector<std::string> all;
+      for (Eigen::Index i = 0; i < c.parameters.size(); ++i)
+        all.push_back(fmt::format("{} = {:.3g} ± {:.2g}", c.parameter_names[std::size_t(i)],
+                                  c.parameters[i], c.sigma[i]));
+      first = fmt::format("{}", fmt::join(all, ", "));
+      break;
+    }
+    default:
+      break;
+  }
+  return first;
+}
+
+}  // namespace
+
+bool acts_through_dynamics(EffectKind kind) {
+  switch (kind) {
+    case EffectKind::kBacklash:
+    case EffectKind::kCoulombFriction:
+    case EffectKind::kGearCompliance:
+    case EffectKind::kTransmissionError:
+    case EffectKind::kResonance:
+    case EffectKind::kPayloadMismatch:
+      return true;
+    default:
+      return false;
+  }
+}
+
 std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, std::size_t joint,
                                           const std::vector<bool>& training) {
   const std::vector<CandidateShape> shapes = candidate_shapes(kind, s, joint);
   if (shapes.empty()) return std::nullopt;
-  // The shape is chosen by a 2-fold validation inside the training rows: they are cut into
-  // chunks of 1 s of consecutive training rows, alternately in fold A and B; each shape is fitted
-  // on A and judged on B and vice versa. Unlike a BIC it needs no count of independent rows (the
-  // residuals are coloured), and it sees whether the shape carries over to other motion. Of
-  // shapes within 1 % of the best validation error, the one with the fewest parameters.
-  const std::size_t chunk = std::max<std::size_t>(1, std::size_t(std::lround(1.0 / s.cycle_s)));
-  std::vector<Eigen::Index> fold_a, fold_b;
-  std::size_t count = 0;
-  for (std::size_t k = 0; k < training.size(); ++k)
-    if (training[k]) ((count++ / chunk) % 2 == 0 ? fold_a : fold_b).push_back(Eigen::Index(k));
+  // The shape is chosen by the 2-fold validation inside the training rows
+  // (eval/gap_validation.hpp). Of shapes within 1 % of the best validation error, the one with the
+  // fewest parameters.
+  const TrainingFolds folds = training_folds(s, training);
   const Eigen::Index n = Eigen::Index(s.sample_count());
+  const auto validation_score = [&](const std::vector<Eigen::MatrixXd>& columns) {
+    const Stacked st = stack(columns, s.gap_rad);
+    double sse = 0.0;
+    for (std::size_t i = 0; i < folds.folds.size(); ++i)
+      sse += validation_sse(st.x, st.y, stacked_rows(folds.complements[i], st.joints.size(), n),
+                            stacked_rows(folds.folds[i], st.joints.size(), n));
+    return sse;
+  };
   std::size_t chosen = 0;
-  if (shapes.size() > 1 && !fold_b.empty()) {
+  if (shapes.size() > 1 && folds.usable()) {
     std::vector<double> score;
-    for (const auto& sh : shapes) {
-      const Stacked st = stack(sh.columns, s.gap_rad);
-      const auto a = stacked_rows(fold_a, st.joints.size(), n);
-      const auto b = stacked_rows(fold_b, st.joints.size(), n);
-      score.push_back(validation_sse(st.x, st.y, a, b) + validation_sse(st.x, st.y, b, a));
-    }
+    for (const auto& sh : shapes) score.push_back(validation_score(sh.columns));
     const double best_score = *std::min_element(score.begin(), score.end());
     const auto width = [&](std::size_t i) { return shapes[i].parameter_names.size(); };
     for (std::size_t i = 0; i < shapes.size(); ++i) {
@@ -647,55 +724,63 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
     }
   }
   const CandidateShape& sh = shapes[chosen];
-  const LinearFit f = fit_joint_columns(sh.columns, s.gap_rad, training);
   CandidateFit c;
   c.kind = kind;
   c.joint = joint;
   c.shape = sh.label;
   c.parameter_names = sh.parameter_names;
-  c.parameters = f.parameters;
-  c.sigma = f.sigma;
   c.columns = sh.columns;
-  c.training_rms_rad = f.rms;
-  c.prediction = predict_joint_columns(c.columns, c.parameters);
-  // Acting on several joints: located where its modelled gap has the most energy.
+  LinearFit f = fit_joint_columns(c.columns, s.gap_rad, training);
+  c.prediction = predict_joint_columns(c.columns, f.parameters);
+  // Acting on several joints by its own columns: located where its modelled gap has the most
+  // energy; acting on one: that joint, wherever its coupling carries it.
   std::size_t acting = 0;
-  double most = -1.0, total = 0.0;
+  double most = -1.0;
   for (std::size_t j = 0; j < c.prediction.size(); ++j) {
     if (c.prediction[j].empty()) continue;
     ++acting;
     double e = 0.0;
     for (double v : c.prediction[j]) e += v * v;
-    total += e;
     if (e > most) most = e, c.joint = j;
   }
   c.spans_joints = acting > 1;
-  const double modelled_rms = std::sqrt(total / double(std::max<Eigen::Index>(n, 1)));
-  // Size in words: the first parameter with its sigma, and the RMS of the modelled gap.
-  const double arcsec = 180.0 / M_PI * 3600.0;
-  std::string first =
-      fmt::format("{} = {:.4g} ± {:.2g}", c.parameter_names[0], c.parameters[0], c.sigma[0]);
-  if (kind == EffectKind::kGearCompliance && c.parameters[0] != 0.0)
-    first += fmt::format(" (stiffness {:.3g} N m/rad)", 1.0 / c.parameters[0]);
-  if (kind == EffectKind::kBacklash)
-    first += fmt::format(" ({:.2f} arcsec, full play {:.2f} arcsec)", c.parameters[0] * arcsec,
-                         2.0 * std::abs(c.parameters[0]) * arcsec);
-  if (kind == EffectKind::kTransmissionError)
-    first = fmt::format("amplitude {:.3g} rad ({:.2f} arcsec)",
-                        std::hypot(c.parameters[0], c.parameters[1]),
-                        std::hypot(c.parameters[0], c.parameters[1]) * arcsec);
-  if (kind == EffectKind::kTimeOffset) first += " s";
-  if (kind == EffectKind::kSensorMounting || kind == EffectKind::kKinematicParameters ||
-      kind == EffectKind::kImsScaleFactor || kind == EffectKind::kImsBias) {
-    std::vector<std::string> all;
-    for (Eigen::Index i = 0; i < c.parameters.size(); ++i)
-      all.push_back(fmt::format("{} = {:.3g} ± {:.2g}", c.parameter_names[std::size_t(i)],
-                                c.parameters[i], c.sigma[i]));
-    first = fmt::format("{}", fmt::join(all, ", "));
+  double own_energy = 0.0;
+  for (double v : c.prediction[c.joint]) own_energy += v * v;
+  // Spread over the other joints through the coupled dynamics (effects that move a link only).
+  if (acts_through_dynamics(kind)) {
+    std::vector<std::vector<double>> residual = s.gap_rad;
+    for (std::size_t j = 0; j < residual.size(); ++j)
+      for (std::size_t k = 0; k < c.prediction[j].size(); ++k) residual[j][k] -= c.prediction[j][k];
+    const CouplingColumns coupling = coupling_columns(s, c.prediction, residual, folds);
+    if (!coupling.joints.empty()) {
+      c.columns = join_columns(c.columns, coupling.columns, s.sample_count());
+      c.parameter_names.insert(c.parameter_names.end(), coupling.parameter_names.begin(),
+                               coupling.parameter_names.end());
+      c.coupled_joints = coupling.joints;
+      c.coupling_parameter_count = coupling.parameter_names.size();
+      std::vector<std::string> reach;
+      for (std::size_t i = 0; i < coupling.joints.size(); ++i)
+        reach.push_back(
+            fmt::format("{} ({})", s.joint_names[coupling.joints[i]], coupling.shapes[i]));
+      c.coupling = fmt::format("through the inertia M_ij q̈_j into {}", fmt::join(reach, ", "));
+      f = fit_joint_columns(c.columns, s.gap_rad, training);
+      c.prediction = predict_joint_columns(c.columns, f.parameters);
+    }
   }
-  c.size_text =
-      fmt::format("{}; modelled gap RMS {:.3g} rad ({:.2f} arcsec){}", first, modelled_rms,
-                  modelled_rms * arcsec, c.spans_joints ? " over all joints" : "");
+  c.parameters = f.parameters;
+  c.sigma = f.sigma;
+  c.training_rms_rad = f.rms;
+  double total = 0.0;
+  for (const auto& p : c.prediction)
+    for (double v : p) total += v * v;
+  const double modelled_rms = std::sqrt(total / double(std::max<Eigen::Index>(n, 1)));
+  const double own_rms = std::sqrt(own_energy / double(std::max<Eigen::Index>(n, 1)));
+  c.size_text = size_in_words(c, sh, own_rms);
+  c.size_text += fmt::format("; modelled gap RMS {:.3g} rad ({:.2f} arcsec){}", modelled_rms,
+                             modelled_rms * kArcsecPerRad,
+                             c.spans_joints             ? " over all joints"
+                             : c.coupled_joints.empty() ? ""
+                                                        : " with its coupling");
   return c;
 }
 

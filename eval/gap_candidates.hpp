@@ -2,35 +2,42 @@
 // The library of candidate effects of the gap diagnosis ("which", issue 7): each candidate is a
 // small parametric model of one joint's gap g (eval/gap_signals.hpp), linear in its parameters,
 // built from known signals only. Its nonlinear shape (a time constant, a resonance frequency, a
-// harmonic) is chosen from a small grid by a 2-fold validation inside the training rows (see
-// fit_candidate); the linear parameters are
-// then the least-squares solution on the training rows with 1-sigma from the residual variance,
-// inflated by the residual's integrated autocorrelation (the residuals are coloured, so the plain
-// LS sigma would be far too small).
+// harmonic) is chosen from a small grid by the 2-fold validation inside the training rows
+// (eval/gap_validation.hpp); the linear parameters are then the least-squares solution on the
+// training rows with 1-sigma from the residual variance, inflated by the residual's integrated
+// autocorrelation (the residuals are coloured, so the plain LS sigma would be far too small).
+// An effect that moves a link also reaches the other joints through the coupled dynamics: its
+// fit is extended to the joints the validation chooses (eval/gap_coupling.hpp).
 //
 // Candidates (u: the candidate's driving signal; L_tau,i: the i-th discrete Laguerre filter of
 // time scale tau, an orthonormal basis of stable linear responses: the closed joint loop's
-// reaction to u without knowing its poles; HP_tau = 1 - first-order lag):
-//   backlash        u = tanh(tau_a / 1, 5 or 20 % of its RMS), tau_a the rigid-body torque of the
-//                   drive's actual motion (q_internal): the link crosses the play where the gear
-//                   torque changes sign; [u] or [u, L_10/30/100ms,0..3 u]; or u = tanh(q̇_a / 5
-//                   mrad/s) (paper, eq. 3) as [u] or [u, LP_30ms u] (torque-sign shapes only when
-//                   >= 5 % of the samples lie on its minority side)
-//   coulomb         u = tanh(q̇_a / v_s), q̇_a the motor's own velocity (q_internal), v_s 5, 10,
-//                   20 mrad/s: the friction acts on it and the PI loop works it off after every
-//                   reversal: [L_100ms,0..5 u], [L_100ms,0..3 u], [L_30ms,0..5 u] or
-//                   [HP_30/100/300ms u]
+// reaction to u without knowing its poles; HP_tau = 1 - first-order lag; q̇_a, tau_a the
+// velocity and rigid-body torque of the drive's actual motion, q_internal):
+//   backlash        the flank the link rests on: a relay with memory r of the sign of
+//                   z = tau_a / RMS + c tanh(q̇_a / 5 mrad/s) (c = 0 .. 3: the friction at the link
+//                   can outweigh a light axis' inertia torque; hold thresholds 2 / 10 %), or of q̇_a
+//                   alone, as [r] or [r, L_10/30/100ms,0..3 r]; the smooth tanh(tau_a / 1, 5 or
+//                   20 % of its RMS) as [u] or [u, L_10/30/100ms,0..3 u] (when >= 5 % of the
+//                   samples lie on the torque's minority side); tanh(q̇_a / 5 mrad/s) (paper,
+//                   eq. 3) as [u] or [u, LP_30ms u]. A relay that never switches is the one-flank
+//                   shape kOneFlankShape: a constant, half the play
+//   coulomb         u = tanh(q̇_a / v_s), v_s 5, 10, 20 mrad/s: the friction acts on the motor's
+//                   own velocity and the PI loop works it off after every reversal:
+//                   [L_100ms,0..5 u], [L_100ms,0..3 u], [L_30ms,0..5 u] or [HP_30/100/300ms u]
 //   compliance      u = tau_d (inverse dynamics on q_d): deflection tau/k; [u], [G, u - G] (gravity
 //                   and motion parts apart), [u, L_30ms,0..1 u] or [u, L_30ms,0..5 u]
-//   transmission    sin/cos(h N q_internal), h = 1..3 per motor revolution, raw or through the
-//                   link's mode on the gear ω²/(s² + 2ζωs + ω²) (f 5..20 Hz, ζ 0.2 / 0.4): above
-//                   that mode the link does not follow the gear's error
-//   resonance       q̈_d through ω²/(s² + 2ζωs + ω²), f 2..40 Hz x ζ {0.02, 0.05, 0.1, 0.3};
-//                   [y, ẏ/ω] (gain and phase)
+//   transmission    s, c = sin/cos(h N q_internal), h = 1..3 per motor revolution: raw, through
+//                   L_3ms (x3, x4), L_10ms or L_30ms (x4), or with the ripple torque tau_d s,
+//                   tau_d c (the gear's virtual work on the motor) through L_100ms x3 beside
+//                   L_10ms x3 or L_3ms + L_30ms x3 of s, c: below the loop's bandwidth the link
+//                   follows the error, above the link's mode it does not
+//   resonance       q̈_d through ω²/(s² + 2ζωs + ω²), f 2..40 Hz in 10 % steps x ζ {0.02, 0.04,
+//                   0.07, 0.12, 0.3}; [y, ẏ/ω] (gain and phase)
 //   time_offset     [q̇_d]: the parameter is the offset dt [s] between the streams
 //   payload         all joints at once (one mass acts on every joint it loads): per joint
-//                   u_j = d tau_j / d m_payload, [u_j], [L_30ms,0..3 u_j] or [L_100ms,0..5 u_j]
-//                   with its own parameters per joint (Δm / k_j through joint j's loop)
+//                   u_j = d tau_j / d m_payload, [u_j], [L_30ms,0..3 u_j], [L_100ms,0..5 u_j] or
+//                   [L_30ms,0..3 u_j, L_100ms,0..5 u_j] with its own parameters per joint (Δm / k_j
+//                   through joint j's loop)
 //   zero_offset     [1]
 //   thermal_drift   [1, t', t'^2], t' = (t - t_mid) / duration
 //   operating_point [o, o sign(q̇_d)], o = how far |q̇_d| lies beyond the identified speed range
@@ -90,13 +97,29 @@ struct CandidateShape {
 std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& signals,
                                              std::size_t joint);
 
+// The backlash shape of a joint whose gear torque never changes sign on the data: the link rests
+// on one flank and the play is a constant offset of half its width, indistinguishable there from
+// a zero offset of the joint (eval/gap_ambiguity.hpp).
+inline constexpr const char* kOneFlankShape =
+    "held on one flank (the gear torque never changes sign)";
+
+// Effects that move a link (and so reach the other joints through the coupled dynamics,
+// eval/gap_coupling.hpp), unlike offsets, drifts, time offsets, table extrapolation and errors of
+// the IMS chain, which act on the measurement or the model only.
+bool acts_through_dynamics(EffectKind kind);
+
 struct CandidateFit {
   EffectKind kind = EffectKind::kZeroOffset;
   // The joint whose signals drive the candidate, or (candidates acting on several joints) the
   // joint where its modelled gap has the most energy.
   std::size_t joint = 0;
-  bool spans_joints = false;  // its columns act on more than one joint
+  bool spans_joints = false;  // its own columns act on more than one joint
   std::string shape;
+  // The joints its coupling reaches (eval/gap_coupling.hpp; their parameters follow the shape's in
+  // `parameters`), and that reach in words. Empty: it stays on its own joint(s).
+  std::vector<std::size_t> coupled_joints;
+  std::string coupling;
+  std::size_t coupling_parameter_count = 0;  // the last ones of `parameters`
   std::vector<std::string> parameter_names;
   Eigen::VectorXd parameters, sigma;            // 1-sigma (autocorrelation-inflated)
   std::vector<Eigen::MatrixXd> columns;         // [joint], of the chosen shape (for combinations)

@@ -6,51 +6,10 @@
 #include <cmath>
 #include <random>
 
+#include "eval/gap_verdict.hpp"
+
 namespace imscal::eval {
 namespace {
-
-const char* what_to_measure(EffectKind kind) {
-  switch (kind) {
-    case EffectKind::kBacklash:
-      return "slow reversals of the joint and static poses approached from both sides (play does "
-             "not depend on speed)";
-    case EffectKind::kCoulombFriction:
-      return "reversals of the joint at several speeds (friction transients follow the "
-             "controller, not the play)";
-    case EffectKind::kGearCompliance:
-      return "the same path at two accelerations and with two payloads (deflection scales with "
-             "the torque)";
-    case EffectKind::kTransmissionError:
-      return "a slow constant-speed move of the joint over several motor revolutions (the error "
-             "is periodic in the motor angle)";
-    case EffectKind::kResonance:
-      return "fast stops of the joint recorded by the IMS at its full rate (ring-down frequency "
-             "and damping)";
-    case EffectKind::kTimeOffset:
-      return "sharp starts and stops with both streams stamped by one clock";
-    case EffectKind::kPayloadMismatch:
-      return "the path with and without a known extra mass";
-    case EffectKind::kZeroOffset:
-      return "static poses of the joint (a constant error does not depend on the motion)";
-    case EffectKind::kThermalDrift:
-      return "a repeat of the path after a warm-up and the drive temperatures";
-    case EffectKind::kOperatingPoint:
-      return "identification runs at the speeds and joint positions of this path";
-    case EffectKind::kKinematicParameters:
-      return "static poses spread over the workspace with an external reference (laser tracker), "
-             "or a kinematic calibration (the error depends on the pose, not on the motion)";
-    case EffectKind::kSensorMounting:
-      return "the frame calibration's rest poses again with larger wrist rotations (the mounting "
-             "error grows with the rotation away from the first pose)";
-    case EffectKind::kImsScaleFactor:
-      return "turn tests of the IMS about each axis by a known angle (rotary table or joint 6) "
-             "and a known linear displacement";
-    case EffectKind::kImsBias:
-      return "a longer rest of the IMS before and after the path, and rests during it (the "
-             "rests bound the attitude drift)";
-  }
-  return "";
-}
 
 struct Rows {
   std::vector<std::size_t> heldout;
@@ -74,6 +33,66 @@ std::vector<std::vector<double>> residual_after(const std::vector<Eigen::MatrixX
   for (std::size_t j = 0; j < r.size(); ++j)
     for (std::size_t k = 0; k < pred[j].size(); ++k) r[j][k] -= pred[j][k];
   return r;
+}
+
+// Ranking charge per parameter [percentage points of shrinkage]: of two candidates that explain
+// the same (a drift that nests an offset), the simpler first.
+constexpr double kParsimonyPercentPerParameter = 0.5;
+
+// The ambiguity groups of the ranked candidates that explain something on the held-out rows
+// (supported on all joints or on their own), on all joints.
+void group_ambiguous(const GapSignals& s, const std::vector<std::size_t>& heldout, Diagnosis& d) {
+  std::vector<const CandidateFit*> ranked;
+  std::vector<bool> eligible;
+  for (const auto& c : d.candidates) {
+    ranked.push_back(&c.fit);
+    eligible.push_back(c.supported || c.joint_supported);
+  }
+  d.ambiguity_groups = ambiguity_groups(s, ranked, eligible, heldout);
+  for (std::size_t g = 0; g < d.ambiguity_groups.size(); ++g)
+    for (std::size_t m : d.ambiguity_groups[g].members) d.candidates[m].ambiguity_group = int(g);
+}
+
+// Per joint: its candidates ranked by their own-joint held-out shrinkage less the parsimony charge
+// on their own parameters, the leader and those ambiguous with it on that joint (among those that
+// explain at least min_shrinkage_percent of it: no groups of noise fits).
+void find_per_joint(const GapSignals& s, const DiagnosisOptions& o,
+                    const std::vector<std::size_t>& heldout, Diagnosis& d) {
+  for (std::size_t j = 0; j < s.joint_count(); ++j) {
+    std::vector<std::size_t> on_joint;
+    for (std::size_t c = 0; c < d.candidates.size(); ++c)
+      if (d.candidates[c].fit.joint == j) on_joint.push_back(c);
+    if (on_joint.empty()) continue;
+    const auto score = [&](std::size_t c) {
+      const CandidateResult& r = d.candidates[c];
+      const double own = double(r.fit.parameters.size() - r.fit.coupling_parameter_count);
+      return r.joint_shrinkage_percent - kParsimonyPercentPerParameter * own;
+    };
+    const auto one_flank = [&](std::size_t c) {
+      return d.candidates[c].fit.shape == kOneFlankShape;
+    };
+    std::stable_sort(on_joint.begin(), on_joint.end(), [&](std::size_t a, std::size_t b) {
+      if (score(a) != score(b)) return score(a) > score(b);
+      return !one_flank(a) && one_flank(b);
+    });
+    JointFinding f;
+    f.joint = j;
+    f.leading = {on_joint.front()};
+    f.supported = d.candidates[on_joint.front()].joint_supported;
+    std::vector<const CandidateFit*> ranked;
+    std::vector<bool> eligible;
+    for (std::size_t c : on_joint) {
+      ranked.push_back(&d.candidates[c].fit);
+      eligible.push_back(d.candidates[c].joint_shrinkage_percent >= o.min_shrinkage_percent);
+    }
+    const auto groups = ambiguity_groups(s, ranked, eligible, heldout, j);
+    if (!groups.empty() && groups.front().members.front() == 0) {
+      f.leading.clear();
+      for (std::size_t m : groups.front().members) f.leading.push_back(on_joint[m]);
+      f.separate_by = groups.front().separate_by;
+    }
+    d.joint_findings.push_back(std::move(f));
+  }
 }
 
 }  // namespace
@@ -140,7 +159,7 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
       if (!fit) continue;
       CandidateResult r;
       // Per held-out row the reduction of the squared gap summed over the joints it acts on.
-      std::vector<double> d(rows.heldout.size(), 0.0);
+      std::vector<double> d(rows.heldout.size(), 0.0), d_joint(rows.heldout.size(), 0.0);
       double gain = 0.0, ej0 = 0.0, joint_gain = 0.0;
       for (std::size_t jj = 0; jj < s.joint_count(); ++jj) {
         const auto& p = fit->prediction[jj];
@@ -152,7 +171,7 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
           const double di = g[k] * g[k] - res * res;
           d[i] += di;
           gain += di;
-          if (jj == fit->joint) joint_gain += di;
+          if (jj == fit->joint) joint_gain += di, d_joint[i] += di;
         }
       }
       for (std::size_t k : rows.heldout) ej0 += s.gap_rad[fit->joint][k] * s.gap_rad[fit->joint][k];
@@ -161,18 +180,27 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
           ej0 > 0.0 ? 100.0 * (1.0 - std::sqrt(std::max(ej0 - joint_gain, 0.0) / ej0)) : 0.0;
       r.p_value = block_bootstrap_p_value(d, block, o.bootstrap_resamples, seed++);
       r.supported = r.p_value < o.alpha && r.shrinkage_percent >= o.min_shrinkage_percent;
+      r.joint_p_value = block_bootstrap_p_value(d_joint, block, o.bootstrap_resamples, seed++);
+      r.joint_supported =
+          r.joint_p_value < o.alpha && r.joint_shrinkage_percent >= o.min_shrinkage_percent;
       r.fit = std::move(*fit);
       out.candidates.push_back(std::move(r));
     }
   // Ranked by held-out shrinkage less a parsimony charge of 0.5 percentage points per parameter:
   // of two candidates that explain the same (a drift that nests an offset), the simpler first.
   const auto score = [](const CandidateResult& c) {
-    return c.shrinkage_percent - 0.5 * double(c.fit.parameters.size());
+    return c.shrinkage_percent - kParsimonyPercentPerParameter * double(c.fit.parameters.size());
   };
-  std::stable_sort(
-      out.candidates.begin(), out.candidates.end(),
-      [&](const CandidateResult& a, const CandidateResult& b) { return score(a) > score(b); });
+  // Equal scores (the same modelled gap): a backlash held on one flank after the plain
+  // explanation it cannot be told from (a zero offset); eval/gap_ambiguity.hpp groups them.
+  const auto one_flank = [](const CandidateResult& c) { return c.fit.shape == kOneFlankShape; };
+  std::stable_sort(out.candidates.begin(), out.candidates.end(),
+                   [&](const CandidateResult& a, const CandidateResult& b) {
+                     if (score(a) != score(b)) return score(a) > score(b);
+                     return !one_flank(a) && one_flank(b);
+                   });
   out.significant_gap = !out.candidates.empty() && out.candidates.front().supported;
+  group_ambiguous(s, rows.heldout, out);
 
   // Greedy combination of the supported candidates: each step adds the candidate whose columns,
   // fitted jointly with those already chosen (one stacked LS over the joints they act on), shrink
@@ -180,9 +208,23 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
   if (out.significant_gap) {
     std::vector<std::vector<double>> residual = s.gap_rad;
     std::vector<Eigen::MatrixXd> chosen_columns(s.joint_count());
+    // The pool: the best supported candidates, and on every other joint its best candidate with a
+    // significant held-out gain (an effect on a joint with a small share of the gap shrinks the
+    // whole gap by less than min_shrinkage_percent, yet is a cause of its own).
     std::vector<std::size_t> pool;
+    std::vector<bool> joint_in_pool(s.joint_count(), false);
     for (std::size_t c = 0; c < out.candidates.size() && int(pool.size()) < o.combination_pool; ++c)
-      if (out.candidates[c].supported) pool.push_back(c);
+      if (out.candidates[c].supported) {
+        pool.push_back(c);
+        joint_in_pool[out.candidates[c].fit.joint] = true;
+      }
+    for (std::size_t c = 0; c < out.candidates.size(); ++c) {
+      const CandidateResult& r = out.candidates[c];
+      if (joint_in_pool[r.fit.joint] || r.p_value >= o.alpha || r.shrinkage_percent <= 0.0)
+        continue;
+      pool.push_back(c);
+      joint_in_pool[r.fit.joint] = true;
+    }
     std::vector<bool> used(out.candidates.size(), false);
     double energy = e0;
     for (int step = 0; step < o.max_combination; ++step) {
@@ -219,102 +261,20 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
       chosen_columns = std::move(best_columns);
       residual = std::move(best_residual);
       energy = best_energy;
-      out.combination.push_back({candidate_label(s, f), shrink(energy), p});
+      out.combination.push_back({candidate_label(s, f), shrink(energy), p, std::size_t(best)});
     }
     out.heldout_rms_modelled_rad = std::sqrt(std::max(energy, 0.0) / m);
   }
 
-  // The verdict in plain words.
-  const double arcsec = 180.0 / M_PI * 3600.0;
-  std::size_t top_joint = 0;
-  for (std::size_t j = 0; j < out.where.joints.size(); ++j)
-    if (out.where.joints[j].energy_share > out.where.joints[top_joint].energy_share) top_joint = j;
-  std::string where;
-  if (!out.where.joints.empty()) {
-    const auto& ja = out.where.joints[top_joint];
-    auto top_of = [](const std::vector<GapShare>& v) {
-      return *std::max_element(v.begin(), v.end(), [](const GapShare& a, const GapShare& b) {
-        return a.energy_share < b.energy_share;
-      });
-    };
-    const GapShare ph = top_of(ja.by_phase), band = top_of(ja.by_band);
-    where = fmt::format(
-        "The gap (RMS {:.3g} rad = {:.1f} arcsec over all joints) lies mostly in joint {} ({:.0f} "
-        "% "
-        "of its energy), there mostly during {} ({:.0f} % of the joint's gap energy in {:.0f} % of "
-        "the time) and in the {} band ({:.0f} %).",
-        out.where.rms_rad, out.where.rms_rad * arcsec, ja.joint, 100.0 * ja.energy_share, ph.label,
-        100.0 * ph.energy_share, 100.0 * ph.time_share, band.label, 100.0 * band.energy_share);
-    // Cells outside the identified range, on every joint that runs in them.
-    std::vector<std::string> outside;
-    for (const auto& jo : out.where.joints) {
-      double time = 0.0, energy = 0.0;
-      for (const auto& c : jo.by_cell)
-        if (c.outside_identified_range) time += c.time_share, energy += c.energy_share;
-      if (time > 0.0)
-        outside.push_back(fmt::format("{} {:.0f} % of the time ({:.0f} % of its gap energy)",
-                                      jo.joint, 100.0 * time, 100.0 * energy));
-    }
-    if (!outside.empty())
-      where += fmt::format(
-          " The path runs at operating points outside the identified range (cells of the error "
-          "model not identified from data): {}.",
-          fmt::join(outside, ", "));
-  }
-  if (!out.significant_gap) {
-    out.verdict = fmt::format(
-        "{} No significant structured gap: no candidate effect shrinks the held-out gap by at "
-        "least {:.0f} % with p < {:g}; what remains looks like measurement noise or an effect "
-        "outside the library.",
-        where, o.min_shrinkage_percent, o.alpha);
-    if (!out.candidates.empty())
-      out.measure_next.push_back(
-          fmt::format("if a gap of {:.3g} rad matters: longer records of the path, and {}",
-                      out.heldout_rms_rad, what_to_measure(out.candidates.front().fit.kind)));
-    return out;
-  }
-  const CandidateResult& top = out.candidates.front();
-  out.verdict = fmt::format(
-      "{} Most likely cause: {} on joint {} ({}; {}), which shrinks the held-out gap by {:.0f} % "
-      "(p = {:.3f}). Modelled with {}, the held-out gap is expected to fall from {:.3g} rad to "
-      "{:.3g} rad ({:.0f} % smaller).",
-      where, to_string(top.fit.kind), s.joint_names[top.fit.joint], top.fit.shape,
-      top.fit.size_text, top.shrinkage_percent, top.p_value,
-      out.combination.empty() ? std::string("it")
-                              : fmt::format("{}", fmt::join(
-                                                      [&] {
-                                                        std::vector<std::string> l;
-                                                        for (const auto& c : out.combination)
-                                                          l.push_back(c.label);
-                                                        return l;
-                                                      }(),
-                                                      " + ")),
-      out.heldout_rms_rad, out.heldout_rms_modelled_rad,
-      100.0 * (1.0 - out.heldout_rms_modelled_rad / std::max(out.heldout_rms_rad, 1e-300)));
-  std::vector<std::string> unsupported;
-  for (const auto& c : out.candidates)
-    if (!c.supported && c.fit.joint == top.fit.joint) unsupported.push_back(to_string(c.fit.kind));
-  if (!unsupported.empty())
-    out.verdict += fmt::format(" Not supported on joint {}: {}.", s.joint_names[top.fit.joint],
-                               fmt::join(unsupported, ", "));
-  // Weak evidence: a different effect explains nearly as much, or the best explains little.
-  for (std::size_t c = 1; c < out.candidates.size(); ++c) {
-    const auto& r = out.candidates[c];
-    if (!r.supported) break;
-    if (r.fit.kind == top.fit.kind && r.fit.joint == top.fit.joint) continue;
-    if (top.shrinkage_percent - r.shrinkage_percent < 5.0) {
-      out.measure_next.push_back(
-          fmt::format("{} explains nearly as much ({:.0f} % vs {:.0f} %); to tell them apart "
-                      "measure {}, and {}",
-                      candidate_label(s, r.fit), r.shrinkage_percent, top.shrinkage_percent,
-                      what_to_measure(top.fit.kind), what_to_measure(r.fit.kind)));
-    }
-  }
-  if (top.shrinkage_percent < 30.0)
-    out.measure_next.push_back(
-        fmt::format("the best candidate explains only {:.0f} % of the gap: measure {}",
-                    top.shrinkage_percent, what_to_measure(top.fit.kind)));
+  find_per_joint(s, o, rows.heldout, out);
+  write_verdict(s, o, out);
   return out;
+}
+
+std::vector<std::size_t> leading_group(const Diagnosis& d) {
+  if (!d.significant_gap || d.candidates.empty()) return {};
+  const int g = d.candidates.front().ambiguity_group;
+  return g >= 0 ? d.ambiguity_groups[std::size_t(g)].members : std::vector<std::size_t>{0};
 }
 
 }  // namespace imscal::eval

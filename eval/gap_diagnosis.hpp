@@ -9,12 +9,17 @@
 // Significance: a moving-block bootstrap of the held-out per-sample reduction of the squared gap
 // (summed over joints); blocks because the residuals are coloured. A candidate is supported when
 // the bootstrap p-value is below `alpha` and the shrinkage at least `min_shrinkage_percent`.
-// Supported candidates are then combined greedily (a joint fit of the chosen columns per joint),
-// a step kept only when it shrinks the held-out gap significantly further.
+// Supported candidates (and on every other joint its best candidate with a significant gain) are
+// then combined greedily (a joint fit of the chosen columns per joint), a step kept only when it
+// shrinks the held-out gap significantly further. Candidates the data cannot tell apart form
+// ambiguity groups (eval/gap_ambiguity.hpp), reported together with what would separate them,
+// overall and per joint (its candidates ranked on its own gap); the plain words are
+// eval/gap_verdict.hpp's.
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "eval/gap_ambiguity.hpp"
 #include "eval/gap_analysis.hpp"
 #include "eval/gap_candidates.hpp"
 #include "eval/gap_model_error.hpp"
@@ -40,12 +45,28 @@ struct CandidateResult {
   double joint_shrinkage_percent = 0.0;  // held-out, its own joint
   double p_value = 1.0;
   bool supported = false;
+  // The same on its own joint only (the gain on that joint's held-out rows), for the per-joint
+  // findings: an effect on a joint with a small share of the whole gap is still that joint's cause.
+  double joint_p_value = 1.0;
+  bool joint_supported = false;
+  int ambiguity_group = -1;  // index into Diagnosis::ambiguity_groups, -1: none
+};
+
+// Per joint: the candidates located on it, ranked by their held-out shrinkage of that joint's gap
+// (less the same parsimony charge), the leading one and those the data cannot tell apart from it
+// on that joint (eval/gap_ambiguity.hpp).
+struct JointFinding {
+  std::size_t joint = 0;
+  std::vector<std::size_t> leading;  // indices into Diagnosis::candidates, the leader first
+  bool supported = false;            // the leader's own-joint gain is significant
+  std::string separate_by;           // when `leading` has several members
 };
 
 struct CombinationStep {
   std::string label;               // "A2 backlash"
   double shrinkage_percent = 0.0;  // held-out, all joints, cumulative
   double p_value = 1.0;            // of this step's further shrinkage
+  std::size_t candidate = 0;       // index into Diagnosis::candidates
 };
 
 struct Diagnosis {
@@ -57,6 +78,10 @@ struct Diagnosis {
   double heldout_rms_modelled_rad = 0.0;     // after the kept combination
   std::vector<CandidateResult> candidates;   // sorted by held-out shrinkage, best first
   std::vector<CombinationStep> combination;  // kept greedy steps
+  // Candidates the data cannot tell apart (members index `candidates`; groups in ranking order,
+  // the group of the first candidate first when it has one).
+  std::vector<AmbiguityGroup> ambiguity_groups;
+  std::vector<JointFinding> joint_findings;  // every joint with candidates, in joint order
   bool significant_gap = false;              // some candidate supported
   std::string verdict;                       // plain words
   std::vector<std::string> measure_next;     // when the evidence is weak
@@ -72,5 +97,9 @@ double block_bootstrap_p_value(const std::vector<double>& d, std::size_t block, 
 Diagnosis diagnose_gap(const GapSignals& signals, const DiagnosisOptions& options = {});
 
 std::string candidate_label(const GapSignals& signals, const CandidateFit& fit);
+
+// The members of the leading ambiguity group (the first candidate and those the data cannot tell
+// apart from it), indices into `candidates`; empty without a significant gap.
+std::vector<std::size_t> leading_group(const Diagnosis& diagnosis);
 
 }  // namespace imscal::eval

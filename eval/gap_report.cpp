@@ -41,16 +41,45 @@ nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
       params.push_back({{"name", c.fit.parameter_names[std::size_t(i)]},
                         {"value", c.fit.parameters[i]},
                         {"sigma", c.fit.sigma[i]}});
-    candidates.push_back({{"effect", to_string(c.fit.kind)},
-                          {"joint", s.joint_names[c.fit.joint]},
-                          {"shape", c.fit.shape},
-                          {"parameters", params},
-                          {"size", c.fit.size_text},
-                          {"training_rms_rad", c.fit.training_rms_rad},
-                          {"heldout_shrinkage_percent", c.shrinkage_percent},
-                          {"heldout_joint_shrinkage_percent", c.joint_shrinkage_percent},
-                          {"p_value", c.p_value},
-                          {"supported", c.supported}});
+    json coupled = json::array();
+    for (std::size_t j : c.fit.coupled_joints) coupled.push_back(s.joint_names[j]);
+    candidates.push_back(
+        {{"effect", to_string(c.fit.kind)},
+         {"joint", s.joint_names[c.fit.joint]},
+         {"shape", c.fit.shape},
+         {"coupled_joints", coupled},
+         {"coupling", c.fit.coupling},
+         {"parameters", params},
+         {"size", c.fit.size_text},
+         {"training_rms_rad", c.fit.training_rms_rad},
+         {"heldout_shrinkage_percent", c.shrinkage_percent},
+         {"heldout_joint_shrinkage_percent", c.joint_shrinkage_percent},
+         {"p_value", c.p_value},
+         {"supported", c.supported},
+         {"joint_p_value", c.joint_p_value},
+         {"joint_supported", c.joint_supported},
+         {"ambiguity_group", c.ambiguity_group >= 0 ? json(c.ambiguity_group) : json(nullptr)}});
+  }
+  const auto labels = [&](const std::vector<std::size_t>& members) {
+    json a = json::array();
+    for (std::size_t m : members) a.push_back(candidate_label(s, d.candidates[m].fit));
+    return a;
+  };
+  json groups = json::array();
+  for (const auto& g : d.ambiguity_groups)
+    groups.push_back({{"members", labels(g.members)},
+                      {"difference_rms_rad", g.difference_rms_rad},
+                      {"residual_rms_rad", g.residual_rms_rad},
+                      {"separate_by", g.separate_by}});
+  json findings = json::array();
+  for (const auto& f : d.joint_findings) {
+    const CandidateResult& leader = d.candidates[f.leading.front()];
+    findings.push_back({{"joint", s.joint_names[f.joint]},
+                        {"leading", labels(f.leading)},
+                        {"heldout_joint_shrinkage_percent", leader.joint_shrinkage_percent},
+                        {"joint_p_value", leader.joint_p_value},
+                        {"supported", f.supported},
+                        {"separate_by", f.separate_by}});
   }
   json model_error = json::array();
   for (std::size_t j = 0; j < d.model_error.size(); ++j) {
@@ -85,7 +114,7 @@ nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
   for (const auto& c : d.candidates)
     if (!c.supported) not_supported.push_back(candidate_label(s, c.fit));
   return {{"schema", "imscal-gap-diagnosis"},
-          {"schema_version", 1},
+          {"schema_version", 2},
           {"samples", s.sample_count()},
           {"cycle_s", s.cycle_s},
           {"gap_rms_rad", d.where.rms_rad},
@@ -99,6 +128,9 @@ nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
           {"model_error", model_error},
           {"candidates", candidates},
           {"combination", combination},
+          {"leading_group", labels(leading_group(d))},
+          {"ambiguity_groups", groups},
+          {"joint_findings", findings},
           {"not_supported", not_supported}};
 }
 
@@ -141,12 +173,36 @@ std::string diagnosis_text(const GapSignals& s, const Diagnosis& d) {
              : fmt::format("significant at {} Hz", fmt::join(significant, ", "));
     t += fmt::format("; peak |G| {:.3g} at {:.2g} Hz\n", peak, f_peak);
   }
-  t += "\nCandidates (held-out shrinkage of the gap, all joints; best first)\n";
+  t += "\nCandidates (held-out shrinkage of the gap, all joints; best first; [g] its ambiguity "
+       "group)\n";
   for (const auto& c : d.candidates)
-    t += fmt::format("  {:<36} {:6.1f} % (own joint {:6.1f} %)  p {:.3f}  {}  [{}] {}\n",
+    t += fmt::format("  {:<36} {:6.1f} % (own joint {:6.1f} %)  p {:.3f}  {}{}  [{}] {}{}\n",
                      candidate_label(s, c.fit), c.shrinkage_percent, c.joint_shrinkage_percent,
-                     c.p_value, c.supported ? "supported    " : "not supported", c.fit.shape,
-                     c.fit.size_text);
+                     c.p_value, c.supported ? "supported    " : "not supported",
+                     c.ambiguity_group >= 0 ? fmt::format(" [{}]", c.ambiguity_group) : "",
+                     c.fit.shape, c.fit.size_text,
+                     c.fit.coupling.empty() ? "" : "; coupled " + c.fit.coupling);
+  t += "\nAmbiguity groups (modelled gaps the data cannot tell apart: they differ by at most a "
+       "tenth "
+       "of what they leave)\n";
+  if (d.ambiguity_groups.empty()) t += "  none\n";
+  for (std::size_t g = 0; g < d.ambiguity_groups.size(); ++g) {
+    const auto& grp = d.ambiguity_groups[g];
+    std::vector<std::string> l;
+    for (std::size_t m : grp.members) l.push_back(candidate_label(s, d.candidates[m].fit));
+    t += fmt::format("  [{}] {}: differ by {:.3g} rad RMS, leave {:.3g} rad; to tell apart: {}\n",
+                     g, fmt::join(l, " / "), grp.difference_rms_rad, grp.residual_rms_rad,
+                     grp.separate_by);
+  }
+  t += "\nPer joint (its candidates ranked on its own held-out gap)\n";
+  for (const auto& f : d.joint_findings) {
+    const CandidateResult& leader = d.candidates[f.leading.front()];
+    std::vector<std::string> l;
+    for (std::size_t m : f.leading) l.push_back(candidate_label(s, d.candidates[m].fit));
+    t += fmt::format("  {:<4} {:<44} {:6.1f} % of its gap  p {:.3f}  {}\n", s.joint_names[f.joint],
+                     fmt::format("{}", fmt::join(l, " / ")), leader.joint_shrinkage_percent,
+                     leader.joint_p_value, f.supported ? "supported" : "not supported");
+  }
   t += "\nGreedy combination\n";
   for (const auto& c : d.combination)
     t += fmt::format("  + {:<34} cumulative {:6.1f} %  p {:.3f}\n", c.label, c.shrinkage_percent,

@@ -308,6 +308,8 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
   g.gravity_torque_nm.assign(nj, std::vector<double>(n));
   g.unit_payload_nm_kg.assign(nj, std::vector<double>(n));
   g.torque_internal_nm.assign(nj, std::vector<double>(n));
+  g.unit_payload_internal_nm_kg.assign(nj, std::vector<double>(n));
+  g.mass_matrix_kg_m2.assign(nj * nj, std::vector<double>(n));
   std::vector<std::vector<double>> qdd_internal;
   for (std::size_t j = 0; j < nj; ++j)
     qdd_internal.push_back(derivative(g.qd_internal_rad_s[j], g.runs, g.cycle_s));
@@ -333,13 +335,20 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
     }
     const calib::JointVector tau_internal = dynamics.inverse_dynamics(qi, qdi, qddi);
     const calib::JointVector tau_gravity = dynamics.gravity_torque(q);
+    const sim::JointMatrix mass = dynamics.mass_matrix(q);
+    for (std::size_t i = 0; i < nj; ++i)
+      for (std::size_t j = 0; j < nj; ++j)
+        g.mass_matrix_kg_m2[i * nj + j][k] = mass(long(i), long(j));
     const calib::JointVector tau_unit =
         unit.inverse_dynamics(q, qd, qdd) - bare.inverse_dynamics(q, qd, qdd);
+    const calib::JointVector tau_unit_internal =
+        unit.inverse_dynamics(qi, qdi, qddi) - bare.inverse_dynamics(qi, qdi, qddi);
     for (std::size_t j = 0; j < nj; ++j) {
       g.torque_nm[j][k] = tau[long(j)];
       g.torque_internal_nm[j][k] = tau_internal[long(j)];
       g.gravity_torque_nm[j][k] = tau_gravity[long(j)];
       g.unit_payload_nm_kg[j][k] = tau_unit[long(j)];
+      g.unit_payload_internal_nm_kg[j][k] = tau_unit_internal[long(j)];
     }
   }
   g.ims_chain_columns =

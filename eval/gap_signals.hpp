@@ -41,8 +41,16 @@ struct GapSignals {
   std::vector<std::vector<double>> gravity_torque_nm;   // its gravity part G(q_d)
   std::vector<std::vector<double>> torque_nm;           // inverse dynamics on q_d, logged payload
   std::vector<std::vector<double>> unit_payload_nm_kg;  // torque change per kg of extra payload
-  std::vector<double> gear_ratio;                       // motor angle = N * joint angle
-  std::vector<double> max_speed_rad_s;                  // the robot's joint speed limits
+  // The same along the drive's actual motion (q_internal): the payload loads the arm as it moves,
+  // ~80 ms behind q_d on the main axes. Empty: not known (the candidates then use the above).
+  std::vector<std::vector<double>> unit_payload_internal_nm_kg;
+  // The arm's mass matrix along q_d with the logged payload, M_ij(q_d) [kg m²] at
+  // [i * joint_count() + j][sample]: how much torque an acceleration of joint j asks of joint i.
+  // The coupled dynamics spread one joint's effect over the others through it (see
+  // eval/gap_coupling.hpp). Empty: not known (no robot model, e.g. in synthetic tests).
+  std::vector<std::vector<double>> mass_matrix_kg_m2;
+  std::vector<double> gear_ratio;       // motor angle = N * joint angle
+  std::vector<double> max_speed_rad_s;  // the robot's joint speed limits
   // The operating-point grids of the identified model (empty without a table), per joint, and
   // whether each of its cells was identified from data (false: filled from a neighbour).
   std::vector<std::vector<ident::CellDimension>> table_dimensions;

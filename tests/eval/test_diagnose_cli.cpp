@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -38,10 +39,31 @@ TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesAllOrNothing) {
                            robot + " --out " + out.string();
   ASSERT_EQ(run(args, dir_ / "a.log"), 0) << read(dir_ / "a.log");
   const auto report = nlohmann::json::parse(read(out / "report.json"));
+  EXPECT_EQ(report["schema_version"], 2);
   EXPECT_TRUE(report["significant_gap"].get<bool>());
   EXPECT_EQ(report["candidates"][0]["effect"], "zero_offset");
   EXPECT_EQ(report["candidates"][0]["joint"], "A3");
   EXPECT_NE(read(out / "report.txt").find("Most likely cause: zero_offset on joint A3"),
+            std::string::npos);
+  // A3 carries the forearm against gravity: its gear torque along the program never changes
+  // sign (checked here on the rigid-body torque of the drive's motion), so a backlash of A3 would
+  // hold its link on one flank, a constant offset of half the play: on these data exactly the
+  // zero offset. The report must say so, with the measurement that separates them.
+  const eval::GapSignals signals =
+      eval::make_gap_signals(c.real, c.sim_joint_error_rad, world.robot);
+  const auto& tau = signals.torque_internal_nm[2];
+  ASSERT_TRUE(std::all_of(tau.begin(), tau.end(), [](double v) { return v > 0.0; }) ||
+              std::all_of(tau.begin(), tau.end(), [](double v) { return v < 0.0; }));
+  EXPECT_EQ(report["leading_group"], nlohmann::json::array({"A3 zero_offset", "A3 backlash"}));
+  ASSERT_FALSE(report["ambiguity_groups"].empty());
+  const auto& group = report["ambiguity_groups"][0];
+  EXPECT_EQ(group["members"], report["leading_group"]);
+  // The same column (a constant) fitted to the same rows: the same model up to rounding.
+  EXPECT_LE(group["difference_rms_rad"].get<double>(),
+            1e-9 * group["residual_rms_rad"].get<double>());
+  EXPECT_NE(group["separate_by"].get<std::string>().find("changes sign"), std::string::npos);
+  EXPECT_EQ(report["candidates"][1]["shape"], eval::kOneFlankShape);
+  EXPECT_NE(read(out / "report.txt").find("indistinguishable from it on these data"),
             std::string::npos);
   // Existing outputs are refused without --force (exit 2, files unchanged), kept with it.
   const std::string before = read(out / "report.json");

@@ -129,6 +129,35 @@ TEST(GapDiagnosis, SyntheticTimeOffsetIsNamedSizedAndShrinks) {
   EXPECT_NEAR(d.heldout_rms_modelled_rad, std::sqrt(6.0) * 1e-4, 0.03 * std::sqrt(6.0) * 1e-4);
 }
 
+TEST(GapDiagnosis, OffsetOnAJointWhoseTorqueKeepsItsSignIsAnAmbiguityWithBacklash) {
+  GapSignals s = synthetic();
+  // Joint 3's gear torque stays positive (a gravity load larger than its motion torque): a
+  // backlash would hold its link on one flank, a constant offset of half the play.
+  for (std::size_t k = 0; k < s.sample_count(); ++k)
+    s.torque_nm[2][k] = 300.0 + 50.0 * std::sin(2.0 * M_PI * 0.4 * s.time_s[k]);
+  const double offset = 1.5e-4;  // rad
+  for (double& g : s.gap_rad[2]) g = offset;
+  add_white_noise(s, 1e-5, 9);
+  const Diagnosis d = diagnose_gap(s);
+  ASSERT_TRUE(d.significant_gap);
+  const std::vector<std::size_t> lead = leading_group(d);
+  ASSERT_EQ(lead.size(), 2u);
+  const CandidateFit& first = d.candidates[lead[0]].fit;
+  const CandidateFit& second = d.candidates[lead[1]].fit;
+  EXPECT_EQ(first.kind, EffectKind::kZeroOffset);  // of equal scores, the plain offset first
+  EXPECT_EQ(second.kind, EffectKind::kBacklash);
+  EXPECT_EQ(second.shape, kOneFlankShape);
+  EXPECT_EQ(first.joint, 2u);
+  EXPECT_EQ(second.joint, 2u);
+  // Both carry the offset: 4 sigma of the white noise's mean over the 5000 training rows.
+  EXPECT_NEAR(first.parameters[0], offset, 4.0 * 1e-5 / std::sqrt(5000.0));
+  EXPECT_NEAR(std::abs(second.parameters[0]), offset, 4.0 * 1e-5 / std::sqrt(5000.0));
+  EXPECT_NE(d.verdict.find("indistinguishable from it on these data"), std::string::npos)
+      << d.verdict;
+  ASSERT_FALSE(d.measure_next.empty());
+  EXPECT_NE(d.measure_next.front().find("changes sign"), std::string::npos);
+}
+
 TEST(GapDiagnosis, PureNoiseIsNoSignificantGap) {
   GapSignals s = synthetic();
   add_white_noise(s, 1e-5, 7);

@@ -7,12 +7,17 @@
 // effect on (+ noise), "sim" = without. The diagnosis runs blind; scored: the withheld effect
 // ranked first, its joint located, the predicted shrinkage of the held-out gap against the
 // shrinkage obtained with the true effect switched on (the noise is then all that remains), false
-// alarms on controls, and two-effect cases. Prints the confusion matrix and the figures. Under
+// alarms on controls, and two-effect cases. "Ranked first" accepts the withheld effect inside the
+// leading ambiguity group (candidates whose modelled gaps the data cannot tell apart,
+// eval/gap_ambiguity.hpp: e.g. a backlash held on one flank and a zero offset of A3, whose torque
+// never changes sign here); the group's size is printed and bounded. Prints the confusion matrix
+// and the figures. Under
 // IMSCAL_SANITIZED a subset of the cases runs (each case is one plant simulation of ~8.5 s of
 // motion).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <map>
 
@@ -33,8 +38,9 @@ struct HarnessCase {
 
 struct Score {
   std::string name;
-  std::string top;  // "A2 backlash" or "none"
+  std::string top;  // "A2 backlash" or "none"; with its ambiguity group "A3 backlash / A3 ..."
   bool ranked_first = false, joint_located = false, alarm = false;
+  std::size_t group_size = 0;  // members of the leading ambiguity group
   double predicted = 0.0, truth = 0.0;
 };
 
@@ -123,8 +129,17 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
                : fmt::format("{} {}", world.robot.joints[std::size_t(e.joint)].name, e.name));
     if (s.name.empty()) s.name = "control";
     s.alarm = d.significant_gap;
-    s.top = d.significant_gap ? candidate_label(signals, d.candidates.front().fit) : "none";
+    s.top = "none";
     if (d.significant_gap) {
+      // Ranked first: the withheld effect is the top candidate or one of those the data cannot
+      // tell apart from it (the leading ambiguity group: modelled gaps within 10 % of the
+      // residual, no more parameters; eval/gap_ambiguity.hpp). Its size is printed and bounded
+      // below, so that a large group cannot buy a hit.
+      const std::vector<std::size_t> lead = leading_group(d);
+      s.group_size = lead.size();
+      s.top.clear();
+      for (std::size_t m : lead)
+        s.top += (s.top.empty() ? "" : " / ") + candidate_label(signals, d.candidates[m].fit);
       const auto& top = d.candidates.front().fit;
       for (const auto& e : hc.effects) {
         // An effect that spreads over the joints (the IMS chain's errors, the payload): its kind
@@ -132,8 +147,11 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
         // energy. The others: kind and source joint.
         const bool spread = test::spreads_over_joints(e.name);
         const int joint = spread ? c.spread_joint : e.joint;
-        s.ranked_first |=
-            top.kind == test::expected_kind(e.name) && (spread || int(top.joint) == joint);
+        for (std::size_t m : lead) {
+          const auto& f = d.candidates[m].fit;
+          s.ranked_first |=
+              f.kind == test::expected_kind(e.name) && (spread || int(f.joint) == joint);
+        }
         s.joint_located |= int(top.joint) == joint;
       }
       s.predicted = d.combination.empty() ? d.candidates.front().shrinkage_percent
@@ -151,6 +169,7 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
       }
     s.truth = 100.0 * (1.0 - std::sqrt(e_noise / e_gap));
     const std::string row = hc.effects.empty() ? "control" : hc.effects.front().name;
+    // The confusion matrix counts the top candidate (the first of its group).
     const std::string col = d.significant_gap ? to_string(d.candidates.front().fit.kind) : "none";
     ++confusion[row][col];
     fmt::print(
@@ -174,7 +193,10 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
     fmt::print("\n");
   }
   int effect_cases = 0, first = 0, located = 0, within = 0, controls = 0, alarms = 0;
+  std::size_t largest_group = 0, grouped = 0;
   for (const auto& s : scores) {
+    largest_group = std::max(largest_group, s.group_size);
+    grouped += s.group_size > 1;
     if (s.name == "control") {
       ++controls;
       alarms += s.alarm;
@@ -188,21 +210,24 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
   const auto pct = [](int a, int b) { return b ? 100.0 * a / b : 0.0; };
   fmt::print(
       "\nwithheld effect ranked first {}/{} ({:.0f} %), joint located {}/{} ({:.0f} %), predicted "
-      "shrinkage within ±20 pp of the true one {}/{} ({:.0f} %), false alarms {}/{} controls\n",
+      "shrinkage within ±20 pp of the true one {}/{} ({:.0f} %), false alarms {}/{} controls\n"
+      "leading ambiguity groups of two or more: {} cases, largest {}\n",
       first, effect_cases, pct(first, effect_cases), located, effect_cases,
-      pct(located, effect_cases), within, effect_cases, pct(within, effect_cases), alarms,
-      controls);
+      pct(located, effect_cases), within, effect_cases, pct(within, effect_cases), alarms, controls,
+      grouped, largest_group);
 
-  // The issue's goals: ranked first >= 90 %, joint located >= 90 %, false alarms <= 10 % of the
-  // controls (met, asserted); predicted shrinkage within ±20 pp of the true one, the goal for
-  // every case: reached in 79 % of them (printed above), asserted with a margin of ~10 pp so
-  // that a regression fails (the misses: backlash, transmission error, payload and a resonance
-  // whose candidates explain less than the truth; see the report of issue 7).
+  // The issue's goals, all met and asserted: ranked first >= 90 % (the withheld effect first or
+  // in the leading ambiguity group, which must stay small: at most 3 members, measured at most 2),
+  // joint located >= 90 %, false alarms <= 10 % of the controls, predicted shrinkage within
+  // ±20 pp of the true one >= 90 % (measured 47/52; the misses: transmission error on A1 and A2,
+  // whose response through the loop and the wrist modes the Laguerre bases follow only in part,
+  // backlash on A2 and the payload, ~21 pp under the truth each; see the report of issue 7).
   EXPECT_LE(alarms, controls / 10) << "false alarms on controls";
   EXPECT_GE(pct(first, effect_cases), 90.0);
   EXPECT_GE(pct(located, effect_cases), 90.0);
+  EXPECT_LE(largest_group, 3u);
   if (!sanitized()) {  // a figure of the whole set: the subset's few cases say little
-    EXPECT_GE(pct(within, effect_cases), 70.0);
+    EXPECT_GE(pct(within, effect_cases), 90.0);
   }
 }
 

@@ -1,0 +1,112 @@
+#include "eval/gap_filters.hpp"
+
+#include <cmath>
+
+namespace imscal::eval {
+
+Column to_column(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), Eigen::Index(v.size()));
+}
+
+double rms_of(const Column& c) {
+  return c.size() ? std::sqrt(c.squaredNorm() / double(c.size())) : 0.0;
+}
+
+Eigen::MatrixXd matrix_of(const std::vector<Column>& cols) {
+  Eigen::MatrixXd m(cols.empty() ? 0 : cols[0].size(), Eigen::Index(cols.size()));
+  for (std::size_t i = 0; i < cols.size(); ++i) m.col(Eigen::Index(i)) = cols[i];
+  return m;
+}
+
+Column lag(const Column& u, double tau_s, const GapSignals& s) {
+  Column y(u.size());
+  const double a = std::exp(-s.cycle_s / tau_s);
+  for (const auto& [b, e] : s.runs) {
+    double state = e > b ? u[Eigen::Index(b)] : 0.0;
+    for (std::size_t k = b; k < e; ++k) {
+      state = a * state + (1.0 - a) * u[Eigen::Index(k)];
+      y[Eigen::Index(k)] = state;
+    }
+  }
+  return y;
+}
+
+std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta,
+                                       const GapSignals& s) {
+  const double w = 2.0 * M_PI * f_hz;
+  const int sub = 8;
+  const double h = s.cycle_s / sub;
+  Column y(u.size()), r(u.size());
+  for (const auto& [b, e] : s.runs) {
+    double p = e > b ? u[Eigen::Index(b)] : 0.0, v = 0.0;  // at rest in its first input
+    for (std::size_t k = b; k < e; ++k) {
+      const double x = u[Eigen::Index(k)];
+      for (int i = 0; i < sub; ++i) {
+        v += h * (w * w * (x - p) - 2.0 * zeta * w * v);
+        p += h * v;
+      }
+      y[Eigen::Index(k)] = p;
+      r[Eigen::Index(k)] = v / w;
+    }
+  }
+  return {y, r};
+}
+
+std::vector<Column> laguerre(const Column& u, double tau_s, int order, const GapSignals& s) {
+  const double a = std::exp(-s.cycle_s / tau_s), g0 = std::sqrt(1.0 - a * a);
+  std::vector<Column> out(std::size_t(order), Column(u.size()));
+  for (const auto& [b, e] : s.runs) {
+    if (e <= b) continue;
+    const double u0 = u[Eigen::Index(b)];
+    std::vector<double> y(std::size_t(order), g0 / (1.0 - a) * u0);
+    std::vector<double> x_previous = y;  // each stage's previous input
+    x_previous[0] = u0;
+    for (std::size_t k = b; k < e; ++k) {
+      double x = u[Eigen::Index(k)];
+      for (int i = 0; i < order; ++i) {
+        double& yi = y[std::size_t(i)];
+        const double next = i == 0 ? a * yi + g0 * x : a * yi + x_previous[std::size_t(i)] - a * x;
+        x_previous[std::size_t(i)] = x;
+        yi = next;
+        out[std::size_t(i)][Eigen::Index(k)] = next;
+        x = next;
+      }
+    }
+  }
+  return out;
+}
+
+Column relay(const Column& z, double h, const GapSignals& s) {
+  Column r = Column::Zero(z.size());
+  for (const auto& [b, e] : s.runs) {
+    double state = 0.0;
+    for (std::size_t k = b; k < e && state == 0.0; ++k) {
+      const double v = z[Eigen::Index(k)];
+      if (std::abs(v) > h) state = v > 0.0 ? 1.0 : -1.0;
+    }
+    if (state == 0.0)
+      state = 1.0;  // never decided: one flank all along (which one: the fit's sign)
+    for (std::size_t k = b; k < e; ++k) {
+      const double v = z[Eigen::Index(k)];
+      if (v > h) state = 1.0;
+      if (v < -h) state = -1.0;
+      r[Eigen::Index(k)] = state;
+    }
+  }
+  return r;
+}
+
+Column run_derivative(const Column& x, const GapSignals& s) {
+  Column d = Column::Zero(x.size());
+  const double dt = s.cycle_s;
+  for (const auto& [b, e] : s.runs) {
+    if (e - b < 2) continue;
+    const Eigen::Index bi = Eigen::Index(b), ei = Eigen::Index(e);
+    d[bi] = (x[bi + 1] - x[bi]) / dt;
+    d[ei - 1] = (x[ei - 1] - x[ei - 2]) / dt;
+    for (Eigen::Index k = bi + 1; k + 1 < ei; ++k) d[k] = (x[k + 1] - x[k - 1]) / (2.0 * dt);
+  }
+  return d;
+}
+
+}  // namespace imscal::eval

@@ -1,0 +1,32 @@
+#pragma once
+// The cross-validation inside the training rows that chooses the nonlinear shape of a candidate
+// effect (eval/gap_candidates.hpp) and the joints its coupling reaches (eval/gap_coupling.hpp):
+// the training rows are cut into chunks of consecutive training rows, dealt to the folds in
+// turn; a set of columns is fitted on all folds but one and judged on that one, for each fold.
+// Unlike a BIC it needs no count of independent rows (the residuals are coloured), and it sees
+// whether a shape carries over to other motion.
+#include <Eigen/Core>
+#include <vector>
+
+#include "eval/gap_signals.hpp"
+
+namespace imscal::eval {
+
+struct TrainingFolds {
+  std::vector<std::vector<Eigen::Index>> folds;  // sample indices per fold
+  // The rows of all folds but fold i.
+  std::vector<std::vector<Eigen::Index>> complements;
+  bool usable() const { return folds.size() > 1 && !folds.back().empty(); }
+};
+TrainingFolds training_folds(const GapSignals& signals, const std::vector<bool>& training);
+
+// Sum of squared residuals on the rows `check` of the LS fit of columns to y on the rows `fit`
+// (parameters only: no sigma is needed to choose a shape).
+double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
+                      const std::vector<Eigen::Index>& fit, const std::vector<Eigen::Index>& check);
+
+// The validation error summed over the folds.
+double cross_validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
+                            const TrainingFolds& folds);
+
+}  // namespace imscal::eval

@@ -1,0 +1,152 @@
+#include "eval/gap_verdict.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace imscal::eval {
+namespace {
+
+constexpr double kArcsecPerRad = 180.0 / M_PI * 3600.0;
+
+// Where the gap lies, and the cells outside the identified range on every joint that runs there.
+std::string where_in_words(const Diagnosis& d) {
+  if (d.where.joints.empty()) return {};
+  std::size_t top_joint = 0;
+  for (std::size_t j = 0; j < d.where.joints.size(); ++j)
+    if (d.where.joints[j].energy_share > d.where.joints[top_joint].energy_share) top_joint = j;
+  const auto& ja = d.where.joints[top_joint];
+  const auto top_of = [](const std::vector<GapShare>& v) {
+    return *std::max_element(v.begin(), v.end(), [](const GapShare& a, const GapShare& b) {
+      return a.energy_share < b.energy_share;
+    });
+  };
+  const GapShare ph = top_of(ja.by_phase), band = top_of(ja.by_band);
+  std::string where = fmt::format(
+      "The gap (RMS {:.3g} rad = {:.1f} arcsec over all joints) lies mostly in joint {} ({:.0f} % "
+      "of its energy), there mostly during {} ({:.0f} % of the joint's gap energy in {:.0f} % of "
+      "the time) and in the {} band ({:.0f} %).",
+      d.where.rms_rad, d.where.rms_rad * kArcsecPerRad, ja.joint, 100.0 * ja.energy_share, ph.label,
+      100.0 * ph.energy_share, 100.0 * ph.time_share, band.label, 100.0 * band.energy_share);
+  std::vector<std::string> outside;
+  for (const auto& jo : d.where.joints) {
+    double time = 0.0, energy = 0.0;
+    for (const auto& c : jo.by_cell)
+      if (c.outside_identified_range) time += c.time_share, energy += c.energy_share;
+    if (time > 0.0)
+      outside.push_back(fmt::format("{} {:.0f} % of the time ({:.0f} % of its gap energy)",
+                                    jo.joint, 100.0 * time, 100.0 * energy));
+  }
+  if (!outside.empty())
+    where += fmt::format(
+        " The path runs at operating points outside the identified range (cells of the error "
+        "model not identified from data): {}.",
+        fmt::join(outside, ", "));
+  return where;
+}
+
+// "X, or indistinguishable on these data: Y, Z" for a list of candidate indices.
+std::string members_in_words(const GapSignals& s, const Diagnosis& d,
+                             const std::vector<std::size_t>& members) {
+  std::string t = candidate_in_words(s, d.candidates[members.front()].fit);
+  if (members.size() > 1) {
+    std::vector<std::string> others;
+    for (std::size_t i = 1; i < members.size(); ++i)
+      others.push_back(candidate_in_words(s, d.candidates[members[i]].fit));
+    t += fmt::format(", or, indistinguishable from it on these data, {}", fmt::join(others, "; "));
+  }
+  return t;
+}
+
+std::string labels_of(const GapSignals& s, const Diagnosis& d,
+                      const std::vector<std::size_t>& members) {
+  std::vector<std::string> l;
+  for (std::size_t m : members) l.push_back(candidate_label(s, d.candidates[m].fit));
+  return fmt::format("{}", fmt::join(l, " / "));
+}
+
+}  // namespace
+
+std::string candidate_in_words(const GapSignals& s, const CandidateFit& f) {
+  return fmt::format("{} on joint {} ({}; {}{})", to_string(f.kind), s.joint_names[f.joint],
+                     f.shape, f.size_text, f.coupling.empty() ? "" : "; coupled " + f.coupling);
+}
+
+void write_verdict(const GapSignals& s, const DiagnosisOptions& o, Diagnosis& out) {
+  const std::string where = where_in_words(out);
+  if (!out.significant_gap) {
+    out.verdict = fmt::format(
+        "{} No significant structured gap: no candidate effect shrinks the held-out gap by at "
+        "least {:.0f} % with p < {:g}; what remains looks like measurement noise or an effect "
+        "outside the library.",
+        where, o.min_shrinkage_percent, o.alpha);
+    if (!out.candidates.empty())
+      out.measure_next.push_back(
+          fmt::format("if a gap of {:.3g} rad matters: longer records of the path, and {}",
+                      out.heldout_rms_rad, what_to_measure(out.candidates.front().fit.kind)));
+    return;
+  }
+  const CandidateResult& top = out.candidates.front();
+  const std::vector<std::size_t> lead = leading_group(out);
+  std::vector<std::string> steps;
+  for (const auto& c : out.combination) steps.push_back(c.label);
+  out.verdict = fmt::format(
+      "{} Most likely cause: {}, which shrinks the held-out gap by {:.0f} % (p = {:.3f}). "
+      "Modelled with {}, the held-out gap is expected to fall from {:.3g} rad to {:.3g} rad "
+      "({:.0f} "
+      "% smaller).",
+      where, members_in_words(s, out, lead), top.shrinkage_percent, top.p_value,
+      steps.empty() ? std::string("it") : fmt::format("{}", fmt::join(steps, " + ")),
+      out.heldout_rms_rad, out.heldout_rms_modelled_rad,
+      100.0 * (1.0 - out.heldout_rms_modelled_rad / std::max(out.heldout_rms_rad, 1e-300)));
+  if (lead.size() > 1) {
+    const AmbiguityGroup& g = out.ambiguity_groups[std::size_t(top.ambiguity_group)];
+    out.measure_next.push_back(fmt::format(
+        "to tell {} apart (their modelled gaps differ by {:.2g} "
+        "rad RMS, {:.0f} % of what they leave): {}",
+        labels_of(s, out, lead), g.difference_rms_rad,
+        100.0 * g.difference_rms_rad / std::max(g.residual_rms_rad, 1e-300), g.separate_by));
+  }
+  // A joint whose own gap's leading explanation is ambiguous (and explains at least
+  // min_shrinkage_percent of it): named with its alternatives and what would separate them, with
+  // the evidence's strength (the leading cause overall may hide it, e.g. a constant offset that a
+  // multi-joint candidate also absorbs).
+  for (const JointFinding& f : out.joint_findings) {
+    const CandidateResult& leader = out.candidates[f.leading.front()];
+    if (f.leading.size() < 2 || f.leading == lead ||
+        leader.joint_shrinkage_percent < o.min_shrinkage_percent)
+      continue;
+    out.verdict += fmt::format(
+        " On joint {} alone, its gap's leading explanation ({:.0f} % of its held-out gap, p = "
+        "{:.3f}{}) is ambiguous: {}.",
+        s.joint_names[f.joint], leader.joint_shrinkage_percent, leader.joint_p_value,
+        f.supported ? "" : ", weak evidence", members_in_words(s, out, f.leading));
+    out.measure_next.push_back(
+        fmt::format("to tell {} apart: {}", labels_of(s, out, f.leading), f.separate_by));
+  }
+  std::vector<std::string> unsupported;
+  for (const auto& c : out.candidates)
+    if (!c.supported && !c.joint_supported && c.fit.joint == top.fit.joint)
+      unsupported.push_back(to_string(c.fit.kind));
+  if (!unsupported.empty())
+    out.verdict += fmt::format(" Not supported on joint {}: {}.", s.joint_names[top.fit.joint],
+                               fmt::join(unsupported, ", "));
+  // Weak evidence: a different effect explains nearly as much, or the best explains little.
+  for (std::size_t c = 1; c < out.candidates.size(); ++c) {
+    const auto& r = out.candidates[c];
+    if (!r.supported) break;
+    if (std::find(lead.begin(), lead.end(), c) != lead.end()) continue;
+    if (top.shrinkage_percent - r.shrinkage_percent < 5.0)
+      out.measure_next.push_back(
+          fmt::format("{} explains nearly as much ({:.0f} % vs {:.0f} %); to tell them apart: {}",
+                      candidate_label(s, r.fit), r.shrinkage_percent, top.shrinkage_percent,
+                      separating_measurement(s, top.fit, r.fit)));
+  }
+  if (top.shrinkage_percent < 30.0)
+    out.measure_next.push_back(
+        fmt::format("the best candidate explains only {:.0f} % of the gap: measure {}",
+                    top.shrinkage_percent, what_to_measure(top.fit.kind)));
+}
+
+}  // namespace imscal::eval
