@@ -15,7 +15,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 
 #include "core/config_node.hpp"
@@ -28,16 +27,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool sanitized() {
-  return std::getenv("IMSCAL_SANITIZED") != nullptr;
-}
-
 TEST(GapPaperCase, NamesTheOperatingPointMismatchAndJoint2Backlash) {
-  // Identification: the whole program (its first 30 s under sanitizers: ~5x less to simulate).
+  // Identification: the whole program, under sanitizers too (a shorter part identifies another
+  // model, whose gap on A2 is no longer led by the play's constant: the assertions below are
+  // about the paper's setting, so CI runs that).
   const ident::JointErrorLog identification = simulate_truth_joint_errors(
       sim::load_scenario(fs::path(IMSCAL_TEST_DATA_DIR) /
                          "scenarios/identification-a2-no-backlash.yaml"),
-      sanitized() ? 30.0 : 1e9);
+      1e9);
   ident::IdentificationConfig config = ident::load_identification_config(ConfigNode::load_file(
       fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-paper.yaml"));
   config.options.form = ident::ArxModelForm::kJointError;  // the forward error model
@@ -76,9 +73,7 @@ TEST(GapPaperCase, NamesTheOperatingPointMismatchAndJoint2Backlash) {
   for (const auto& step : d.combination)
     fmt::print("  combination + {:<30} {:6.1f} %\n", step.label, step.shrinkage_percent);
 
-  if (!sanitized()) {  // the whole identification: a structured gap is left (its top: printed)
-    EXPECT_TRUE(d.significant_gap) << d.verdict;
-  }
+  EXPECT_TRUE(d.significant_gap) << d.verdict;  // a structured gap is left (its top: printed)
   // The operating-point mismatch: seed-line's A2 runs in cells of the identified grid that the
   // identification runs did not fill (its positions at the outer limits of the workspace), and
   // the verdict says so.
