@@ -19,48 +19,18 @@
 #include "sim/motion_profile.hpp"
 #include "sim/motion_program.hpp"
 #include "tests/sim/joint_limit_use.hpp"
+#include "tests/sim/planned_path_helpers.hpp"
 
 namespace imscal::sim {
 namespace {
 
 using calib::JointVector;
+using test::fk;
+using test::program;
+using test::range;
+using test::robot;
+using test::segment;
 constexpr double kDeg = M_PI / 180.0;
-
-const calib::RobotDescription& robot() {
-  static const calib::RobotDescription r =
-      calib::load_robot_description(std::string(IMSCAL_SOURCE_DIR) + "/datasets/robots/kr16.yaml");
-  return r;
-}
-
-// The joint limits of the shipped programs (datasets/programs/seed-line.yaml).
-const char* kHeader = R"(
-name: test
-start_joints_deg: [10, -60, 80, 20, 50, 30]
-profile: jerk_limited
-joint_acceleration_deg_s2: [200, 200, 250, 600, 600, 900]
-joint_jerk_deg_s3: [2000, 2000, 2500, 6000, 6000, 9000]
-)";
-
-MotionProgram program(const std::string& segments, const char* header = kHeader) {
-  return parse_motion_program(
-      ConfigNode::load_string(std::string(header) + "segments:\n" + segments, "test.yaml"));
-}
-
-const PathSegment& segment(const DesiredJointPath& path, const std::string& label) {
-  for (const auto& s : path.segments) {
-    if (s.label == label) return s;
-  }
-  throw std::runtime_error("no segment " + label);
-}
-
-std::pair<std::size_t, std::size_t> range(const DesiredJointPath& path, const PathSegment& s) {
-  return {static_cast<std::size_t>(std::lround(s.begin_s / path.cycle_s)),
-          static_cast<std::size_t>(std::lround(s.end_s / path.cycle_s))};
-}
-
-Eigen::Isometry3d fk(const JointVector& q) {
-  return calib::forward_kinematics<double>(robot().kinematics, q);
-}
 
 // The planned arc-length profile of a Cartesian segment, recomputed from its recorded limits.
 MotionProfile planned_profile(const PathSegment& seg, double length) {

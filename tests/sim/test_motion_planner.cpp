@@ -18,54 +18,23 @@
 #include "sim/motion_profile.hpp"
 #include "sim/motion_program.hpp"
 #include "tests/sim/joint_limit_use.hpp"
+#include "tests/sim/planned_path_helpers.hpp"
 
 namespace imscal::sim {
 namespace {
 
 using calib::JointVector;
+using test::fk;
+using test::program;
+using test::range;
+using test::robot;
+using test::segment;
 constexpr double kDeg = M_PI / 180.0;
 
-const calib::RobotDescription& robot() {
-  static const calib::RobotDescription r =
-      calib::load_robot_description(std::string(IMSCAL_SOURCE_DIR) + "/datasets/robots/kr16.yaml");
-  return r;
-}
-
-// A generic start pose, away from the singularities (elbow bent 20 deg, wrist bent 50 deg).
-const char* kHeader = R"(
-name: test
-start_joints_deg: [10, -60, 80, 20, 50, 30]
-profile: jerk_limited
-joint_acceleration_deg_s2: [200, 200, 250, 600, 600, 900]
-joint_jerk_deg_s3: [2000, 2000, 2500, 6000, 6000, 9000]
-)";
-
-MotionProgram program(const std::string& segments) {
-  return parse_motion_program(
-      ConfigNode::load_string(std::string(kHeader) + "segments:\n" + segments, "test.yaml"));
-}
-
-// kHeader's joint limits.
+// test::kHeader's joint limits.
 const MotionProgram& header_program() {
   static const MotionProgram p = program("  - rest: {duration_s: 1}\n");
   return p;
-}
-
-Eigen::Isometry3d fk(const JointVector& q) {
-  return calib::forward_kinematics<double>(robot().kinematics, q);
-}
-
-const PathSegment& segment(const DesiredJointPath& path, const std::string& label) {
-  for (const auto& s : path.segments) {
-    if (s.label == label) return s;
-  }
-  throw std::runtime_error("no segment " + label);
-}
-
-// Sample indices [first, last] of a segment (borders fall on samples).
-std::pair<std::size_t, std::size_t> range(const DesiredJointPath& path, const PathSegment& s) {
-  return {static_cast<std::size_t>(std::lround(s.begin_s / path.cycle_s)),
-          static_cast<std::size_t>(std::lround(s.end_s / path.cycle_s))};
 }
 
 double rotation_angle(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
@@ -173,7 +142,7 @@ void check_cartesian(const DesiredJointPath& path, const PathSegment& seg, doubl
   const ProfileLimits limits = seg.timing->planned;
   const MotionProfile profile = MotionProfile::plan(ProfileKind::kJerkLimited, length, limits)
                                     .stretched_to(seg.end_s - seg.begin_s);
-  // Within the joint limits of kHeader (the planner's tolerance: 1e-6).
+  // Within the joint limits of test::kHeader (the planner's tolerance: 1e-6).
   const MeasuredLimitUse use = measured_limit_use(
       path, seg, header_program().max_acceleration_rad_s2, header_program().max_jerk_rad_s3);
   EXPECT_LE(use.acceleration, 1.0 + kJointLimitTolerance);

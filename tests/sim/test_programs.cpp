@@ -19,18 +19,17 @@
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "tests/sim/joint_limit_use.hpp"
+#include "tests/sim/planned_path_helpers.hpp"
 
 namespace imscal::sim {
 namespace {
 
 using calib::JointVector;
+using test::fk;
+using test::range;
+using test::robot;
+using test::segment;
 namespace fs = std::filesystem;
-
-const calib::RobotDescription& robot() {
-  static const calib::RobotDescription r =
-      calib::load_robot_description(std::string(IMSCAL_SOURCE_DIR) + "/datasets/robots/kr16.yaml");
-  return r;
-}
 
 fs::path programs_dir() {
   return fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "programs";
@@ -52,22 +51,6 @@ const Planned& planned(const std::string& name) {
     it = cache.emplace(name, std::move(p)).first;
   }
   return it->second;
-}
-
-std::pair<std::size_t, std::size_t> range(const DesiredJointPath& path, const PathSegment& s) {
-  return {static_cast<std::size_t>(std::lround(s.begin_s / path.cycle_s)),
-          static_cast<std::size_t>(std::lround(s.end_s / path.cycle_s))};
-}
-
-const PathSegment& segment(const DesiredJointPath& path, const std::string& label) {
-  for (const auto& s : path.segments) {
-    if (s.label == label) return s;
-  }
-  throw std::runtime_error("no segment " + label);
-}
-
-Eigen::Isometry3d fk(const JointVector& q) {
-  return calib::forward_kinematics<double>(robot().kinematics, q);
 }
 
 double path_speed(const JointVector& q, const JointVector& qd) {
