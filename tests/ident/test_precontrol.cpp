@@ -3,8 +3,8 @@
 // model (ArxModel::predict_joint_error); blending is continuous; backlash does not chatter; the
 // supervisor and every fault of the runtime list have their defined reaction; no heap
 // allocation happens inside a cycle.
-// GCC 12 flags the malloc/free pair of the counting operator new below at every inlined
-// std::allocator use in this file (a false positive: new and delete here are a matching pair).
+// GCC 12 flags the malloc/free pair of the counting operator new (tests/support/
+// allocation_counter.hpp) at every inlined std::allocator use in this file (a false positive).
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 
 #include "ident/joint_identification.hpp"
@@ -20,22 +20,9 @@
 #include <vector>
 
 #include "ident/arx_model.hpp"
+#include "tests/support/allocation_counter.hpp"
 #include "tests/support/arx_systems.hpp"
 #include "tests/support/reference_precontrol.hpp"
-
-// Counts every heap allocation of this test program (to prove there is none in a cycle).
-static std::atomic<long> g_allocations{0};
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace imscal::ident {
 namespace {
@@ -397,14 +384,14 @@ TEST(Precontrol, SameOffsetsAsTheAllCellsReferenceWithBlendingAndFaults) {
 TEST(Precontrol, NoHeapAllocationInsideTheCycle) {
   Precontrol p = make(table({cell(0.0), cell(0.01)}, {0.0, 0.2, 0.4}, 1e-4), PrecontrolOptions{});
   std::array<double, 6> qd{};
-  const long before = g_allocations.load();
+  const long before = test_support::g_allocations.load();
   for (int k = 0; k < 20000; ++k) {
     qd.fill(0.1 * std::sin(k * 0.001));
     if (k == 5000) qd[2] = std::nan("");  // faults too
     p.cycle(qd, 3.0, k == 7000 ? k + 5 : k);
     if (k == 6000) p.reactivate();
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(test_support::g_allocations.load() - before, 0);
 }
 
 }  // namespace

@@ -3,8 +3,8 @@
 // its offsets against the all-cells reference (tests/support/reference_precontrol.hpp: every
 // sum an Eigen dot product over exactly its nx_e coefficients) on a 3 x 2 grid with blending and
 // the runtime's faults, and no heap allocation in the torque-fed cycle of an order-32 grid.
-// GCC 12 flags the malloc/free pair of the counting operator new below at every inlined
-// std::allocator use in this file (a false positive: new and delete here are a matching pair).
+// GCC 12 flags the malloc/free pair of the counting operator new (tests/support/
+// allocation_counter.hpp) at every inlined std::allocator use in this file (a false positive).
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 
 #include <gtest/gtest.h>
@@ -18,22 +18,9 @@
 #include <string>
 
 #include "ident/precontrol.hpp"
+#include "tests/support/allocation_counter.hpp"
 #include "tests/support/arx_systems.hpp"
 #include "tests/support/reference_precontrol.hpp"
-
-// Counts every heap allocation of this test program (to prove there is none in a cycle).
-static std::atomic<long> g_allocations{0};
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace imscal::ident {
 namespace {
@@ -211,7 +198,7 @@ TEST(PrecontrolFurtherInputs, NoHeapAllocationInsideTheTorqueFedCycle) {
   ASSERT_TRUE(Precontrol::create(order_32_grid_table(), "kr16", o, &p, &why)) << why;
   std::array<double, 6> qd{}, torque{};
   int active = 0;
-  const long before = g_allocations.load();
+  const long before = test_support::g_allocations.load();
   for (int k = 0; k < 20000; ++k) {
     const double t = k * kCycle;
     for (int j = 0; j < 6; ++j) qd[j] = 0.8 * std::sin(0.5 * t + j);  // sweeps the speed cells
@@ -223,7 +210,7 @@ TEST(PrecontrolFurtherInputs, NoHeapAllocationInsideTheTorqueFedCycle) {
                                            : p.cycle(qd, payload, torque, k == 7000 ? k + 5 : k);
     active += out.state == PrecontrolState::kActive;
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(test_support::g_allocations.load() - before, 0);
   EXPECT_GT(active, 15000);  // the work was done, not switched off
 }
 
