@@ -21,6 +21,25 @@ std::size_t rows_of(std::span<const IoSegment> views, std::size_t first_row) {
   return rows;
 }
 
+// NRMSE fit [%] streamed over pieces (ident/model_validation.hpp's fit_percent takes one
+// contiguous series): 100 (1 - |residual| / |reference - mean(reference)|); NaN when the
+// reference is constant.
+struct NrmseFit {
+  double misfit = 0.0, sum = 0.0, sum_sq = 0.0;
+  std::size_t count = 0;
+  void add(double residual, double reference) {
+    misfit += residual * residual;
+    sum += reference;
+    sum_sq += reference * reference;
+    ++count;
+  }
+  double percent() const {
+    const double spread = count ? sum_sq - sum * sum / double(count) : 0.0;
+    if (!(spread > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    return 100.0 * (1.0 - std::sqrt(misfit / spread));
+  }
+};
+
 // NRMSE fit [%] of the free-run joint error on the views: what the precontrol adds,
 // Δq̂(k) = q_d(k-d) - (ŷ(k) - l s(k)) (eq. 2 + eq. 3), against the error it has to cancel at
 // that cycle, Δq(k) = q_d(k) - q_m(k). With y = q_m + l s the fitted output,
@@ -33,24 +52,16 @@ double joint_error_fit(const ArxModel& model, std::span<const IoSegment> views,
   const auto first = std::size_t(model.structure().max_lag());
   const auto d = std::size_t(model.structure().dead_time);
   std::vector<double> simulated;
-  double misfit = 0.0, sum = 0.0, sum_sq = 0.0;
-  std::size_t count = 0;
+  NrmseFit fit;
   for (const IoSegment& v : views) {
     const std::size_t offset = std::size_t(v.output.data() - output.data());
     simulated.resize(v.output.size());
     model.simulate(v, simulated);
-    for (std::size_t k = first; k < v.output.size(); ++k) {
-      const double r = v.input[k] - v.input[k - d] + simulated[k] - v.output[k];
-      const double error = q_desired[offset + k] - q_measured[offset + k];
-      misfit += r * r;
-      sum += error;
-      sum_sq += error * error;
-      ++count;
-    }
+    for (std::size_t k = first; k < v.output.size(); ++k)
+      fit.add(v.input[k] - v.input[k - d] + simulated[k] - v.output[k],
+              q_desired[offset + k] - q_measured[offset + k]);
   }
-  const double spread = count ? sum_sq - sum * sum / double(count) : 0.0;
-  if (!(spread > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  return 100.0 * (1.0 - std::sqrt(misfit / spread));
+  return fit.percent();
 }
 
 // NRMSE fit [%] of the command an inverse-form error model predicts, q̂_d = y + ê (free run of
@@ -60,23 +71,15 @@ double command_fit(const ArxModel& error_model, std::span<const IoSegment> views
                    std::span<const double> error, std::span<const double> q_desired) {
   const auto first = std::size_t(error_model.structure().max_lag());
   std::vector<double> simulated;
-  double misfit = 0.0, sum = 0.0, sum_sq = 0.0;
-  std::size_t count = 0;
+  NrmseFit fit;
   for (const IoSegment& v : views) {
     const std::size_t offset = std::size_t(v.output.data() - error.data());
     simulated.resize(v.output.size());
     error_model.simulate(v, simulated);
-    for (std::size_t k = first; k < v.output.size(); ++k) {
-      const double r = simulated[k] - v.output[k];
-      misfit += r * r;
-      sum += q_desired[offset + k];
-      sum_sq += q_desired[offset + k] * q_desired[offset + k];
-      ++count;
-    }
+    for (std::size_t k = first; k < v.output.size(); ++k)
+      fit.add(simulated[k] - v.output[k], q_desired[offset + k]);
   }
-  const double spread = count ? sum_sq - sum * sum / double(count) : 0.0;
-  if (!(spread > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  return 100.0 * (1.0 - std::sqrt(misfit / spread));
+  return fit.percent();
 }
 
 // Fills `cell` from its nearest identified cell (band steps, then the lower number).
