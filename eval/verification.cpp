@@ -23,9 +23,7 @@ namespace {
 // The scenario's plant, feeling the site's normal gravity in R (as sim::run_simulation does).
 sim::PlantConfig scenario_plant(const sim::Scenario& scenario,
                                 const calib::RobotDescription& robot) {
-  sim::PlantConfig config =
-      sim::make_plant_config(robot, scenario.effects ? &*scenario.effects : nullptr,
-                             scenario.integration_step ? &*scenario.integration_step : nullptr);
+  sim::PlantConfig config = sim::make_plant_config(robot, scenario);
   const ims::EarthModel earth(scenario.site);
   config.gravity_in_base_m_s2 =
       scenario.T_W_R.linear().transpose() * earth.gravity_W(scenario.T_W_R.translation());

@@ -132,4 +132,9 @@ fs::path resolve_scenario(const std::string& name_or_file) {
   return file;
 }
 
+PlantConfig make_plant_config(const calib::RobotDescription& robot, const Scenario& scenario) {
+  return make_plant_config(robot, scenario.effects ? &*scenario.effects : nullptr,
+                           scenario.integration_step ? &*scenario.integration_step : nullptr);
+}
+
 }  // namespace imscal::sim

@@ -11,6 +11,7 @@
 
 #include "core/config_node.hpp"
 #include "ims/earth_model.hpp"
+#include "sim/plant_config.hpp"
 
 namespace imscal::sim {
 
@@ -51,5 +52,9 @@ Scenario load_scenario(const std::filesystem::path& file);
 // as <datasets>/scenarios/NAME.yaml, where <datasets> is $IMSCAL_DATASETS if set, else the
 // repository's datasets/ folder this binary was built from.
 std::filesystem::path resolve_scenario(const std::string& name_or_file);
+
+// The plant of a scenario: its `effects` and `integration_step_s` sections on `robot` (the
+// scenario's robot file, loaded by the caller). InputError on a bad key/value.
+PlantConfig make_plant_config(const calib::RobotDescription& robot, const Scenario& scenario);
 
 }  // namespace imscal::sim

@@ -116,9 +116,7 @@ SimulationResult run_simulation(const Scenario& scenario, std::uint64_t seed,
   result.T_H_S = draw_mount(scenario, result.robot, rng);
   result.imu_clock_offset_s = scenario.imu_clock_offset_s;
 
-  PlantConfig config =
-      make_plant_config(result.robot, scenario.effects ? &*scenario.effects : nullptr,
-                        scenario.integration_step ? &*scenario.integration_step : nullptr);
+  PlantConfig config = make_plant_config(result.robot, scenario);
   // The arm feels the site's gravity (GeographicLib normal gravity at the base), in R.
   const ims::EarthModel earth(scenario.site);
   config.gravity_in_base_m_s2 =

@@ -108,9 +108,7 @@ PlantRun run_plant(const std::string& scenario_name, double max_duration_s) {
   while (path.samples.size() > 1 && path.samples.back().t_s > max_duration_s) {
     path.samples.pop_back();
   }
-  run.config =
-      sim::make_plant_config(run.robot, scenario.effects ? &*scenario.effects : nullptr,
-                             scenario.integration_step ? &*scenario.integration_step : nullptr);
+  run.config = sim::make_plant_config(run.robot, scenario);
   // As sim/simulation.cpp: the site's gravity at the base, in R.
   const ims::EarthModel earth(scenario.site);
   run.config.gravity_in_base_m_s2 =

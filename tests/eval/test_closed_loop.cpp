@@ -55,9 +55,7 @@ TEST(ClosedLoop, ZeroErrorTableLeavesTheSimulatorRunUnchanged) {
   // Under sanitizers 6.6 s (0.6 s of motion) keeps the run short.
   const double keep_s = std::getenv("IMSCAL_SANITIZED") ? 6.6 : 8.0;
   while (path.samples.back().t_s > keep_s) path.samples.pop_back();
-  const sim::PlantConfig config =
-      sim::make_plant_config(robot, scenario.effects ? &*scenario.effects : nullptr,
-                             scenario.integration_step ? &*scenario.integration_step : nullptr);
+  const sim::PlantConfig config = sim::make_plant_config(robot, scenario);
   const ClosedLoopRun run =
       run_closed_loop(path, zero_error_table(), "kr16", simulator_plant(config));
   ASSERT_EQ(run.compensated.samples.size(), path.samples.size());

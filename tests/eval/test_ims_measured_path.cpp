@@ -29,9 +29,7 @@ TEST(ImsMeasuredPath, GivesThePlantsFlangePathOnSeedLine) {
   // under the sanitizers up to the start of the line.
   const double until_s = std::getenv("IMSCAL_SANITIZED") ? 10.5 : 13.0;
   while (path.samples.back().t_s > until_s) path.samples.pop_back();
-  sim::PlantConfig config =
-      sim::make_plant_config(robot, scenario.effects ? &*scenario.effects : nullptr,
-                             scenario.integration_step ? &*scenario.integration_step : nullptr);
+  sim::PlantConfig config = sim::make_plant_config(robot, scenario);
   config.gravity_in_base_m_s2 = scenario_model_torque(scenario).gravity_in_base_m_s2;
   const sim::PlantLog plant = sim::simulate_plant(config, path, path.cycle_s);
   const ImsJointMeasurement m = measure_joints_with_ims(scenario, robot, path, plant, 5.9, 1);

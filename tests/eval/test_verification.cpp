@@ -298,9 +298,7 @@ TEST(Verification, TrueJointErrorAsOffsetBound) {
   const calib::RobotDescription robot = calib::load_robot_description(s.robot_file);
   const sim::DesiredJointPath path =
       sim::plan_motion(robot, sim::load_motion_program(s.program_file));
-  const sim::PlantConfig config =
-      sim::make_plant_config(robot, s.effects ? &*s.effects : nullptr,
-                             s.integration_step ? &*s.integration_step : nullptr);
+  const sim::PlantConfig config = sim::make_plant_config(robot, s);
   const sim::PlantLog before = sim::simulate_plant(config, path, path.cycle_s);
   const sim::PlantLog after =
       sim::simulate_plant(config, command_path(path, joint_errors(path, before)), path.cycle_s);

@@ -35,9 +35,7 @@ TEST_P(ShippedScenario, StaysBelowEveryDrivesTorqueLimit) {
                                           (GetParam() + ".yaml"));
   const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
   const DesiredJointPath path = plan_motion(robot, load_motion_program(scenario.program_file));
-  const PlantConfig config =
-      make_plant_config(robot, scenario.effects ? &*scenario.effects : nullptr,
-                        scenario.integration_step ? &*scenario.integration_step : nullptr);
+  const PlantConfig config = make_plant_config(robot, scenario);
   const PlantLog log = simulate_plant(config, path, path.cycle_s);
   for (int j = 0; j < calib::kJointCount; ++j) {
     double peak = 0.0, at = 0.0;

@@ -45,9 +45,7 @@ const SeedLineRun& seed_line() {
     SeedLineRun r;
     r.robot = calib::load_robot_description(scenario.robot_file);
     r.path = plan_motion(r.robot, load_motion_program(scenario.program_file));
-    const PlantConfig config =
-        make_plant_config(r.robot, scenario.effects ? &*scenario.effects : nullptr,
-                          scenario.integration_step ? &*scenario.integration_step : nullptr);
+    const PlantConfig config = make_plant_config(r.robot, scenario);
     r.plant = simulate_plant(config, r.path, r.path.cycle_s);
     return r;
   }();
