@@ -312,6 +312,36 @@ IdentifiedTable identify_table(const ident::JointErrorLog& log,
   return out;
 }
 
+std::vector<double> replay_held_out_fits(const IdentifiedTable& identified,
+                                         const ident::JointErrorLog& reference,
+                                         const ident::IdentificationConfig& config,
+                                         const ModelTorqueSource* torque_model) {
+  if (config.options.model_torque_input && reference.model_torque_nm.empty()) {
+    if (torque_model == nullptr)
+      throw std::invalid_argument(
+          "replay_held_out_fits: the config's models take the model torque; give the robot's "
+          "rigid-body model");
+    ident::JointErrorLog with_torque = reference;
+    attach_model_torques(with_torque, *torque_model, config.options);
+    return replay_held_out_fits(identified, with_torque, config);
+  }
+  if (identified.joints.size() != reference.joint_count())
+    throw std::invalid_argument("replay_held_out_fits: the table and the record differ in joints");
+  const auto segments = reference.segments();
+  std::vector<double> fits;
+  for (std::size_t j = 0; j < identified.joints.size(); ++j) {
+    const std::span<const double> torque = reference.model_torque_nm.empty()
+                                               ? std::span<const double>()
+                                               : reference.model_torque_nm[j];
+    fits.push_back(ident::replay_held_out_fit(identified.joints[j], reference.q_desired_rad[j],
+                                              reference.q_measured_rad[j], reference.payload_kg,
+                                              segments, reference.cycle_s, config.joint_grid(j),
+                                              config.options, torque)
+                       .joint_error_fit_percent);
+  }
+  return fits;
+}
+
 ident::IdentificationConfig with_operating_point_grid(ident::IdentificationConfig config) {
   config.speed_fraction_bounds = {0.0, 0.2, 0.8, 1.0};
   config.payload_fraction_bounds = {0.0, 0.5, 1.0};

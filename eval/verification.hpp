@@ -96,6 +96,16 @@ ident::IdentificationConfig with_operating_point_grid(ident::IdentificationConfi
 ident::IdentificationConfig single_cell(ident::IdentificationConfig config);
 ident::IdentificationConfig paper_form(ident::IdentificationConfig config);
 
+// The held-out joint-error fit of every joint of an identified table on ANOTHER record of the
+// same runs (ident::replay_held_out_fit): e.g. a table identified from the IMS-measured joint
+// errors, judged against the simulator's true joint errors, which tells the model's own error
+// from the measurement's noise in the held-out target. One figure per joint (NaN: the joint was
+// not identified, or no held-out rows). config and torque_model as for identify_table.
+std::vector<double> replay_held_out_fits(const IdentifiedTable& identified,
+                                         const ident::JointErrorLog& reference,
+                                         const ident::IdentificationConfig& config,
+                                         const ModelTorqueSource* torque_model = nullptr);
+
 // Held-out simulation fit of a joint: the identified cells' figures weighted by their held-out
 // rows (NaN when no cell has held-out data).
 struct JointFitSummary {

@@ -106,6 +106,129 @@ void fill_from_nearest(const CellGrid& grid, std::vector<CellIdentification>& re
   target.figures.validation_rows = report.validation_rows;
 }
 
+// The last validation_fraction of every segment (or of every block of validation_block_s) held
+// out: (estimation, held-out) ranges.
+std::pair<Ranges, Ranges> split_held_out(
+    std::span<const std::pair<std::size_t, std::size_t>> segments, double cycle_s,
+    const JointIdentificationOptions& options) {
+  Ranges estimation, held_out;
+  const std::size_t block =
+      options.validation_block_s > 0.0
+          ? std::max<std::size_t>(1,
+                                  std::size_t(std::llround(options.validation_block_s / cycle_s)))
+          : std::numeric_limits<std::size_t>::max();
+  for (const auto& [segment_begin, segment_end] : segments) {
+    for (std::size_t begin = segment_begin; begin < segment_end;) {
+      // The last block takes the remainder when it would be shorter than half a block.
+      std::size_t end = segment_end - begin > block ? begin + block : segment_end;
+      if (segment_end - end < block / 2) end = segment_end;
+      const std::size_t len = end - begin;
+      const auto cut = end - std::size_t(std::llround(options.validation_fraction * double(len)));
+      if (cut > begin) estimation.emplace_back(begin, cut);
+      if (end > cut) held_out.emplace_back(cut, end);
+      begin = end;
+    }
+  }
+  return {std::move(estimation), std::move(held_out)};
+}
+
+// The joint's RMS model torque times torque_sign_scale_fraction: the scale of tanh(τ / τ_s).
+double torque_sign_scale_of(const std::string& name,
+                            std::span<const std::pair<std::size_t, std::size_t>> segments,
+                            std::span<const double> model_torque_nm,
+                            const JointIdentificationOptions& options) {
+  double sum_sq = 0.0;
+  std::size_t count = 0;
+  for (const auto& [begin, end] : segments)
+    for (std::size_t k = begin; k < end; ++k, ++count)
+      sum_sq += model_torque_nm[k] * model_torque_nm[k];
+  const double scale =
+      count ? options.torque_sign_scale_fraction * std::sqrt(sum_sq / double(count)) : 0.0;
+  if (!(scale > 0.0))
+    throw std::runtime_error(fmt::format("joint {}: the model torque is zero throughout", name));
+  return scale;
+}
+
+// The signals an ARX structure of the options' form is fitted to, over the whole record: (q_d, y)
+// in the angle form, (w, e) in the joint-error and inverse forms (w: desired increments, or the
+// link's increments P cycles ahead; 0 beyond the end of a run, where the robot stands), and the
+// further inputs (multi-input form), P cycles ahead like w and held at the end of a run: the
+// model torque along the driver's path, the direction of the driver's motion, the side of the
+// gear the torque presses on (tanh(τ / torque_sign_scale_nm)).
+struct FitSignals {
+  std::vector<double> input, output;  // (w, e); empty in the angle form
+  std::array<std::vector<double>, kMaxExtraInputs> extra;
+  int extra_count = 0;
+
+  IoSegment with_extras(std::span<const double> in, std::span<const double> out) const {
+    IoSegment all{in, out, {}, extra_count};
+    for (int e = 0; e < extra_count; ++e) all.extra[std::size_t(e)] = extra[std::size_t(e)];
+    return all;
+  }
+};
+
+bool is_error_form(const JointIdentificationOptions& options) {
+  return options.form == ArxModelForm::kJointError || options.form == ArxModelForm::kInverse;
+}
+
+// output: the play-free joint angle y.
+FitSignals make_fit_signals(std::span<const double> q_desired, std::span<const double> output,
+                            std::span<const std::pair<std::size_t, std::size_t>> segments,
+                            double cycle_s, const JointIdentificationOptions& options,
+                            std::span<const double> model_torque_nm, double torque_sign_scale_nm) {
+  const std::size_t n = q_desired.size();
+  const bool inverse = options.form == ArxModelForm::kInverse;
+  const auto preview = std::size_t(options.preview_cycles);
+  // The path the model's input follows: the desired angles, or (inverse form) the play-free link
+  // angle y, whose increments the precontrol is later fed from the desired path.
+  const std::span<const double> driver = inverse ? output : q_desired;
+  FitSignals s;
+  if (is_error_form(options)) {
+    s.input.assign(n, 0.0);
+    s.output.resize(n);
+    for (std::size_t k = 0; k < n; ++k) s.output[k] = q_desired[k] - output[k];
+    for (const auto& [begin, end] : segments)
+      for (std::size_t k = begin; k + preview < end; ++k)
+        if (k + preview > begin) s.input[k] = driver[k + preview] - driver[k + preview - 1];
+  }
+  auto ahead = [&](std::span<const double> signal, std::vector<double>& out) {
+    out.resize(n);
+    for (const auto& [begin, end] : segments)
+      for (std::size_t k = begin; k < end; ++k) out[k] = signal[std::min(k + preview, end - 1)];
+  };
+  if (options.model_torque_input) ahead(model_torque_nm, s.extra[std::size_t(s.extra_count++)]);
+  if (options.direction_input) {
+    std::vector<double> direction(n, 0.0);
+    for (const auto& [begin, end] : segments)
+      for (std::size_t k = begin + 1; k < end; ++k)
+        direction[k] =
+            std::tanh((driver[k] - driver[k - 1]) / cycle_s / options.direction_speed_scale_rad_s);
+    ahead(direction, s.extra[std::size_t(s.extra_count++)]);
+  }
+  if (options.torque_sign_input) {
+    std::vector<double> side(n);
+    for (std::size_t k = 0; k < n; ++k)
+      side[k] = std::tanh(model_torque_nm[k] / torque_sign_scale_nm);
+    ahead(side, s.extra[std::size_t(s.extra_count++)]);
+  }
+  return s;
+}
+
+// y = q_m + l s: the joint lags by l in the direction of motion, so adding l s restores the
+// play-free angle (no change without an identified, non-negative l).
+std::vector<double> play_free_angle(std::span<const double> q_desired,
+                                    std::span<const double> q_measured,
+                                    std::span<const std::pair<std::size_t, std::size_t>> segments,
+                                    double cycle_s, const BacklashOptions& options,
+                                    const BacklashEstimate& backlash) {
+  std::vector<double> output(q_measured.begin(), q_measured.end());
+  if (!backlash.identified || backlash.l_rad < 0.0) return output;
+  const std::vector<double> s =
+      motion_direction(q_desired, segments, cycle_s, options.min_speed_rad_s, backlash.lag_samples);
+  for (std::size_t k = 0; k < output.size(); ++k) output[k] += backlash.l_rad * s[k];
+  return output;
+}
+
 }  // namespace
 
 const char* to_string(ArxModelForm form) {
@@ -205,15 +328,10 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
   out.parameters.name = name;
   out.parameters.dimensions = grid.dimensions();
 
-  // 1. Backlash and the output without it: y = q_m + l s (the joint lags by l in the direction
-  // of motion, so adding l s restores the play-free angle).
-  std::vector<double> output(q_measured.begin(), q_measured.end());
+  // 1. Backlash and the output without it, y = q_m + l s (play_free_angle).
   if (options.identify_backlash) {
     out.backlash = identify_backlash(q_desired, q_measured, segments, cycle_s, options.backlash);
     if (out.backlash.identified) {
-      const std::vector<double> s = motion_direction(
-          q_desired, segments, cycle_s, options.backlash.min_speed_rad_s, out.backlash.lag_samples);
-      for (std::size_t k = 0; k < n; ++k) output[k] += out.backlash.l_rad * s[k];
       out.parameters.backlash_identified = true;
       // A negative estimate (noise around a play-free joint) is kept in the report but the
       // table holds l >= 0: equation 3 has no meaning for l < 0.
@@ -224,7 +342,6 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
       out.parameters.backlash_lag_samples =
           out.backlash.lag_samples + std::size_t(std::max(options.preview_cycles, 0));
       if (out.backlash.l_rad < 0.0) {
-        for (std::size_t k = 0; k < n; ++k) output[k] = q_measured[k];
         out.parameters.backlash_identified = false;
         out.backlash.reason =
             fmt::format("estimate {:.3g} rad is negative: no backlash", out.backlash.l_rad);
@@ -233,6 +350,8 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
   } else {
     out.backlash.reason = "backlash identification disabled";
   }
+  const std::vector<double> output =
+      play_free_angle(q_desired, q_measured, segments, cycle_s, options.backlash, out.backlash);
 
   // The envelope of the joint error in the data (the supervisor's default tolerances): its
   // largest magnitude, and its largest rate over 8 ms (central difference over ±2 cycles: the
@@ -254,91 +373,31 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
   }
 
   // 2. Estimation and held-out parts of every segment.
-  Ranges estimation, held_out;
-  const std::size_t block =
-      options.validation_block_s > 0.0
-          ? std::max<std::size_t>(1,
-                                  std::size_t(std::llround(options.validation_block_s / cycle_s)))
-          : std::numeric_limits<std::size_t>::max();
-  for (const auto& [segment_begin, segment_end] : segments) {
-    for (std::size_t begin = segment_begin; begin < segment_end;) {
-      // The last block takes the remainder when it would be shorter than half a block.
-      std::size_t end = segment_end - begin > block ? begin + block : segment_end;
-      if (segment_end - end < block / 2) end = segment_end;
-      const std::size_t len = end - begin;
-      const auto cut = end - std::size_t(std::llround(options.validation_fraction * double(len)));
-      if (cut > begin) estimation.emplace_back(begin, cut);
-      if (end > cut) held_out.emplace_back(cut, end);
-      begin = end;
-    }
-  }
+  const std::pair<Ranges, Ranges> split = split_held_out(segments, cycle_s, options);
+  const Ranges& estimation = split.first;
+  const Ranges& held_out = split.second;
 
-  // The signals the ARX structure is fitted to: (q_d, y), or (w, e) in the joint-error and
-  // inverse forms (w: desired increments, or the link's increments P cycles ahead; 0 beyond the
-  // end of a run, where the robot stands).
+  // The signals the structure is fitted to (make_fit_signals).
   const bool inverse = options.form == ArxModelForm::kInverse;
-  const bool error_form = options.form == ArxModelForm::kJointError || inverse;
+  const bool error_form = is_error_form(options);
   if (options.preview_cycles < 0 || (options.preview_cycles > 0 && !inverse))
     throw std::invalid_argument("identify_joint: preview_cycles >= 0, and only in inverse form");
   if ((options.model_torque_input || options.torque_sign_input) && model_torque_nm.size() != n)
     throw std::invalid_argument(
         "identify_joint: the model torque and torque-sign inputs need one model torque per "
         "sample");
-  const auto preview = std::size_t(options.preview_cycles);
-  // The path the model's input follows: the desired angles, or (inverse form) the play-free link
-  // angle y, whose increments the precontrol is later fed from the desired path.
-  const std::span<const double> driver = inverse ? std::span<const double>(output) : q_desired;
-  std::vector<double> fit_input, fit_output;
-  if (error_form) {
-    fit_input.assign(n, 0.0);
-    fit_output.resize(n);
-    for (std::size_t k = 0; k < n; ++k) fit_output[k] = q_desired[k] - output[k];
-    for (const auto& [begin, end] : segments)
-      for (std::size_t k = begin; k + preview < end; ++k)
-        if (k + preview > begin) fit_input[k] = driver[k + preview] - driver[k + preview - 1];
-  }
-  // Further inputs (multi-input form), P cycles ahead like w and held at the end of a run:
-  // the model torque along the driver's path, and the direction of the driver's motion.
-  std::array<std::vector<double>, kMaxExtraInputs> extra;
-  int extra_count = 0;
-  auto ahead = [&](std::span<const double> signal, std::vector<double>& out) {
-    out.resize(n);
-    for (const auto& [begin, end] : segments)
-      for (std::size_t k = begin; k < end; ++k) out[k] = signal[std::min(k + preview, end - 1)];
-  };
-  if (options.model_torque_input) ahead(model_torque_nm, extra[std::size_t(extra_count++)]);
-  if (options.direction_input) {
-    std::vector<double> direction(n, 0.0);
-    for (const auto& [begin, end] : segments)
-      for (std::size_t k = begin + 1; k < end; ++k)
-        direction[k] =
-            std::tanh((driver[k] - driver[k - 1]) / cycle_s / options.direction_speed_scale_rad_s);
-    ahead(direction, extra[std::size_t(extra_count++)]);
-  }
-  if (options.torque_sign_input) {
-    double sum_sq = 0.0;
-    std::size_t count = 0;
-    for (const auto& [begin, end] : segments)
-      for (std::size_t k = begin; k < end; ++k, ++count)
-        sum_sq += model_torque_nm[k] * model_torque_nm[k];
-    const double scale =
-        count ? options.torque_sign_scale_fraction * std::sqrt(sum_sq / double(count)) : 0.0;
-    if (!(scale > 0.0))
-      throw std::runtime_error(fmt::format("joint {}: the model torque is zero throughout", name));
-    out.parameters.torque_sign_scale_nm = scale;
-    std::vector<double> side(n);
-    for (std::size_t k = 0; k < n; ++k) side[k] = std::tanh(model_torque_nm[k] / scale);
-    ahead(side, extra[std::size_t(extra_count++)]);
-  }
-  auto with_extras = [&](std::span<const double> input, std::span<const double> out_signal) {
-    IoSegment all{input, out_signal, {}, extra_count};
-    for (int e = 0; e < extra_count; ++e) all.extra[std::size_t(e)] = extra[std::size_t(e)];
-    return all;
-  };
+  if (options.torque_sign_input)
+    out.parameters.torque_sign_scale_nm =
+        torque_sign_scale_of(name, segments, model_torque_nm, options);
+  const FitSignals signals_of_fit =
+      make_fit_signals(q_desired, output, segments, cycle_s, options, model_torque_nm,
+                       out.parameters.torque_sign_scale_nm);
+  const std::vector<double>& fit_output = signals_of_fit.output;
   // (input, output) of the fitted structure, and of the stored angle-form model (forward forms).
-  const IoSegment fit_signals =
-      error_form ? with_extras(fit_input, fit_output) : with_extras(q_desired, output);
-  const IoSegment angle_signals = with_extras(q_desired, output);
+  const IoSegment fit_signals = error_form
+                                    ? signals_of_fit.with_extras(signals_of_fit.input, fit_output)
+                                    : signals_of_fit.with_extras(q_desired, output);
+  const IoSegment angle_signals = signals_of_fit.with_extras(q_desired, output);
 
   // 3. Cells and their runs (one pass each).
   const OperatingSignals signals = operating_signals(q_desired, segments, cycle_s);
@@ -480,6 +539,74 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
     spdlog::warn("joint {} cell {} ({}) filled from cell {}: {}", name, cell, r.label,
                  r.filled_from, r.reason);
   }
+  return out;
+}
+
+}  // namespace imscal::ident
+
+namespace imscal::ident {
+
+HeldOutReplay replay_held_out_fit(const JointIdentification& identified,
+                                  std::span<const double> q_desired,
+                                  std::span<const double> q_measured,
+                                  std::span<const double> payload,
+                                  std::span<const std::pair<std::size_t, std::size_t>> segments,
+                                  double cycle_s, const CellGrid& grid,
+                                  const JointIdentificationOptions& options,
+                                  std::span<const double> model_torque_nm) {
+  const std::size_t n = q_desired.size();
+  if (q_measured.size() != n || payload.size() != n)
+    throw std::invalid_argument("replay_held_out_fit: signal lengths differ");
+  if ((options.model_torque_input || options.torque_sign_input) && model_torque_nm.size() != n)
+    throw std::invalid_argument("replay_held_out_fit: the model's inputs need the model torque");
+  HeldOutReplay out;
+  if (std::none_of(identified.cells.begin(), identified.cells.end(),
+                   [](const CellIdentification& c) { return c.status == CellStatus::kIdentified; }))
+    return out;  // a neutral joint: no model to judge
+  if (identified.cells.size() != std::size_t(grid.cell_count()))
+    throw std::invalid_argument("replay_held_out_fit: the identification has another cell grid");
+  const std::vector<double> output = play_free_angle(
+      q_desired, q_measured, segments, cycle_s, options.backlash,
+      identified.parameters.backlash_identified ? identified.backlash : BacklashEstimate{});
+  const FitSignals s =
+      make_fit_signals(q_desired, output, segments, cycle_s, options, model_torque_nm,
+                       identified.parameters.torque_sign_scale_nm);
+  const bool inverse = options.form == ArxModelForm::kInverse;
+  const IoSegment fit_signals =
+      is_error_form(options) ? s.with_extras(s.input, s.output) : s.with_extras(q_desired, output);
+  const IoSegment angle_signals = s.with_extras(q_desired, output);
+  const std::vector<int> cell_of =
+      assign_cells(grid, q_desired, payload, operating_signals(q_desired, segments, cycle_s));
+  const auto val_runs =
+      cell_runs(cell_of, grid.cell_count(), split_held_out(segments, cycle_s, options).second);
+
+  double weighted = 0.0;
+  for (std::size_t c = 0; c < identified.cells.size(); ++c) {
+    const CellIdentification& cell = identified.cells[c];
+    if (cell.status != CellStatus::kIdentified || !cell.fit) continue;
+    const ArxModel& fitted = cell.fit->model;
+    double fit = std::numeric_limits<double>::quiet_NaN();
+    std::size_t rows = 0;
+    if (inverse) {
+      const auto views =
+          run_views(val_runs[c], fit_signals, std::size_t(fitted.structure().max_lag()));
+      if (views.empty()) continue;
+      const ArxValidationReport report = validate_arx(fitted, views, options.validation);
+      fit = report.simulation_fit_percent;
+      rows = report.sample_count;
+    } else {
+      const ArxModel model = is_error_form(options) ? angle_form_of_error_model(fitted) : fitted;
+      const auto views =
+          run_views(val_runs[c], angle_signals, std::size_t(model.structure().max_lag()));
+      if (views.empty()) continue;
+      fit = joint_error_fit(model, views, output, q_desired, q_measured);
+      rows = rows_of(views, std::size_t(model.structure().max_lag()));
+    }
+    if (!std::isfinite(fit) || rows == 0) continue;
+    weighted += fit * double(rows);
+    out.validation_rows += rows;
+  }
+  if (out.validation_rows) out.joint_error_fit_percent = weighted / double(out.validation_rows);
   return out;
 }
 

@@ -48,7 +48,9 @@
 // It is stored exactly like the joint-error form (angle_form_of_error_model, d = 0): the
 // precontrol computes the same Δq̂(k) = x(k) - q̂(k) = ê(k) from its input x; the table's
 // preview_cycles tells the caller to feed x(k) = q_d(k + P). P covers the loop's dead time and
-// the non-minimum-phase part of the loop, which a causal inverse cannot follow. <cstddef>
+// the non-minimum-phase part of the loop, which a causal inverse cannot follow.
+#include <cstddef>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -166,5 +168,27 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
                                    double cycle_s, const CellGrid& grid,
                                    const JointIdentificationOptions& options = {},
                                    std::span<const double> model_torque_nm = {});
+
+// The held-out joint-error fit of an identified joint's models on ANOTHER record of the same
+// joint (e.g. the simulator's truth of a run that was identified from its measurement, or a
+// second measurement of the same motion): the record is split into estimation and held-out rows
+// as identify_joint splits it, its samples are assigned to the identification's cells, and each
+// identified cell's fitted model is run free on the held-out rows with the identification's
+// backlash and torque-sign scale, as identify_joint validates it on its own data (the same
+// figure as CellFitFigures::joint_error_fit_percent). Row-weighted over the cells; NaN without
+// held-out rows. options and grid: those of the identification. Throws std::invalid_argument on
+// size mismatches or another grid.
+struct HeldOutReplay {
+  double joint_error_fit_percent = std::numeric_limits<double>::quiet_NaN();
+  std::size_t validation_rows = 0;
+};
+HeldOutReplay replay_held_out_fit(const JointIdentification& identified,
+                                  std::span<const double> q_desired,
+                                  std::span<const double> q_measured,
+                                  std::span<const double> payload,
+                                  std::span<const std::pair<std::size_t, std::size_t>> segments,
+                                  double cycle_s, const CellGrid& grid,
+                                  const JointIdentificationOptions& options,
+                                  std::span<const double> model_torque_nm = {});
 
 }  // namespace imscal::ident

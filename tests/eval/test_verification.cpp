@@ -407,12 +407,16 @@ TEST(Verification, IdentifiedFromTheImsChain) {
   const sim::Scenario identification = scenario("identification");
   const ident::JointErrorLog measured = simulate_ims_joint_errors(identification, 1);
   const ident::JointErrorLog truth = simulate_truth_joint_errors(identification);
-  // The measurement's own error on the joint errors (the same plant run: deterministic).
+  // The measurement's own error on the joint errors (the same plant run: deterministic), and
+  // the measured log with the true link angles in place of the IMS's (same rows and runs).
   std::size_t k_truth = 0;
   calib::JointVector sq_error = calib::JointVector::Zero(), sq_signal = sq_error;
+  ident::JointErrorLog truth_on_measured_rows = measured;
   for (std::size_t k = 0; k < measured.sample_count(); ++k) {
     while (truth.time_s[k_truth] < measured.time_s[k] - 1e-9) ++k_truth;
     for (int j = 0; j < 6; ++j) {
+      truth_on_measured_rows.q_measured_rad[std::size_t(j)][k] =
+          truth.q_measured_rad[std::size_t(j)][k_truth];
       const double e_true = truth.q_desired_rad[std::size_t(j)][k_truth] -
                             truth.q_measured_rad[std::size_t(j)][k_truth];
       const double e_ims =
@@ -437,12 +441,31 @@ TEST(Verification, IdentifiedFromTheImsChain) {
   const ModelTorqueSource torque_model = scenario_model_torque(identification);
   const IdentifiedTable table = identify_table(measured, config, "IMS chain", &torque_model);
   EXPECT_TRUE(table.failed_joints.empty());
-  for (const auto& joint : table.joints) {
+  // The same models judged against the TRUE joint errors of the held-out rows: the model's own
+  // error, without the measurement's in the target (ident::replay_held_out_fit).
+  const std::vector<double> against_truth =
+      replay_held_out_fits(table, truth_on_measured_rows, config, &torque_model);
+  for (std::size_t j = 0; j < table.joints.size(); ++j) {
+    const auto& joint = table.joints[j];
     const JointFitSummary s = summarize_fit(joint);
+    const double signal_rms =
+        std::sqrt(sq_signal(Eigen::Index(j)) / double(measured.sample_count()));
+    const double noise_rms = std::sqrt(sq_error(Eigen::Index(j)) / double(measured.sample_count()));
     std::printf(
-        "%s (from the IMS chain): held-out simulation fit %.3f %%, joint-error fit %.1f %%\n",
-        joint.parameters.name.c_str(), s.simulation_fit_percent, s.joint_error_fit_percent);
+        "%s (from the IMS chain): held-out simulation fit %.3f %%, joint-error fit %.1f %% "
+        "against the IMS-measured error, %.1f %% against the true error (a perfect model against "
+        "the measured error: ~%.1f %%)\n",
+        joint.parameters.name.c_str(), s.simulation_fit_percent, s.joint_error_fit_percent,
+        against_truth[j], 100.0 * (1.0 - noise_rms / std::hypot(signal_rms, noise_rms)));
   }
+  // Issue 5's goal, >= 90 % held-out fit for every primary joint, is a property of the model: met
+  // against the true joint errors. Measured: A1 95.7, A2 93.8, A3 93.0 % (identified from the
+  // truth itself: 95.8, 94.9, 94.3 %). Against the IMS-measured errors the same models score
+  // 93.5, 90.4, 84.4 %: the measurement's own error in the held-out target (0.21-0.31 mrad RMS
+  // against a 3.5-3.7 mrad signal) caps even a perfect model at ~94.4, 93.2, 91.3 %, and A3's
+  // largest measurement error costs it most.
+  for (std::size_t j = 0; j < 3; ++j)
+    EXPECT_GE(against_truth[j], 90.0) << table.joints[j].parameters.name;
   VerificationOptions options;
   options.cycles = 5;
   options.segment_filter = "line";
