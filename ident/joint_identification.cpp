@@ -542,10 +542,6 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
   return out;
 }
 
-}  // namespace imscal::ident
-
-namespace imscal::ident {
-
 HeldOutReplay replay_held_out_fit(const JointIdentification& identified,
                                   std::span<const double> q_desired,
                                   std::span<const double> q_measured,
