@@ -246,6 +246,16 @@ std::vector<RateWindow> cut_rate_windows(const FrameCalibrationInput& input,
   return windows;
 }
 
+// The spec's prior of a bias triad, N(0, sigma) per axis (with known frames only, see below).
+struct BiasPriorResidual {
+  double inverse_sigma = 0.0;
+  template <typename T>
+  bool operator()(const T* bias, T* residual) const {
+    for (int k = 0; k < 3; ++k) residual[k] = bias[k] * T(inverse_sigma);
+    return true;
+  }
+};
+
 struct Stage {
   std::unique_ptr<ceres::Problem> problem;
   std::vector<ImuPreintegration> motions;
@@ -279,7 +289,13 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
   if (input.imu->quantity != ims::ImuQuantity::kIncrements) {
     throw InputError(source, 0, "imu", "the frame calibration needs increments, not rates");
   }
-  if (input.rests.size() < 3) {
+  const bool frames_known = input.known_frames.has_value();
+  if (frames_known && input.rests.empty()) {
+    throw InputError(source, 0, "rests",
+                     "no rest pose: with the frames known (from " + input.known_frames->source +
+                         ") at least one is needed for the biases");
+  }
+  if (!frames_known && input.rests.size() < 3) {
     throw InputError(source, 0, "rests",
                      fmt::format("{} rest poses; at least 3 are needed (T_R_W and T_S_H from "
                                  "rotations about two different axes)",
@@ -298,7 +314,17 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
 
   // Initial values.
   const std::vector<ImuPreintegration> chain_motions = integrate_motions(imu, rests, ImuBiases{});
-  const FrameInitialValues init = initial_frame_values(input, rests, chain_motions, earth);
+  // With known frames: those, held constant (no hand-eye: it needs >= 3 rests).
+  const FrameInitialValues init = [&] {
+    if (!frames_known) return initial_frame_values(input, rests, chain_motions, earth);
+    FrameInitialValues known;
+    known.T_S_H = input.known_frames->T_S_H;
+    known.T_R_W.linear() = input.known_frames->R_W_R.transpose();
+    known.time_offset_s = input.time_offset_initial_s;
+    for (const RestObservation& r : input.rests)
+      known.T_R_H_rest.push_back(forward_kinematics<double>(input.kinematics, r.q_link_rad));
+    return known;
+  }();
   Parameters x;
   set_quaternion(x.q_W_R, init.T_R_W.linear().transpose());
   set_quaternion(x.q_S_H, init.T_S_H.linear());
@@ -394,8 +420,27 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
     problem.AddParameterBlock(x.q_W_R, 4, new ceres::EigenQuaternionManifold);
     problem.AddParameterBlock(x.q_S_H, 4, new ceres::EigenQuaternionManifold);
     problem.AddParameterBlock(x.p_S_H, 3);
+    if (frames_known) {
+      problem.SetParameterBlockConstant(x.q_W_R);
+      problem.SetParameterBlockConstant(x.q_S_H);
+      problem.SetParameterBlockConstant(x.p_S_H);
+    }
     problem.AddParameterBlock(x.b_g, 3);
     for (auto& b : x.b_a) problem.AddParameterBlock(b.data(), 3);
+    if (frames_known) {
+      // With few rests and no motion between them the tilt of a rest (its joint deviations:
+      // backlash play, deflection; priors of up to ~1e-3 rad) trades with the accelerometer bias
+      // (1e-3 rad of tilt = 1000 ug); a full session separates them through the motions. The
+      // spec's turn-on priors (ImuNoiseModel::*_bias_sigma) keep the biases to what the unit
+      // can have (measured on the two-session chain: 1 rest gave acc_bias 1200 ug 1-sigma
+      // without them and joint errors that diverged from the first move on).
+      for (auto [block, sigma] : {std::pair{x.b_g, input.noise.gyro_bias_sigma_rad_s},
+                                  std::pair{x.b_a_blocks.front(), input.noise.acc_bias_sigma_m_s2}})
+        if (sigma > 0.0)
+          problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BiasPriorResidual, 3, 3>(
+                                       new BiasPriorResidual{1.0 / sigma}),
+                                   nullptr, block);
+    }
     for (std::size_t i = 0; acc_bias_drifts && i + 1 < rests.size(); ++i) {
       // Between the rests' mid-times.
       const double gap_s = 0.5 * (rests[i + 1].begin_s + rests[i + 1].end_s) -
@@ -672,7 +717,20 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
     blocks.push_back(
         {"play_scale_deviation", x.m_p, static_cast<int>(play_names.size()), 1.0, play_names});
   if (link_share_estimated) blocks.push_back({"link_share", x.link_share, 1, 1.0, {"s"}});
-  const FrameCovariance cov = compute_frame_covariance(problem, blocks);
+  FrameCovariance cov = compute_frame_covariance(problem, blocks);
+  if (frames_known && cov.computed) {
+    // The held frames have no covariance from this problem (constant blocks: zero); theirs is
+    // the earlier session's, reported as it is (the other unknowns are conditional on them).
+    cov.covariance.topLeftCorner<9, 9>() = input.known_frames->covariance;
+    cov.covariance.topRightCorner(9, cov.covariance.cols() - 9).setZero();
+    cov.covariance.bottomLeftCorner(cov.covariance.rows() - 9, 9).setZero();
+    const Eigen::VectorXd sigma = cov.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+    for (Eigen::Index i = 0; i < sigma.size(); ++i)
+      for (Eigen::Index j = 0; j < sigma.size(); ++j) {
+        const double d = sigma[i] * sigma[j];
+        cov.correlation(i, j) = d > 0.0 ? cov.covariance(i, j) / d : (i == j ? 1.0 : 0.0);
+      }
+  }
   result.parameter_names = cov.parameter_names;
   result.covariance = cov.covariance;
   result.correlation = cov.correlation;
@@ -775,6 +833,13 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
   }
   result.weak_directions = describe_weak_directions(cov, 0, 3, 6, offset_dt, time_offset_observed,
                                                     R_S_H, flange_rotations);
+  if (frames_known) {
+    // The frames are not estimated from this record's poses: what its poses do not excite is no
+    // weakness of the frames (their sigma is the earlier session's).
+    std::erase_if(result.weak_directions, [](const WeakDirection& w) {
+      return w.description.rfind("the poses hardly turn the flange", 0) == 0;
+    });
+  }
 
   // Residuals per rest and motion, outliers.
   for (std::size_t i = 0; i < rests.size(); ++i) {

@@ -36,6 +36,7 @@
 // reports it as it is; the observability report names it.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -105,11 +106,26 @@ struct ImuNoiseModel {
   double acc_quantization_m_s = 0.0;
 };
 
+// T_R_W's rotation and T_S_H from an earlier session with the same robot, base and mount (its
+// frames.json): the bundle then holds them and estimates only what changes between sessions,
+// the biases (turn-on), the clock offset and the per-rest unknowns, from as few as one rest.
+// W's origin stays the convention above (the sensor at this record's first rest): T_R_W's
+// translation is derived anew, only its rotation R_W_R is taken.
+struct KnownFrames {
+  Eigen::Matrix3d R_W_R = Eigen::Matrix3d::Identity();
+  Eigen::Isometry3d T_S_H = Eigen::Isometry3d::Identity();
+  // Their tangent covariance from the earlier session, [R_W_R (rad, small angles about W ENU),
+  // R_S_H (rad, about S), p_S_H (m)]: reported in the result's covariance as it is (the rest of
+  // the covariance is conditional on these frames: the bundle does not move them).
+  Eigen::Matrix<double, 9, 9> covariance = Eigen::Matrix<double, 9, 9>::Zero();
+  std::string source;  // e.g. the frames.json path, for messages
+};
+
 struct FrameCalibrationInput {
   const ims::ImuSeries* imu = nullptr;  // increments (ImuQuantity::kIncrements), IMS clock
   ims::Site site;
   KinematicModel kinematics;
-  std::vector<RestObservation> rests;  // in time order, at least 3
+  std::vector<RestObservation> rests;  // in time order, at least 3 (1 with known_frames)
   RobotJointSeries robot;              // may be empty: then dt stays at its initial value
   ImuNoiseModel noise;
   double time_offset_initial_s = 0.0;  // t_ims = t_robot + dt, e.g. from estimate_time_offset
@@ -118,6 +134,8 @@ struct FrameCalibrationInput {
   // model) [m]: only for the gravity field (normal gravity falls by 3.1e-6 m/s^2 per metre of
   // height, 0.3 ug per 1 m); a tape-measure value is plenty. Zero: the sensor at the site point.
   Eigen::Vector3d first_rest_position_W_m = Eigen::Vector3d::Zero();
+  // Set: the frames are held at these values (KnownFrames above), not estimated.
+  std::optional<KnownFrames> known_frames;
 };
 
 struct FrameCalibrationOptions {
@@ -233,8 +251,9 @@ struct FrameCalibrationResult {
   bool converged = false;
 };
 
-// Solves the bundle from automatic initial values. Throws InputError for unusable input (no
-// increments, rests outside the record, fewer than 3 rests) and HandEyeUnobservable
+// Solves the bundle from automatic initial values (with input.known_frames: from those frames,
+// held constant). Throws InputError for unusable input (no increments, rests outside the record,
+// fewer than 3 rests, or none with known_frames) and HandEyeUnobservable
 // (calib/hand_eye.hpp) when the rest poses cannot determine the frames (too few, identical, no
 // rotation about one axis), naming the missing directions.
 FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,

@@ -1,11 +1,16 @@
 // `imscal calibrate --imu FILE --robot-log FILE --robot ROBOT.yaml --sensor SPEC.yaml
-//  [--config YAML] [--unit-calibration YAML] --out DIR [--force]`: the wrist/sensor calibration of
-//  the paper. From the raw
+//  [--config YAML] [--unit-calibration YAML] [--frames PREVIOUS/frames.json] --out DIR [--force]`:
+//  the wrist/sensor calibration of the paper. From the raw
 // IMS record and the robot's log: rest poses (calib/rest_poses.hpp), the frame-and-bias bundle
 // (calib/frame_calibration.hpp: T_R_W, T_S_H, biases, time offset with covariance), the mounting
 // validation (calib/mounting_validation.hpp) and the joint errors (calib/joint_space_errors.hpp).
 // Writes, all or nothing (core/output_folder.hpp), the files of datasets/FORMAT.md §16:
 //   frames.json  mounting_report.json  summary.txt  joint_errors.csv
+// With --frames (a later session with the same robot, base and mount, e.g. identification runs
+// with too few rests for the frames): T_R_W's rotation and T_S_H are taken from the earlier
+// session's frames.json and held; the bundle estimates the biases and the clock offset from as
+// few as one rest, and the mounting report gives this record's residuals against those frames
+// (a slipped mount shows there) instead of the halves and segments (which calibrate frames).
 // Exit codes: 0 verdict pass or warn, 1 verdict fail (the outputs are still written), 2 bad input.
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -13,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -57,6 +63,7 @@ struct CalibrateArgs {
   std::string sensor;
   std::string config;
   std::string unit_calibration;
+  std::string frames;  // earlier session's frames.json (--frames); empty: estimate the frames
   std::string out;
   bool force = false;
 };
@@ -148,6 +155,111 @@ json input_json(const std::string& file) {
   return {{"path", file}, {"sha256", sha256_hex_of_file(file)}};
 }
 
+// The frames of an earlier session (--frames), with where they came from.
+struct PreviousFrames {
+  calib::KnownFrames frames;
+  std::string path;
+  std::string sha256;
+  std::string robot;
+};
+
+// Reads T_R_W's rotation, T_S_H and their covariance from an earlier frames.json (§16.2 of
+// datasets/FORMAT.md); refuses (InputError naming the file and the field) a file of another
+// format version, of another robot, or with a missing or non-finite value (frames.json writes
+// NaN as null).
+PreviousFrames read_previous_frames(const std::string& file, const std::string& robot_name) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file, 0, "", "cannot open the earlier session's frames.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  json j;
+  try {
+    j = json::parse(text.str());
+  } catch (const json::parse_error& e) {
+    throw InputError(file, 0, "", fmt::format("not a JSON file: {}", e.what()));
+  }
+  if (!j.is_object() || !j.contains("imscal-frames"))
+    throw InputError(file, 0, "imscal-frames",
+                     "not an imscal frames.json (no 'imscal-frames' version key)");
+  if (!(j["imscal-frames"].is_number_integer() && j["imscal-frames"].get<long long>() == 1))
+    throw InputError(file, 0, "imscal-frames",
+                     fmt::format("unknown format version {} (this imscal reads version 1)",
+                                 j["imscal-frames"].dump()));
+  if (!j.contains("robot") || !j["robot"].is_string())
+    throw InputError(file, 0, "robot",
+                     "no robot name: the file does not say which robot it was calibrated on "
+                     "(written by an imscal before --frames existed); recalibrate the frames");
+  const std::string robot = j["robot"].get<std::string>();
+  if (robot != robot_name)
+    throw InputError(file, 0, "robot",
+                     fmt::format("the frames are for robot '{}', this record is of robot '{}'",
+                                 robot, robot_name));
+  // A finite number at a JSON path, or InputError naming it.
+  auto number = [&](const json& node, const std::string& field) {
+    if (!node.is_number())
+      throw InputError(file, 0, field,
+                       node.is_null() ? std::string("not a finite number (NaN or missing)")
+                                      : "not a number: " + node.dump());
+    const double v = node.get<double>();
+    if (!std::isfinite(v)) throw InputError(file, 0, field, "not a finite number");
+    return v;
+  };
+  auto at = [&](const json& node, const std::string& key, const std::string& field) -> const json& {
+    if (!node.is_object() || !node.contains(key)) throw InputError(file, 0, field, "missing");
+    return node[key];
+  };
+  auto vector_at = [&](const json& node, std::size_t n, const std::string& field) {
+    if (!node.is_array() || node.size() != n)
+      throw InputError(file, 0, field, fmt::format("not a list of {} numbers", n));
+    Eigen::VectorXd v(static_cast<Eigen::Index>(n));
+    for (std::size_t k = 0; k < n; ++k)
+      v[Eigen::Index(k)] = number(node[k], fmt::format("{}[{}]", field, k));
+    return v;
+  };
+  auto rotation_at = [&](const std::string& frame) {
+    const std::string field = frame + ".quaternion_wxyz";
+    const Eigen::VectorXd q =
+        vector_at(at(at(j, frame, frame), "quaternion_wxyz", field), 4, field);
+    if (std::abs(q.norm() - 1.0) > 1e-6)
+      throw InputError(file, 0, field, fmt::format("not a unit quaternion (norm {})", q.norm()));
+    return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+  };
+  PreviousFrames out;
+  out.path = file;
+  out.sha256 = sha256_hex_of_file(file);
+  out.robot = robot;
+  out.frames.source = file;
+  out.frames.R_W_R = rotation_at("T_R_W").transpose();
+  out.frames.T_S_H.linear() = rotation_at("T_S_H");
+  out.frames.T_S_H.translation() =
+      vector_at(at(j["T_S_H"], "xyz_mm", "T_S_H.xyz_mm"), 3, "T_S_H.xyz_mm") * 1e-3;
+  // The covariance of the frames: the first nine parameters, in the bundle's order.
+  const std::vector<std::string> names = {"R_W_R.east", "R_W_R.north", "R_W_R.up",
+                                          "R_S_H.x",    "R_S_H.y",     "R_S_H.z",
+                                          "p_S_H.x",    "p_S_H.y",     "p_S_H.z"};
+  const json& listed = at(j, "parameter_names", "parameter_names");
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (!listed.is_array() || listed.size() <= k || listed[k] != names[k])
+      throw InputError(file, 0, "parameter_names",
+                       fmt::format("parameter {} is not '{}': not the bundle's covariance layout",
+                                   k + 1, names[k]));
+  const json& covariance = at(j, "covariance_si", "covariance_si");
+  if (!covariance.is_array() || covariance.size() < names.size())
+    throw InputError(file, 0, "covariance_si", fmt::format("fewer than {} rows", names.size()));
+  for (std::size_t r = 0; r < names.size(); ++r) {
+    const std::string row = fmt::format("covariance_si[{}]", r);
+    if (!covariance[r].is_array() || covariance[r].size() < names.size())
+      throw InputError(file, 0, row, fmt::format("fewer than {} columns", names.size()));
+    for (std::size_t c = 0; c < names.size(); ++c)
+      out.frames.covariance(Eigen::Index(r), Eigen::Index(c)) =
+          number(covariance[r][c], fmt::format("{}[{}]", row, c));
+  }
+  for (Eigen::Index k = 0; k < 9; ++k)
+    if (out.frames.covariance(k, k) < 0.0)
+      throw InputError(file, 0, fmt::format("covariance_si[{}][{}]", k, k), "negative variance");
+  return out;
+}
+
 struct Inputs {
   calib::CalibrationConfig config;
   fs::path robot_file, sensor_file;
@@ -156,6 +268,7 @@ struct Inputs {
   ims::SensorSpec spec;
   ims::ImuSeries imu;
   calib::RobotLog log;
+  std::optional<PreviousFrames> previous;  // --frames
 };
 
 Inputs read_inputs(const CalibrateArgs& args) {
@@ -173,6 +286,8 @@ Inputs read_inputs(const CalibrateArgs& args) {
   in.sensor_file = pick(args.sensor, in.config.sensor_file, "--sensor");
   in.robot = calib::load_robot_description(in.robot_file);
   in.spec = ims::load_sensor_spec(in.sensor_file);
+  // The earlier session's frames before the (long) records: a wrong file fails fast.
+  if (!args.frames.empty()) in.previous = read_previous_frames(args.frames, in.robot.name);
   ims::ImuReadOptions read_options;
   if (in.spec.gyro.range > 0.0) read_options.gyro_range_rad_s = in.spec.gyro.range;
   if (in.spec.acc.range > 0.0) read_options.acc_range_m_s2 = in.spec.acc.range;
@@ -212,6 +327,9 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
   line(fmt::format("imscal {} calibrate", kVersion));
   line(fmt::format("IMS record  {}", args.imu));
   line(fmt::format("robot log   {}", args.robot_log));
+  if (!args.frames.empty())
+    line(fmt::format("frames      {} (T_R_W's rotation and T_S_H held: not estimated here)",
+                     args.frames));
   line("");
   line(fmt::format("VERDICT: {}", calib::to_string(v.verdict)));
   for (const auto& reason : v.reasons) line("  - " + reason);
@@ -283,6 +401,43 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
     }
   }
   return s.str();
+}
+
+// The mounting check of a record calibrated with an earlier session's frames: the bundle's
+// outlier check on this record's rests and motions against those frames (a slipped or
+// re-mounted IMS shows up as outliers there) and what the record can say at all.
+calib::MountingValidation previous_frames_validation(const calib::FrameCalibrationResult& result,
+                                                     const calib::MountingThresholds& thresholds,
+                                                     double outlier_threshold_sigma,
+                                                     const PreviousFrames& previous) {
+  calib::MountingValidation v = calib::assess_mounting(result, {}, {}, thresholds);
+  double worst = 0.0;
+  for (const auto* list : {&result.rest_residuals, &result.motion_residuals})
+    for (const auto& r : *list) worst = std::max(worst, r.normalised);
+  const std::size_t motions = result.motion_residuals.size();
+  calib::MountingCheck check;
+  check.name = "previous_frames";
+  if (motions == 0) {
+    check.level = calib::Verdict::kWarn;
+    check.message = fmt::format(
+        "frames held at {}: with {} rest and no motion between rests the biases absorb the rest "
+        "residuals, so a slipped mount cannot be seen against these frames (record 2 or more "
+        "rests)",
+        previous.path, result.rest_residuals.size());
+  } else {
+    check.level = calib::Verdict::kPass;
+    check.message = fmt::format(
+        "frames held at {}: this record's {} rests and {} motions against them, largest "
+        "normalised residual {:.2f} sigma (outlier above {}; a slipped mount shows there)",
+        previous.path, result.rest_residuals.size(), motions, worst, outlier_threshold_sigma);
+  }
+  v.checks.push_back(check);
+  if (check.level != calib::Verdict::kPass) {
+    if (v.verdict == calib::Verdict::kPass) v.reasons.clear();  // the "all passed" line
+    v.verdict = std::max(v.verdict, check.level);
+    v.reasons.push_back(check.message);
+  }
+  return v;
 }
 
 ident::JointErrorLog joint_error_log(const calib::JointSpaceErrors& e, const calib::RobotLog& log,
@@ -376,14 +531,24 @@ void run(const CalibrateArgs& args) {
   frame_input.time_offset_initial_s = dt0.offset_s;
   frame_input.source = args.imu;
   frame_input.first_rest_position_W_m = config.first_rest_position_W_m;
+  if (in.previous) {
+    frame_input.known_frames = in.previous->frames;
+    spdlog::info("calibrate: T_R_W's rotation and T_S_H held at {} (sha256 {})", in.previous->path,
+                 in.previous->sha256);
+  }
   const calib::FrameCalibrationResult result = calib::calibrate_frames(frame_input, config.bundle);
   spdlog::info("calibrate: bundle {} after {} iterations",
                result.converged ? "converged" : "did NOT converge", result.iterations);
 
-  // Mounting validation.
-  const calib::MountingValidation validation = calib::validate_mounting(
-      frame_input, config.bundle, result, config.validation,
-      [&](const std::string& stage, double fraction) { progress.update(stage, fraction); });
+  // Mounting validation: with the frames of an earlier session, this record's residuals against
+  // them (the halves and segments would calibrate frames, which this record need not determine).
+  const calib::MountingValidation validation =
+      in.previous ? previous_frames_validation(result, config.validation.thresholds,
+                                               config.bundle.outlier_threshold_sigma, *in.previous)
+                  : calib::validate_mounting(frame_input, config.bundle, result, config.validation,
+                                             [&](const std::string& stage, double fraction) {
+                                               progress.update(stage, fraction);
+                                             });
 
   // Joint errors.
   std::optional<calib::JointSpaceErrors> joint_errors;
@@ -414,7 +579,17 @@ void run(const CalibrateArgs& args) {
       {"sensor", input_json(in.sensor_file.string())},
       {"config", input_json(args.config)},
       {"unit_calibration",
-       input_json(in.unit_calibration_file ? in.unit_calibration_file->string() : std::string())}};
+       input_json(in.unit_calibration_file ? in.unit_calibration_file->string() : std::string())},
+      {"frames", input_json(args.frames)}};
+  const json frames_from =
+      in.previous ? json{{"path", in.previous->path},
+                         {"sha256", in.previous->sha256},
+                         {"held",
+                          "T_R_W's rotation and T_S_H (with their covariance) are the earlier "
+                          "session's, not estimated here; T_R_W's translation follows this "
+                          "record's rest 1 (W convention); the other estimates are conditional "
+                          "on these frames"}}
+                  : json(nullptr);
   json estimates = json::array();
   for (const auto& e : result.estimates) estimates.push_back(estimate_json(e));
   json weak = json::array();
@@ -422,6 +597,8 @@ void run(const CalibrateArgs& args) {
   const json frames = {
       {"imscal-frames", 1},
       {"created_by", created_by},
+      {"robot", in.robot.name},
+      {"frames_from", frames_from},
       {"conventions",
        {{"transforms", "T_A_B maps coordinates in B into A (p_A = T_A_B p_B)"},
         {"W", "Earth-fixed ENU at the site; origin at the sensor's position at rest 1"},
@@ -478,6 +655,7 @@ void run(const CalibrateArgs& args) {
   const auto& t = config.validation.thresholds;
   const json report = {{"imscal-mounting-report", 1},
                        {"created_by", created_by},
+                       {"frames_from", frames_from},
                        {"verdict", calib::to_string(validation.verdict)},
                        {"reasons", validation.reasons},
                        {"checks", checks},
@@ -549,6 +727,13 @@ tools::CommandRegistration registration{
                      "The IMS unit's lab calibration (scale factors, misalignments; "
                      "ims/sensor_error_model.hpp format), applied to the raw record; default: "
                      "the config's unit_calibration");
+      sub.add_option(
+          "--frames", args->frames,
+          "frames.json of an earlier session with the same robot, base and IMS mount: T_R_W's "
+          "rotation and T_S_H (with their covariance) are taken from it and held, and only the "
+          "biases and the clock offset are estimated, from as few as 1 rest (e.g. identification "
+          "runs); the mounting report then gives this record's residuals against those frames. "
+          "Refused: another robot, another format version, missing or NaN values");
       sub.add_option("--out", args->out, "Output folder")->required();
       sub.add_flag("--force", args->force, "Replace existing outputs");
       sub.callback([args] { run(*args); });
