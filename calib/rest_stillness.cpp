@@ -137,8 +137,9 @@ double chi_square_3_upper_quantile(double probability) {
 std::string RestStillness::describe() const {
   if (!flagged) return "";
   return fmt::format(
-      "the IMS shows the flange turn by {:.3g} rad ({:.3g} rad/s) between {:.3f} s and {:.3f} s "
-      "beyond the {:.3g} rad the joint readings explain (test {:.3g} > {:.3g}, chi-square 3)",
+      "the IMS shows the flange turn by {:.3g} rad ({:.3g} rad/s on average) between {:.3f} s and "
+      "{:.3f} s beyond the {:.3g} rad the joint readings explain (test {:.3g} > {:.3g}, "
+      "chi-square 3)",
       unexplained_rotation_rad, rate_change_rad_s, motion_begin_ims_s, motion_end_ims_s,
       explained_rotation_rad, test_statistic, threshold);
 }
