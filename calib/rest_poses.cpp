@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/zupt_options.hpp"
@@ -65,8 +66,8 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
     }
     auto first = std::lower_bound(samples.begin(), samples.end(), robot_begin,
                                   [](const RobotLogSample& s, double t) { return s.t_s < t; });
-    const auto last = std::upper_bound(samples.begin(), samples.end(), robot_end,
-                                       [](double t, const RobotLogSample& s) { return t < s.t_s; });
+    auto last = std::upper_bound(samples.begin(), samples.end(), robot_end,
+                                 [](double t, const RobotLogSample& s) { return t < s.t_s; });
     if (last - first < 2) {
       result.rejected.push_back(fmt::format("{}: fewer than 2 robot samples", where));
       continue;
@@ -112,6 +113,56 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
         }
       }
     }
+    // The IMS must be still there too, beyond what the readings show (rest_stillness.hpp).
+    double rest_end = end;
+    if (options.check_stillness) {
+      const JointVector q_reference = first->q_internal_rad;
+      const Eigen::Matrix<double, 3, kJointCount> rotation_jacobian =
+          geometric_jacobian(input.robot->kinematics, q_reference).bottomRows<3>();
+      // The flange's mean rotation over [t0, t1] from the readings, relative to the rest's
+      // first reading (the Jacobian holds over the few 1e-4 rad a rest creeps).
+      const ExplainedRotation explained = [&](double t0_ims, double t1_ims) {
+        const auto from =
+            std::lower_bound(first, last, t0_ims - input.time_offset_s,
+                             [](const RobotLogSample& s, double t) { return s.t_s < t; });
+        const auto to =
+            std::lower_bound(from, last, t1_ims - input.time_offset_s,
+                             [](const RobotLogSample& s, double t) { return s.t_s < t; });
+        if (from == to) return Eigen::Vector3d(Eigen::Vector3d::Zero());
+        JointVector q_sum = JointVector::Zero();
+        for (auto it = from; it != to; ++it) q_sum += it->q_internal_rad - q_reference;
+        return Eigen::Vector3d(rotation_jacobian * q_sum / double(to - from));
+      };
+      const RestStillness stillness = assess_rest_stillness(
+          *input.imu, earth, input.sensor, rest_begin, end, explained, options.stillness);
+      if (stillness.flagged && !stillness.usable) {
+        result.rejected.push_back(fmt::format("{}: {}; still for less than {} s", where,
+                                              stillness.describe(), options.stillness.min_still_s));
+        continue;
+      }
+      if (stillness.flagged) {
+        rest_begin = stillness.still_begin_ims_s;
+        rest_end = stillness.still_end_ims_s;
+        result.trimmed.push_back(fmt::format("{}: {}; used only where still, {} .. {}", where,
+                                             stillness.describe(), seconds(rest_begin),
+                                             seconds(rest_end)));
+        first = std::lower_bound(first, last, rest_begin - input.time_offset_s,
+                                 [](const RobotLogSample& s, double t) { return s.t_s < t; });
+        last = std::upper_bound(first, last, rest_end - input.time_offset_s,
+                                [](double t, const RobotLogSample& s) { return t < s.t_s; });
+        if (last - first < 2) {
+          result.rejected.push_back(
+              fmt::format("{}: fewer than 2 robot samples where still", where));
+          continue;
+        }
+        low = high = first->q_internal_rad;
+        for (auto it = first; it != last; ++it) {
+          low = low.cwiseMin(it->q_internal_rad);
+          high = high.cwiseMax(it->q_internal_rad);
+        }
+        detail.q_internal_spread_rad = high - low;
+      }
+    }
     JointVector sum = JointVector::Zero();
     for (auto it = first; it != last; ++it) sum += it->q_internal_rad;
     detail.robot_samples = static_cast<std::size_t>(last - first);
@@ -152,7 +203,7 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
     };
     JointVector q_begin, q_end, rate_begin, rate_end;
     end_fit(rest_begin - input.time_offset_s, q_begin, rate_begin);
-    end_fit(end - input.time_offset_s, q_end, rate_end);
+    end_fit(rest_end - input.time_offset_s, q_end, rate_end);
 
     RestObservation rest;
     rest.q_creep_begin_rad = q_begin - detail.q_internal_mean_rad;
@@ -162,7 +213,7 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
 
     rest.label = fmt::format("rest {} at {:.1f} s", result.rests.size() + 1, begin);
     rest.begin_ims_s = rest_begin;
-    rest.end_ims_s = end;
+    rest.end_ims_s = rest_end;
     rest.q_link_rad = detail.deflection.q_link_rad;
     rest.q_link_sigma_rad = detail.deflection.q_link_sigma_rad;
     rest.q_windup_rad = detail.deflection.windup_rad;

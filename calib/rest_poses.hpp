@@ -14,6 +14,12 @@
 //    log's payload_kg, its centre of mass from the given payload body (in the tool frame T).
 //    The readings at the rest's ends relative to the mean and the joint rates there describe
 //    what the arm still creeps (RestObservation::q_creep_*, q_rate_*).
+// 2b. The IMS must be still there too, beyond what the readings explain (calib/rest_stillness:
+//    a link sliding in its backlash, brakes settling or a slipping mount turn the flange where
+//    the encoders do not see it, and bias the rest's mean gyro rate, the heading's only source):
+//    a rest where the IMS shows such motion is trimmed to its still part, or rejected when that
+//    is shorter than stillness.min_still_s; each trimmed rest is listed with the finding
+//    (RestPoseResult::trimmed), each rejected one with it as the reason.
 //
 // Also: the log as a RobotJointSeries (calib/frame_calibration.hpp) and the initial time offset
 // by cross-correlation of the angular-rate magnitudes (calib/time_offset.hpp).
@@ -21,6 +27,7 @@
 #include <vector>
 
 #include "calib/frame_calibration.hpp"
+#include "calib/rest_stillness.hpp"
 #include "calib/robot_description.hpp"
 #include "calib/robot_log.hpp"
 #include "calib/static_deflection.hpp"
@@ -52,6 +59,9 @@ struct RestPoseOptions {
   // The joint rates at the ends of a rest (RestObservation::q_rate_*) from a straight line
   // through the readings of this span at each end (encoder quantisation averages down) [s].
   double creep_fit_s = 0.05;
+  // The IMS stillness check of every rest the readings accept (2b above); off: not checked.
+  bool check_stillness = true;
+  RestStillnessOptions stillness;
   StaticDeflectionOptions deflection;
 };
 
@@ -81,7 +91,10 @@ struct RestPoseResult {
   std::vector<RestObservation> rests;   // accepted, in time order
   std::vector<RestPoseDetail> details;  // parallel to rests
   std::vector<std::string> rejected;    // rests not used, each with the reason in words
-  ims::RestDetection detection;         // the IMS-only detection (all intervals)
+  // Rests used only in part because the IMS moved in the rest of them, each with the finding
+  // (the unexplained rotation, its rate and span) and the part kept.
+  std::vector<std::string> trimmed;
+  ims::RestDetection detection;  // the IMS-only detection (all intervals)
 };
 
 // Throws InputError for missing inputs (null pointers, an empty log) and when the detector

@@ -336,6 +336,7 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
   line("");
   line(fmt::format("rests used: {}, rejected: {}", rests.rests.size(), rests.rejected.size()));
   for (const auto& why : rests.rejected) line("  rejected: " + why);
+  for (const auto& why : rests.trimmed) line("  trimmed: " + why);
   line(fmt::format("initial time offset (cross-correlation): {:.3f} ms (peak {:.3f})",
                    dt0.offset_s * 1e3, dt0.peak_correlation));
   line(fmt::format("solver: {} ({} iterations, {})", r.converged ? "converged" : "NOT converged",
@@ -515,6 +516,7 @@ void run(const CalibrateArgs& args) {
   progress.update("rests", 0.5);
   const calib::RestPoseResult rests = calib::find_rest_poses(rest_input, rest_options);
   for (const auto& why : rests.rejected) spdlog::warn("calibrate: rest not used: {}", why);
+  for (const auto& why : rests.trimmed) spdlog::warn("calibrate: rest used in part: {}", why);
   spdlog::info("calibrate: {} rest poses ({} rejected)", rests.rests.size(), rests.rejected.size());
 
   // The bundle.
@@ -634,7 +636,8 @@ void run(const CalibrateArgs& args) {
         {"T_S_H", pose_json(result.initial_T_S_H)},
         {"time_offset_ms", result.initial_time_offset_s * 1e3},
         {"time_offset_peak_correlation", dt0.peak_correlation}}},
-      {"rests", {{"used", rests.rests.size()}, {"rejected", rests.rejected}}},
+      {"rests",
+       {{"used", rests.rests.size()}, {"rejected", rests.rejected}, {"trimmed", rests.trimmed}}},
       {"inputs", inputs}};
 
   json rest_res = json::array(), motion_res = json::array();

@@ -331,23 +331,41 @@ TEST(CalibrateCampaign, MountingScenarioAsShipped) {
   // Met: the initial clock offset from the cross-correlation of rate magnitudes, within 1 ms of
   // the simulated 12.3 ms (the robot cycle is 2 ms; the correlation peak is sub-sample).
   EXPECT_LT(f.worst_initial_dt_ms, 1.0);
-  // Met: every seed finds its rests (13-14 of 14; before the bundle modelled the joint
+  // Met: every seed keeps enough rests (7-10 of 14; before the bundle modelled the joint
   // controllers' creep at the rests, the readings' 1e-5 rad stillness limit left 2-4 and 21 of
   // 50 seeds were refused) and converges from the automatic initial values.
   EXPECT_EQ(f.calibrated, f.seeds);
   EXPECT_EQ(f.calibrated, f.converged);
   if (sanitized()) return;  // 60 s, 7 rests: the figures below are those of the full record
-  // Measured (worst of 50): T_S_H 0.0055 deg / 0.109 mm, T_R_W tilt 0.0099 deg, dt 0.95 sigma.
-  // NOT honest: heading, biases and dt within 1/2/3 sigma 0.25 / 0.40 / 0.53, heading up to 7.4
-  // and the gyro bias up to 11 sigma, 11 of 27 blocks outliers. The cause: links whose gears
-  // carry (almost) no load slide inside their backlash at rest where the encoders cannot see it
-  // (A5 of poses 5 and 6 by 6e-4 rad over the rest in truth/joints.csv, the motor still): the
-  // plant's smooth Coulomb law has no static friction to hold them. Asserted (2x margin on the
-  // measured worst) so that the chain does not fall back behind what it reaches here.
-  EXPECT_LT(f.S_H_rotation_deg, 0.011);
-  EXPECT_LT(f.S_H_translation_mm, 0.22);
+  // Links whose gears carry (almost) no load slide inside their backlash at rest where the
+  // encoders cannot see it (A5 of poses 5 and 6 at 2e-4 rad/s over the whole rest, A4 of poses
+  // 1, 2, 3, 7 and 14 by up to 4.5e-4 rad, decaying over seconds; truth/joints.csv, the motor
+  // still): the plant's smooth Coulomb law has no static friction to hold them. The IMS
+  // stillness check (calib/rest_stillness.hpp) drops those rests (4-7 per seed; none is still
+  // long enough to be trimmed), so 7-10 rests remain.
+  // Measured (worst of 50): T_S_H 0.0148 deg / 0.192 mm, T_R_W tilt 0.0090 deg, translation
+  // 0.263 mm, heading 4.8 sigma, gyro bias 5.7 sigma, acc bias 4.4 sigma, dt 0.96 sigma, up to
+  // 6 outlier blocks; heading, biases and dt within 1/2/3 sigma 0.51 / 0.81 / 0.94.
+  // Before the stillness check (all 13-14 rests, the sliding ones too): T_S_H 0.0055 deg /
+  // 0.109 mm, tilt 0.0099 deg, translation 0.274 mm, heading 7.4, gyro bias 11, acc bias 8.3
+  // sigma, 11 outlier blocks, within 1/2/3 sigma 0.25 / 0.40 / 0.53: more precise-looking, but
+  // not honest. Still not honest (goal 0.68 / 0.95 / 0.997): slides too slow for the check over
+  // a rest (about an axis across both the vertical and the horizontal Earth rate only the
+  // accelerometers resolve, ~6e-6 rad/s over 5 s) still bias the gyro means; T_S_H misses the
+  // goal with half of the rests gone. Asserted: the issue's 3-sigma goal for dt (met); the
+  // others with a 2x margin on the measured worst, the sigma shares with room for 50 draws
+  // (0.40, 0.70, 0.85), so that the chain does not fall back behind what it reaches here.
+  EXPECT_GE(f.min_rests, 6u);
+  EXPECT_LT(f.S_H_rotation_deg, 0.03);
+  EXPECT_LT(f.S_H_translation_mm, 0.4);
   EXPECT_LT(f.R_W_tilt_deg, 0.02);
   EXPECT_LT(f.dt_sigmas, 3.0);
+  EXPECT_LT(f.heading_sigmas, 10.0);
+  EXPECT_LT(f.gyro_bias_sigmas, 11.0);
+  EXPECT_GT(f.within_1, 0.40);
+  EXPECT_GT(f.within_2, 0.70);
+  EXPECT_GT(f.within_3, 0.85);
+  EXPECT_LE(f.worst_outliers, 12u);
 }
 
 TEST(CalibrateCampaign, MountingRigid) {
@@ -422,13 +440,14 @@ TEST_F(CalibrateCampaignScratch, MountingWithoutBacklash) {
   EXPECT_EQ(f.calibrated, f.converged);
   EXPECT_LT(f.dt_sigmas, 3.0);
   if (sanitized()) return;
-  // Measured (worst of 10): T_S_H 0.0023 deg / 0.043 mm, T_R_W tilt 0.0051 deg, translation
-  // 0.121 mm, heading 2.1 sigma, gyro bias 1.6 sigma, acc bias 3.1 sigma, dt 0.84 sigma, no
-  // outlier block; within 1/2/3 sigma 0.79 / 0.95 / 0.99. Before the creep and the bias drift
-  // were modelled: T_S_H 0.0043 deg / 0.108 mm, heading 6.2, gyro bias 4.9, acc bias 77 sigma,
-  // 15 of 27 blocks outliers. Asserted: issue 4's goals for T_S_H and the 3-sigma bounds where
-  // met, the sigma shares as for `rigid`, the tilt at 0.01 deg; the T_R_W translation is not
-  // met (0.12 mm, the unloaded A1's play prior at the first rest, see `rigid`).
+  // Measured (worst of 10): T_S_H 0.0023 deg / 0.043 mm, T_R_W tilt 0.0042 deg (0.0051
+  // before the IMS stillness check, which keeps all 14 rests here but trims some to where the
+  // IMS is still), translation 0.121 mm, heading 2.1 sigma, gyro bias 1.6 sigma, acc bias 3.1
+  // sigma, dt 0.84 sigma, no outlier block; within 1/2/3 sigma 0.79 / 0.95 / 0.99. Before the creep
+  // and the bias drift were modelled: T_S_H 0.0043 deg / 0.108 mm, heading 6.2, gyro bias 4.9, acc
+  // bias 77 sigma, 15 of 27 blocks outliers. Asserted: issue 4's goals for T_S_H and the 3-sigma
+  // bounds where met, the sigma shares as for `rigid`, the tilt at 0.01 deg; the T_R_W translation
+  // is not met (0.12 mm, the unloaded A1's play prior at the first rest, see `rigid`).
   EXPECT_LT(f.S_H_rotation_deg, 0.005);
   EXPECT_LT(f.S_H_translation_mm, 0.05);
   EXPECT_LT(f.R_W_tilt_deg, 0.01);
