@@ -16,6 +16,7 @@
 
 #include "calib/forward_kinematics.hpp"
 #include "calib/frame_calibration.hpp"
+#include "calib/time_offset.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/imu_noise.hpp"
 #include "ims/imu_synthesis.hpp"
@@ -155,6 +156,26 @@ inline calib::FrameCalibrationInput frame_input(const FrameScene& scene,
       scene.T_H_S;
   in.first_rest_position_W_m = T_W_S_1.translation();
   return in;
+}
+
+// The automatic initial time offset as `imscal calibrate` has it: cross-correlation of the rate
+// magnitudes (calib/time_offset.hpp), the Earth rate plus gyro bias in S taken as the first
+// rest's mean gyro reading.
+inline double automatic_time_offset(const calib::FrameCalibrationInput& in) {
+  const calib::RateMagnitudeSeries robot =
+      calib::flange_rate_magnitude(in.kinematics, in.robot.t_robot_s, in.robot.q_rad);
+  Eigen::Vector3d rest_rate = Eigen::Vector3d::Zero();
+  double rest_time = 0.0;
+  for (std::size_t k = 1; k < in.imu->samples.size(); ++k) {
+    const ims::ImuSample& s = in.imu->samples[k];
+    if (s.t_s > in.rests[0].begin_ims_s && s.t_s <= in.rests[0].end_ims_s) {
+      rest_rate += s.gyro;
+      rest_time += s.t_s - in.imu->samples[k - 1].t_s;
+    }
+  }
+  const calib::RateMagnitudeSeries ims =
+      calib::ims_rate_magnitude(*in.imu, Eigen::Vector3d(rest_rate / rest_time));
+  return calib::estimate_time_offset(robot, ims).offset_s;
 }
 
 }  // namespace imscal::test_support

@@ -40,25 +40,6 @@ double rotation_error_rad(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return ims::quat_log<double>(Eigen::Quaterniond(a * b.transpose())).norm();
 }
 
-// The automatic initial time offset: cross-correlation of the rate magnitudes, the Earth rate
-// (plus gyro bias) in S taken as the first rest's mean gyro reading.
-double automatic_time_offset(const FrameCalibrationInput& in) {
-  const RateMagnitudeSeries robot =
-      flange_rate_magnitude(in.kinematics, in.robot.t_robot_s, in.robot.q_rad);
-  Eigen::Vector3d rest_rate = Eigen::Vector3d::Zero();
-  double rest_time = 0.0;
-  for (std::size_t k = 1; k < in.imu->samples.size(); ++k) {
-    const ims::ImuSample& s = in.imu->samples[k];
-    if (s.t_s > in.rests[0].begin_ims_s && s.t_s <= in.rests[0].end_ims_s) {
-      rest_rate += s.gyro;
-      rest_time += s.t_s - in.imu->samples[k - 1].t_s;
-    }
-  }
-  const RateMagnitudeSeries ims =
-      ims_rate_magnitude(*in.imu, Eigen::Vector3d(rest_rate / rest_time));
-  return estimate_time_offset(robot, ims).offset_s;
-}
-
 RobotDescription kr16() {
   return load_robot_description(std::filesystem::path(IMSCAL_SOURCE_DIR) / "datasets" / "robots" /
                                 "kr16.yaml");
@@ -79,7 +60,7 @@ TEST(FrameCalibration, NoiseFreeRecordGivesTheFramesBack) {
   const ims::SensorSpec spec = ims::load_sensor_spec(
       std::filesystem::path(IMSCAL_SOURCE_DIR) / "datasets" / "sensors" / "navigation-grade.yaml");
   FrameCalibrationInput in = test_support::frame_input(scene, test_support::noise_model_of(spec));
-  in.time_offset_initial_s = automatic_time_offset(in);
+  in.time_offset_initial_s = test_support::automatic_time_offset(in);
   const FrameCalibrationResult r = calibrate_frames(in);
   ASSERT_TRUE(r.converged) << r.solver_brief_report;
   const Eigen::Isometry3d T_R_W_true = frame_calibration_truth_convention(
@@ -142,7 +123,7 @@ TEST(FrameCalibration, JointDeviationPriorsAndScaleFactorsKeepAnExactRecordExact
     rest.q_link_sigma_rad = JointVector::Constant(20e-6);  // 4 arcsec, a backlash-class play
     rest.q_link_sigma_rad[0] = 0.0;
   }
-  in.time_offset_initial_s = automatic_time_offset(in);
+  in.time_offset_initial_s = test_support::automatic_time_offset(in);
   FrameCalibrationOptions options;
   options.estimate_scale_factors = true;
   const FrameCalibrationResult r = calibrate_frames(in, options);
@@ -244,7 +225,7 @@ SeedOutcome run_mounting_seed(std::uint64_t seed) {
   test_support::corrupt_scene_imu(scene, motion.spec, seed);
   FrameCalibrationInput in =
       test_support::frame_input(scene, test_support::noise_model_of(motion.spec));
-  in.time_offset_initial_s = automatic_time_offset(in);
+  in.time_offset_initial_s = test_support::automatic_time_offset(in);
   const FrameCalibrationResult r = calibrate_frames(in);
 
   SeedOutcome out;

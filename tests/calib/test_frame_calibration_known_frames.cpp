@@ -29,25 +29,6 @@ namespace {
 using test_support::FrameScene;
 constexpr double kDeg = M_PI / 180.0;
 
-// The automatic initial time offset as `imscal calibrate` has it: cross-correlation of the rate
-// magnitudes (calib/time_offset.hpp), the Earth rate plus gyro bias taken from the first rest.
-double automatic_time_offset(const FrameCalibrationInput& in) {
-  const RateMagnitudeSeries robot =
-      flange_rate_magnitude(in.kinematics, in.robot.t_robot_s, in.robot.q_rad);
-  Eigen::Vector3d rest_rate = Eigen::Vector3d::Zero();
-  double rest_time = 0.0;
-  for (std::size_t k = 1; k < in.imu->samples.size(); ++k) {
-    const ims::ImuSample& s = in.imu->samples[k];
-    if (s.t_s > in.rests[0].begin_ims_s && s.t_s <= in.rests[0].end_ims_s) {
-      rest_rate += s.gyro;
-      rest_time += s.t_s - in.imu->samples[k - 1].t_s;
-    }
-  }
-  const RateMagnitudeSeries ims =
-      ims_rate_magnitude(*in.imu, Eigen::Vector3d(rest_rate / rest_time));
-  return estimate_time_offset(robot, ims).offset_s;
-}
-
 double sigma_of(const FrameCalibrationResult& r, const std::string& name) {
   for (std::size_t i = 0; i < r.parameter_names.size(); ++i)
     if (r.parameter_names[i] == name)
@@ -111,7 +92,7 @@ FrameCalibrationInput known_frames_input(const Record& record, const std::vector
   known.covariance = frame_covariance;
   known.source = "truth";
   in.known_frames = known;
-  in.time_offset_initial_s = automatic_time_offset(in);
+  in.time_offset_initial_s = test_support::automatic_time_offset(in);
   return in;
 }
 
