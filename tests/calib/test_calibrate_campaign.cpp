@@ -331,12 +331,19 @@ TEST(CalibrateCampaign, MountingScenarioAsShipped) {
   // Met: the initial clock offset from the cross-correlation of rate magnitudes, within 1 ms of
   // the simulated 12.3 ms (the robot cycle is 2 ms; the correlation peak is sub-sample).
   EXPECT_LT(f.worst_initial_dt_ms, 1.0);
+  if (sanitized()) {
+    // The first 60 s hold poses 1-7, of which only pose 4 is still for the IMS (see below): the
+    // stillness check leaves 1-2 rests and the chain refuses with its defined message (the
+    // bundle itself runs under the sanitizers in MountingRigid and MountingWithoutBacklash).
+    EXPECT_EQ(f.calibrated, 0u);
+    EXPECT_NE(f.first_refusal.find("at least 3 are needed"), std::string::npos) << f.first_refusal;
+    return;
+  }
   // Met: every seed keeps enough rests (7-10 of 14; before the bundle modelled the joint
   // controllers' creep at the rests, the readings' 1e-5 rad stillness limit left 2-4 and 21 of
   // 50 seeds were refused) and converges from the automatic initial values.
   EXPECT_EQ(f.calibrated, f.seeds);
   EXPECT_EQ(f.calibrated, f.converged);
-  if (sanitized()) return;  // 60 s, 7 rests: the figures below are those of the full record
   // Links whose gears carry (almost) no load slide inside their backlash at rest where the
   // encoders cannot see it (A5 of poses 5 and 6 at 2e-4 rad/s over the whole rest, A4 of poses
   // 1, 2, 3, 7 and 14 by up to 4.5e-4 rad, decaying over seconds; truth/joints.csv, the motor
