@@ -31,6 +31,26 @@ std::string seconds(double t) {
   return fmt::format("{:.3f} s", t);
 }
 
+using SampleIterator = std::vector<RobotLogSample>::const_iterator;
+
+// The first sample of [from, to) at or after t, and the first after t [s, robot clock].
+SampleIterator first_at_or_after(SampleIterator from, SampleIterator to, double t) {
+  return std::lower_bound(from, to, t, [](const RobotLogSample& s, double x) { return s.t_s < x; });
+}
+SampleIterator first_after(SampleIterator from, SampleIterator to, double t) {
+  return std::upper_bound(from, to, t, [](double x, const RobotLogSample& s) { return x < s.t_s; });
+}
+
+// Per joint, max - min of the readings of [first, last) (not empty) [rad].
+JointVector reading_spread(SampleIterator first, SampleIterator last) {
+  JointVector low = first->q_internal_rad, high = first->q_internal_rad;
+  for (auto it = first; it != last; ++it) {
+    low = low.cwiseMin(it->q_internal_rad);
+    high = high.cwiseMax(it->q_internal_rad);
+  }
+  return high - low;
+}
+
 }  // namespace
 
 RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions& options) {
@@ -64,24 +84,19 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
                                             seconds(samples.back().t_s)));
       continue;
     }
-    auto first = std::lower_bound(samples.begin(), samples.end(), robot_begin,
-                                  [](const RobotLogSample& s, double t) { return s.t_s < t; });
-    auto last = std::upper_bound(samples.begin(), samples.end(), robot_end,
-                                 [](double t, const RobotLogSample& s) { return t < s.t_s; });
+    auto first = first_at_or_after(samples.begin(), samples.end(), robot_begin);
+    auto last = first_after(samples.begin(), samples.end(), robot_end);
     if (last - first < 2) {
       result.rejected.push_back(fmt::format("{}: fewer than 2 robot samples", where));
       continue;
     }
     RestPoseDetail detail;
-    JointVector low = first->q_internal_rad, high = first->q_internal_rad;
     double payload_low = first->payload_kg, payload_high = first->payload_kg;
     for (auto it = first; it != last; ++it) {
-      low = low.cwiseMin(it->q_internal_rad);
-      high = high.cwiseMax(it->q_internal_rad);
       payload_low = std::min(payload_low, it->payload_kg);
       payload_high = std::max(payload_high, it->payload_kg);
     }
-    detail.q_internal_spread_rad = high - low;
+    detail.q_internal_spread_rad = reading_spread(first, last);
     int moving = -1;
     detail.q_internal_spread_rad.maxCoeff(&moving);
     if (detail.q_internal_spread_rad(moving) > options.max_joint_spread_rad) {
@@ -122,12 +137,8 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
       // The flange's mean rotation over [t0, t1] from the readings, relative to the rest's
       // first reading (the Jacobian holds over the few 1e-4 rad a rest creeps).
       const ExplainedRotation explained = [&](double t0_ims, double t1_ims) {
-        const auto from =
-            std::lower_bound(first, last, t0_ims - input.time_offset_s,
-                             [](const RobotLogSample& s, double t) { return s.t_s < t; });
-        const auto to =
-            std::lower_bound(from, last, t1_ims - input.time_offset_s,
-                             [](const RobotLogSample& s, double t) { return s.t_s < t; });
+        const auto from = first_at_or_after(first, last, t0_ims - input.time_offset_s);
+        const auto to = first_at_or_after(from, last, t1_ims - input.time_offset_s);
         if (from == to) return Eigen::Vector3d(Eigen::Vector3d::Zero());
         JointVector q_sum = JointVector::Zero();
         for (auto it = from; it != to; ++it) q_sum += it->q_internal_rad - q_reference;
@@ -146,21 +157,14 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
         result.trimmed.push_back(fmt::format("{}: {}; used only where still, {} .. {}", where,
                                              stillness.describe(), seconds(rest_begin),
                                              seconds(rest_end)));
-        first = std::lower_bound(first, last, rest_begin - input.time_offset_s,
-                                 [](const RobotLogSample& s, double t) { return s.t_s < t; });
-        last = std::upper_bound(first, last, rest_end - input.time_offset_s,
-                                [](double t, const RobotLogSample& s) { return t < s.t_s; });
+        first = first_at_or_after(first, last, rest_begin - input.time_offset_s);
+        last = first_after(first, last, rest_end - input.time_offset_s);
         if (last - first < 2) {
           result.rejected.push_back(
               fmt::format("{}: fewer than 2 robot samples where still", where));
           continue;
         }
-        low = high = first->q_internal_rad;
-        for (auto it = first; it != last; ++it) {
-          low = low.cwiseMin(it->q_internal_rad);
-          high = high.cwiseMax(it->q_internal_rad);
-        }
-        detail.q_internal_spread_rad = high - low;
+        detail.q_internal_spread_rad = reading_spread(first, last);
       }
     }
     JointVector sum = JointVector::Zero();
