@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/input_error.hpp"
+#include "ims/zupt_options.hpp"
 
 namespace imscal::calib {
 namespace {
@@ -200,10 +201,8 @@ RestStillness assess_rest_stillness(const ims::ImuSeries& imu, const ims::EarthM
   NoiseModel m;
   m.gyro_density = sensor.gyro.white_noise_density;
   m.gyro_lsb_rad = sensor.gyro.quantization_lsb;
-  double gyro_bias_var = sensor.gyro.turn_on_bias_sigma * sensor.gyro.turn_on_bias_sigma;
-  for (const ims::GaussMarkovTerm& term : sensor.gyro.bias_instability)
-    gyro_bias_var += term.sigma * term.sigma;
-  m.gyro_bias_bound = 3.0 * std::sqrt(gyro_bias_var);
+  // 3 sigma of turn-on and in-run bias, as the rest detector bounds it (calib/rest_poses.cpp).
+  m.gyro_bias_bound = 3.0 * ims::zupt_options_from_spec(sensor).initial_gyro_bias_sigma_rad_s;
   m.acc_density = sensor.acc.white_noise_density;
   m.acc_lsb_m_s = sensor.acc.quantization_lsb;
   m.acc_drift = sensor.acc.bias_instability;
