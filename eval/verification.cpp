@@ -283,19 +283,34 @@ ModelTorqueSource scenario_model_torque(const sim::Scenario& scenario) {
   return model;
 }
 
+namespace {
+
+// Whether `log` lacks the model torques the config's models take; then a robot model is needed
+// (std::invalid_argument naming the caller otherwise) and they are attached to a copy.
+bool needs_model_torques(const ident::JointErrorLog& log, const ident::IdentificationConfig& config,
+                         const ModelTorqueSource* torque_model, const char* caller) {
+  if (!config.options.model_torque_input || !log.model_torque_nm.empty()) return false;
+  if (torque_model == nullptr)
+    throw std::invalid_argument(std::string(caller) +
+                                ": the config's models take the model torque; give the robot's "
+                                "rigid-body model");
+  return true;
+}
+
+ident::JointErrorLog with_model_torques(ident::JointErrorLog log, const ModelTorqueSource& model,
+                                        const ident::IdentificationConfig& config) {
+  attach_model_torques(log, model, config.options);
+  return log;
+}
+
+}  // namespace
+
 IdentifiedTable identify_table(const ident::JointErrorLog& log,
                                const ident::IdentificationConfig& config,
                                const std::string& source_file,
                                const ModelTorqueSource* torque_model) {
-  if (config.options.model_torque_input && log.model_torque_nm.empty()) {
-    if (torque_model == nullptr)
-      throw std::invalid_argument(
-          "identify_table: the config's models take the model torque; give the robot's "
-          "rigid-body model");
-    ident::JointErrorLog with_torque = log;
-    attach_model_torques(with_torque, *torque_model, config.options);
-    return identify_table(with_torque, config, source_file);
-  }
+  if (needs_model_torques(log, config, torque_model, "identify_table"))
+    return identify_table(with_model_torques(log, *torque_model, config), config, source_file);
   if (config.max_speed_rad_s.size() != log.joint_count()) {
     throw std::invalid_argument(fmt::format("identify_table: config has {} joints, the data {}",
                                             config.max_speed_rad_s.size(), log.joint_count()));
@@ -316,15 +331,9 @@ std::vector<double> replay_held_out_fits(const IdentifiedTable& identified,
                                          const ident::JointErrorLog& reference,
                                          const ident::IdentificationConfig& config,
                                          const ModelTorqueSource* torque_model) {
-  if (config.options.model_torque_input && reference.model_torque_nm.empty()) {
-    if (torque_model == nullptr)
-      throw std::invalid_argument(
-          "replay_held_out_fits: the config's models take the model torque; give the robot's "
-          "rigid-body model");
-    ident::JointErrorLog with_torque = reference;
-    attach_model_torques(with_torque, *torque_model, config.options);
-    return replay_held_out_fits(identified, with_torque, config);
-  }
+  if (needs_model_torques(reference, config, torque_model, "replay_held_out_fits"))
+    return replay_held_out_fits(identified, with_model_torques(reference, *torque_model, config),
+                                config);
   if (identified.joints.size() != reference.joint_count())
     throw std::invalid_argument("replay_held_out_fits: the table and the record differ in joints");
   const auto segments = reference.segments();
