@@ -2,10 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <numbers>
 #include <stdexcept>
 #include <string>
 #include <tuple>
+
+#include "ident/precontrol.hpp"
 
 namespace imscal::ident {
 namespace {
@@ -156,6 +159,24 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
         o.criterion = OrderCriterion::kValidation;
       else
         n->fail("criterion must be aic, bic or validation");
+    }
+  }
+  // The exported table must load into the precontrol (ident/precontrol.hpp): a further input's
+  // coefficients move behind the dead time when the model is written in the angle form, so
+  // taps + largest dead time must fit the runtime's kMaxPrecontrolOrder per input.
+  if (o.model_torque_input || o.direction_input) {
+    const int longest =
+        std::max(o.input_taps, o.torque_sign_input ? o.torque_sign_taps : 0) + o.grid.dead_time_max;
+    if (longest > kMaxPrecontrolOrder) {
+      const ConfigNode at =
+          root.optional_child("model") && root.child("model").optional_child("input_taps")
+              ? root.child("model").child("input_taps")
+              : root.child("order").child("dead_time");
+      at.fail(fmt::format(
+          "model.input_taps ({}) plus the largest dead time (order.dead_time max {}) is {} "
+          "coefficients per further input; the precontrol holds at most {}",
+          std::max(o.input_taps, o.torque_sign_input ? o.torque_sign_taps : 0),
+          o.grid.dead_time_max, longest, kMaxPrecontrolOrder));
     }
   }
   if (auto v = root.optional_child("validation")) {
