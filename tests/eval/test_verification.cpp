@@ -6,7 +6,7 @@
 // the held-out simulation fit per joint with the chosen orders and dead times.
 //
 // Release: ~identification 130 s of plant + 3 identifications + 10 cycles x 4 runs of seed-line
-// + 10 x 2 runs of the iso9283 100 % part. Under IMSCAL_SANITIZED: the first 60 s of the
+// + 10 x 2 runs of the iso9283 100 % part (~55 s). Under IMSCAL_SANITIZED: the first 60 s of the
 // identification program and 2 cycles (the figures are then only printed, the goals not
 // asserted: too little identification data).
 #include <gtest/gtest.h>
@@ -30,9 +30,10 @@ namespace fs = std::filesystem;
 bool sanitized() {
   return std::getenv("IMSCAL_SANITIZED") != nullptr;
 }
-// The issue's goals (>= 95 % / >= 90 % reduction, >= 90 % fit) are asserted only with
-// IMSCAL_VERIFY_GOALS set: with the current identification they are not met (printed figures and
-// the report say why); the always-on assertions check the measurement itself.
+// The issue's goals not yet met (>= 95 % reduction on seed-line, >= 90 % fit against the
+// IMS-measured errors) are asserted only with IMSCAL_VERIFY_GOALS set (printed figures and the
+// report say why); the always-on assertions check the measurement itself, and the ISO 9283 set's
+// >= 90 %, which is met, is asserted always in Release.
 bool assert_goals() {
   return std::getenv("IMSCAL_VERIFY_GOALS") != nullptr;
 }
@@ -101,8 +102,8 @@ void print_case(const VerificationCase& c, const PathFigures& before,
 
 VerificationResult run(const std::string& name, const std::string& filter, bool ablation) {
   VerificationOptions options;
-  // 10 cycles (ISO 9283) on seed-line; 5 on the longer iso9283 part to keep the test < 60 s.
-  options.cycles = sanitized() ? 2 : (ablation ? 10 : 5);
+  // ISO 9283's 10 cycles (2 under the sanitizers).
+  options.cycles = sanitized() ? 2 : 10;
   if (const char* n = std::getenv("IMSCAL_VERIFY_CYCLES")) options.cycles = std::atoi(n);
   options.segment_filter = filter;
   // Under the sanitizers the attained paths are the plant's own (the IMS chain's measurement of
@@ -284,8 +285,9 @@ TEST(Verification, Iso9283FullVelocity) {
   const VerificationResult r = run("iso9283", "100%", false);
   EXPECT_GT(r.before.figures.max_path_deviation_m, 0.001);
   if (!sanitized()) {
-    // What the chain reaches today (Release, 5 cycles): as the IMS chain measures the attained
-    // paths 8.20 -> 0.73 mm (91.1 %), on the true paths 8.19 -> 0.62 mm (92.4 %), the precontrol
+    // What the chain reaches today (Release, 10 cycles): as the IMS chain measures the attained
+    // paths 8.20 -> 0.79 mm (90.4 %), on the true paths 8.19 -> 0.73 mm (91.2 %; with 5 cycles
+    // 91.1 and 92.4 %: a longer series meets more of the drawn frictions), the precontrol
     // active throughout (its default tolerances come from the identification data's envelope).
     // The planner keeps Cartesian moves within the joints' acceleration and jerk limits
     // (sim/cartesian_timing.hpp): the 100 % D 40 mm circle runs at 42 % of its programmed speed.
@@ -293,12 +295,15 @@ TEST(Verification, Iso9283FullVelocity) {
     EXPECT_EQ(r.after[0].inactive_cycles, 0u);
     EXPECT_GE(reduction_percent(r.before.figures.max_path_deviation_m,
                                 r.after[0].figures.max_path_deviation_m),
-              88.1);
+              87.4);
     EXPECT_GE(reduction_percent(r.before.true_figures.max_path_deviation_m,
                                 r.after[0].true_figures.max_path_deviation_m),
-              89.4);
+              88.2);
   }
-  if (assert_goals() && !sanitized()) {
+  // Issue 6's goal on this path set, met since the eighth round's 60 input taps (90.4 % as the
+  // IMS chain measures it): asserted whenever the figures are (Release), not only under
+  // IMSCAL_VERIFY_GOALS, so that a change that loses it fails here.
+  if (!sanitized()) {
     const double full = reduction_percent(r.before.figures.max_path_deviation_m,
                                           r.after[0].figures.max_path_deviation_m);
     EXPECT_GE(full, 90.0) << "issue 6 goal on the ISO 9283 path set at 100 % velocity";
@@ -482,7 +487,7 @@ TEST(Verification, IdentifiedFromTheImsChain) {
   for (std::size_t j = 0; j < 3; ++j)
     EXPECT_GE(against_truth[j], 90.0) << table.joints[j].parameters.name;
   VerificationOptions options;
-  options.cycles = 5;
+  options.cycles = 10;  // ISO 9283
   options.segment_filter = "line";
   const VerificationResult r =
       verify_scenario(scenario("seed-line"), {{"from the IMS chain", table.table}}, options);
@@ -490,14 +495,14 @@ TEST(Verification, IdentifiedFromTheImsChain) {
   print_case(r.before, r.before.figures, r.before.true_figures);
   print_case(r.after[0], r.before.figures, r.before.true_figures);
   EXPECT_EQ(r.after[0].inactive_cycles, 0u);
-  // Measured: 94.1 % as the IMS chain sees the path, 93.8 % on the true path (5 cycles);
-  // asserted 3 %-points below, as above.
+  // Measured: 92.8 % as the IMS chain sees the path, 92.9 % on the true path (10 cycles; 94.1
+  // and 93.8 % over the first 5); asserted 3 %-points below, as above.
   EXPECT_GE(reduction_percent(r.before.figures.max_path_deviation_m,
                               r.after[0].figures.max_path_deviation_m),
-            91.1);
+            89.8);
   EXPECT_GE(reduction_percent(r.before.true_figures.max_path_deviation_m,
                               r.after[0].true_figures.max_path_deviation_m),
-            90.8);
+            89.9);
 }
 
 }  // namespace
