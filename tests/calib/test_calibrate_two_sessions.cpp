@@ -9,13 +9,28 @@
 //   --gravity-m-s2 the site's normal gravity).
 // Printed: (a) the chain's joint errors against the simulator's truth (q_desired - q_link of
 // truth/joints.csv at the same robot samples), RMS per joint of the truth and of the
-// measurement error; (b) the held-out joint-error fit per joint that identify reports (cells
-// weighted by their validation rows, as eval::summarize_fit). With TRUE frames the chain gives
-// A1 93.5 %, A2 90.4 %, A3 84.4 % (tests/eval/test_verification.cpp, IdentifiedFromTheImsChain);
-// issue 5's goal, >= 90 % per primary joint A1..A3, is asserted only with IMSCAL_VERIFY_GOALS
-// set (as there). Release only: two plant runs (~15 s), two calibrations and an identification
-// (~1 min); under the sanitizers (5-10x slower) it is skipped, and the known-frames bundle is
-// covered there by tests/calib/test_frame_calibration_known_frames.cpp.
+// measurement error: measured A1 0.171, A2 0.513, A3 0.856 mrad (signal ~3.5-3.7 mrad); (b) the
+// held-out joint-error fit per joint that identify reports (cells weighted by their validation
+// rows, as eval::summarize_fit): A1 94.3, A2 86.5, A3 82.0 %; (c) the same identification
+// in-process (eval::identify_table, checked equal to identify's figures) with its models judged
+// against the TRUE joint errors of the held-out rows (eval::replay_held_out_fits, as
+// tests/eval/test_verification.cpp's IdentifiedFromTheImsChain): A1 94.7, A2 91.6, A3 78.6 %,
+// asserted 3 %-points below. A3 falls short of issue 5's goal (>= 90 % per primary joint,
+// asserted only with IMSCAL_VERIFY_GOALS set): its model fits part of the chain's own A3 error.
+// Why this record's error is larger than the identification scenario's (0.21/0.25/0.31 mrad in
+// IdentifiedFromTheImsChain): not the random mount or base heading, nor the bias and clock
+// offset --frames estimates (the in-process chain with the true frames, biases and clock on this
+// plant run and this unit's draw gives 0.16/0.48/0.76 mrad, the same with the nominal mount and
+// heading; a 30 ug error of the initial acc bias changes it < 0.001 mrad, 0.1 ms of clock offset
+// by 0.01-0.02), but the unit's draw: its in-run acc bias drifts by 19 ug in 170 s (2.5 times
+// the spec's 1-sigma for that span; without that drift 0.15/0.38/0.54 mrad), and a floor the
+// creep velocity updates (calib/encoder_motion.hpp) leave even with an error-free IMS,
+// 0.18/0.32/0.46 mrad, mostly from the pause after A4 +90 deg, where A5's axis stands vertical:
+// unloaded, A5's link slides in its play while its motor creeps, so the readings' velocity is
+// wrong there by ~1e-4 m/s (10 sigma).
+// Release only: two plant runs (~10 s), two calibrations and two identifications (~5 s); under
+// the sanitizers (5-10x slower) it is skipped, and the known-frames bundle is covered there by
+// tests/calib/test_frame_calibration_known_frames.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,7 +42,11 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "calib/robot_description.hpp"
+#include "core/config_node.hpp"
 #include "core/sha256.hpp"
+#include "eval/verification.hpp"
+#include "ident/identification_config.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/sensor_error_model.hpp"
@@ -167,11 +186,14 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   const auto truth = read_truth_link_angles(id_sim / "truth" / "joints.csv");
   std::array<double, 6> sq_true{}, sq_error{};
   std::size_t matched = 0;
+  // The measured log with the true link angles in place of the chain's (same rows and runs).
+  ident::JointErrorLog truth_on_measured_rows = measured;
   for (std::size_t k = 0; k < measured.sample_count(); ++k) {
     const auto it = truth.find(std::llround(measured.time_s[k] * 1e6));
     if (it == truth.end()) continue;
     ++matched;
     for (std::size_t j = 0; j < 6; ++j) {
+      truth_on_measured_rows.q_measured_rad[j][k] = it->second[j];
       const double e_true = measured.q_desired_rad[j][k] - it->second[j];
       const double e_ims = measured.q_desired_rad[j][k] - measured.q_measured_rad[j][k];
       sq_true[j] += e_true * e_true;
@@ -198,9 +220,13 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
       sim::load_scenario(kScenarios / "two-sessions-identification.yaml").site);
   const double g = earth.gravity_W(Eigen::Vector3d::Zero()).norm();
   const fs::path ident_out = dir_ / "ident";
+  // Gravity to 17 digits: the in-process identification below takes the same number.
+  std::ostringstream gravity;
+  gravity.precision(17);
+  gravity << -g;
   ASSERT_EQ(run("identify --joint-errors " + (id / "joint_errors.csv").string() + " --config " +
                     kIdentConfig.string() + " --robot " + kRobot.string() + " --gravity-m-s2 0 0 " +
-                    std::to_string(-g) + " --out " + ident_out.string(),
+                    gravity.str() + " --out " + ident_out.string(),
                 dir_ / "ident.log"),
             0)
       << read(dir_ / "ident.log");
@@ -224,8 +250,54 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   for (const char* joint : {"A1", "A2", "A3"}) {
     ASSERT_TRUE(fit.count(joint)) << joint;
     EXPECT_TRUE(std::isfinite(fit[joint])) << joint;
+  }
+
+  // (c) The same identification in-process (eval::identify_table: the config and the model
+  // torque identify was given), which must give identify's figures, and its models judged
+  // against the TRUE joint errors of the same held-out rows (eval::replay_held_out_fits): the
+  // models' own error, without the measurement's in the held-out target.
+  const ident::IdentificationConfig config =
+      ident::load_identification_config(ConfigNode::load_file(kIdentConfig));
+  eval::ModelTorqueSource torque_model;
+  torque_model.robot = calib::load_robot_description(kRobot);
+  torque_model.gravity_in_base_m_s2 = Eigen::Vector3d(0.0, 0.0, -g);
+  const eval::IdentifiedTable table =
+      eval::identify_table(measured, config, (id / "joint_errors.csv").string(), &torque_model);
+  for (const std::string& failed : table.failed_joints) {
+    std::printf("not identified: %s\n", failed.c_str());
+    // A6's measurement error exceeds its signal (above): it may fail; A1..A3 must not.
+    for (const char* primary : {"A1:", "A2:", "A3:"})
+      EXPECT_NE(failed.rfind(primary, 0), 0u) << failed;
+  }
+  const std::vector<double> against_truth =
+      eval::replay_held_out_fits(table, truth_on_measured_rows, config, &torque_model);
+  ASSERT_EQ(against_truth.size(), table.joints.size());
+  for (std::size_t j = 0; j < table.joints.size(); ++j) {
+    const std::string& name = table.joints[j].parameters.name;
+    const double in_process = eval::summarize_fit(table.joints[j]).joint_error_fit_percent;
+    std::printf(
+        "%s (two-session chain): held-out joint-error fit %.1f %% against the IMS-measured "
+        "error, %.1f %% against the true error\n",
+        name.c_str(), in_process, against_truth[j]);
+    // The same data, config, gravity and code as identify, whose JSON numbers round-trip:
+    // equal but for the order of the sums (1e-9 %-points).
+    ASSERT_TRUE(fit.count(name)) << name;
+    EXPECT_EQ(std::isfinite(in_process), std::isfinite(fit[name])) << name;
+    if (std::isfinite(fit[name])) {
+      EXPECT_NEAR(in_process, fit[name], 1e-9) << name;
+    }
+  }
+  // Measured against the truth: A1 94.7, A2 91.6, A3 78.6 % (against the IMS-measured errors
+  // 94.3, 86.5, 82.0 %: A3's model has learnt part of the chain's A3 error, see the header).
+  // Asserted 3 %-points below, as IdentifiedFromTheImsChain (the chain is deterministic; the
+  // margin covers other platforms' rounding through the order selection). Issue 5's goal,
+  // >= 90 % per primary joint, only with IMSCAL_VERIFY_GOALS: A3 misses it.
+  const std::array<double, 3> measured_against_truth = {94.7, 91.6, 78.6};
+  for (std::size_t j = 0; j < 3; ++j) {
+    EXPECT_GE(against_truth[j], measured_against_truth[j] - 3.0) << table.joints[j].parameters.name;
     if (std::getenv("IMSCAL_VERIFY_GOALS")) {
-      EXPECT_GE(fit[joint], 90.0) << joint;
+      EXPECT_GE(against_truth[j], 90.0) << table.joints[j].parameters.name;
+      EXPECT_GE(fit[table.joints[j].parameters.name], 90.0) << table.joints[j].parameters.name;
     }
   }
 }
