@@ -172,8 +172,9 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   ims::SmoothedState first;
   first.state = initial;
   smoothed.states.insert(smoothed.states.begin(), first);
+  std::vector<PositionErrorSample> errors;
   if (options.revisited_pose_correction) {
-    const std::vector<PositionErrorSample> errors =
+    errors =
         position_errors_at_revisited_poses(smoothed.states, *input.log, input.kinematics, T_W_R,
                                            input.frames.T_S_H.inverse().translation(),
                                            input.frames.time_offset_s, options.revisited_poses);
@@ -182,6 +183,7 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   JointSpaceErrors out = joint_errors_along(smoothed.states, *input.log, input.kinematics,
                                             input.frames, options.min_wrist_sin);
   out.smoother = smoothed.summary;
+  out.revisited_pose_errors = std::move(errors);
   out.trajectory = std::move(smoothed.states);
   return out;
 }

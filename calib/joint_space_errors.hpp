@@ -102,6 +102,9 @@ struct JointSpaceErrors {
   std::size_t near_wrist_singularity = 0;  // left out: |sin A5| < JointSpaceOptions::min_wrist_sin
   std::string first_ik_failure;            // reason of the first failure, in words
   ims::ZuptSummary smoother;               // rests, innovation statistics
+  // The smoothed position's errors found and removed at the returns to the first rest's pose
+  // (calib/revisited_poses.hpp; empty when off).
+  std::vector<PositionErrorSample> revisited_pose_errors;
   // The smoothed trajectory (IMS clock), for reports and checks.
   std::vector<ims::SmoothedState> trajectory;
 };
