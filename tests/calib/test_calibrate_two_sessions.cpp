@@ -31,8 +31,8 @@
 // nominal mount and base heading the same): not the frames nor the bias and clock offset that
 // --frames estimates (a 30 ug error of the initial acc bias changes it < 0.001 mrad: the smoother
 // estimates the biases anew; 0.1 ms of clock offset by 0.01-0.02), but the position's random walk,
-// which varies with the unit's noise draw (A3 0.20-1.19 mrad over 8 draws on this plant run; now
-// 0.07-0.12).
+// which varies with the unit's noise draw (A3 0.20-1.19 mrad over 8 draws on this plant run with
+// the true frames, biases and clock; with the correction 0.05-0.12 over 6 of them).
 // Release only: two plant runs (~10 s), two calibrations and two identifications (~5 s); under
 // the sanitizers (5-10x slower) it is skipped, and the known-frames bundle is covered there by
 // tests/calib/test_frame_calibration_known_frames.cpp.
