@@ -172,9 +172,18 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   ims::SmoothedState first;
   first.state = initial;
   smoothed.states.insert(smoothed.states.begin(), first);
+  std::vector<PositionErrorSample> errors;
+  if (options.revisited_pose_correction) {
+    errors =
+        position_errors_at_revisited_poses(smoothed.states, *input.log, input.kinematics, T_W_R,
+                                           input.frames.T_S_H.inverse().translation(),
+                                           input.frames.time_offset_s, options.revisited_poses);
+    remove_position_errors(smoothed.states, errors);
+  }
   JointSpaceErrors out = joint_errors_along(smoothed.states, *input.log, input.kinematics,
                                             input.frames, options.min_wrist_sin);
   out.smoother = smoothed.summary;
+  out.revisited_pose_errors = std::move(errors);
   out.trajectory = std::move(smoothed.states);
   return out;
 }

@@ -6,7 +6,9 @@
 //              convention of calib/frame_calibration.hpp it is 0), biases from the frames; the
 //              robot's readings at commanded standstill say where it is really still and how it
 //              creeps (calib/encoder_motion.hpp): rests only there, velocity updates while it
-//              creeps (never during commanded motion, where the gears deflect);
+//              creeps (never during commanded motion, where the gears deflect); the smoothed
+//              positions then corrected at the returns to the first rest's pose (the robot's
+//              repeatability; calib/revisited_poses.hpp): the smoother cannot observe position;
 //   T_R_H(t)   = T_R_W W_T_S(t + dt) T_S_H at every robot sample (t robot clock, t + dt IMS clock;
 //              the smoothed poses interpolated between IMS samples: linear position, slerp);
 //   q_measured inverse kinematics (calib/inverse_kinematics.hpp) in the configuration of the
@@ -28,6 +30,7 @@
 #include "calib/encoder_motion.hpp"
 #include "calib/frame_calibration.hpp"
 #include "calib/imu_preintegration.hpp"
+#include "calib/revisited_poses.hpp"
 #include "calib/robot_description.hpp"
 #include "calib/robot_log.hpp"
 #include "ims/imu_data.hpp"
@@ -77,6 +80,10 @@ struct JointSpaceOptions {
   bool encoder_stillness = true;
   bool creep_velocity_updates = true;
   EncoderMotionOptions encoder;
+  // The smoothed positions corrected at the returns to the first rest's pose
+  // (calib/revisited_poses.hpp).
+  bool revisited_pose_correction = true;
+  RevisitedPoseOptions revisited_poses;
 };
 
 // One row per kept robot sample (the joint_errors.csv columns) [robot clock, SI].
@@ -95,6 +102,9 @@ struct JointSpaceErrors {
   std::size_t near_wrist_singularity = 0;  // left out: |sin A5| < JointSpaceOptions::min_wrist_sin
   std::string first_ik_failure;            // reason of the first failure, in words
   ims::ZuptSummary smoother;               // rests, innovation statistics
+  // The smoothed position's errors found and removed at the returns to the first rest's pose
+  // (calib/revisited_poses.hpp; empty when off).
+  std::vector<PositionErrorSample> revisited_pose_errors;
   // The smoothed trajectory (IMS clock), for reports and checks.
   std::vector<ims::SmoothedState> trajectory;
 };

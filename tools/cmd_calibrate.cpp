@@ -161,6 +161,9 @@ struct PreviousFrames {
   std::string path;
   std::string sha256;
   std::string robot;
+  // The link share of the drives' viscous friction that session found, with its 1-sigma (a
+  // property of the robot's drives, like the frames of its mount); absent in files without it.
+  std::optional<double> link_share, link_share_sigma;
 };
 
 // Reads T_R_W's rotation, T_S_H and their covariance from an earlier frames.json (§16.2 of
@@ -257,6 +260,20 @@ PreviousFrames read_previous_frames(const std::string& file, const std::string& 
   for (Eigen::Index k = 0; k < 9; ++k)
     if (out.frames.covariance(k, k) < 0.0)
       throw InputError(file, 0, fmt::format("covariance_si[{}][{}]", k, k), "negative variance");
+  // Optional: estimates[].name "link_share (...)" with value[0] and sigma[0].
+  if (j.contains("estimates") && j["estimates"].is_array()) {
+    for (std::size_t k = 0; k < j["estimates"].size(); ++k) {
+      const json& e = j["estimates"][k];
+      if (!e.is_object() || !e.contains("name") || !e["name"].is_string() ||
+          e["name"].get<std::string>().rfind("link_share", 0) != 0)
+        continue;
+      const std::string field = fmt::format("estimates[{}]", k);
+      out.link_share = vector_at(at(e, "value", field + ".value"), 1, field + ".value")[0];
+      out.link_share_sigma = vector_at(at(e, "sigma", field + ".sigma"), 1, field + ".sigma")[0];
+      if (!(*out.link_share_sigma > 0.0))
+        throw InputError(file, 0, field + ".sigma[0]", "not a positive 1-sigma");
+    }
+  }
   return out;
 }
 
@@ -388,6 +405,15 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
         "joint errors: {} samples ({} outside the IMS record, {} inverse-kinematics "
         "failures, {} left out near the wrist singularity)",
         je->t_s.size(), je->outside_record, je->ik_failures, je->near_wrist_singularity));
+    // The position the smoother could not observe, corrected where the arm stood at its first
+    // rest's pose again (calib/revisited_poses.hpp): the first visit is that rest itself.
+    if (je->revisited_pose_errors.size() > 1) {
+      double largest = 0.0;
+      for (const auto& e : je->revisited_pose_errors) largest = std::max(largest, e.error_W.norm());
+      line(fmt::format(
+          "  position corrected at {} returns to the first rest's pose (largest {:.3f} mm)",
+          je->revisited_pose_errors.size() - 1, largest * 1e3));
+    }
     if (!je->t_s.empty()) {
       for (int j = 0; j < calib::kJointCount; ++j) {
         double sum = 0.0, worst = 0.0;
@@ -533,12 +559,22 @@ void run(const CalibrateArgs& args) {
   frame_input.time_offset_initial_s = dt0.offset_s;
   frame_input.source = args.imu;
   frame_input.first_rest_position_W_m = config.first_rest_position_W_m;
+  calib::FrameCalibrationOptions bundle = config.bundle;
   if (in.previous) {
     frame_input.known_frames = in.previous->frames;
     spdlog::info("calibrate: T_R_W's rotation and T_S_H held at {} (sha256 {})", in.previous->path,
                  in.previous->sha256);
+    // The drives' link share as that session found it, as this one's prior: it trades against
+    // the clock offset, which a record with few rests and short pauses separates poorly
+    // (measured: 0.32 +- 0.06 here against 0.06 +- 0.07 there, and the clock 0.1 ms off).
+    if (in.previous->link_share) {
+      bundle.link_share_prior_mean = *in.previous->link_share;
+      bundle.link_share_prior_sigma = *in.previous->link_share_sigma;
+      spdlog::info("calibrate: link share prior {:.3f} +- {:.3f} from {}",
+                   bundle.link_share_prior_mean, bundle.link_share_prior_sigma, in.previous->path);
+    }
   }
-  const calib::FrameCalibrationResult result = calib::calibrate_frames(frame_input, config.bundle);
+  const calib::FrameCalibrationResult result = calib::calibrate_frames(frame_input, bundle);
   spdlog::info("calibrate: bundle {} after {} iterations",
                result.converged ? "converged" : "did NOT converge", result.iterations);
 

@@ -9,13 +9,34 @@
 //   --gravity-m-s2 the site's normal gravity).
 // Printed: (a) the chain's joint errors against the simulator's truth (q_desired - q_link of
 // truth/joints.csv at the same robot samples), RMS per joint of the truth and of the
-// measurement error; (b) the held-out joint-error fit per joint that identify reports (cells
-// weighted by their validation rows, as eval::summarize_fit). With TRUE frames the chain gives
-// A1 93.5 %, A2 90.4 %, A3 84.4 % (tests/eval/test_verification.cpp, IdentifiedFromTheImsChain);
-// issue 5's goal, >= 90 % per primary joint A1..A3, is asserted only with IMSCAL_VERIFY_GOALS
-// set (as there). Release only: two plant runs (~15 s), two calibrations and an identification
-// (~1 min); under the sanitizers (5-10x slower) it is skipped, and the known-frames bundle is
-// covered there by tests/calib/test_frame_calibration_known_frames.cpp.
+// measurement error: measured A1 0.051, A2 0.102, A3 0.194 mrad (signal ~3.5-3.7 mrad); (b) the
+// held-out joint-error fit per joint that identify reports (cells weighted by their validation
+// rows, as eval::summarize_fit): A1 96.1, A2 94.7, A3 93.5 %; (c) the same identification
+// in-process (eval::identify_table, checked equal to identify's figures) with its models judged
+// against the TRUE joint errors of the held-out rows (eval::replay_held_out_fits, as
+// tests/eval/test_verification.cpp's IdentifiedFromTheImsChain): A1 96.1, A2 95.2, A3 93.1 %
+// (the shipped config's 60 input taps; 95.2/94.1/93.4 and 95.1/94.7/93.0 % with 32), asserted
+// 3 %-points below; issue 5's goal (>= 90 % per primary joint) is met both ways and asserted
+// (Release).
+// The clock offset: 0.033 ms off (asserted below), with session 1's link share of the drives'
+// friction as the prior (0.098 ms off without; it costs A1 0.02 mrad). The biases --frames finds
+// from the 1 usable rest (acc ~30 ug off the truth, within their 18-27 ug sigma) do not matter:
+// the smoother estimates them anew.
+// Before the correction at the revisited poses (calib/revisited_poses.hpp) the chain erred by
+// 0.171/0.513/0.856 mrad here (fits 94.3/86.5/82.0 % measured, 94.7/91.6/78.6 % against the
+// truth): the smoother's attitude stayed within 0.02 mrad, but its position, which no
+// zero-velocity or creep update observes, walked off by 0.3-0.7 mm over the record (0.4 mm after
+// the pause that follows A4 +90 deg alone, where A5's axis stands vertical and its unloaded link
+// slides in its play while the creep updates take the motor's motion for the link's). With the
+// true frames, biases and clock the in-process chain erred as much (0.16/0.48/0.76 mrad; with the
+// nominal mount and base heading the same): not the frames nor the bias and clock offset that
+// --frames estimates (a 30 ug error of the initial acc bias changes it < 0.001 mrad: the smoother
+// estimates the biases anew; 0.1 ms of clock offset by 0.01-0.02), but the position's random walk,
+// which varies with the unit's noise draw (A3 0.20-1.19 mrad over 8 draws on this plant run with
+// the true frames, biases and clock; with the correction 0.05-0.12 over 6 of them).
+// Release only: two plant runs (~10 s), two calibrations and two identifications (~5 s); under
+// the sanitizers (5-10x slower) it is skipped, and the known-frames bundle is covered there by
+// tests/calib/test_frame_calibration_known_frames.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,7 +48,11 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "calib/robot_description.hpp"
+#include "core/config_node.hpp"
 #include "core/sha256.hpp"
+#include "eval/verification.hpp"
+#include "ident/identification_config.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/sensor_error_model.hpp"
@@ -129,6 +154,9 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
           dir_ / "id.log");
   ASSERT_TRUE(status == 0 || status == 1) << read(dir_ / "id.log");
   std::printf("%s", read(id / "summary.txt").c_str());
+  // The identification program returns home after every single-joint move and every fourth mixed
+  // move: the summary says where the positions were corrected (calib/revisited_poses.hpp).
+  EXPECT_NE(read(id / "summary.txt").find("returns to the first rest's pose"), std::string::npos);
   const json cal_frames = json::parse(read(cal / "frames.json"));
   const json id_frames = json::parse(read(id / "frames.json"));
   const json report = json::parse(read(id / "mounting_report.json"));
@@ -157,21 +185,29 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   for (const auto& check : report.at("checks"))
     previous_frames_check |= check.at("name") == "previous_frames";
   EXPECT_TRUE(previous_frames_check) << report.at("checks").dump(1);
-  // The clock offset of session 2 (37.1 ms in the scenario, session 1 has 12.3 ms): printed.
+  // The clock offset of session 2 (37.1 ms in the scenario, session 1 has 12.3 ms).
   const double dt_true_ms = id_truth.at("imu_clock_offset_s").get<double>() * 1e3;
   std::printf("time offset: %.4f ms (truth %.4f ms)\n",
               id_frames.at("time_offset_ms").get<double>(), dt_true_ms);
+  // With session 1's link share of the drives' friction as its prior (it trades against the
+  // clock offset; tools/cmd_calibrate.cpp): measured 0.033 ms off (0.098 ms with the default
+  // prior 0.5 +- 0.5, the share then found at 0.32 against session 1's 0.06). Bound 0.06 ms: 2
+  // of the estimate's own sigma (0.029 ms).
+  EXPECT_LT(std::abs(id_frames.at("time_offset_ms").get<double>() - dt_true_ms), 0.06);
 
   // (a) The chain's joint errors against the truth at the same robot samples.
   const ident::JointErrorLog measured = ident::read_joint_errors_csv(id / "joint_errors.csv");
   const auto truth = read_truth_link_angles(id_sim / "truth" / "joints.csv");
   std::array<double, 6> sq_true{}, sq_error{};
   std::size_t matched = 0;
+  // The measured log with the true link angles in place of the chain's (same rows and runs).
+  ident::JointErrorLog truth_on_measured_rows = measured;
   for (std::size_t k = 0; k < measured.sample_count(); ++k) {
     const auto it = truth.find(std::llround(measured.time_s[k] * 1e6));
     if (it == truth.end()) continue;
     ++matched;
     for (std::size_t j = 0; j < 6; ++j) {
+      truth_on_measured_rows.q_measured_rad[j][k] = it->second[j];
       const double e_true = measured.q_desired_rad[j][k] - it->second[j];
       const double e_ims = measured.q_desired_rad[j][k] - measured.q_measured_rad[j][k];
       sq_true[j] += e_true * e_true;
@@ -190,7 +226,8 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   // The measurement must resolve the signal it is taken for: on the primary joints A1..A3 (issue
   // 5's goal) the error below the true joint errors' RMS (a chain whose error is as large as the
   // signal identifies noise). A4..A6 are printed only: their joint errors are small (A4, A6
-  // without play) and the chain's error is of their size (measured: A6 0.79 mrad against 0.49).
+  // without play) and the chain's error is of their size (measured: A6 0.22 mrad against 0.49; 0.75
+  // before the correction at the revisited poses).
   for (std::size_t j = 0; j < 3; ++j) EXPECT_LT(sq_error[j], sq_true[j]) << "A" << j + 1;
 
   // (b) identify on the chain's joint errors.
@@ -198,9 +235,13 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
       sim::load_scenario(kScenarios / "two-sessions-identification.yaml").site);
   const double g = earth.gravity_W(Eigen::Vector3d::Zero()).norm();
   const fs::path ident_out = dir_ / "ident";
+  // Gravity to 17 digits: the in-process identification below takes the same number.
+  std::ostringstream gravity;
+  gravity.precision(17);
+  gravity << -g;
   ASSERT_EQ(run("identify --joint-errors " + (id / "joint_errors.csv").string() + " --config " +
                     kIdentConfig.string() + " --robot " + kRobot.string() + " --gravity-m-s2 0 0 " +
-                    std::to_string(-g) + " --out " + ident_out.string(),
+                    gravity.str() + " --out " + ident_out.string(),
                 dir_ / "ident.log"),
             0)
       << read(dir_ / "ident.log");
@@ -224,17 +265,62 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   for (const char* joint : {"A1", "A2", "A3"}) {
     ASSERT_TRUE(fit.count(joint)) << joint;
     EXPECT_TRUE(std::isfinite(fit[joint])) << joint;
-    if (std::getenv("IMSCAL_VERIFY_GOALS")) {
-      EXPECT_GE(fit[joint], 90.0) << joint;
+  }
+
+  // (c) The same identification in-process (eval::identify_table: the config and the model
+  // torque identify was given), which must give identify's figures, and its models judged
+  // against the TRUE joint errors of the same held-out rows (eval::replay_held_out_fits): the
+  // models' own error, without the measurement's in the held-out target.
+  const ident::IdentificationConfig config =
+      ident::load_identification_config(ConfigNode::load_file(kIdentConfig));
+  eval::ModelTorqueSource torque_model;
+  torque_model.robot = calib::load_robot_description(kRobot);
+  torque_model.gravity_in_base_m_s2 = Eigen::Vector3d(0.0, 0.0, -g);
+  const eval::IdentifiedTable table =
+      eval::identify_table(measured, config, (id / "joint_errors.csv").string(), &torque_model);
+  for (const std::string& failed : table.failed_joints) {
+    std::printf("not identified: %s\n", failed.c_str());
+    // A6's measurement error is of its signal's size (above): it may fail; A1..A3 must not.
+    for (const char* primary : {"A1:", "A2:", "A3:"})
+      EXPECT_NE(failed.rfind(primary, 0), 0u) << failed;
+  }
+  const std::vector<double> against_truth =
+      eval::replay_held_out_fits(table, truth_on_measured_rows, config, &torque_model);
+  ASSERT_EQ(against_truth.size(), table.joints.size());
+  for (std::size_t j = 0; j < table.joints.size(); ++j) {
+    const std::string& name = table.joints[j].parameters.name;
+    const double in_process = eval::summarize_fit(table.joints[j]).joint_error_fit_percent;
+    std::printf(
+        "%s (two-session chain): held-out joint-error fit %.1f %% against the IMS-measured "
+        "error, %.1f %% against the true error\n",
+        name.c_str(), in_process, against_truth[j]);
+    // The same data, config, gravity and code as identify, whose JSON numbers round-trip:
+    // equal but for the order of the sums (1e-9 %-points).
+    ASSERT_TRUE(fit.count(name)) << name;
+    EXPECT_EQ(std::isfinite(in_process), std::isfinite(fit[name])) << name;
+    if (std::isfinite(fit[name])) {
+      EXPECT_NEAR(in_process, fit[name], 1e-9) << name;
     }
+  }
+  // Measured against the truth: A1 96.1, A2 95.2, A3 93.1 % (against the IMS-measured errors
+  // 96.1, 94.7, 93.5 %). Asserted 3 %-points below, as IdentifiedFromTheImsChain (the chain is
+  // deterministic; the margin covers other platforms' rounding through the order selection).
+  // Issue 5's goal, >= 90 % per primary joint both ways, asserted at the goal itself: met by
+  // 3.1 %-points or more.
+  const std::array<double, 3> measured_against_truth = {96.1, 95.2, 93.1};
+  for (std::size_t j = 0; j < 3; ++j) {
+    EXPECT_GE(against_truth[j], measured_against_truth[j] - 3.0) << table.joints[j].parameters.name;
+    EXPECT_GE(against_truth[j], 90.0) << table.joints[j].parameters.name;
+    EXPECT_GE(fit[table.joints[j].parameters.name], 90.0) << table.joints[j].parameters.name;
   }
 }
 
 // Refusals of --frames, before the records are read (file and field named, exit 2, nothing
 // written). The base is a minimal frames.json with the fields --frames reads (datasets/FORMAT.md
-// §16.2: imscal-frames, robot, T_R_W, T_S_H, parameter_names, covariance_si), which passes the
-// checks (the run then fails later for other reasons or not at all: only the refusal's message
-// is checked); each case changes one field. The record is the shipped campaign's (kr16).
+// §16.2: imscal-frames, robot, T_R_W, T_S_H, parameter_names, covariance_si; the link share in
+// estimates is optional), which passes the checks (the run then fails later for other reasons or
+// not at all: only the refusal's message is checked); each case changes one field. The record is
+// the shipped campaign's (kr16).
 TEST_F(CalibrateTwoSessions, FramesOfAnotherRobotVersionOrWithNaNAreRefused) {
   json base = {{"imscal-frames", 1},
                {"robot", "kr16"},
@@ -272,6 +358,20 @@ TEST_F(CalibrateTwoSessions, FramesOfAnotherRobotVersionOrWithNaNAreRefused) {
        "covariance_si[4][4]", "not a finite number"},
       {"other covariance layout", [](json& j) { j["parameter_names"][0] = "gyro_bias.x"; },
        "parameter_names", "R_W_R.east"},
+      {"NaN link share (optional, but then valid)",
+       [](json& j) {
+         j["estimates"] = {{{"name", "link_share (of the drives' viscous friction)"},
+                            {"value", {nullptr}},
+                            {"sigma", {0.05}}}};
+       },
+       "estimates[0].value[0]", "not a finite number"},
+      {"link share without a positive sigma",
+       [](json& j) {
+         j["estimates"] = {{{"name", "link_share (of the drives' viscous friction)"},
+                            {"value", {0.1}},
+                            {"sigma", {0.0}}}};
+       },
+       "estimates[0].sigma[0]", "not a positive 1-sigma"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);

@@ -478,14 +478,19 @@ TEST(Verification, IdentifiedFromTheImsChain) {
         joint.parameters.name.c_str(), s.simulation_fit_percent, s.joint_error_fit_percent,
         against_truth[j], 100.0 * (1.0 - noise_rms / std::hypot(signal_rms, noise_rms)));
   }
-  // Issue 5's goal, >= 90 % held-out fit for every primary joint, is a property of the model: met
-  // against the true joint errors. Measured: A1 96.5, A2 93.8, A3 93.1 % (identified from the
-  // truth itself: 96.2, 95.3, 94.5 %). Against the IMS-measured errors the same models score
-  // 94.1, 90.2, 84.6 %: the measurement's own error in the held-out target (0.21-0.31 mrad RMS
-  // against a 3.5-3.7 mrad signal) caps even a perfect model at ~94.4, 93.2, 91.3 %, and A3's
-  // largest measurement error costs it most.
-  for (std::size_t j = 0; j < 3; ++j)
+  // Issue 5's goal, >= 90 % held-out fit for every primary joint, met both ways (60 input taps,
+  // positions corrected at the revisited poses, calib/revisited_poses.hpp). Measured: against
+  // the IMS-measured errors A1 96.1, A2 94.9, A3 94.2 %; against the true errors 96.3, 95.1,
+  // 94.4 % (identified from the truth itself: 96.2, 95.3, 94.5 %). The measurement's own error
+  // in the held-out target (0.045-0.05 mrad RMS against a 3.5-3.7 mrad signal) caps a perfect
+  // model at ~98.7 %. Before the eighth round that error was 0.21-0.31 mrad (cap ~94.4, 93.2,
+  // 91.3 %) and the fits 93.5, 90.4, 84.4 % (95.7, 93.8, 93.0 % against the truth). Asserted in
+  // Release at the goal itself: the chain is deterministic, the margin 4 %-points.
+  for (std::size_t j = 0; j < 3; ++j) {
     EXPECT_GE(against_truth[j], 90.0) << table.joints[j].parameters.name;
+    EXPECT_GE(summarize_fit(table.joints[j]).joint_error_fit_percent, 90.0)
+        << table.joints[j].parameters.name << " against the IMS-measured errors";
+  }
   VerificationOptions options;
   options.cycles = 10;  // ISO 9283
   options.segment_filter = "line";
@@ -495,14 +500,14 @@ TEST(Verification, IdentifiedFromTheImsChain) {
   print_case(r.before, r.before.figures, r.before.true_figures);
   print_case(r.after[0], r.before.figures, r.before.true_figures);
   EXPECT_EQ(r.after[0].inactive_cycles, 0u);
-  // Measured: 92.8 % as the IMS chain sees the path, 92.9 % on the true path (10 cycles; 94.1
-  // and 93.8 % over the first 5); asserted 3 %-points below, as above.
+  // Measured: 92.4 % as the IMS chain sees the path, 93.5 % on the true path (10 cycles);
+  // asserted 3 %-points below, as above.
   EXPECT_GE(reduction_percent(r.before.figures.max_path_deviation_m,
                               r.after[0].figures.max_path_deviation_m),
-            89.8);
+            89.4);
   EXPECT_GE(reduction_percent(r.before.true_figures.max_path_deviation_m,
                               r.after[0].true_figures.max_path_deviation_m),
-            89.9);
+            90.5);
 }
 
 }  // namespace

@@ -1,0 +1,107 @@
+#include "calib/revisited_poses.hpp"
+
+#include <algorithm>
+#include <optional>
+
+#include "calib/forward_kinematics.hpp"
+#include "calib/joint_space_errors.hpp"
+
+namespace imscal::calib {
+namespace {
+
+// A commanded standstill long enough to have settled: its pose, payload and the settled means.
+struct SettledStandstill {
+  std::size_t first = 0, last = 0;  // log samples of the whole standstill
+  double end_robot_s = 0.0;
+  JointVector q_desired_rad = JointVector::Zero();
+  double payload_kg = 0.0;
+  Eigen::Vector3d difference_W = Eigen::Vector3d::Zero();  // p_IMS - p_FK(q_internal)
+};
+
+}  // namespace
+
+std::vector<PositionErrorSample> position_errors_at_revisited_poses(
+    const std::vector<ims::SmoothedState>& trajectory, const RobotLog& log,
+    const KinematicModel& kinematics, const Eigen::Isometry3d& T_W_R, const Eigen::Vector3d& p_H_S,
+    double time_offset_s, const RevisitedPoseOptions& options) {
+  const std::vector<RobotLogSample>& s = log.samples;
+  // The mean of p_IMS - p_FK over samples [first, last]; nullopt outside the trajectory.
+  const auto mean_difference = [&](std::size_t first,
+                                   std::size_t last) -> std::optional<Eigen::Vector3d> {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (std::size_t k = first; k <= last; ++k) {
+      Eigen::Isometry3d T_W_S;
+      if (!interpolate_sensor_pose(trajectory, s[k].t_s + time_offset_s, T_W_S))
+        return std::nullopt;
+      const Eigen::Vector3d p_fk =
+          T_W_R * (forward_kinematics<double>(kinematics, s[k].q_internal_rad) * p_H_S);
+      sum += T_W_S.translation() - p_fk;
+    }
+    return sum / double(last - first + 1);
+  };
+  std::vector<SettledStandstill> standstills;
+  for (std::size_t i = 0; i < s.size();) {
+    std::size_t last = i;
+    while (last + 1 < s.size() && s[last + 1].q_desired_rad == s[i].q_desired_rad &&
+           s[last + 1].payload_kg == s[i].payload_kg)
+      ++last;
+    if (s[last].t_s - s[i].t_s >= options.settle_s) {
+      std::size_t first_averaged = last;
+      while (first_averaged > i && s[last].t_s - s[first_averaged - 1].t_s <= options.average_s)
+        --first_averaged;
+      if (const auto d = mean_difference(first_averaged, last))
+        standstills.push_back({i, last, s[last].t_s, s[i].q_desired_rad, s[i].payload_kg, *d});
+    }
+    i = last + 1;
+  }
+  std::vector<PositionErrorSample> out;
+  if (standstills.empty()) return out;
+  const auto same_pose = [&](const JointVector& a, const JointVector& b) {
+    return (a - b).cwiseAbs().maxCoeff() <= options.same_pose_tolerance_rad;
+  };
+  // The reference pose and payload, and the difference p_IMS - p_FK the error is zero for.
+  JointVector pose = standstills.front().q_desired_rad;
+  double payload = standstills.front().payload_kg;
+  Eigen::Vector3d reference = standstills.front().difference_W;
+  Eigen::Vector3d last_error = Eigen::Vector3d::Zero();
+  bool previous_was_reference = true;
+  for (std::size_t k = 0; k < standstills.size(); ++k) {
+    const SettledStandstill& st = standstills[k];
+    if (k > 0 && previous_was_reference && standstills[k - 1].last + 1 == st.first &&
+        same_pose(st.q_desired_rad, pose) && st.payload_kg != payload) {
+      // A payload change at rest (the standstill before it ends where this one begins): a new
+      // reference with the error of the standstill before it.
+      payload = st.payload_kg;
+      reference = st.difference_W - last_error;
+    }
+    previous_was_reference = same_pose(st.q_desired_rad, pose) && st.payload_kg == payload;
+    if (!previous_was_reference) continue;
+    last_error = st.difference_W - reference;
+    out.push_back({st.end_robot_s + time_offset_s, last_error});
+  }
+  return out;
+}
+
+void remove_position_errors(std::vector<ims::SmoothedState>& trajectory,
+                            const std::vector<PositionErrorSample>& errors) {
+  if (errors.empty()) return;
+  std::size_t next = 0;  // first error sample after the state's time
+  for (ims::SmoothedState& state : trajectory) {
+    const double t = state.state.t_s;
+    while (next < errors.size() && errors[next].t_s <= t) ++next;
+    Eigen::Vector3d e;
+    if (next == 0) {
+      e = errors.front().error_W;
+    } else if (next == errors.size()) {
+      e = errors.back().error_W;
+    } else {
+      const PositionErrorSample& a = errors[next - 1];
+      const PositionErrorSample& b = errors[next];
+      const double f = (t - a.t_s) / (b.t_s - a.t_s);
+      e = (1.0 - f) * a.error_W + f * b.error_W;
+    }
+    state.state.p_W -= e;
+  }
+}
+
+}  // namespace imscal::calib

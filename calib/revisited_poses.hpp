@@ -1,0 +1,61 @@
+#pragma once
+// The robot's pose repeatability as an aid to the smoothed sensor trajectory (calib/
+// joint_space_errors.hpp). Zero-velocity and creep updates make the smoother's velocity, attitude
+// and biases observable, but not its position: each move leaves a position error of its own
+// (sensor noise, in-run bias changes, creep velocities a few 1e-6 m/s off) and these add up over
+// the record. Measured on the identification program with the true frames, biases and clock: the
+// attitude stays within 0.02 mrad, the position walks off by 0.3-0.7 mm, and the joint angles by
+// inverse kinematics take 0.2-0.8 mrad RMS from it. A robot that returns to a commanded pose with
+// the same payload stands there again to its repeatability (ISO 9283 RP: ~0.05 mm for a KR 16
+// class arm); what differs between the visits, the motors' remaining position error, its readings
+// show. So at the end of every commanded standstill at the first rest's pose and payload
+//   e_k = (p_IMS - p_FK(q_internal))_k - (p_IMS - p_FK(q_internal))_first rest
+// is the smoothed position's error there (the gear deflection, equal at every visit, cancels);
+// the smoothed positions are corrected by e(t), linear in time between the visits and held
+// beyond them. The first rest is the first settled standstill inside the smoothed record (where
+// the smoothing starts from its forward kinematics; a later one when the record starts later: the
+// corrections are then relative to its error). A payload change at rest (commanded pose
+// unchanged, no move between) starts a second reference: the standstill after it inherits the
+// error of the standstill before it (the IMS's position error does not change while the arm
+// stands, though the gears' deflection does). Other poses' revisits are not used.
+#include <Eigen/Core>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "calib/robot_description.hpp"
+#include "calib/robot_log.hpp"
+#include "ims/zupt_smoother.hpp"
+
+namespace imscal::calib {
+
+struct RevisitedPoseOptions {
+  // The settled end of a standstill: its readings from this long before its last sample on.
+  // At least this long, too: shorter standstills are not used.
+  double settle_s = 1.5;
+  double average_s = 0.1;  // readings and positions averaged over the standstill's last 0.1 s
+  // Commanded poses this close per joint are the same (1e-6 rad: 1 um at a metre; an
+  // interpolator may round a taught point differently on the way back).
+  double same_pose_tolerance_rad = 1e-6;
+};
+
+// The smoothed position's error at one visit (IMS clock, in W).
+struct PositionErrorSample {
+  double t_s = 0.0;
+  Eigen::Vector3d error_W = Eigen::Vector3d::Zero();
+};
+
+// The errors at the visits of the first standstill's pose (and of the same pose after payload
+// changes at rest), sorted by time; the first is zero by definition. trajectory: the smoothed
+// sensor poses (IMS clock, sorted); T_W_R the robot base in W, p_H_S the sensor's origin in the
+// flange frame, t_ims = t_robot + time_offset_s.
+std::vector<PositionErrorSample> position_errors_at_revisited_poses(
+    const std::vector<ims::SmoothedState>& trajectory, const RobotLog& log,
+    const KinematicModel& kinematics, const Eigen::Isometry3d& T_W_R, const Eigen::Vector3d& p_H_S,
+    double time_offset_s, const RevisitedPoseOptions& options = {});
+
+// p_W(t) -= e(t): linear between the samples, held before the first and after the last.
+void remove_position_errors(std::vector<ims::SmoothedState>& trajectory,
+                            const std::vector<PositionErrorSample>& errors);
+
+}  // namespace imscal::calib
