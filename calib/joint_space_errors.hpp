@@ -7,7 +7,7 @@
 //              robot's readings at commanded standstill say where it is really still and how it
 //              creeps (calib/encoder_motion.hpp): rests only there, velocity updates while it
 //              creeps (never during commanded motion, where the gears deflect); the smoothed
-//              positions then corrected at the returns to the first rest's pose (the robot's
+//              positions then corrected at the returns to poses stood at before (the robot's
 //              repeatability; calib/revisited_poses.hpp): the smoother cannot observe position;
 //   T_R_H(t)   = T_R_W W_T_S(t + dt) T_S_H at every robot sample (t robot clock, t + dt IMS clock;
 //              the smoothed poses interpolated between IMS samples: linear position, slerp);
@@ -80,7 +80,7 @@ struct JointSpaceOptions {
   bool encoder_stillness = true;
   bool creep_velocity_updates = true;
   EncoderMotionOptions encoder;
-  // The smoothed positions corrected at the returns to the first rest's pose
+  // The smoothed positions corrected at the returns to poses stood at before
   // (calib/revisited_poses.hpp).
   bool revisited_pose_correction = true;
   RevisitedPoseOptions revisited_poses;
@@ -102,7 +102,7 @@ struct JointSpaceErrors {
   std::size_t near_wrist_singularity = 0;  // left out: |sin A5| < JointSpaceOptions::min_wrist_sin
   std::string first_ik_failure;            // reason of the first failure, in words
   ims::ZuptSummary smoother;               // rests, innovation statistics
-  // The smoothed position's errors found and removed at the returns to the first rest's pose
+  // The smoothed position's errors found and removed at the settled standstills
   // (calib/revisited_poses.hpp; empty when off).
   std::vector<PositionErrorSample> revisited_pose_errors;
   // The smoothed trajectory (IMS clock), for reports and checks.

@@ -59,26 +59,53 @@ std::vector<PositionErrorSample> position_errors_at_revisited_poses(
   const auto same_pose = [&](const JointVector& a, const JointVector& b) {
     return (a - b).cwiseAbs().maxCoeff() <= options.same_pose_tolerance_rad;
   };
-  // The reference pose and payload, and the difference p_IMS - p_FK the error is zero for.
-  JointVector pose = standstills.front().q_desired_rad;
-  double payload = standstills.front().payload_kg;
-  Eigen::Vector3d reference = standstills.front().difference_W;
-  Eigen::Vector3d last_error = Eigen::Vector3d::Zero();
-  bool previous_was_reference = true;
-  for (std::size_t k = 0; k < standstills.size(); ++k) {
+  // The normal equations of the least squares in the header, the same for the three axes:
+  // H e = g_axis, e_0 fixed at 0 (H's first row and column dropped: unknowns e_1 .. e_{n-1}).
+  const std::size_t n = standstills.size();
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(Eigen::Index(n), Eigen::Index(n));
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(Eigen::Index(n), 3);
+  // w (e_k - e_j - m)^2 for the difference m [m] with weight w [1/m^2].
+  const auto add_difference = [&](std::size_t j, std::size_t k, double w,
+                                  const Eigen::Vector3d& m) {
+    const auto J = Eigen::Index(j), K = Eigen::Index(k);
+    H(J, J) += w;
+    H(K, K) += w;
+    H(J, K) -= w;
+    H(K, J) -= w;
+    g.row(K) += w * m.transpose();
+    g.row(J) -= w * m.transpose();
+  };
+  const double w_visit = 1.0 / (2.0 * options.repeatability_m * options.repeatability_m);
+  std::vector<bool> revisit(n, false);
+  for (std::size_t k = 1; k < n; ++k) {
     const SettledStandstill& st = standstills[k];
-    if (k > 0 && previous_was_reference && standstills[k - 1].last + 1 == st.first &&
-        same_pose(st.q_desired_rad, pose) && st.payload_kg != payload) {
-      // A payload change at rest (the standstill before it ends where this one begins): a new
-      // reference with the error of the standstill before it.
-      payload = st.payload_kg;
-      reference = st.difference_W - last_error;
+    const double dt = std::max(st.end_robot_s - standstills[k - 1].end_robot_s, 1e-3);
+    add_difference(k - 1, k, 1.0 / (options.position_walk_m2_per_s * dt), Eigen::Vector3d::Zero());
+    // A payload change at rest: the standstill before it ends where this one begins.
+    if (standstills[k - 1].last + 1 == st.first &&
+        same_pose(st.q_desired_rad, standstills[k - 1].q_desired_rad)) {
+      add_difference(k - 1, k, w_visit, Eigen::Vector3d::Zero());
+      revisit[k] = true;
+      continue;
     }
-    previous_was_reference = same_pose(st.q_desired_rad, pose) && st.payload_kg == payload;
-    if (!previous_was_reference) continue;
-    last_error = st.difference_W - reference;
-    out.push_back({st.end_robot_s + time_offset_s, last_error});
+    // The latest earlier visit of the same pose with the same payload.
+    for (std::size_t j = k; j-- > 0;) {
+      if (standstills[j].payload_kg == st.payload_kg &&
+          same_pose(standstills[j].q_desired_rad, st.q_desired_rad)) {
+        add_difference(j, k, w_visit, st.difference_W - standstills[j].difference_W);
+        revisit[k] = true;
+        break;
+      }
+    }
   }
+  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(Eigen::Index(n), 3);
+  if (n > 1) {
+    const auto m = Eigen::Index(n - 1);
+    e.bottomRows(m) = H.bottomRightCorner(m, m).ldlt().solve(g.bottomRows(m));
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    out.push_back({standstills[k].end_robot_s + time_offset_s, e.row(Eigen::Index(k)).transpose(),
+                   revisit[k]});
   return out;
 }
 

@@ -405,14 +405,19 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
         "joint errors: {} samples ({} outside the IMS record, {} inverse-kinematics "
         "failures, {} left out near the wrist singularity)",
         je->t_s.size(), je->outside_record, je->ik_failures, je->near_wrist_singularity));
-    // The position the smoother could not observe, corrected where the arm stood at its first
-    // rest's pose again (calib/revisited_poses.hpp): the first visit is that rest itself.
-    if (je->revisited_pose_errors.size() > 1) {
+    // The position the smoother could not observe, corrected where the arm stood at a pose
+    // again (calib/revisited_poses.hpp) and interpolated at the other standstills.
+    if (std::any_of(je->revisited_pose_errors.begin(), je->revisited_pose_errors.end(),
+                    [](const auto& e) { return e.revisit; })) {
       double largest = 0.0;
       for (const auto& e : je->revisited_pose_errors) largest = std::max(largest, e.error_W.norm());
+      const auto returns =
+          std::count_if(je->revisited_pose_errors.begin(), je->revisited_pose_errors.end(),
+                        [](const auto& e) { return e.revisit; });
       line(fmt::format(
-          "  position corrected at {} returns to the first rest's pose (largest {:.3f} mm)",
-          je->revisited_pose_errors.size() - 1, largest * 1e3));
+          "  position corrected at {} returns to a pose stood at before, {} standstills in all "
+          "(largest {:.3f} mm)",
+          returns, je->revisited_pose_errors.size(), largest * 1e3));
     }
     if (!je->t_s.empty()) {
       for (int j = 0; j < calib::kJointCount; ++j) {

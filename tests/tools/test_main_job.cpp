@@ -14,6 +14,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -108,13 +109,15 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
             0.005 * kDeg);
   EXPECT_LT(q_R_W.angularDistance(q_R_W_true), 0.5 * kDeg);
 
-  // Measured joint angles (IMS trajectory + inverse kinematics) against the link truth. Measured
-  // RMS 0.13 / 0.31 / 0.28 / 0.08 / 0.11 / 0.14 mrad (A1..A6), i.e. the smoothed IMS trajectory's
-  // error during the full-speed moves (issue 4's notes); the true joint errors are 0.1-2 mrad.
-  // Tolerance 0.5 mrad: a regression of the chain (frames, clock, inverse kinematics) shows as
-  // whole milliradians.
+  // Measured joint angles (IMS trajectory + inverse kinematics) against the link truth, printed
+  // (RMS 0.030 / 0.045 / 0.059 / 0.040 / 0.038 / 0.035 mrad, A1..A6; 0.13 / 0.31 / 0.28 on A1..A3
+  // in the fifth round); the true joint errors are 0.1-2 mrad. Tolerance 0.5 mrad: a regression
+  // of the chain (frames, clock, inverse kinematics) shows as whole milliradians.
   const auto rms = measured_joint_rms_error(out / "calibrate" / "joint_errors.csv",
                                             sim / "truth" / "joints.csv");
+  std::printf("main job: measured joint angles against the link truth, RMS [mrad]:");
+  for (int j = 0; j < 6; ++j) std::printf(" A%d %.3f", j + 1, rms[j] * 1e3);
+  std::printf("\n");
   for (int j = 0; j < 6; ++j) EXPECT_LT(rms[j], 0.5e-3) << "A" << j + 1;
 
   // The parameter table: every joint, from calibrate's joint errors, every cell with a model.
@@ -125,8 +128,8 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
   for (const auto& joint : table.joints) EXPECT_FALSE(joint.cells.empty()) << joint.name;
   EXPECT_TRUE(fs::exists(out / "identify" / "parameters.csv"));
 
-  // ISO 9283 figures with and without the precontrol on the paper's line. Measured: maximum
-  // path deviation 10.31 -> 5.51 mm (-46.5 %), RT_p 3.23 -> 0.13 mm. A precontrol that no longer
+  // ISO 9283 figures with and without the precontrol on the paper's line, printed (10.42 ->
+  // 0.93 mm, -91.1 %; 10.31 -> 5.51 mm, -46.5 % in the fifth round). A precontrol that no longer
   // helps (< 20 % reduction) is a regression of identify or verify.
   const json verification =
       json::parse(read_file_text(out / "verify" / "campaign-line" / "verification.json"));
@@ -136,6 +139,11 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
       EXPECT_TRUE(std::isfinite(c.at(figure).get<double>())) << c.at("case") << " " << figure;
   }
   EXPECT_EQ(verification.at("cases")[1].at("case"), "compensated");
+  std::printf(
+      "main job: campaign line, max path deviation %.3f -> %.3f mm (%.1f %% less)\n",
+      verification.at("cases")[0].at("max_path_deviation_mm").get<double>(),
+      verification.at("cases")[1].at("max_path_deviation_mm").get<double>(),
+      verification.at("cases")[1].at("reduction_of_max_path_deviation_percent").get<double>());
   EXPECT_GT(verification.at("cases")[1].at("reduction_of_max_path_deviation_percent").get<double>(),
             20.0);
 
