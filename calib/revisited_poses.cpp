@@ -54,8 +54,11 @@ std::vector<PositionErrorSample> position_errors_at_revisited_poses(
     }
     i = last + 1;
   }
+  // One sample per standstill, at its end; errors from the solve below.
   std::vector<PositionErrorSample> out;
-  if (standstills.empty()) return out;
+  for (const SettledStandstill& st : standstills)
+    out.push_back({st.end_robot_s + time_offset_s, Eigen::Vector3d::Zero(), false});
+  if (out.empty()) return out;
   const auto same_pose = [&](const JointVector& a, const JointVector& b) {
     return (a - b).cwiseAbs().maxCoeff() <= options.same_pose_tolerance_rad;
   };
@@ -76,7 +79,6 @@ std::vector<PositionErrorSample> position_errors_at_revisited_poses(
     g.row(J) -= w * m.transpose();
   };
   const double w_visit = 1.0 / (2.0 * options.repeatability_m * options.repeatability_m);
-  std::vector<bool> revisit(n, false);
   for (std::size_t k = 1; k < n; ++k) {
     const SettledStandstill& st = standstills[k];
     const double dt = std::max(st.end_robot_s - standstills[k - 1].end_robot_s, 1e-3);
@@ -85,7 +87,7 @@ std::vector<PositionErrorSample> position_errors_at_revisited_poses(
     if (standstills[k - 1].last + 1 == st.first &&
         same_pose(st.q_desired_rad, standstills[k - 1].q_desired_rad)) {
       add_difference(k - 1, k, w_visit, Eigen::Vector3d::Zero());
-      revisit[k] = true;
+      out[k].revisit = true;
       continue;
     }
     // The latest earlier visit of the same pose with the same payload.
@@ -93,19 +95,16 @@ std::vector<PositionErrorSample> position_errors_at_revisited_poses(
       if (standstills[j].payload_kg == st.payload_kg &&
           same_pose(standstills[j].q_desired_rad, st.q_desired_rad)) {
         add_difference(j, k, w_visit, st.difference_W - standstills[j].difference_W);
-        revisit[k] = true;
+        out[k].revisit = true;
         break;
       }
     }
   }
-  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(Eigen::Index(n), 3);
   if (n > 1) {
     const auto m = Eigen::Index(n - 1);
-    e.bottomRows(m) = H.bottomRightCorner(m, m).ldlt().solve(g.bottomRows(m));
+    const Eigen::MatrixXd e = H.bottomRightCorner(m, m).ldlt().solve(g.bottomRows(m));
+    for (std::size_t k = 1; k < n; ++k) out[k].error_W = e.row(Eigen::Index(k - 1)).transpose();
   }
-  for (std::size_t k = 0; k < n; ++k)
-    out.push_back({standstills[k].end_robot_s + time_offset_s, e.row(Eigen::Index(k)).transpose(),
-                   revisit[k]});
   return out;
 }
 

@@ -165,8 +165,8 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
   // coefficients move behind the dead time when the model is written in the angle form, so
   // taps + largest dead time must fit the runtime's kMaxPrecontrolOrder per input.
   if (o.model_torque_input || o.direction_input) {
-    const int longest =
-        std::max(o.input_taps, o.torque_sign_input ? o.torque_sign_taps : 0) + o.grid.dead_time_max;
+    const int taps = std::max(o.input_taps, o.torque_sign_input ? o.torque_sign_taps : 0);
+    const int longest = taps + o.grid.dead_time_max;
     if (longest > kMaxPrecontrolOrder) {
       const ConfigNode at =
           root.optional_child("model") && root.child("model").optional_child("input_taps")
@@ -175,8 +175,7 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
       at.fail(fmt::format(
           "model.input_taps ({}) plus the largest dead time (order.dead_time max {}) is {} "
           "coefficients per further input; the precontrol holds at most {}",
-          std::max(o.input_taps, o.torque_sign_input ? o.torque_sign_taps : 0),
-          o.grid.dead_time_max, longest, kMaxPrecontrolOrder));
+          taps, o.grid.dead_time_max, longest, kMaxPrecontrolOrder));
     }
   }
   if (auto v = root.optional_child("validation")) {

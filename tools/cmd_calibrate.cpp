@@ -407,13 +407,12 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
         je->t_s.size(), je->outside_record, je->ik_failures, je->near_wrist_singularity));
     // The position the smoother could not observe, corrected where the arm stood at a pose
     // again (calib/revisited_poses.hpp) and interpolated at the other standstills.
-    if (std::any_of(je->revisited_pose_errors.begin(), je->revisited_pose_errors.end(),
-                    [](const auto& e) { return e.revisit; })) {
+    const auto returns =
+        std::count_if(je->revisited_pose_errors.begin(), je->revisited_pose_errors.end(),
+                      [](const auto& e) { return e.revisit; });
+    if (returns > 0) {
       double largest = 0.0;
       for (const auto& e : je->revisited_pose_errors) largest = std::max(largest, e.error_W.norm());
-      const auto returns =
-          std::count_if(je->revisited_pose_errors.begin(), je->revisited_pose_errors.end(),
-                        [](const auto& e) { return e.revisit; });
       line(fmt::format(
           "  position corrected at {} returns to a pose stood at before, {} standstills in all "
           "(largest {:.3f} mm)",
