@@ -9,6 +9,9 @@
 //       the best fit time of 3 as JSON.
 //   bench_arx --identify FILE JOINTS   order sweep (na, nb 1..32, d 0..8, BIC) + final fit +
 //       validation statistics for every joint, print the chosen structures and times as JSON.
+//   bench_arx --fit-multi FILE METHOD NA NB D NX...   fit a multi-input model to the blocks
+//       [u, y, x_0, x_1, ...] of FILE (one further input per NX) with METHOD (auto, normal,
+//       refined, qr), print θ, σ, the method used and its refinement steps as JSON.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Core>
@@ -161,12 +164,35 @@ int fit_file(const std::string& file, const ArxStructure& s) {
   std::printf(
       "{\"fit_seconds\": %.6f, \"fit_cpu_seconds\": %.6f, \"method\": \"%s\", "
       "\"scaled_condition\": %.6g, \"rows\": %zu, \"theta\": ",
-      best, best_cpu,
-      kept->method_used == imscal::ident::LeastSquaresMethod::kQr ? "qr" : "cholesky",
-      kept->scaled_condition, kept->row_count);
+      best, best_cpu, imscal::ident::to_string(kept->method_used), kept->scaled_condition,
+      kept->row_count);
   print_vector(kept->model.parameters());
   std::printf(", \"std\": ");
   print_vector(kept->parameter_std);
+  std::printf("}\n");
+  return 0;
+}
+
+int fit_multi_file(const std::string& file, const std::string& method, ArxStructure s) {
+  using imscal::ident::LeastSquaresMethod;
+  const auto blocks = read_blocks(file, 2 + std::size_t(s.extra_inputs));
+  IoSegment data{blocks[0], blocks[1], {}, s.extra_inputs};
+  for (int e = 0; e < s.extra_inputs; ++e) data.extra[std::size_t(e)] = blocks[2 + std::size_t(e)];
+  imscal::ident::ArxFitOptions options;
+  options.method = method == "qr"        ? LeastSquaresMethod::kQr
+                   : method == "normal"  ? LeastSquaresMethod::kNormalEquations
+                   : method == "refined" ? LeastSquaresMethod::kRefinedNormalEquations
+                                         : LeastSquaresMethod::kAuto;
+  const auto start = std::chrono::steady_clock::now();
+  const auto fit = imscal::ident::fit_arx(std::vector<IoSegment>{data}, s, options);
+  std::printf(
+      "{\"fit_seconds\": %.6f, \"method\": \"%s\", \"refinement_steps\": %d, "
+      "\"scaled_condition\": %.6g, \"rows\": %zu, \"rss\": %.17g, \"theta\": ",
+      seconds_since(start), imscal::ident::to_string(fit.method_used), fit.refinement_steps,
+      fit.scaled_condition, fit.row_count, fit.residual_sum_of_squares);
+  print_vector(fit.model.parameters());
+  std::printf(", \"std\": ");
+  print_vector(fit.parameter_std);
   std::printf("}\n");
   return 0;
 }
@@ -189,19 +215,19 @@ int identify_file(const std::string& file, std::size_t joints) {
     const auto stats = imscal::ident::validate_arx(result.final_fit.model, held_out);
     validation_seconds += seconds_since(validation_start);
     char line[512];
-    std::snprintf(
-        line, sizeof line,
-        "%s{\"joint\": %zu, \"na\": %d, \"nb\": %d, \"d\": %d, \"method\": \"%s\", "
-        "\"one_step_fit_percent\": %.4f, \"simulation_fit_percent\": %.4f, "
-        "\"white\": %s, \"white_outside\": %d, \"white_max_over_band\": %.3f, "
-        "\"independent\": %s, \"stable\": %s}",
-        j ? ", " : "", j, result.chosen.na, result.chosen.nb, result.chosen.dead_time,
-        result.final_fit.method_used == imscal::ident::LeastSquaresMethod::kQr ? "qr" : "cholesky",
-        stats.one_step_fit_percent, stats.simulation_fit_percent,
-        stats.residual_whiteness.passed ? "true" : "false", stats.residual_whiteness.outside_count,
-        stats.residual_whiteness.max_abs_correlation / stats.residual_whiteness.band,
-        stats.input_residual.passed ? "true" : "false",
-        result.final_fit.model.is_stable() ? "true" : "false");
+    std::snprintf(line, sizeof line,
+                  "%s{\"joint\": %zu, \"na\": %d, \"nb\": %d, \"d\": %d, \"method\": \"%s\", "
+                  "\"one_step_fit_percent\": %.4f, \"simulation_fit_percent\": %.4f, "
+                  "\"white\": %s, \"white_outside\": %d, \"white_max_over_band\": %.3f, "
+                  "\"independent\": %s, \"stable\": %s}",
+                  j ? ", " : "", j, result.chosen.na, result.chosen.nb, result.chosen.dead_time,
+                  imscal::ident::to_string(result.final_fit.method_used),
+                  stats.one_step_fit_percent, stats.simulation_fit_percent,
+                  stats.residual_whiteness.passed ? "true" : "false",
+                  stats.residual_whiteness.outside_count,
+                  stats.residual_whiteness.max_abs_correlation / stats.residual_whiteness.band,
+                  stats.input_residual.passed ? "true" : "false",
+                  result.final_fit.model.is_stable() ? "true" : "false");
     report += line;
   }
   const double total = seconds_since(start);
@@ -264,7 +290,13 @@ int main(int argc, char** argv) {
     if (mode == "--fit" && argc == 6)
       return fit_file(argv[2], {std::stoi(argv[3]), std::stoi(argv[4]), std::stoi(argv[5])});
     if (mode == "--identify" && argc == 4) return identify_file(argv[2], std::stoul(argv[3]));
-    if (mode.rfind("--write-data", 0) == 0 || mode == "--fit" || mode == "--identify") {
+    if (mode == "--fit-multi" && argc >= 8 && argc <= 7 + imscal::ident::kMaxExtraInputs) {
+      ArxStructure s{std::stoi(argv[4]), std::stoi(argv[5]), std::stoi(argv[6]), argc - 7, {}};
+      for (int e = 0; e < s.extra_inputs; ++e) s.nx[std::size_t(e)] = std::stoi(argv[7 + e]);
+      return fit_multi_file(argv[2], argv[3], s);
+    }
+    if (mode.rfind("--write-data", 0) == 0 || mode == "--fit" || mode == "--identify" ||
+        mode == "--fit-multi") {
       std::fprintf(stderr, "usage: see the comment at the top of bench/bench_arx.cpp\n");
       return 2;
     }

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "ident/lagged_products.hpp"
+
 namespace imscal::ident {
 namespace {
 
@@ -39,11 +41,6 @@ void check_segment(const IoSegment& segment, int extra_inputs) {
           "ARX data segment: further input " + std::to_string(e) + " has " +
           std::to_string(segment.extra[static_cast<std::size_t>(e)].size()) +
           " samples, output has " + std::to_string(segment.output.size()));
-}
-
-double dot_lagged(const double* a, const double* b, std::size_t length) {
-  return ConstMap(a, static_cast<Eigen::Index>(length))
-      .dot(ConstMap(b, static_cast<Eigen::Index>(length)));
 }
 
 // One signal of a LaggedGram: its samples and its lag range [lag_min, lag_max], whose columns
@@ -83,6 +80,9 @@ void add_segment_gram(const IoSegment& segment, const LagSet& lags, int first_ro
     return r <= c ? local(r, c) : local(c, r);
   };
 
+  // Sums of the blocked pass: per pair (a, b), the row against b's lags, the column against
+  // a's further lags (ident/lagged_products.hpp).
+  std::vector<double> row_sums, column_sums;
   for (std::size_t c = f; c < n; c += kChunkRows) {
     const std::size_t len = std::min(kChunkRows, n - c);
     for (std::size_t ia = 0; ia < signals.size(); ++ia) {
@@ -91,11 +91,17 @@ void add_segment_gram(const IoSegment& segment, const LagSet& lags, int first_ro
         const LaggedSignal& b = signals[ib];
         // Row la = a.lag_min against every lag of b, and column lb = b.lag_min against the
         // other lags of a (for a == b the first row covers the upper triangle's base).
+        const double* a0 = a.data + c - a.lag_min;
+        const double* b0 = b.data + c - b.lag_min;
+        row_sums.assign(std::size_t(b.count()), 0.0);
+        add_lagged_dots(a0, b0, len, b.count(), row_sums.data());
         for (int lb = b.lag_min; lb <= b.lag_max; ++lb)
-          entry(a, a.lag_min, b, lb) += dot_lagged(a.data + c - a.lag_min, b.data + c - lb, len);
-        if (ia == ib) continue;
+          entry(a, a.lag_min, b, lb) += row_sums[std::size_t(lb - b.lag_min)];
+        if (ia == ib || a.count() == 1) continue;
+        column_sums.assign(std::size_t(a.count() - 1), 0.0);
+        add_lagged_dots(b0, a0 - 1, len, a.count() - 1, column_sums.data());
         for (int la = a.lag_min + 1; la <= a.lag_max; ++la)
-          entry(a, la, b, b.lag_min) += dot_lagged(a.data + c - la, b.data + c - b.lag_min, len);
+          entry(a, la, b, b.lag_min) += column_sums[std::size_t(la - a.lag_min - 1)];
       }
     }
   }
@@ -177,12 +183,12 @@ void absorb_rows(Eigen::MatrixXd& stack, int q, int rows) {
 
 // Streamed Householder QR of the column-scaled [Φ y]: returns the (p+1)-square R factor.
 Eigen::MatrixXd streamed_qr_factor(std::span<const IoSegment> segments,
-                                   const ArxStructure& structure, const Eigen::VectorXd& scale) {
+                                   const ArxStructure& structure, const Eigen::VectorXd& scale,
+                                   std::size_t first) {
   const int na = structure.na;
   const int nb = structure.nb;
   const int p = structure.parameter_count();
   const int q = p + 1;
-  const std::size_t first = static_cast<std::size_t>(structure.max_lag());
   const std::size_t d = static_cast<std::size_t>(structure.dead_time);
   Eigen::MatrixXd stack = Eigen::MatrixXd::Zero(q + kQrBlockRows, q);
   int rows = 0;
@@ -211,53 +217,72 @@ Eigen::MatrixXd streamed_qr_factor(std::span<const IoSegment> segments,
   return stack.topRows(q);
 }
 
-// One blocked pass over the data: the residual r(k) = y(k) - φ(k)ᵀθ of every regression row;
-// returns Σ r² and, when wanted, accumulates Φᵀr (θ order) into *phi_t_r.
+// One blocked pass over the data: the residual r(k) = y(k) - φ(k)ᵀθ of every regression row
+// k >= first (>= structure.max_lag()) of every segment; returns Σ r² and, when wanted,
+// accumulates Φᵀr (θ order) into *phi_t_r.
 double residual_pass(std::span<const IoSegment> segments, const ArxStructure& structure,
-                     const Eigen::VectorXd& theta, Eigen::VectorXd* phi_t_r) {
+                     const Eigen::VectorXd& theta, Eigen::VectorXd* phi_t_r, std::size_t first) {
   structure.validate();
   if (theta.size() != structure.parameter_count())
     throw std::invalid_argument("residual pass: θ size does not match the structure");
-  const std::size_t first = static_cast<std::size_t>(structure.max_lag());
   const std::size_t d = static_cast<std::size_t>(structure.dead_time);
   const int na = structure.na;
   std::array<double, kChunkRows> residual_buffer;
+  const int nb = structure.nb;
+  std::vector<double> sums(std::size_t(std::max({na, nb, structure.max_nx()})));  // lagged dots
   if (phi_t_r != nullptr) phi_t_r->setZero(theta.size());
   double sum = 0.0;
-  const int nb = structure.nb;
+  // The output regressors enter as -y: their FIR taps are -a.
+  const Eigen::VectorXd minus_a = -theta.head(na);
   for (const IoSegment& segment : segments) {
     check_segment(segment, structure.extra_inputs);
     const double* y = segment.output.data();
     const double* u = segment.input.data();
     const std::size_t n = segment.output.size();
     for (std::size_t c = first; c < n; c += kChunkRows) {
-      const Eigen::Index len = static_cast<Eigen::Index>(std::min(kChunkRows, n - c));
-      Eigen::Map<Eigen::VectorXd> e(residual_buffer.data(), len);
-      e = ConstMap(y + c, len);
-      for (int i = 0; i < na; ++i) e += theta(i) * ConstMap(y + c - 1 - i, len);
-      for (int j = 0; j < nb; ++j) e -= theta(na + j) * ConstMap(u + c - d - j, len);
+      const std::size_t len = std::min(kChunkRows, n - c);
+      double* e = residual_buffer.data();
+      std::copy(y + c, y + c + len, e);
+      if (na > 0) subtract_fir(y + c - 1, minus_a.data(), na, len, e);
+      subtract_fir(u + c - d, theta.data() + na, nb, len, e);
       for (int x = 0; x < structure.extra_inputs; ++x) {
-        const double* xs = segment.extra[static_cast<std::size_t>(x)].data();
         const int c0 = na + nb + structure.extra_offset(x);
-        for (int j = 0; j < structure.nx[std::size_t(x)]; ++j)
-          e -= theta(c0 + j) * ConstMap(xs + c - d - j, len);
+        subtract_fir(segment.extra[static_cast<std::size_t>(x)].data() + c - d, theta.data() + c0,
+                     structure.nx[std::size_t(x)], len, e);
       }
-      sum += e.squaredNorm();
+      sum += ConstMap(e, static_cast<Eigen::Index>(len)).squaredNorm();
       if (phi_t_r == nullptr) continue;
-      for (int i = 0; i < na; ++i) (*phi_t_r)(i) -= e.dot(ConstMap(y + c - 1 - i, len));
-      for (int j = 0; j < nb; ++j) (*phi_t_r)(na + j) += e.dot(ConstMap(u + c - d - j, len));
-      for (int x = 0; x < structure.extra_inputs; ++x) {
-        const double* xs = segment.extra[static_cast<std::size_t>(x)].data();
-        const int c0 = na + nb + structure.extra_offset(x);
-        for (int j = 0; j < structure.nx[std::size_t(x)]; ++j)
-          (*phi_t_r)(c0 + j) += e.dot(ConstMap(xs + c - d - j, len));
-      }
+      // Φᵀr: -Σ r(k) y(k-1-i), Σ r(k) u(k-d-j), Σ r(k) x_e(k-d-j).
+      auto add_dots = [&](const double* signal, int count, int at, double sign) {
+        std::fill(sums.begin(), sums.begin() + count, 0.0);
+        add_lagged_dots(e, signal, len, count, sums.data());
+        for (int j = 0; j < count; ++j) (*phi_t_r)(at + j) += sign * sums[std::size_t(j)];
+      };
+      if (na > 0) add_dots(y + c - 1, na, 0, -1.0);
+      add_dots(u + c - d, nb, na, 1.0);
+      for (int x = 0; x < structure.extra_inputs; ++x)
+        add_dots(segment.extra[static_cast<std::size_t>(x)].data() + c - d,
+                 structure.nx[std::size_t(x)], na + nb + structure.extra_offset(x), 1.0);
     }
   }
   return sum;
 }
 
 }  // namespace
+
+const char* to_string(LeastSquaresMethod method) {
+  switch (method) {
+    case LeastSquaresMethod::kAuto:
+      return "auto";
+    case LeastSquaresMethod::kNormalEquations:
+      return "normal";
+    case LeastSquaresMethod::kQr:
+      return "qr";
+    case LeastSquaresMethod::kRefinedNormalEquations:
+      return "refined-normal";
+  }
+  return "?";
+}
 
 LaggedGram build_lagged_gram(std::span<const IoSegment> segments, const LagSet& lags,
                              int first_row) {
@@ -290,19 +315,43 @@ LaggedGram build_lagged_gram(std::span<const IoSegment> segments, const LagSet& 
 
 double residual_sum_of_squares(std::span<const IoSegment> segments, const ArxStructure& structure,
                                const Eigen::VectorXd& theta) {
-  return residual_pass(segments, structure, theta, nullptr);
+  return residual_pass(segments, structure, theta, nullptr, std::size_t(structure.max_lag()));
 }
 
 ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& structure,
                      const ArxFitOptions& options) {
   structure.validate();
+  LagSet lags{structure.na,
+              structure.dead_time,
+              structure.dead_time + structure.nb - 1,
+              structure.extra_inputs,
+              {}};
+  for (int e = 0; e < structure.extra_inputs; ++e)
+    lags.extra_lag_max[std::size_t(e)] = structure.dead_time + structure.nx[std::size_t(e)] - 1;
+  return fit_arx(segments, structure, build_lagged_gram(segments, lags, structure.max_lag()),
+                 options);
+}
+
+ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& structure,
+                     const LaggedGram& lagged, const ArxFitOptions& options) {
+  structure.validate();
   const int na = structure.na;
   const int nb = structure.nb;
   const int p = structure.parameter_count();
-  LagSet lags{na, structure.dead_time, structure.dead_time + nb - 1, structure.extra_inputs, {}};
-  for (int e = 0; e < structure.extra_inputs; ++e)
-    lags.extra_lag_max[std::size_t(e)] = structure.dead_time + structure.nx[std::size_t(e)] - 1;
-  const LaggedGram lagged = build_lagged_gram(segments, lags, structure.max_lag());
+  const LagSet& lags = lagged.lags;
+  {  // the Gram must hold every lag of the structure
+    bool covers = lags.output_lag_max >= na && lags.input_lag_min <= structure.dead_time &&
+                  lags.input_lag_max >= structure.dead_time + nb - 1 &&
+                  lags.extra_count == structure.extra_inputs &&
+                  lagged.first_row >= structure.max_lag();
+    for (int e = 0; e < structure.extra_inputs; ++e)
+      covers = covers && lags.extra_lag_max[std::size_t(e)] >=
+                             structure.dead_time + structure.nx[std::size_t(e)] - 1;
+    if (!covers)
+      throw std::invalid_argument("fit_arx: the Gram matrix does not hold the lags of " +
+                                  to_string(structure));
+  }
+  const std::size_t first = static_cast<std::size_t>(lagged.first_row);
   if (lagged.row_count <= static_cast<std::size_t>(p))
     throw std::invalid_argument("fit_arx: " + std::to_string(lagged.row_count) +
                                 " regression rows for " + std::to_string(p) + " parameters (" +
@@ -341,13 +390,17 @@ ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& st
   const double condition = lambda_min > 0.0 ? eigen.eigenvalues().maxCoeff() / lambda_min
                                             : std::numeric_limits<double>::infinity();
 
-  bool use_normal = options.method == LeastSquaresMethod::kNormalEquations ||
-                    (options.method == LeastSquaresMethod::kAuto &&
-                     condition <= options.max_condition_normal_equations);
+  LeastSquaresMethod method = options.method;
+  if (method == LeastSquaresMethod::kAuto)
+    method = condition <= options.max_condition_normal_equations
+                 ? LeastSquaresMethod::kNormalEquations
+             : condition <= options.max_condition_refined_normal_equations
+                 ? LeastSquaresMethod::kRefinedNormalEquations
+                 : LeastSquaresMethod::kQr;
   Eigen::VectorXd scaled_theta;
   Eigen::MatrixXd scaled_inverse;
   double reported_condition = condition;
-  if (use_normal) {
+  if (method != LeastSquaresMethod::kQr) {
     Eigen::LLT<Eigen::MatrixXd> llt(scaled);
     if (llt.info() == Eigen::Success) {
       scaled_theta = llt.solve(scaled_rhs);
@@ -356,11 +409,42 @@ ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& st
       throw std::runtime_error("fit_arx: normal equations not positive definite (" +
                                to_string(structure) + ")");
     } else {
-      use_normal = false;
+      method = LeastSquaresMethod::kQr;
     }
   }
-  if (!use_normal) {
-    const Eigen::MatrixXd r_aug = streamed_qr_factor(segments, structure, scale);
+
+  // One refinement step: θ += S (S ΦᵀΦ S)⁻¹ S Φᵀr, r from the data; returns the step's size
+  // in the scaled basis. rss becomes the residual sum of squares of the new θ (header, 4.).
+  Eigen::VectorXd theta, phi_t_r;
+  int steps_taken = 0;
+  double rss = std::numeric_limits<double>::quiet_NaN();
+  auto refine = [&]() {
+    const double rss_before = residual_pass(segments, structure, theta, &phi_t_r, first);
+    const Eigen::VectorXd scaled_step = scaled_inverse * scale.cwiseProduct(phi_t_r);
+    theta += scale.cwiseProduct(scaled_step);
+    ++steps_taken;
+    rss = std::max(0.0, rss_before - 2.0 * scaled_step.dot(scale.cwiseProduct(phi_t_r)) +
+                            scaled_step.dot(scaled * scaled_step));
+    return scaled_step.norm();
+  };
+  if (method == LeastSquaresMethod::kRefinedNormalEquations) {
+    // Iterated to the rounding level of a backward-stable solver (arx_fit.hpp, step 3); a step
+    // that does not halve the one before means κ ε is too large to contract: QR instead.
+    theta = scale.cwiseProduct(scaled_theta);
+    const double floor = 8.0 * std::sqrt(condition) * std::numeric_limits<double>::epsilon();
+    double previous = std::numeric_limits<double>::infinity();
+    bool converged = false;
+    for (int i = 0; i < options.max_refinement_steps && !converged; ++i) {
+      const double step = refine();
+      converged = step <= floor * theta.cwiseQuotient(scale).norm();
+      if (!converged && !(step <= 0.5 * previous)) break;
+      previous = step;
+    }
+    if (!converged) method = LeastSquaresMethod::kQr;
+  }
+  if (method == LeastSquaresMethod::kQr) {
+    steps_taken = 0;
+    const Eigen::MatrixXd r_aug = streamed_qr_factor(segments, structure, scale, first);
     const auto r = r_aug.topLeftCorner(p, p).triangularView<Eigen::Upper>();
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(r_aug.topLeftCorner(p, p));
     const double s_min = svd.singularValues().minCoeff();
@@ -372,19 +456,16 @@ ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& st
     const Eigen::MatrixXd r_inverse = r.solve(Eigen::MatrixXd::Identity(p, p));
     scaled_inverse = r_inverse * r_inverse.transpose();
   }
-
-  Eigen::VectorXd theta = scale.cwiseProduct(scaled_theta);
   // Iterative refinement with residuals computed from the data: the normal equations' error
   // (≈ condition × ε of yᵀy-sized sums) shrinks to that of Φᵀr, r being the small residual. On
   // the QR path the same step is the corrected semi-normal equations (R⁻¹R⁻ᵀ = scaled_inverse):
   // it removes the rounding of the streamed factorisation (an order-32 noise-free fit went from
   // 1.06e-9 relative error to the test's bound). A pass costs O(N p), the QR O(N p²).
-  Eigen::VectorXd phi_t_r;
-  for (int step = 0; step < options.refinement_steps; ++step) {
-    residual_pass(segments, structure, theta, &phi_t_r);
-    theta += scale.cwiseProduct(scaled_inverse * scale.cwiseProduct(phi_t_r));
+  if (method != LeastSquaresMethod::kRefinedNormalEquations) {
+    theta = scale.cwiseProduct(scaled_theta);
+    for (int step = 0; step < options.refinement_steps; ++step) refine();
   }
-  const double rss = residual_pass(segments, structure, theta, nullptr);
+  if (steps_taken == 0) rss = residual_pass(segments, structure, theta, nullptr, first);
   const double variance = rss / static_cast<double>(lagged.row_count - static_cast<std::size_t>(p));
   Eigen::MatrixXd covariance = variance * scale.asDiagonal() * scaled_inverse * scale.asDiagonal();
   Eigen::VectorXd std_dev = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
@@ -396,7 +477,8 @@ ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& st
                       variance,
                       lagged.row_count,
                       reported_condition,
-                      use_normal ? LeastSquaresMethod::kNormalEquations : LeastSquaresMethod::kQr};
+                      method,
+                      steps_taken};
 }
 
 }  // namespace imscal::ident

@@ -4,7 +4,7 @@
 //
 // Regression: y(k) = φ(k)ᵀ θ + e(k),  φ(k) = [-y(k-1) .. -y(k-na), u(k-d) .. u(k-d-nb+1),
 // x_e(k-d) .. x_e(k-d-nx+1) for every further input e], θ = [a_1..a_na, b_0..b_{nb-1}, c],
-// rows k = max_lag .. n-1 of every segment.
+// rows k = max_lag .. n-1 of every segment (or k = first_row .. n-1 of a given Gram matrix).
 //
 // How it is solved (numerically sound and fast on millions of samples):
 //  1. The Gram matrix [Φ y]ᵀ[Φ y] is built without forming Φ. Its entries are lagged correlation
@@ -13,16 +13,28 @@
 //     E(l1+1, l2+1) = E(l1, l2) + s1(k0-1-l1) s2(k0-1-l2) - s1(n-1-l1) s2(n-1-l2).
 //     Cost ≈ 2 (na + nb) dot products of the segment length plus O(p²) sliding updates per
 //     segment (order 32 on 1 M samples: ~75 ms CPU for the whole fit, bench/bench_arx.cpp).
-//  2. The columns are scaled to unit norm and the condition number of the scaled Gram matrix
-//     is computed (symmetric eigenvalues, p ≤ ~100 so this is cheap). When it is at most
-//     ArxFitOptions::max_condition_normal_equations the scaled normal equations are solved by
-//     Cholesky; otherwise (or on request) a streamed Householder QR of [Φ y] in row blocks is
-//     used (R of the rows so far stacked on the next block, never the whole Φ in memory;
-//     ≈ 2 N p² flops, ~25× slower than the Cholesky path at order 32).
-//  3. After a Cholesky solve, one step of iterative refinement θ += (ΦᵀΦ)⁻¹ Φᵀr with r = y - Φθ
-//     computed from the data (one blocked pass) removes most of the normal equations' extra error.
-//  4. The residuals are recomputed from the data (one pass), so the residual sum of squares and
-//     σ² = RSS / (N - p) do not suffer from the cancellation of yᵀy - θᵀΦᵀy, and the parameter
+//  2. The columns are scaled to unit norm and the condition number κ of the scaled Gram matrix
+//     is computed (symmetric eigenvalues, p ≤ ~200 so this is cheap). Then, by κ:
+//       κ ≤ max_condition_normal_equations (1e10): Cholesky of the scaled normal equations and
+//         one refinement step (3.);
+//       κ ≤ max_condition_refined_normal_equations (1e14): the same Cholesky, with the refinement
+//         iterated until its step reaches the rounding level of a backward-stable solver;
+//       otherwise (or when that refinement stops contracting): a streamed Householder QR of
+//         [Φ y] in row blocks (R of the rows so far stacked on the next block, never the whole Φ
+//         in memory; ≈ 2 N p² flops, ~25× slower than the Cholesky path at order 32 and ~100×
+//         at the 185 coefficients of the default inverse model).
+//  3. Iterative refinement θ += (ΦᵀΦ)⁻¹ Φᵀr with r = y - Φθ computed from the data (one blocked
+//     pass, O(N p)). Why it may replace the QR up to κ = 1e14: with the residual taken from the
+//     data, each step shrinks the solution's error by about κ × 1.1e-16 (the Cholesky factor's
+//     relative error; 0.011 at 1e14), and the iteration's fixed point is Φ⁺ applied to the
+//     rounding of r, ‖δθ‖ ≲ √κ ε ‖θ‖ in the scaled basis: the accuracy of a QR solution
+//     (Björck, Numerical Methods for Least Squares Problems, 1996, sec. 2.9; Higham, Accuracy
+//     and Stability of Numerical Algorithms, 2002, ch. 20). At κ ≈ 5e13, the default inverse
+//     model's regressors (60 lags of a smooth model torque), 3-4 steps get there.
+//  4. The residual sum of squares comes from the data, so that it and σ² = RSS / (N - p) do not
+//     suffer from the cancellation of yᵀy - θᵀΦᵀy: the last refinement pass gives ‖r‖² of the θ
+//     before its step δ, and RSS(θ + δ) = ‖r‖² - 2 δᵀΦᵀr + δᵀΦᵀΦδ adds only terms of the step's
+//     small size (no further pass; one pass when no refinement step was taken). The parameter
 //     covariance is σ² (ΦᵀΦ)⁻¹ (standard deviations = sqrt of its diagonal).
 //
 // The model has no constant term (as in the paper): signals with a large offset and little
@@ -85,10 +97,15 @@ LaggedGram build_lagged_gram(std::span<const IoSegment> segments, const LagSet& 
                              int first_row);
 
 enum class LeastSquaresMethod {
-  kAuto,             // Cholesky of the scaled normal equations, QR if too ill-conditioned
+  kAuto,             // by the scaled condition: normal equations, refined ones, or QR
   kNormalEquations,  // always Cholesky (throws if the Gram matrix is not positive definite)
   kQr,               // always the streamed Householder QR
+  // Cholesky with the refinement iterated to convergence (falls back to QR when it does not
+  // contract, e.g. beyond κ ≈ 1e15)
+  kRefinedNormalEquations,
 };
+
+const char* to_string(LeastSquaresMethod method);
 
 struct ArxFitOptions {
   LeastSquaresMethod method = LeastSquaresMethod::kAuto;
@@ -96,11 +113,18 @@ struct ArxFitOptions {
   // equations: their relative error is about condition × 1.1e-16, so 1e10 keeps ~6 digits in
   // the worst case (QR keeps about twice as many digits as the normal equations).
   double max_condition_normal_equations = 1e10;
+  // Largest scaled condition for which kAuto takes the iterated refinement (step 3 of the header)
+  // instead of the QR: a step then contracts the error by ≤ 1e14 × 1.1e-16 ≈ 0.011.
+  double max_condition_refined_normal_equations = 1e14;
   // Steps of iterative refinement after the solve (either method): θ += (ΦᵀΦ)⁻¹ Φᵀr with the
   // residual r recomputed from the data (one pass each). One step brings the normal-equation
-  // solution to QR-level accuracy for condition numbers up to the limit above, and takes the
-  // rounding of the streamed QR out of a QR solution.
+  // solution to QR-level accuracy for condition numbers up to max_condition_normal_equations,
+  // and takes the rounding of the streamed QR out of a QR solution.
   int refinement_steps = 1;
+  // The iterated refinement (kRefinedNormalEquations): at most this many steps; it has converged
+  // when a step is below 8 √κ ε of θ (scaled basis), the rounding level of a backward-stable
+  // solver, and it is given up for the QR when a step is not at most half the one before.
+  int max_refinement_steps = 12;
   double sample_time_s = 0.002;
 };
 
@@ -113,12 +137,20 @@ struct ArxFitResult {
   std::size_t row_count = 0;       // N, regression rows over all segments
   double scaled_condition = 0.0;   // condition number of the column-scaled ΦᵀΦ
   LeastSquaresMethod method_used = LeastSquaresMethod::kNormalEquations;
+  int refinement_steps = 0;  // refinement steps taken (each one pass over the data)
 };
 
 // Throws std::invalid_argument for a bad structure, mismatched segment sizes or fewer rows than
 // parameters, std::runtime_error if the regressors are rank deficient (no excitation).
 ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& structure,
                      const ArxFitOptions& options = {});
+
+// The same fit from the Gram matrix of these segments built already (e.g. by an order sweep,
+// ident/order_selection.hpp, whose lag set holds every candidate's): its rows k >= first_row of
+// every segment are the regression rows. Throws std::invalid_argument when its lag set does not
+// hold the structure's lags or first_row < structure.max_lag().
+ArxFitResult fit_arx(std::span<const IoSegment> segments, const ArxStructure& structure,
+                     const LaggedGram& gram, const ArxFitOptions& options = {});
 
 // Residual sum of squares of θ = [a; b] on the rows k >= structure.max_lag() of every segment,
 // computed from the data (one pass).

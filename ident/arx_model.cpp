@@ -7,6 +7,8 @@
 #include <string>
 #include <utility>
 
+#include "ident/lagged_products.hpp"
+
 namespace imscal::ident {
 
 ArxModel::ArxModel(ArxStructure structure, Eigen::VectorXd a, Eigen::VectorXd b,
@@ -38,18 +40,23 @@ Eigen::VectorXd ArxModel::parameters() const {
 
 namespace {
 
-// sum + Σ_j b_j u(k-d-j) + Σ_e Σ_j c_e,j x_e(k-d-j): the input part of row k, added to the
-// autoregressive part `sum` (in this order: a noise-free model then reproduces its data exactly).
-double add_input_terms(double sum, const ArxStructure& s, const Eigen::VectorXd& b,
-                       const Eigen::VectorXd& c, const IoSegment& segment, std::size_t k) {
-  const std::size_t first = k - static_cast<std::size_t>(s.dead_time);
-  for (int j = 0; j < s.nb; ++j) sum += b[j] * segment.input[first - j];
-  for (int e = 0; e < s.extra_inputs; ++e) {
-    const auto& x = segment.extra[static_cast<std::size_t>(e)];
-    const int c0 = s.extra_offset(e);
-    for (int j = 0; j < s.nx[std::size_t(e)]; ++j) sum += c[c0 + j] * x[first - j];
-  }
-  return sum;
+// Adds the input part of rows first .. n-1, Σ_j b_j u(k-d-j) + Σ_e Σ_j c_e,j x_e(k-d-j), to
+// part[first..n), as FIR filters over the rows (ident/lagged_products.hpp) instead of a scalar
+// sum per row, each row's terms in the order b, then c (the free run then only recurses over
+// the na autoregressive terms).
+void add_input_part(const ArxStructure& s, const Eigen::VectorXd& b, const Eigen::VectorXd& c,
+                    const IoSegment& segment, std::size_t first, std::span<double> part) {
+  const std::size_t n = segment.input.size();
+  if (first >= n) return;
+  const std::size_t rows = n - first;
+  const std::size_t start = first - static_cast<std::size_t>(s.dead_time);
+  // subtract_fir subtracts: the negated coefficients add (exactly: negation does not round).
+  const Eigen::VectorXd minus_b = -b, minus_c = -c;
+  subtract_fir(segment.input.data() + start, minus_b.data(), s.nb, rows, part.data() + first);
+  for (int e = 0; e < s.extra_inputs; ++e)
+    subtract_fir(segment.extra[static_cast<std::size_t>(e)].data() + start,
+                 minus_c.data() + s.extra_offset(e), s.nx[std::size_t(e)], rows,
+                 part.data() + first);
 }
 
 void check_extras(const ArxStructure& s, const IoSegment& segment, const char* where) {
@@ -72,11 +79,15 @@ void ArxModel::predict_one_step(const IoSegment& segment, std::span<double> pred
   const std::size_t first = static_cast<std::size_t>(structure_.max_lag());
   const auto& y = segment.output;
   for (std::size_t k = 0; k < std::min(first, n); ++k) predicted[k] = y[k];
-  for (std::size_t k = first; k < n; ++k) {
-    double sum = 0.0;
-    for (int i = 0; i < structure_.na; ++i) sum -= a_[i] * y[k - 1 - i];
-    predicted[k] = add_input_terms(sum, structure_, b_, c_, segment, k);
-  }
+  if (first >= n) return;
+  // Every row sums -a_1 y(k-1) - ... then + b_0 u(k-d) + ..., then the further inputs: the order
+  // in which data are simulated (tests/support/arx_systems.hpp), so a noise-free model predicts
+  // its own data exactly.
+  std::fill(predicted.begin() + std::ptrdiff_t(first), predicted.end(), 0.0);
+  if (structure_.na > 0)
+    subtract_fir(y.data() + first - 1, a_.data(), structure_.na, n - first,
+                 predicted.data() + first);
+  add_input_part(structure_, b_, c_, segment, first, predicted);
 }
 
 void ArxModel::simulate(std::span<const double> input, std::span<const double> initial_output,
@@ -94,10 +105,12 @@ void ArxModel::simulate(const IoSegment& segment, std::span<double> simulated) c
     throw std::invalid_argument("ArxModel::simulate: need max_lag initial outputs");
   check_extras(structure_, segment, "ArxModel::simulate");
   for (std::size_t k = 0; k < std::min(first, n); ++k) simulated[k] = segment.output[k];
+  if (first < n) std::fill(simulated.begin() + std::ptrdiff_t(first), simulated.end(), 0.0);
+  add_input_part(structure_, b_, c_, segment, first, simulated);
   for (std::size_t k = first; k < n; ++k) {
-    double sum = 0.0;
+    double sum = simulated[k];
     for (int i = 0; i < structure_.na; ++i) sum -= a_[i] * simulated[k - 1 - i];
-    simulated[k] = add_input_terms(sum, structure_, b_, c_, segment, k);
+    simulated[k] = sum;
   }
 }
 

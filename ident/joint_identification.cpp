@@ -420,8 +420,14 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
   sweep_options.min_relative_pivot = options.min_relative_pivot;
   sweep_options.final_fit = options.fit;
   sweep_options.validation_fraction = 0.0;  // the held-out runs are passed explicitly
+  // History before each run: every lag of the grid, the further inputs' too, so that the sweep
+  // and the final fit (on the sweep's Gram matrix) take every sample of the run as a row.
   const OrderGrid& g = options.grid;
-  const auto history = std::size_t(std::max(g.na_max, g.dead_time_max + g.nb_max - 1));
+  int longest_lag = std::max(g.na_max, g.dead_time_max + g.nb_max - 1);
+  for (int e = 0; e < signals_of_fit.extra_count; ++e)
+    longest_lag =
+        std::max(longest_lag, g.dead_time_max + sweep_options.grid.extra_taps[std::size_t(e)] - 1);
+  const auto history = std::size_t(longest_lag);
 
   out.cells.resize(std::size_t(grid.cell_count()));
   out.parameters.cells.resize(std::size_t(grid.cell_count()));
@@ -457,12 +463,10 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
       continue;
     }
     try {
-      report.sweep = sweep_arx_orders(sweep_est, sweep_options, sweep_val);
-      const ArxStructure chosen = report.sweep->chosen;
-      // The final fit on the cell's own rows: views with exactly the chosen model's history.
-      const auto lag = std::size_t(chosen.max_lag());
-      const auto fit_est = run_views(runs, fit_signals, lag);
-      report.fit = fit_arx(fit_est, chosen, options.fit);
+      // The final fit on the sweep's rows, from its Gram matrix (no further pass to build one).
+      LaggedGram gram;
+      report.sweep = sweep_arx_orders(sweep_est, sweep_options, sweep_val, &gram);
+      report.fit = fit_arx(sweep_est, report.sweep->chosen, gram, options.fit);
     } catch (const std::exception& e) {
       reject(fmt::format("fit failed: {}", e.what()));
       continue;

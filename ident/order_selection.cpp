@@ -53,7 +53,8 @@ const char* to_string(OrderCriterion criterion) {
 
 OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
                                   const OrderSelectionOptions& options,
-                                  std::span<const IoSegment> validation) {
+                                  std::span<const IoSegment> validation,
+                                  LaggedGram* estimation_gram) {
   const OrderGrid& grid = options.grid;
   validate_grid(grid);
   if (!(options.validation_fraction >= 0.0 && options.validation_fraction < 1.0))
@@ -90,7 +91,7 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
     lags.extra_lag_max[std::size_t(e)] = grid.dead_time_max + nx[std::size_t(e)] - 1;
   }
   const int first_row = lags.max_lag();
-  const LaggedGram est = build_lagged_gram(estimation, lags, first_row);
+  LaggedGram est = build_lagged_gram(estimation, lags, first_row);
   const LaggedGram val = build_lagged_gram(held_out, lags, first_row);
   const std::size_t n_rows = est.row_count;
   const int q_max = fixed + grid.nb_max + grid.na_max;
@@ -113,7 +114,9 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
   // Work space, reused for every (d, nb).
   std::vector<int> column(q_max);
   Eigen::VectorXd scale(q_max), rhs(q_max), z(q_max), theta(q_max), val_rhs(q_max);
-  Eigen::MatrixXd factor(q_max, q_max), val_gram(q_max, q_max);
+  // Row-major: the left-looking Cholesky below takes dot products of the factor's rows.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> factor(q_max, q_max);
+  Eigen::MatrixXd val_gram(q_max, q_max);
 
   for (int d = grid.dead_time_min; d <= grid.dead_time_max; ++d) {
     for (int nb = grid.nb_min; nb <= grid.nb_max; ++nb) {
@@ -194,6 +197,7 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
   if (best == nullptr)
     throw std::runtime_error("select_arx_order: every candidate is rank deficient");
   const ArxStructure chosen = best->structure;
+  if (estimation_gram != nullptr) *estimation_gram = std::move(est);
   return OrderSweepResult{chosen, options.criterion, std::move(candidates), n_rows, val.row_count};
 }
 

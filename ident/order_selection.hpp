@@ -88,9 +88,14 @@ struct OrderSweepResult {
   std::size_t estimation_rows = 0;
   std::size_t validation_rows = 0;
 };
+// estimation_gram: when given, receives the sweep's Gram matrix of the estimation rows (its lag
+// set holds every candidate's lags; rows k >= the grid's largest lag), from which the chosen
+// structure can be fitted on the same rows without another pass over the data
+// (fit_arx(segments, structure, gram)).
 OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
                                   const OrderSelectionOptions& options = {},
-                                  std::span<const IoSegment> validation = {});
+                                  std::span<const IoSegment> validation = {},
+                                  LaggedGram* estimation_gram = nullptr);
 
 // validation: separate validation runs; when empty, validation_fraction of every segment is
 // held out instead. Throws std::invalid_argument for a bad grid or too little data.

@@ -113,14 +113,14 @@ json joint_report(const ident::JointIdentification& r, double seconds) {
       cell["criterion_curves"] = curves_json(*c.sweep);
     }
     if (c.fit) {
-      cell["fit"] = {
-          {"rows", c.fit->row_count},
-          {"residual_variance_rad2", c.fit->residual_variance},
-          {"scaled_condition", c.fit->scaled_condition},
-          {"method", c.fit->method_used == ident::LeastSquaresMethod::kQr ? "qr" : "normal"},
-          {"parameter_std",
-           std::vector<double>(c.fit->parameter_std.data(),
-                               c.fit->parameter_std.data() + c.fit->parameter_std.size())}};
+      cell["fit"] = {{"rows", c.fit->row_count},
+                     {"residual_variance_rad2", c.fit->residual_variance},
+                     {"scaled_condition", c.fit->scaled_condition},
+                     {"method", ident::to_string(c.fit->method_used)},
+                     {"refinement_steps", c.fit->refinement_steps},
+                     {"parameter_std", std::vector<double>(c.fit->parameter_std.data(),
+                                                           c.fit->parameter_std.data() +
+                                                               c.fit->parameter_std.size())}};
     }
     if (c.stability) {
       cell["stability"] = {{"stable", c.stability->stable},

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdio>
 #include <cstdlib>
 #include <random>
 #include <vector>
@@ -68,12 +69,20 @@ TEST(ArxFit, RecoversNoiseFreeSystemExactly) {
       // White input keeps the scaled Gram condition small at low orders (checked), so both
       // solvers are accurate to ~condition × 1e-16; 1e-9 is the required recovery. At order 32
       // the noise-free regressors are nearly dependent (near pole-zero cancellations of random
-      // 32nd-degree A and B), kAuto then takes the QR path, which still recovers θ.
+      // 32nd-degree A and B), kAuto then takes the iterated refinement or the QR path, which
+      // still recover θ.
       if (s.na <= 8) {
         EXPECT_LT(fit.scaled_condition, 1e6) << to_string(s);
       }
-      if (fit.scaled_condition > ArxFitOptions{}.max_condition_normal_equations) {
-        EXPECT_EQ(fit.method_used, LeastSquaresMethod::kQr);
+      if (method == LeastSquaresMethod::kAuto) {
+        const ArxFitOptions defaults;
+        EXPECT_EQ(fit.method_used,
+                  fit.scaled_condition <= defaults.max_condition_normal_equations
+                      ? LeastSquaresMethod::kNormalEquations
+                  : fit.scaled_condition <= defaults.max_condition_refined_normal_equations
+                      ? LeastSquaresMethod::kRefinedNormalEquations
+                      : LeastSquaresMethod::kQr)
+            << to_string(s) << " condition " << fit.scaled_condition;
       }
       EXPECT_LT(relative_error(fit.model.parameters(), truth.parameters()), 1e-9)
           << to_string(s) << " method " << int(method);
@@ -197,18 +206,127 @@ TEST(ArxFit, LaggedGramEqualsExplicitRegressorProducts) {
 
 TEST(ArxFit, IllConditionedDataFallsBackToQr) {
   // A large input offset with little motion: the input columns are nearly collinear (scaled
-  // condition ≈ (offset / motion)² ≈ 1e12), where the normal equations lose ~4 digits more than
-  // QR can afford.
+  // condition ≈ (offset / motion)² ≈ 1e12 per pair of lags; 2.2e14 measured with the output's
+  // lags), above the 1e14 up to which the iterated refinement of the normal equations replaces
+  // the QR.
   std::mt19937_64 rng(21);
   const ArxStructure s{2, 3, 1};
   const ArxModel truth(s, polynomial_from_poles(random_poles(s.na, rng)), random_b(s.nb, rng));
   const Record run = simulate(truth, 5000, 0.0, rng, 1000.0, 1e-3, truth.static_gain() * 1000.0);
   const std::vector<IoSegment> data{view(run)};
   const auto fit = fit_arx(data, s);
+  std::printf("scaled condition %.3g: %s\n", fit.scaled_condition, to_string(fit.method_used));
   EXPECT_EQ(fit.method_used, LeastSquaresMethod::kQr);
   EXPECT_GT(fit.scaled_condition, 1e10);
-  // QR error ≈ √condition × 1e-16 ≈ 1e-10 (relative); 1e-7 leaves room for the data's rounding.
+  // QR error ≈ √condition × 1e-16 ≈ 1.5e-9 (relative); 1e-7 leaves room for the data's rounding.
   EXPECT_LT(relative_error(fit.model.parameters(), truth.parameters()), 1e-7);
+}
+
+// Smooth inputs with many lags, as in imscal's default inverse model (60 taps of a model torque
+// and of the direction of motion): consecutive lags are nearly equal, the scaled Gram condition
+// is 1e11-1e14, where kAuto iterates the refinement of the normal equations instead of the QR.
+// u: a path (integral of twice low-passed noise), x_e: twice low-passed noise with a little
+// broadband content, corner_hz the low-pass corner at T = 2 ms.
+imscal::test_support::MultiRecord smooth_multi_record(const ArxModel& m, std::size_t n,
+                                                      double corner_hz, double broadband,
+                                                      double noise_std, std::mt19937_64& rng) {
+  const ArxStructure& s = m.structure();
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double alpha = 1.0 - std::exp(-2.0 * M_PI * corner_hz * 0.002);
+  auto smooth = [&](double broadband) {
+    std::vector<double> out(n);
+    double first = 0.0, second = 0.0;
+    for (auto& v : out) {
+      first += alpha * (normal(rng) - first);
+      second += alpha * (first - second);
+      v = second + broadband * normal(rng);
+    }
+    return out;
+  };
+  imscal::test_support::MultiRecord r;
+  r.u = smooth(0.0);
+  for (std::size_t k = 1; k < n; ++k) r.u[k] = r.u[k - 1] + 0.002 * r.u[k];  // a path
+  r.x.clear();
+  for (int e = 0; e < s.extra_inputs; ++e) r.x.push_back(smooth(broadband));
+  r.y.assign(n, 0.0);
+  for (std::size_t k = std::size_t(s.max_lag()); k < n; ++k) {
+    double sum = noise_std * normal(rng);
+    for (int i = 1; i <= s.na; ++i) sum -= m.a()(i - 1) * r.y[k - std::size_t(i)];
+    for (int j = 0; j < s.nb; ++j) sum += m.b()(j) * r.u[k - std::size_t(s.dead_time + j)];
+    for (int e = 0; e < s.extra_inputs; ++e)
+      for (int j = 0; j < s.nx[std::size_t(e)]; ++j)
+        sum += m.c()(s.extra_offset(e) + j) * r.x[std::size_t(e)][k - std::size_t(s.dead_time + j)];
+    r.y[k] = sum;
+  }
+  return r;
+}
+
+TEST(ArxFit, RefinedNormalEquationsMatchTheQrWhereTheyReplaceIt) {
+  // The independent solver is imscal's streamed Householder QR (forced); numpy's lstsq agrees
+  // with both on a regression of this kind (bench/compare_arx_numpy.py, case 5). Bounds: the
+  // fitted outputs to 1e-10 (two backward-stable solutions: ~√condition × 1e-16), the
+  // coefficients to 1e-4 of their σ (they differ by ~condition × 1e-16 in the weakest
+  // directions: statistically nothing), the σ to 2 % (the Cholesky inverse's error ≈ condition ×
+  // 1e-16 relative, ≤ 1 % below the 1e14 limit), the RSS to 1e-10.
+  std::mt19937_64 rng(31);
+  const ArxStructure s{8, 32, 2, 2, {60, 60}};
+  const ArxModel truth = imscal::test_support::random_multi_system(s, rng);
+  const auto run = smooth_multi_record(truth, sanitized() ? 20000 : 60000, 3.0, 0.001, 1e-4, rng);
+  const std::vector<IoSegment> data{run.view()};
+  const auto refined = fit_arx(data, s);
+  ArxFitOptions qr_options;
+  qr_options.method = LeastSquaresMethod::kQr;
+  const auto by_qr = fit_arx(data, s, qr_options);
+  std::printf("scaled condition %.3g: %s with %d refinement steps\n", refined.scaled_condition,
+              to_string(refined.method_used), refined.refinement_steps);
+  ASSERT_GT(refined.scaled_condition, ArxFitOptions{}.max_condition_normal_equations);
+  ASSERT_LE(refined.scaled_condition, ArxFitOptions{}.max_condition_refined_normal_equations);
+  ASSERT_EQ(refined.method_used, LeastSquaresMethod::kRefinedNormalEquations);
+  EXPECT_GE(refined.refinement_steps, 2);
+  EXPECT_LE(refined.refinement_steps, ArxFitOptions{}.max_refinement_steps);
+  // Fitted outputs: Φ(θ_r - θ_q) relative to Φθ_q, from the residuals of both on the data.
+  std::vector<double> fitted_refined(run.y.size()), fitted_qr(run.y.size());
+  refined.model.predict_one_step(run.view(), fitted_refined);
+  by_qr.model.predict_one_step(run.view(), fitted_qr);
+  double difference = 0.0, size = 0.0;
+  for (std::size_t k = std::size_t(s.max_lag()); k < run.y.size(); ++k) {
+    difference += (fitted_refined[k] - fitted_qr[k]) * (fitted_refined[k] - fitted_qr[k]);
+    size += fitted_qr[k] * fitted_qr[k];
+  }
+  EXPECT_LT(std::sqrt(difference / size), 1e-10);
+  const Eigen::VectorXd in_sigma =
+      (refined.model.parameters() - by_qr.model.parameters()).cwiseQuotient(by_qr.parameter_std);
+  EXPECT_LT(in_sigma.cwiseAbs().maxCoeff(), 1e-4);
+  EXPECT_LT(((refined.parameter_std - by_qr.parameter_std).array() / by_qr.parameter_std.array())
+                .abs()
+                .maxCoeff(),
+            0.02);
+  EXPECT_NEAR(refined.residual_sum_of_squares, by_qr.residual_sum_of_squares,
+              1e-10 * by_qr.residual_sum_of_squares);
+  // And both find the system (noise 1e-4 against outputs of ~0.1: within 5 σ).
+  const Eigen::VectorXd z =
+      (refined.model.parameters() - truth.parameters()).cwiseQuotient(refined.parameter_std);
+  EXPECT_LT(z.cwiseAbs().maxCoeff(), 5.0);
+}
+
+TEST(ArxFit, BeyondTheRefinedLimitTheQrIsUsed) {
+  // Smoother inputs: condition ~6e17 (measured), far above 1e14 (where a refinement step could
+  // contract by no more than ~0.011) and beyond condition × ε = 1: kAuto takes the QR, and a
+  // forced refinement, which cannot contract there, gives way to the same QR.
+  std::mt19937_64 rng(32);
+  const ArxStructure s{4, 32, 2, 1, {60}};
+  const ArxModel truth = imscal::test_support::random_multi_system(s, rng);
+  const auto run = smooth_multi_record(truth, 20000, 0.2, 0.0, 1e-4, rng);
+  const std::vector<IoSegment> data{run.view()};
+  const auto fit = fit_arx(data, s);
+  std::printf("scaled condition %.3g: %s\n", fit.scaled_condition, to_string(fit.method_used));
+  EXPECT_GT(fit.scaled_condition, ArxFitOptions{}.max_condition_refined_normal_equations);
+  EXPECT_EQ(fit.method_used, LeastSquaresMethod::kQr);
+  ArxFitOptions forced;
+  forced.method = LeastSquaresMethod::kRefinedNormalEquations;
+  const auto by_refinement = fit_arx(data, s, forced);
+  EXPECT_EQ(by_refinement.method_used, LeastSquaresMethod::kQr);
+  EXPECT_EQ(by_refinement.model.parameters(), fit.model.parameters());  // the same QR solution
 }
 
 TEST(ArxFit, RejectsBadInput) {
