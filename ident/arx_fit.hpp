@@ -29,8 +29,8 @@
 //     relative error; 0.011 at 1e14), and the iteration's fixed point is Φ⁺ applied to the
 //     rounding of r, ‖δθ‖ ≲ √κ ε ‖θ‖ in the scaled basis: the accuracy of a QR solution
 //     (Björck, Numerical Methods for Least Squares Problems, 1996, sec. 2.9; Higham, Accuracy
-//     and Stability of Numerical Algorithms, 2002, ch. 20). At κ ≈ 5e13, the default inverse
-//     model's regressors (60 lags of a smooth model torque), 3-4 steps get there.
+//     and Stability of Numerical Algorithms, 2002, ch. 20). At κ ≈ 1e11-4e13, the default inverse
+//     model's regressors (60 lags of a smooth model torque), 2-3 steps get there (measured).
 //  4. The residual sum of squares comes from the data, so that it and σ² = RSS / (N - p) do not
 //     suffer from the cancellation of yᵀy - θᵀΦᵀy: the last refinement pass gives ‖r‖² of the θ
 //     before its step δ, and RSS(θ + δ) = ‖r‖² - 2 δᵀΦᵀr + δᵀΦᵀΦδ adds only terms of the step's
@@ -101,7 +101,7 @@ enum class LeastSquaresMethod {
   kNormalEquations,  // always Cholesky (throws if the Gram matrix is not positive definite)
   kQr,               // always the streamed Householder QR
   // Cholesky with the refinement iterated to convergence (falls back to QR when it does not
-  // contract, e.g. beyond κ ≈ 1e15)
+  // contract, e.g. at κ ≈ 6e17, tests/ident/test_arx_fit.cpp)
   kRefinedNormalEquations,
 };
 
