@@ -251,8 +251,15 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   std::map<std::string, double> fit;
   for (const auto& joint : ident_report.at("joints")) {
     double sum = 0.0, rows = 0.0;
+    std::string chosen;  // issue 5: the chosen order and dead time are reported
     for (const auto& cell : joint.at("cells")) {
-      if (cell.at("status") != "identified" || !cell.contains("validation")) continue;
+      if (cell.at("status") != "identified") continue;
+      EXPECT_TRUE(cell.contains("chosen")) << joint.at("joint");
+      if (cell.contains("chosen"))
+        chosen += " na " + cell.at("chosen").at("na").dump() + " nb " +
+                  cell.at("chosen").at("nb").dump() + " d " +
+                  cell.at("chosen").at("dead_time").dump();
+      if (!cell.contains("validation")) continue;
       const auto& v = cell.at("validation").at("joint_error_fit_percent");
       const double n = cell.at("validation_rows").get<double>();
       if (v.is_null() || n == 0.0) continue;
@@ -261,8 +268,8 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
     }
     const std::string name = joint.at("joint");
     fit[name] = rows > 0.0 ? sum / rows : std::nan("");
-    std::printf("%s (two-session chain): held-out joint-error fit %.1f %%\n", name.c_str(),
-                fit[name]);
+    std::printf("%s (two-session chain): held-out joint-error fit %.1f %%, chosen%s\n",
+                name.c_str(), fit[name], chosen.c_str());
   }
   for (const char* joint : {"A1", "A2", "A3"}) {
     ASSERT_TRUE(fit.count(joint)) << joint;

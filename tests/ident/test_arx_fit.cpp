@@ -204,11 +204,13 @@ TEST(ArxFit, LaggedGramEqualsExplicitRegressorProducts) {
             1e-12 * explicit_gram.cwiseAbs().maxCoeff());
 }
 
-TEST(ArxFit, IllConditionedDataFallsBackToQr) {
+TEST(ArxFit, IllConditionedDataLeavesThePlainNormalEquations) {
   // A large input offset with little motion: the input columns are nearly collinear (scaled
-  // condition ≈ (offset / motion)² ≈ 1e12 per pair of lags; 2.2e14 measured with the output's
-  // lags), above the 1e14 up to which the iterated refinement of the normal equations replaces
-  // the QR.
+  // condition ≈ (offset / motion)² ≈ 1e12 per pair of lags; with the output's lags 2.2e14 as
+  // GCC's Release build computes it, 5.0e13 in clang's sanitizer build: an estimate this close
+  // to the 1e14 limit depends on the rounding of the sums), beyond what one refinement step of
+  // the normal equations can take: kAuto takes the iterated refinement or the QR, and either
+  // recovers θ.
   std::mt19937_64 rng(21);
   const ArxStructure s{2, 3, 1};
   const ArxModel truth(s, polynomial_from_poles(random_poles(s.na, rng)), random_b(s.nb, rng));
@@ -216,9 +218,10 @@ TEST(ArxFit, IllConditionedDataFallsBackToQr) {
   const std::vector<IoSegment> data{view(run)};
   const auto fit = fit_arx(data, s);
   std::printf("scaled condition %.3g: %s\n", fit.scaled_condition, to_string(fit.method_used));
-  EXPECT_EQ(fit.method_used, LeastSquaresMethod::kQr);
+  EXPECT_NE(fit.method_used, LeastSquaresMethod::kNormalEquations);
   EXPECT_GT(fit.scaled_condition, 1e10);
-  // QR error ≈ √condition × 1e-16 ≈ 1.5e-9 (relative); 1e-7 leaves room for the data's rounding.
+  // A backward-stable solution's error ≈ √condition × 1e-16 ≈ 1.5e-9 (relative); 1e-7 leaves
+  // room for the data's rounding.
   EXPECT_LT(relative_error(fit.model.parameters(), truth.parameters()), 1e-7);
 }
 
@@ -271,7 +274,7 @@ TEST(ArxFit, RefinedNormalEquationsMatchTheQrWhereTheyReplaceIt) {
   std::mt19937_64 rng(31);
   const ArxStructure s{8, 32, 2, 2, {60, 60}};
   const ArxModel truth = imscal::test_support::random_multi_system(s, rng);
-  const auto run = smooth_multi_record(truth, sanitized() ? 20000 : 60000, 3.0, 0.001, 1e-4, rng);
+  const auto run = smooth_multi_record(truth, sanitized() ? 20000 : 60000, 5.0, 0.002, 1e-4, rng);
   const std::vector<IoSegment> data{run.view()};
   const auto refined = fit_arx(data, s);
   ArxFitOptions qr_options;
