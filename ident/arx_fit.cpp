@@ -163,22 +163,19 @@ void add_segment_gram(const IoSegment& segment, const LagSet& lags, int first_ro
   }
 }
 
-// The same code compiled for SSE2 (every x86-64) and for AVX, chosen at start-up: the AVX
-// version halves the time of the QR (bench_identify), bitwise the same result.
+// The same code compiled for SSE2 (every x86-64) and for AVX, chosen on first use with the
+// kernels' CPU check (ident/lagged_products.hpp): the AVX version halves the time of the QR
+// (bench_identify), bitwise the same result.
 void absorb_rows_sse2(double* stack, int ld, int q, int rows) {
   absorb_rows_body(stack, ld, q, rows);
 }
 __attribute__((target("avx"))) void absorb_rows_avx(double* stack, int ld, int q, int rows) {
   absorb_rows_body(stack, ld, q, rows);
 }
-using AbsorbRows = void (*)(double*, int, int, int);
-const AbsorbRows kAbsorbRows = [] {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx") ? absorb_rows_avx : absorb_rows_sse2;
-}();
 
 void absorb_rows(Eigen::MatrixXd& stack, int q, int rows) {
-  kAbsorbRows(stack.data(), static_cast<int>(stack.rows()), q, rows);
+  static const auto kernel = detail::cpu_has_avx() ? absorb_rows_avx : absorb_rows_sse2;
+  kernel(stack.data(), static_cast<int>(stack.rows()), q, rows);
 }
 
 // Streamed Householder QR of the column-scaled [Φ y]: returns the (p+1)-square R factor.
