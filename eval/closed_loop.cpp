@@ -36,8 +36,16 @@ CompensationRun run_stage(const ident::ParameterTable& table, const std::string&
   std::array<ident::PrecontrolEvent, ident::kPrecontrolEventCapacity> events{};
   // An inverse-form table is fed q_d its preview ahead, on top of the smoother's look-ahead.
   const auto look_ahead = std::size_t(options.look_ahead_cycles + table.preview_cycles);
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t ahead = std::min(n - 1, k + look_ahead);
+  // The warm-up (path at rest at its start only): cycles 0 .. W-1 at the first sample; the path's
+  // cycle k is then the precontrol's cycle W + k (its counter stays consecutive). Events are
+  // reported on the path's cycles: those of the warm-up on cycle 0.
+  const bool starts_at_rest = n > 1 && path.samples[0].qd_rad_s.norm() == 0.0 &&
+                              path.samples[0].qdd_rad_s2.norm() == 0.0 &&
+                              path.samples[1].q_rad == path.samples[0].q_rad;
+  const std::size_t warm_up = starts_at_rest ? std::size_t(std::max(0, options.warm_up_cycles)) : 0;
+  for (std::size_t i = 0; i < warm_up + n; ++i) {
+    const std::size_t k = i < warm_up ? 0 : i - warm_up;
+    const std::size_t ahead = i < warm_up ? 0 : std::min(n - 1, k + look_ahead);
     const sim::DesiredJointSample& s = path.samples[ahead];
     std::array<double, ident::kPrecontrolJoints> q{};
     for (int j = 0; j < ident::kPrecontrolJoints; ++j) q[std::size_t(j)] = s.q_rad[j];
@@ -46,15 +54,19 @@ CompensationRun run_stage(const ident::ParameterTable& table, const std::string&
     std::array<double, ident::kPrecontrolJoints> tau{};
     if (!torque.empty())
       for (int j = 0; j < ident::kPrecontrolJoints; ++j) tau[std::size_t(j)] = torque[ahead][j];
-    const ident::PrecontrolOutput out = torque.empty() ? precontrol->cycle(q, payload_kg, k)
-                                                       : precontrol->cycle(q, payload_kg, tau, k);
+    const ident::PrecontrolOutput out = torque.empty() ? precontrol->cycle(q, payload_kg, i)
+                                                       : precontrol->cycle(q, payload_kg, tau, i);
+    const int read = precontrol->read_events(events.data(), int(events.size()));
+    for (int e = 0; e < read; ++e) {
+      run.events.push_back(events[std::size_t(e)]);
+      run.events.back().cycle = k;
+    }
+    if (i < warm_up) continue;
     for (int j = 0; j < ident::kPrecontrolJoints; ++j) {
       run.offset_rad[k][j] = out.offset_rad[std::size_t(j)];
     }
     run.state[k] = out.state;
     run.outside_table[k] = out.outside_table;
-    const int read = precontrol->read_events(events.data(), int(events.size()));
-    run.events.insert(run.events.end(), events.begin(), events.begin() + read);
   }
   return run;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 namespace imscal::eval {
@@ -56,6 +57,19 @@ PathDeviation path_deviation(const std::vector<TimedPoint>& desired,
   }
   out.rms_m = actual.empty() ? 0.0 : std::sqrt(sum_squares / static_cast<double>(actual.size()));
   return out;
+}
+
+double scatter_floor_m(const std::vector<PathDeviation>& cycles) {
+  std::map<long long, std::vector<Eigen::Vector3d>> vectors_at;  // key: time in 0.1 ms
+  for (const PathDeviation& d : cycles)
+    for (std::size_t k = 0; k < d.t_s.size(); ++k)
+      vectors_at[std::llround(d.t_s[k] * 1e4)].push_back(d.deviation_vector_m[k]);
+  double floor_m = 0.0;
+  for (const auto& [key, vectors] : vectors_at)
+    for (std::size_t a = 0; a < vectors.size(); ++a)
+      for (std::size_t b = a + 1; b < vectors.size(); ++b)
+        floor_m = std::max(floor_m, 0.5 * (vectors[a] - vectors[b]).norm());
+  return floor_m;
 }
 
 }  // namespace imscal::eval

@@ -35,4 +35,11 @@ struct PathDeviation {
 PathDeviation path_deviation(const std::vector<TimedPoint>& desired,
                              const std::vector<TimedPoint>& actual, double window_s = 1.0);
 
+// The scatter of n cycles of the same path as a floor under their max deviation: at each instant
+// (samples of the cycles matched by time to 0.1 ms), half the widest distance between two cycles'
+// deviation vectors; the max over the instants [m]. A command that is the same in every cycle
+// moves all of their points alike, so no such command gets the max deviation over the cycles
+// below this, as long as the scatter does not change with the command. 0 for < 2 cycles.
+double scatter_floor_m(const std::vector<PathDeviation>& cycles);
+
 }  // namespace imscal::eval

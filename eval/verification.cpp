@@ -163,6 +163,7 @@ PathFigures path_figures(const std::vector<sim::PathSegment>& segments,
     if (inside(p.t_s)) desired_points.push_back({p.t_s, p.p_m});
   double sum_squares = 0.0;
   std::size_t count = 0;
+  std::vector<PathDeviation> deviations;  // per cycle, for the scatter floor
   for (std::size_t j = 0; j < cycles.size(); ++j) {
     std::vector<TimedPoint> actual;
     for (const PathPose& p : cycles[j])
@@ -183,8 +184,10 @@ PathFigures path_figures(const std::vector<sim::PathSegment>& segments,
         series->deviation_m.push_back(d.deviation_m[k]);
       }
     }
+    deviations.push_back(d);
   }
   f.rms_path_deviation_m = count ? std::sqrt(sum_squares / double(count)) : 0.0;
+  f.scatter_floor_m = scatter_floor_m(deviations);
   return f;
 }
 

@@ -56,6 +56,7 @@ json finite(double v) {
 json figures_json(const eval::PathFigures& f) {
   return {{"max_path_deviation_mm", f.max_path_deviation_m * kMm},
           {"rms_path_deviation_mm", f.rms_path_deviation_m * kMm},
+          {"scatter_floor_mm", f.scatter_floor_m * kMm},
           {"AT_p_mm", f.AT_p_m * kMm},
           {"RT_p_mm", finite(f.RT_p_m * kMm)},
           {"AT_a_deg", f.AT_abc_rad[0] * kDeg},
@@ -114,6 +115,13 @@ std::string slug(std::string s) {
   return s;
 }
 
+// Every case of a result, the uncompensated one first.
+std::vector<const eval::VerificationCase*> all_cases(const eval::VerificationResult& r) {
+  std::vector<const eval::VerificationCase*> cases{&r.before};
+  for (const eval::VerificationCase& c : r.after) cases.push_back(&c);
+  return cases;
+}
+
 void write_scenario(const fs::path& dir, const eval::VerificationResult& r, const VerifyArgs& args,
                     imscal::Overwrite overwrite) {
   fs::create_directories(dir);
@@ -126,7 +134,7 @@ void write_scenario(const fs::path& dir, const eval::VerificationResult& r, cons
   text += fmt::format("{:<16} {:>9} {:>7} {:>8} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}\n",
                       "case", "maxdev_mm", "red_%", "AT_p_mm", "RT_p_mm", "AT_a°", "AT_b°", "AT_c°",
                       "CO_mm", "AV_%", "FV_m/s");
-  for (const eval::VerificationCase* c = &r.before;;) {
+  for (const eval::VerificationCase* c : all_cases(r)) {
     json j = figures_json(c->figures);
     j["case"] = c->label;
     j["reduction_of_max_path_deviation_percent"] =
@@ -145,9 +153,6 @@ void write_scenario(const fs::path& dir, const eval::VerificationResult& r, cons
     cases.push_back(j);
     csv += csv_row(*c, before);
     text += text_row(*c, before);
-    const std::size_t next = c == &r.before ? 0 : std::size_t(c - r.after.data()) + 1;
-    if (next >= r.after.size()) break;
-    c = &r.after[next];
   }
   if (args.measure_with_ims) {
     // The same cases on the plant's true link-side path: the measurement's own share.
@@ -157,17 +162,24 @@ void write_scenario(const fs::path& dir, const eval::VerificationResult& r, cons
         "the\n"
         "plant's true link-side path:\n{:<16} {:>9} {:>7} {:>8} {:>7}\n",
         "case", "maxdev_mm", "red_%", "AT_p_mm", "RT_p_mm");
-    for (const eval::VerificationCase* c = &r.before;;) {
+    for (const eval::VerificationCase* c : all_cases(r)) {
       const auto& f = c->true_figures;
       text += fmt::format("{:<16} {:>9.3f} {:>7.1f} {:>8.3f} {:>7.3f}\n", c->label,
                           f.max_path_deviation_m * kMm,
                           eval::reduction_percent(r.before.true_figures.max_path_deviation_m,
                                                   f.max_path_deviation_m),
                           f.AT_p_m * kMm, f.RT_p_m * kMm);
-      const std::size_t next = c == &r.before ? 0 : std::size_t(c - r.after.data()) + 1;
-      if (next >= r.after.size()) break;
-      c = &r.after[next];
     }
+  }
+  text +=
+      "\nScatter floor (the cycles' own scatter; no precontrol fed the desired path gets the "
+      "max deviation below it):\n";
+  for (const eval::VerificationCase* c : all_cases(r)) {
+    text +=
+        fmt::format("{:<16} {:>7.3f} mm as measured", c->label, c->figures.scatter_floor_m * kMm);
+    if (args.measure_with_ims)
+      text += fmt::format(", {:.3f} mm on the true path", c->true_figures.scatter_floor_m * kMm);
+    text += "\n";
   }
   text +=
       "\nCO: overshoot beyond the end point of each straight segment (the paths stop at every "

@@ -1,7 +1,7 @@
 // The precontrol in the loop (eval/closed_loop.hpp): a table whose models predict no error leaves
 // the robot simulator's run bit for bit unchanged; a table holding the exact inverse of a linear
 // plant makes the attained joints equal the desired ones; the feed-forward derivatives of the
-// modified command are exact on a polynomial offset.
+// modified command are exact on a polynomial offset; the warm-up starts a path at rest settled.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -227,6 +227,40 @@ TEST(ClosedLoop, FeedForwardOfTheCommandIsTheOffsetsDerivative) {
     EXPECT_EQ(s.qd_rad_s[0], path.samples[k].qd_rad_s[0]);
   }
   EXPECT_THROW(command_path(path, {}), std::invalid_argument);
+}
+
+// The warm-up (CompensationOptions::warm_up_cycles): a path that starts at rest gets the offset
+// the precontrol settles at for its first sample from the first cycle on, instead of the ramp of
+// a cold start; a path that starts in motion is run as without it.
+TEST(ClosedLoop, WarmUpStartsAPathAtRestAtTheSettledOffset) {
+  // q̂ = 1.001 q_d: a static offset of 1e-3 q_d (1e-4 .. 6e-4 rad), passed through the default
+  // smoother (τ = 4 ms); supervisor out of reach.
+  const ident::ParameterTable table =
+      fir_table({{{1.001}, {1.001}, {1.001}, {1.001}, {1.001}, {1.001}}});
+  CompensationOptions options;
+  options.precontrol.offset_tolerance_rad.fill(10.0);
+  options.precontrol.rate_tolerance_rad_s.fill(1e6);
+  const sim::DesiredJointPath path = smooth_joint_path();  // at rest for its first 0.2 s
+  const CompensationRun cold = run_precontrol(table, "kr16", path, options);
+  options.warm_up_cycles = 500;
+  const CompensationRun warm = run_precontrol(table, "kr16", path, options);
+  // Cold: the offset ramps in over the first cycles (at k = 0 less than half of where it
+  // settles by k = 90, 22 time constants later, still at rest).
+  EXPECT_GT((cold.offset_rad[90] - cold.offset_rad[0]).norm(), 0.5 * cold.offset_rad[90].norm());
+  // Warm: settled from k = 0 (500 cycles = 250 time constants: rounding only, 1e-15 rad), and
+  // the same as the cold run once that has settled.
+  for (std::size_t k = 0; k < 90; ++k)
+    EXPECT_LT((warm.offset_rad[k] - warm.offset_rad[90]).norm(), 1e-15) << k;
+  EXPECT_LT((warm.offset_rad[90] - cold.offset_rad[90]).norm(), 1e-15);
+  EXPECT_TRUE(warm.events.empty());
+  // A path that starts in motion (cut 0.5 s in): no warm-up, bit for bit the cold run.
+  sim::DesiredJointPath moving = path;
+  moving.samples.erase(moving.samples.begin(), moving.samples.begin() + 250);
+  options.warm_up_cycles = 0;
+  const CompensationRun moving_cold = run_precontrol(table, "kr16", moving, options);
+  options.warm_up_cycles = 500;
+  const CompensationRun moving_warm = run_precontrol(table, "kr16", moving, options);
+  EXPECT_EQ(moving_warm.offset_rad, moving_cold.offset_rad);
 }
 
 TEST(ClosedLoop, RefusedTableIsAnError) {

@@ -1,5 +1,5 @@
 // Path deviation against closed forms: an offset parallel line, a late robot on the right line, a
-// circle of another radius, and the paper's line there and back.
+// circle of another radius, the paper's line there and back, and the cycles' scatter floor.
 #include "eval/path_deviation.hpp"
 
 #include <gtest/gtest.h>
@@ -77,6 +77,39 @@ TEST(PathDeviation, RefusesTooFewPointsAndBadWindow) {
   EXPECT_THROW(path_deviation({{0.0, Eigen::Vector3d::Zero()}}, {}), std::invalid_argument);
   const auto desired = line(0.0, 1.0, 0.1, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX());
   EXPECT_THROW(path_deviation(desired, desired, 0.0), std::invalid_argument);
+}
+
+TEST(PathDeviation, ScatterFloorIsHalfTheWidestSpreadBetweenCycles) {
+  // Three cycles on a line along y, offset by +0.3, -0.1 and +0.1 mm in x; cycle 1 also lifts by
+  // 0.4 mm in z at one instant (t = 1 s) and runs late by 20 ms (along the line: no deviation).
+  const Eigen::Vector3d v(0.0, 0.4, 0.0);
+  const auto desired = line(0.0, 2.0, 0.002, Eigen::Vector3d::Zero(), v);
+  auto cycle = [&](double dx_m, double late_s) {
+    std::vector<TimedPoint> points;
+    for (int k = 50; k <= 950; ++k) {
+      const double t = 0.002 * k;
+      Eigen::Vector3d p = v * (t - late_s) + Eigen::Vector3d(dx_m, 0, 0);
+      if (k == 500 && late_s > 0) p.z() += 0.4e-3;
+      points.push_back({t, p});
+    }
+    return points;
+  };
+  std::vector<PathDeviation> cycles;
+  for (auto [dx, late] : {std::pair{0.3e-3, 0.0}, {-0.1e-3, 0.02}, {0.1e-3, 0.0}})
+    cycles.push_back(path_deviation(desired, cycle(dx, late)));
+  // Closed form: everywhere the widest pair is 0.4 mm apart (floor 0.2 mm); at t = 1 s cycles 0
+  // and 1 are hypot(0.4, 0.4) mm apart. Rounding only (1e-12 m).
+  EXPECT_NEAR(scatter_floor_m(cycles), 0.5 * std::hypot(0.4e-3, 0.4e-3), 1e-12);
+  // The floor is a lower bound of the max deviation over the cycles, and one cycle has none.
+  double max_m = 0.0;
+  for (const auto& d : cycles) max_m = std::max(max_m, d.max_m);
+  EXPECT_LE(scatter_floor_m(cycles), max_m);
+  EXPECT_EQ(scatter_floor_m({cycles[0]}), 0.0);
+  // A common shift of every cycle (a command the same in each) leaves the floor unchanged.
+  std::vector<PathDeviation> shifted;
+  for (auto [dx, late] : {std::pair{0.8e-3, 0.0}, {0.4e-3, 0.02}, {0.6e-3, 0.0}})
+    shifted.push_back(path_deviation(desired, cycle(dx, late)));
+  EXPECT_NEAR(scatter_floor_m(shifted), scatter_floor_m(cycles), 1e-12);
 }
 
 }  // namespace

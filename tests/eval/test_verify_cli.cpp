@@ -75,6 +75,13 @@ TEST_F(VerifyCli, ZeroTableVerifiesUnchangedAndEvaluateAgrees) {
   EXPECT_EQ(before["max_path_deviation_mm"], after["max_path_deviation_mm"]);
   EXPECT_EQ(after["reduction_of_max_path_deviation_percent"].get<double>(), 0.0);
   EXPECT_GT(before["max_path_deviation_mm"].get<double>(), 1.0);  // the uncalibrated robot errs
+  // The cycles' scatter floor (eval::scatter_floor_m): the same for both, under the maximum, and
+  // in the text report.
+  EXPECT_EQ(before["scatter_floor_mm"], after["scatter_floor_mm"]);
+  EXPECT_LE(before["scatter_floor_mm"].get<double>(),
+            before["max_path_deviation_mm"].get<double>());
+  EXPECT_GT(before["scatter_floor_mm"].get<double>(), 0.0);  // friction drawn anew per cycle
+  EXPECT_NE(read(s / "verification.txt").find("Scatter floor"), std::string::npos);
 
   // `imscal evaluate` on the written files over the evaluated segment, same window.
   ASSERT_EQ(
