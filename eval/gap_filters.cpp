@@ -36,15 +36,27 @@ std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta
   const double w = 2.0 * M_PI * f_hz;
   const int sub = 8;
   const double h = s.cycle_s / sub;
+  // One substep of (p, v) with the input x held: v' = (1 - 2ζωh) v - hω² p + hω² x, p' = p + h v'.
+  // It is linear, so the 8 substeps of a cycle are one map s' = A s + B x, composed once here
+  // (the same filter, 8x fewer operations per sample; it was a quarter of `imscal diagnose`).
+  Eigen::Matrix2d step_A;
+  step_A << 1.0 - h * h * w * w, h * (1.0 - 2.0 * zeta * w * h), -h * w * w,
+      1.0 - 2.0 * zeta * w * h;
+  const Eigen::Vector2d step_B(h * h * w * w, h * w * w);
+  Eigen::Matrix2d A = Eigen::Matrix2d::Identity();
+  Eigen::Vector2d B = Eigen::Vector2d::Zero();
+  for (int i = 0; i < sub; ++i) {
+    A = step_A * A;
+    B = step_A * B + step_B;
+  }
   Column y(u.size()), r(u.size());
   for (const auto& [b, e] : s.runs) {
     double p = e > b ? u[Eigen::Index(b)] : 0.0, v = 0.0;  // at rest in its first input
     for (std::size_t k = b; k < e; ++k) {
       const double x = u[Eigen::Index(k)];
-      for (int i = 0; i < sub; ++i) {
-        v += h * (w * w * (x - p) - 2.0 * zeta * w * v);
-        p += h * v;
-      }
+      const double p_next = A(0, 0) * p + A(0, 1) * v + B[0] * x;
+      v = A(1, 0) * p + A(1, 1) * v + B[1] * x;
+      p = p_next;
       y[Eigen::Index(k)] = p;
       r[Eigen::Index(k)] = v / w;
     }

@@ -21,8 +21,9 @@ Eigen::MatrixXd matrix_of(const std::vector<Column>& cols);
 // First-order lag y' = (u - y) / tau, exact discretisation.
 Column lag(const Column& u, double tau_s, const GapSignals& s);
 
-// Lightly damped second-order response ω²/(s² + 2ζωs + ω²) to u (semi-implicit Euler with 8
-// substeps per cycle: stable and accurate to < 1 % up to 40 Hz at 2 ms), and its rate / ω.
+// Lightly damped second-order response ω²/(s² + 2ζωs + ω²) to u held over each cycle
+// (semi-implicit Euler with 8 substeps per cycle, composed into one map per cycle: stable and
+// accurate to < 1 % up to 40 Hz at 2 ms), and its rate / ω.
 std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta,
                                        const GapSignals& s);
 
