@@ -52,9 +52,9 @@ struct CompensationOptions {
   // W >= 0 cycles the precontrol runs at the path's first sample before the path starts, when the
   // path starts at rest (its first two samples equal, no rates): on a controller the compensation
   // runs from power-on, so it has settled at the start pose's static offset long before a test
-  // path. Without it, a run cut out of a
-  // program starts the precontrol cold and its offset ramps in during the first cycles (2 mrad
-  // on A2 within 40 ms on seed-line): a jump of the robot that its own rest does not show.
+  // path. Without it, a run cut out of a program starts the precontrol cold and its offset ramps
+  // in during the first cycles (2 mrad on A2 within 40 ms on seed-line): a jump of the robot that
+  // its own rest does not show.
   int warm_up_cycles = 0;
   // The robot's rigid-body model, for tables whose models take the model torque: the precontrol
   // is then fed the torque along the desired path at the sample it is fed (eval/model_torque.hpp).

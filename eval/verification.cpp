@@ -7,6 +7,7 @@
 #include <optional>
 #include <random>
 #include <stdexcept>
+#include <utility>
 
 #include "calib/forward_kinematics.hpp"
 #include "eval/ims_measured_path.hpp"
@@ -168,7 +169,7 @@ PathFigures path_figures(const std::vector<sim::PathSegment>& segments,
     std::vector<TimedPoint> actual;
     for (const PathPose& p : cycles[j])
       if (inside(p.t_s)) actual.push_back({p.t_s, p.p_m});
-    const PathDeviation d = path_deviation(desired_points, actual, options.deviation_window_s);
+    PathDeviation d = path_deviation(desired_points, actual, options.deviation_window_s);
     f.max_path_deviation_m = std::max(f.max_path_deviation_m, d.max_m);
     for (double e : d.deviation_m) sum_squares += e * e;
     count += d.deviation_m.size();
@@ -184,7 +185,7 @@ PathFigures path_figures(const std::vector<sim::PathSegment>& segments,
         series->deviation_m.push_back(d.deviation_m[k]);
       }
     }
-    deviations.push_back(d);
+    deviations.push_back(std::move(d));
   }
   f.rms_path_deviation_m = count ? std::sqrt(sum_squares / double(count)) : 0.0;
   f.scatter_floor_m = scatter_floor_m(deviations);

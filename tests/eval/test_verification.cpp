@@ -1,6 +1,6 @@
 // Issue 6 and 5 figures, measured against the simulator's truth: the ARX tables identified on the
 // `identification` scenario (joint errors q_d - q_link from the plant, a stand-in for the IMS
-// chain), verified on `seed-line` (the paper's line, backlash on every joint incl. A2) and on the
+// chain), verified on `seed-line` (the paper's line; backlash on A2, A3 and A5) and on the
 // 100 % velocity paths of `iso9283`, which were not used for identification. Prints the
 // before/after ISO 9283 table, the ablation (backlash term off, one cell instead of the grid) and
 // the held-out simulation fit per joint with the chosen orders and dead times.
