@@ -8,7 +8,8 @@ if(IMSCAL_WERROR)
 endif()
 if(IMSCAL_SANITIZE)
   target_compile_options(imscal_build_options INTERFACE
-    -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+    -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+    -fsanitize-ignorelist=${PROJECT_SOURCE_DIR}/cmake/ubsan-ignorelist.txt)
   target_link_options(imscal_build_options INTERFACE -fsanitize=address,undefined)
 endif()
 
