@@ -59,17 +59,40 @@ PathDeviation path_deviation(const std::vector<TimedPoint>& desired,
   return out;
 }
 
-double scatter_floor_m(const std::vector<PathDeviation>& cycles) {
-  std::map<long long, std::vector<Eigen::Vector3d>> vectors_at;  // key: time in 0.1 ms
+namespace {
+
+// The cycles' deviation vectors grouped by instant (key: time in 0.1 ms).
+std::map<long long, std::vector<Eigen::Vector3d>> vectors_by_instant(
+    const std::vector<PathDeviation>& cycles) {
+  std::map<long long, std::vector<Eigen::Vector3d>> vectors_at;
   for (const PathDeviation& d : cycles)
     for (std::size_t k = 0; k < d.t_s.size(); ++k)
       vectors_at[std::llround(d.t_s[k] * 1e4)].push_back(d.deviation_vector_m[k]);
+  return vectors_at;
+}
+
+}  // namespace
+
+double scatter_floor_m(const std::vector<PathDeviation>& cycles) {
   double floor_m = 0.0;
-  for (const auto& [key, vectors] : vectors_at)
+  for (const auto& [key, vectors] : vectors_by_instant(cycles))
     for (std::size_t a = 0; a < vectors.size(); ++a)
       for (std::size_t b = a + 1; b < vectors.size(); ++b)
         floor_m = std::max(floor_m, 0.5 * (vectors[a] - vectors[b]).norm());
   return floor_m;
+}
+
+CycleSplit split_cycles(const std::vector<PathDeviation>& cycles) {
+  CycleSplit split;
+  for (const auto& [key, vectors] : vectors_by_instant(cycles)) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& v : vectors) mean += v;
+    mean /= double(vectors.size());
+    split.systematic_max_m = std::max(split.systematic_max_m, mean.norm());
+    for (const Eigen::Vector3d& v : vectors)
+      split.about_mean_max_m = std::max(split.about_mean_max_m, (v - mean).norm());
+  }
+  return split;
 }
 
 }  // namespace imscal::eval

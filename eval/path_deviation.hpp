@@ -42,4 +42,16 @@ PathDeviation path_deviation(const std::vector<TimedPoint>& desired,
 // below this, as long as the scatter does not change with the command. 0 for < 2 cycles.
 double scatter_floor_m(const std::vector<PathDeviation>& cycles);
 
+// The cycles' deviations split into what repeats and what does not, at each instant (matched as
+// for the floor): the mean of the cycles' deviation vectors, which a command the same in every
+// cycle can remove, and each cycle's distance from that mean, which it cannot. [m]
+struct CycleSplit {
+  double systematic_max_m = 0.0;  // max over the instants of |mean vector|: the model's own error
+  // max over instants and cycles of |vector - mean|: what a precontrol exact on average (the
+  // mean removed at every instant) leaves as the max deviation; >= the scatter floor, which a
+  // precontrol aiming at the middle of the spread instead of its mean would reach.
+  double about_mean_max_m = 0.0;
+};
+CycleSplit split_cycles(const std::vector<PathDeviation>& cycles);
+
 }  // namespace imscal::eval

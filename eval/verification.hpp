@@ -176,6 +176,11 @@ struct PathFigures {
   // speeds, on which friction depends, by < 1 %). It is the repeatability's share of the max
   // deviation: the friction drawn per cycle and, as measured, the IMS's per-cycle errors.
   double scatter_floor_m = 0.0;
+  // The same cycles split at each instant into their mean (systematic_max_m: the max of the
+  // repeatable error, what the model gets wrong) and the distances from it (about_mean_max_m:
+  // the max deviation a precontrol exact on average would leave) (eval::split_cycles).
+  double systematic_max_m = 0.0;
+  double about_mean_max_m = 0.0;
   int missed_crossings = 0;
 };
 

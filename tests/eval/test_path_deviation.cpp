@@ -79,7 +79,7 @@ TEST(PathDeviation, RefusesTooFewPointsAndBadWindow) {
   EXPECT_THROW(path_deviation(desired, desired, 0.0), std::invalid_argument);
 }
 
-TEST(PathDeviation, ScatterFloorIsHalfTheWidestSpreadBetweenCycles) {
+TEST(PathDeviation, ScatterFloorAndTheSplitAboutTheMeanFollowTheClosedForm) {
   // Three cycles on a line along y, offset by +0.3, -0.1 and +0.1 mm in x; cycle 1 also lifts by
   // 0.4 mm in z at one instant (t = 1 s) and runs late by 20 ms (along the line: no deviation).
   const Eigen::Vector3d v(0.0, 0.4, 0.0);
@@ -110,6 +110,20 @@ TEST(PathDeviation, ScatterFloorIsHalfTheWidestSpreadBetweenCycles) {
   for (auto [dx, late] : {std::pair{0.8e-3, 0.0}, {0.4e-3, 0.02}, {0.6e-3, 0.0}})
     shifted.push_back(path_deviation(desired, cycle(dx, late)));
   EXPECT_NEAR(scatter_floor_m(shifted), scatter_floor_m(cycles), 1e-12);
+
+  // The split about the mean, closed form: the x offsets 0.3, -0.1, 0.1 mm have the mean 0.1 mm
+  // everywhere; at t = 1 s cycle 1 adds 0.4 mm in z, so the mean is (0.1, 0, 0.4 / 3) mm there
+  // and cycle 1 lies (-0.2, 0, 0.8 / 3) mm from it: 1/3 mm, the largest distance (elsewhere 0.2).
+  // Rounding only (1e-12 m).
+  const CycleSplit split = split_cycles(cycles);
+  EXPECT_NEAR(split.systematic_max_m, std::hypot(0.1e-3, 0.4e-3 / 3.0), 1e-12);
+  EXPECT_NEAR(split.about_mean_max_m, 1e-3 / 3.0, 1e-12);
+  // A common shift moves the mean, not the distances from it; the latter are >= the floor.
+  const CycleSplit shifted_split = split_cycles(shifted);
+  EXPECT_NEAR(shifted_split.systematic_max_m, std::hypot(0.6e-3, 0.4e-3 / 3.0), 1e-12);
+  EXPECT_NEAR(shifted_split.about_mean_max_m, split.about_mean_max_m, 1e-12);
+  EXPECT_GE(split.about_mean_max_m, scatter_floor_m(cycles));
+  EXPECT_EQ(split_cycles({cycles[0]}).about_mean_max_m, 0.0);
 }
 
 }  // namespace
