@@ -74,17 +74,16 @@ std::map<long long, std::vector<Eigen::Vector3d>> vectors_by_instant(
 }  // namespace
 
 double scatter_floor_m(const std::vector<PathDeviation>& cycles) {
-  double floor_m = 0.0;
-  for (const auto& [key, vectors] : vectors_by_instant(cycles))
-    for (std::size_t a = 0; a < vectors.size(); ++a)
-      for (std::size_t b = a + 1; b < vectors.size(); ++b)
-        floor_m = std::max(floor_m, 0.5 * (vectors[a] - vectors[b]).norm());
-  return floor_m;
+  return split_cycles(cycles).scatter_floor_m;
 }
 
 CycleSplit split_cycles(const std::vector<PathDeviation>& cycles) {
   CycleSplit split;
   for (const auto& [key, vectors] : vectors_by_instant(cycles)) {
+    for (std::size_t a = 0; a < vectors.size(); ++a)
+      for (std::size_t b = a + 1; b < vectors.size(); ++b)
+        split.scatter_floor_m =
+            std::max(split.scatter_floor_m, 0.5 * (vectors[a] - vectors[b]).norm());
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (const Eigen::Vector3d& v : vectors) mean += v;
     mean /= double(vectors.size());

@@ -44,8 +44,10 @@ double scatter_floor_m(const std::vector<PathDeviation>& cycles);
 
 // The cycles' deviations split into what repeats and what does not, at each instant (matched as
 // for the floor): the mean of the cycles' deviation vectors, which a command the same in every
-// cycle can remove, and each cycle's distance from that mean, which it cannot. [m]
+// cycle can remove, and each cycle's distance from that mean, which it cannot; with the scatter
+// floor of the same instants (one grouping of the cycles for all three). [m]
 struct CycleSplit {
+  double scatter_floor_m = 0.0;   // as scatter_floor_m()
   double systematic_max_m = 0.0;  // max over the instants of |mean vector|: the model's own error
   // max over instants and cycles of |vector - mean|: what a precontrol exact on average (the
   // mean removed at every instant) leaves as the max deviation; >= the scatter floor, which a

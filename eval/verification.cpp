@@ -188,8 +188,8 @@ PathFigures path_figures(const std::vector<sim::PathSegment>& segments,
     deviations.push_back(std::move(d));
   }
   f.rms_path_deviation_m = count ? std::sqrt(sum_squares / double(count)) : 0.0;
-  f.scatter_floor_m = scatter_floor_m(deviations);
   const CycleSplit split = split_cycles(deviations);
+  f.scatter_floor_m = split.scatter_floor_m;
   f.systematic_max_m = split.systematic_max_m;
   f.about_mean_max_m = split.about_mean_max_m;
   return f;
