@@ -5,8 +5,10 @@
 //            nb 1..32 and d 0..4 with BIC, 3 speed x 2 payload cells, eq. 3's backlash, on known
 //            ARX joints with backlash (tests/ident/joint_simulation.hpp).
 //   default  datasets/identification/ident-default.yaml: imscal's inverse form with the model
-//            torque, direction and torque-sign inputs (60 + 60 + 1 further coefficients in every
-//            candidate of the same sweep), one cell, on the simulator's `identification` run
+//            torque, direction, torque-sign and transmission-error inputs (60 + 60 + 1 + 32 + 32
+//            further coefficients in every candidate of the same sweep; --summary also times it
+//            without the transmission-error pair, the eleventh round's default, in the same
+//            run), one cell, on the simulator's `identification` run
 //            (the plant's true joint errors and the KDL model torques, 130 s) repeated as
 //            separate runs up to 1 M samples, each repetition with its own white measurement
 //            noise of 0.03 mrad (the IMS chain's error on this record, test_verification.cpp):
@@ -49,6 +51,7 @@ struct Data {
   ident::JointErrorLog known_arx;       // the paper config's data
   ident::JointErrorLog identification;  // the default config's data
   ident::IdentificationConfig paper, shipped_default;
+  ident::IdentificationConfig without_transmission_error;  // the default without the pair
 };
 
 // Known ARX joints with backlash, 1 M samples each.
@@ -121,6 +124,8 @@ const Data& data() {
     Data out;
     out.paper = config_of("ident-paper.yaml");
     out.shipped_default = config_of("ident-default.yaml");
+    out.without_transmission_error = out.shipped_default;
+    out.without_transmission_error.options.transmission_error_input = false;
     out.known_arx = known_arx_log();
     out.identification = tiled_identification_log(out.shipped_default);
     return out;
@@ -134,19 +139,28 @@ double cpu_seconds() {
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
+enum class Config { kPaper, kDefault, kDefaultWithoutTransmissionError };
+
 // threads: 0 = every core (as `imscal identify`), 1 = the sequential baseline. Each config on
 // its own data (see the header).
-std::vector<ident::JointOutcome> identify_all(bool shipped_default, unsigned threads) {
-  return shipped_default
-             ? ident::identify_joints(data().identification, data().shipped_default, threads)
-             : ident::identify_joints(data().known_arx, data().paper, threads);
+std::vector<ident::JointOutcome> identify_all(Config config, unsigned threads) {
+  switch (config) {
+    case Config::kPaper:
+      return ident::identify_joints(data().known_arx, data().paper, threads);
+    case Config::kDefault:
+      return ident::identify_joints(data().identification, data().shipped_default, threads);
+    case Config::kDefaultWithoutTransmissionError:
+      break;
+  }
+  return ident::identify_joints(data().identification, data().without_transmission_error, threads);
 }
 
 // Arg 0: the config (0 paper, 1 default); arg 1: threads (1 baseline, 0 all cores). Wall time:
 // the goal is the user's wait.
 void BM_Identify6Joints1M(benchmark::State& state) {
   for (auto _ : state)
-    benchmark::DoNotOptimize(identify_all(state.range(0) == 1, unsigned(state.range(1))));
+    benchmark::DoNotOptimize(identify_all(state.range(0) == 1 ? Config::kDefault : Config::kPaper,
+                                          unsigned(state.range(1))));
 }
 BENCHMARK(BM_Identify6Joints1M)
     ->Args({0, 1})
@@ -163,13 +177,18 @@ BENCHMARK(BM_Identify6Joints1M)
 int main(int argc, char** argv) {
   if (argc > 1 && std::strcmp(argv[1], "--summary") == 0) {
     data();
-    for (const bool shipped_default : {false, true}) {
-      std::printf("%s\n", shipped_default
-                              ? "default config (ident-default.yaml: inverse form, 60-tap "
-                                "torque and direction inputs, one cell) on the simulated "
-                                "identification run, repeated; issue 5's goal < 2 s"
-                              : "paper config (ident-paper.yaml: eq. 2 ARX, 3 x 2 cells, "
-                                "backlash) on known ARX joints; issue 5's goal < 2 s");
+    for (const Config config :
+         {Config::kPaper, Config::kDefault, Config::kDefaultWithoutTransmissionError}) {
+      std::printf("%s\n",
+                  config == Config::kPaper
+                      ? "paper config (ident-paper.yaml: eq. 2 ARX, 3 x 2 cells, backlash) on "
+                        "known ARX joints; issue 5's goal < 2 s"
+                  : config == Config::kDefault
+                      ? "default config (ident-default.yaml: inverse form, 60-tap torque and "
+                        "direction inputs, 32-tap transmission-error pair, one cell) on the "
+                        "simulated identification run, repeated; issue 5's goal < 2 s"
+                      : "the default without the transmission-error pair (the eleventh round's "
+                        "default), the same run");
       // All cores first: the first run also pays the first touches of memory, so the ratio to
       // the one-thread baseline after it is on the safe side.
       std::vector<ident::JointOutcome> result;
@@ -177,7 +196,7 @@ int main(int argc, char** argv) {
       for (const unsigned threads : {0u, 1u}) {
         const auto wall0 = std::chrono::steady_clock::now();
         const double cpu0 = cpu_seconds();
-        auto outcomes = identify_all(shipped_default, threads);
+        auto outcomes = identify_all(config, threads);
         const double wall =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
         std::printf("  6 joints x %zu samples, %s: %.3f s wall, %.3f s CPU", kSamples,

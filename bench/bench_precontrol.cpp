@@ -24,19 +24,27 @@ namespace {
 using namespace imscal::ident;
 
 // The default identification's coefficients per torque and direction input
-// (datasets/identification/ident-default.yaml, model.input_taps: 60 since the eighth round).
+// (datasets/identification/ident-default.yaml, model.input_taps: 60 since the eighth round) and
+// per input of the transmission-error pair (model.transmission_error_taps: 32 since the twelfth).
 constexpr int kDefaultInputTaps = 60;
+constexpr int kDefaultTransmissionErrorTaps = 32;
 
-// with_inputs: every cell also takes the three further inputs of the default identification
-// (model torque and direction with kDefaultInputTaps coefficients each, the torque's sign with
-// one).
-ParameterTable order_32_table(bool with_inputs) {
+// inputs: 0, or every cell also takes the first 3 or all 5 further inputs of the default
+// identification (model torque and direction with kDefaultInputTaps coefficients each, the
+// torque's sign with one, the transmission-error pair with kDefaultTransmissionErrorTaps each;
+// 3 is the default before the twelfth round).
+ParameterTable order_32_table(int inputs) {
+  const bool with_inputs = inputs > 0, transmission_error = inputs == 5;
   std::mt19937_64 rng(32);
   ParameterTable t;
   t.robot = "kr16";
   t.sample_time_s = 0.002;
   if (with_inputs)
     t.extra_inputs = {TableInput::kModelTorque, TableInput::kDirection, TableInput::kTorqueSign};
+  if (transmission_error) {
+    t.extra_inputs.push_back(TableInput::kTransmissionErrorSin);
+    t.extra_inputs.push_back(TableInput::kTransmissionErrorCos);
+  }
   for (int j = 0; j < 6; ++j) {
     JointParameters joint;
     joint.name = std::string(1, 'A').append(std::to_string(j + 1));
@@ -44,6 +52,10 @@ ParameterTable order_32_table(bool with_inputs) {
                         CellDimension{OperatingQuantity::kPayload, {0.0, 8.0, 16.0}}};
     joint.backlash_l_rad = 1e-4;
     if (with_inputs) joint.torque_sign_scale_nm = 1.0;
+    if (transmission_error) {
+      joint.transmission_error_rad_per_rad = 160.0;           // harmonic 1 x gear ratio 160
+      joint.transmission_error_compliance_rad_per_nm = 2e-6;  // 1 / (5e5 N m/rad)
+    }
     for (int c = 0; c < 6; ++c) {
       CellParameters cell;
       cell.bands = {c / 2, c % 2};
@@ -54,10 +66,11 @@ ParameterTable order_32_table(bool with_inputs) {
       cell.a.assign(a.data(), a.data() + a.size());
       cell.b.assign(32, a_sum / 32.0);  // static gain 1
       if (with_inputs) {
-        cell.structure.extra_inputs = 3;
-        cell.structure.nx = {kDefaultInputTaps, kDefaultInputTaps, 1};
-        cell.c.assign(2 * kDefaultInputTaps + 1,
-                      1e-7);  // a small response to torque, direction, side
+        cell.structure.extra_inputs = inputs;
+        cell.structure.nx = {kDefaultInputTaps, kDefaultInputTaps, 1, kDefaultTransmissionErrorTaps,
+                             kDefaultTransmissionErrorTaps};
+        // A small response to torque, direction, side and the transmission error.
+        cell.c.assign(std::size_t(cell.structure.extra_coefficient_count()), 1e-7);
       }
       joint.cells.push_back(cell);
     }
@@ -74,8 +87,9 @@ ParameterTable order_32_table(bool with_inputs) {
 // interrupt or by a neighbour's cache traffic number some 10^2..10^3 per 10^6, so the 99.9th
 // percentile is the machine's as much as the cycle's once `over_2us` nears 1000.
 template <class Runtime>
-void time_cycles(benchmark::State& state, bool with_inputs) {
-  const ParameterTable table = order_32_table(with_inputs);
+void time_cycles(benchmark::State& state, int inputs) {
+  const bool with_inputs = inputs > 0;
+  const ParameterTable table = order_32_table(inputs);
   PrecontrolOptions options;
   options.offset_tolerance_rad.fill(1.0);  // keep it active: measure the full work
   options.rate_tolerance_rad_s.fill(1e9);
@@ -118,28 +132,37 @@ void time_cycles(benchmark::State& state, bool with_inputs) {
 }
 
 void BM_PrecontrolCycle6JointsOrder32(benchmark::State& state) {
-  time_cycles<Precontrol>(state, false);
+  time_cycles<Precontrol>(state, 0);
 }
 BENCHMARK(BM_PrecontrolCycle6JointsOrder32)->Unit(benchmark::kMillisecond)->Iterations(1);
 
-// The same table with the default identification's three further inputs in every cell (the
+// The same table with the default identification's five further inputs in every cell (the
 // model torque fed by the caller): the heaviest table the default config can produce per cell.
 void BM_PrecontrolCycle6JointsOrder32FurtherInputs(benchmark::State& state) {
-  time_cycles<Precontrol>(state, true);
+  time_cycles<Precontrol>(state, 5);
 }
 BENCHMARK(BM_PrecontrolCycle6JointsOrder32FurtherInputs)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
+
+// The eleventh round's default, without the transmission-error pair: what the pair costs, in
+// the same run.
+void BM_PrecontrolCycle6JointsOrder32ThreeFurtherInputs(benchmark::State& state) {
+  time_cycles<Precontrol>(state, 3);
+}
+BENCHMARK(BM_PrecontrolCycle6JointsOrder32ThreeFurtherInputs)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1);
 
 // The same with the runtime as it was before issue 6's speed work (every cell runs every cycle):
 // the before/after comparison in one run, on the same machine load.
 void BM_AllCellsReferenceCycle6JointsOrder32(benchmark::State& state) {
-  time_cycles<imscal::test_support::AllCellsPrecontrol>(state, false);
+  time_cycles<imscal::test_support::AllCellsPrecontrol>(state, 0);
 }
 BENCHMARK(BM_AllCellsReferenceCycle6JointsOrder32)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 void BM_AllCellsReferenceCycle6JointsOrder32FurtherInputs(benchmark::State& state) {
-  time_cycles<imscal::test_support::AllCellsPrecontrol>(state, true);
+  time_cycles<imscal::test_support::AllCellsPrecontrol>(state, 5);
 }
 BENCHMARK(BM_AllCellsReferenceCycle6JointsOrder32FurtherInputs)
     ->Unit(benchmark::kMillisecond)

@@ -352,7 +352,7 @@ std::vector<double> replay_held_out_fits(const IdentifiedTable& identified,
     fits.push_back(ident::replay_held_out_fit(identified.joints[j], reference.q_desired_rad[j],
                                               reference.q_measured_rad[j], reference.payload_kg,
                                               segments, reference.cycle_s, config.joint_grid(j),
-                                              config.options, torque)
+                                              config.joint_options(j), torque)
                        .joint_error_fit_percent);
   }
   return fits;
@@ -376,6 +376,7 @@ ident::IdentificationConfig paper_form(ident::IdentificationConfig config) {
   o.form = ident::ArxModelForm::kJointError;
   o.preview_cycles = 0;
   o.model_torque_input = o.direction_input = o.torque_sign_input = false;
+  o.transmission_error_input = false;
   o.identify_backlash = true;
   return with_operating_point_grid(std::move(config));
 }
@@ -385,6 +386,13 @@ std::vector<AblationConfig> ablation_configs(const ident::IdentificationConfig& 
   if (config.options.model_torque_input) {
     AblationConfig a{"without model torque", config};
     a.config.options.model_torque_input = a.config.options.torque_sign_input = false;
+    // The transmission error's phase then from the link angle alone (no torque, no deflection).
+    a.config.gear_stiffness_nm_per_rad.clear();
+    out.push_back(std::move(a));
+  }
+  if (config.options.transmission_error_input) {
+    AblationConfig a{"without transmission error", config};
+    a.config.options.transmission_error_input = false;
     out.push_back(std::move(a));
   }
   AblationConfig backlash{

@@ -80,7 +80,9 @@ IdentifiedTable identify_table(const ident::JointErrorLog& log,
 // of each part is measured on the same paths. Labels say what changed:
 //  * "paper form": the paper's model as it stands (eq. 2 in joint-error form, no further inputs,
 //    the operating-point grid of Table 2, the backlash term of eq. 3), for any config;
-//  * "without model torque": the torque and torque-sign inputs off (configs that have them);
+//  * "without model torque": the torque and torque-sign inputs off (configs that have them; the
+//    transmission error's phase then from the link angle alone);
+//  * "without transmission error": the transmission-error pair off (configs that have it);
 //  * "with/without backlash term": eq. 3's backlash identification and term switched;
 //  * "with operating-point grid" / "single cell": Table 2's speed x payload cells instead of one
 //    cell per joint, or the reverse.

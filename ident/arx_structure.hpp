@@ -19,7 +19,7 @@
 
 namespace imscal::ident {
 
-inline constexpr int kMaxExtraInputs = 3;
+inline constexpr int kMaxExtraInputs = 5;
 
 struct ArxStructure {
   int na = 1;            // number of autoregressive coefficients a_1..a_na

@@ -27,6 +27,20 @@ void check_increasing(const ConfigNode& node, const std::vector<double>& v) {
     if (!(v[i] > v[i - 1])) node.fail("bounds must be strictly increasing");
 }
 
+// One positive value per joint (`what` names it in the messages): empty when the key is absent.
+std::vector<double> per_joint_positive(const ConfigNode& joints, const char* key,
+                                       std::size_t joint_count, const char* what) {
+  const auto node = joints.optional_child(key);
+  if (!node) return {};
+  std::vector<double> v = node->as_doubles();
+  if (v.size() != joint_count)
+    node->fail(
+        fmt::format("one {} per joint: {} given, {} maximum speeds", what, v.size(), joint_count));
+  for (double x : v)
+    if (!(x > 0.0)) node->fail(fmt::format("every {} must be > 0", what));
+  return v;
+}
+
 std::pair<int, int> range(const ConfigNode& node, int lowest) {
   const std::vector<double> v = node.as_doubles();
   if (v.size() != 2 || v[0] != double(long(v[0])) || v[1] != double(long(v[1])) || v[0] < lowest ||
@@ -51,6 +65,21 @@ CellGrid IdentificationConfig::joint_grid(std::size_t joint) const {
   return CellGrid(std::move(dims));
 }
 
+JointIdentificationOptions IdentificationConfig::joint_options(std::size_t joint) const {
+  JointIdentificationOptions o = options;
+  if (o.transmission_error_input) {
+    if (joint >= gear_ratio.size())
+      throw std::invalid_argument(fmt::format(
+          "identification config: no gear ratio for joint {} (joints.gear_ratio has {})", joint + 1,
+          gear_ratio.size()));
+    o.transmission_error_rad_per_rad =
+        transmission_error_harmonic_per_motor_rev * gear_ratio[joint];
+    if (joint < gear_stiffness_nm_per_rad.size())
+      o.transmission_error_compliance_rad_per_nm = 1.0 / gear_stiffness_nm_per_rad[joint];
+  }
+  return o;
+}
+
 IdentificationConfig load_identification_config(const ConfigNode& root) {
   root.require_only_keys({"imscal-identification-config", "joints", "cells", "model", "order",
                           "validation", "stability_margin", "backlash"});
@@ -60,10 +89,14 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
   auto& o = c.options;
 
   const ConfigNode joints = root.child("joints");
-  joints.require_only_keys({"max_speed_deg_s", "nominal_payload_kg"});
+  joints.require_only_keys(
+      {"max_speed_deg_s", "nominal_payload_kg", "gear_ratio", "gear_stiffness_nm_per_rad"});
   c.max_speed_rad_s = scaled(joints.child("max_speed_deg_s").as_doubles(), kDeg);
   for (double v : c.max_speed_rad_s)
     if (!(v > 0.0)) joints.child("max_speed_deg_s").fail("every maximum speed must be > 0");
+  c.gear_ratio = per_joint_positive(joints, "gear_ratio", c.max_speed_rad_s.size(), "gear ratio");
+  c.gear_stiffness_nm_per_rad = per_joint_positive(joints, "gear_stiffness_nm_per_rad",
+                                                   c.max_speed_rad_s.size(), "stiffness");
   c.nominal_payload_kg = joints.child("nominal_payload_kg").as_double();
   if (!(c.nominal_payload_kg > 0.0))
     joints.child("nominal_payload_kg").fail("nominal payload must be > 0");
@@ -109,7 +142,9 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
   if (auto model = root.optional_child("model")) {
     model->require_only_keys({"form", "preview_cycles", "model_torque", "direction",
                               "direction_speed_scale_deg_s", "torque_sign",
-                              "torque_sign_scale_fraction", "input_taps", "torque_sign_taps"});
+                              "torque_sign_scale_fraction", "input_taps", "torque_sign_taps",
+                              "transmission_error", "transmission_error_harmonic_per_motor_rev",
+                              "transmission_error_taps"});
     if (auto n = model->optional_child("form")) {
       try {
         o.form = arx_model_form_from_string(n->as_string());
@@ -142,6 +177,28 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
     o.torque_sign_taps = int(model->get_int("torque_sign_taps", o.torque_sign_taps));
     if (o.torque_sign_taps < 1 || o.torque_sign_taps > 64)
       model->child("torque_sign_taps").fail("must be in 1..64 coefficients");
+    o.transmission_error_input = model->get_bool("transmission_error", false);
+    if (o.transmission_error_input && c.gear_ratio.empty())
+      model->child("transmission_error")
+          .fail(
+              "the transmission-error inputs need joints.gear_ratio (their phase advances "
+              "harmonic x gear ratio per rad of joint angle)");
+    if (o.transmission_error_input && !c.gear_stiffness_nm_per_rad.empty() && !o.model_torque_input)
+      model->child("transmission_error")
+          .fail(
+              "the transmission error's phase with the gear's deflection (joints."
+              "gear_stiffness_nm_per_rad) needs model_torque: true");
+    c.transmission_error_harmonic_per_motor_rev = model->get_double(
+        "transmission_error_harmonic_per_motor_rev", c.transmission_error_harmonic_per_motor_rev);
+    if (!(c.transmission_error_harmonic_per_motor_rev > 0.0))
+      model->child("transmission_error_harmonic_per_motor_rev").fail("must be > 0");
+    o.transmission_error_taps =
+        int(model->get_int("transmission_error_taps", o.transmission_error_taps));
+    if (o.transmission_error_taps < 1 || o.transmission_error_taps > 64)
+      model->child("transmission_error_taps").fail("must be in 1..64 coefficients");
+    if (extra_input_count(o) > kMaxExtraInputs)
+      model->fail(fmt::format("at most {} further inputs (the transmission error counts twice)",
+                              kMaxExtraInputs));
   }
   if (auto order = root.optional_child("order")) {
     order->require_only_keys({"na", "nb", "dead_time", "criterion"});
@@ -164,8 +221,10 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
   // The exported table must load into the precontrol (ident/precontrol.hpp): a further input's
   // coefficients move behind the dead time when the model is written in the angle form, so
   // taps + largest dead time must fit the runtime's kMaxPrecontrolOrder per input.
-  if (o.model_torque_input || o.direction_input) {
-    const int taps = std::max(o.input_taps, o.torque_sign_input ? o.torque_sign_taps : 0);
+  if (o.model_torque_input || o.direction_input || o.transmission_error_input) {
+    const int taps = std::max({o.model_torque_input || o.direction_input ? o.input_taps : 0,
+                               o.torque_sign_input ? o.torque_sign_taps : 0,
+                               o.transmission_error_input ? o.transmission_error_taps : 0});
     const int longest = taps + o.grid.dead_time_max;
     if (longest > kMaxPrecontrolOrder) {
       const ConfigNode at =

@@ -19,6 +19,11 @@ struct ExtraDimension {
 
 struct IdentificationConfig {
   std::vector<double> max_speed_rad_s;  // per joint, in the joint order of the data
+  // Per joint (motor revolutions per joint revolution), for the transmission-error inputs; empty
+  // when the config gives none.
+  std::vector<double> gear_ratio;
+  std::vector<double> gear_stiffness_nm_per_rad;  // per joint; empty: the phase from q alone
+  double transmission_error_harmonic_per_motor_rev = 1.0;
   double nominal_payload_kg = 16.0;
   std::vector<double> speed_fraction_bounds{0.0, 0.2, 0.8, 1.0};  // of max speed (paper, Table 2)
   std::vector<double> payload_fraction_bounds{0.0, 0.5, 1.0};     // of nominal payload
@@ -28,6 +33,10 @@ struct IdentificationConfig {
   // Speed × payload (× extra dimensions) of one joint, in SI. Throws std::invalid_argument for
   // a joint without a maximum speed.
   CellGrid joint_grid(std::size_t joint) const;
+  // The options of one joint: `options` with the joint's transmission-error phase rate
+  // (harmonic x gear ratio) when that input is on. Throws std::invalid_argument for a joint
+  // without a gear ratio then.
+  JointIdentificationOptions joint_options(std::size_t joint) const;
 };
 
 // InputError (file, line, key) on unknown keys, bad values or an inconsistent grid.

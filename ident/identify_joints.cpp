@@ -24,6 +24,10 @@ ParameterTable parameter_table_header(const JointErrorLog& log, const Identifica
   if (config.options.model_torque_input) table.extra_inputs.push_back(TableInput::kModelTorque);
   if (config.options.direction_input) table.extra_inputs.push_back(TableInput::kDirection);
   if (config.options.torque_sign_input) table.extra_inputs.push_back(TableInput::kTorqueSign);
+  if (config.options.transmission_error_input) {
+    table.extra_inputs.push_back(TableInput::kTransmissionErrorSin);
+    table.extra_inputs.push_back(TableInput::kTransmissionErrorCos);
+  }
   table.direction_speed_scale_rad_s = config.options.direction_speed_scale_rad_s;
   table.source = std::move(source);
   return table;
@@ -51,7 +55,7 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
             log.model_torque_nm.empty() ? std::span<const double>() : log.model_torque_nm[j];
         outcomes[j].result = identify_joint(
             log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j], log.payload_kg,
-            segments, log.cycle_s, config.joint_grid(j), config.options, torque);
+            segments, log.cycle_s, config.joint_grid(j), config.joint_options(j), torque);
       } catch (const InputError&) {
         errors[j] = std::current_exception();
       } catch (const std::runtime_error& e) {
@@ -63,6 +67,9 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
         // coefficient is zero, so any positive one serves.
         if (config.options.torque_sign_input)
           outcomes[j].result.parameters.torque_sign_scale_nm = 1.0;
+        if (config.options.transmission_error_input)
+          outcomes[j].result.parameters.transmission_error_rad_per_rad =
+              config.joint_options(j).transmission_error_rad_per_rad;
       } catch (...) {
         errors[j] = std::current_exception();
       }

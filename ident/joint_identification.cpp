@@ -211,6 +211,18 @@ FitSignals make_fit_signals(std::span<const double> q_desired, std::span<const d
       side[k] = std::tanh(model_torque_nm[k] / torque_sign_scale_nm);
     ahead(side, s.extra[std::size_t(s.extra_count++)]);
   }
+  if (options.transmission_error_input) {
+    const double f = options.transmission_error_rad_per_rad;
+    const double compliance = options.transmission_error_compliance_rad_per_nm;
+    std::vector<double> sine(n), cosine(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double motor = driver[k] + (compliance != 0.0 ? compliance * model_torque_nm[k] : 0.0);
+      sine[k] = std::sin(f * motor);
+      cosine[k] = std::cos(f * motor);
+    }
+    ahead(sine, s.extra[std::size_t(s.extra_count++)]);
+    ahead(cosine, s.extra[std::size_t(s.extra_count++)]);
+  }
   return s;
 }
 
@@ -278,7 +290,7 @@ ArxModel angle_form_of_error_model(const ArxModel& error_model) {
 
 int extra_input_count(const JointIdentificationOptions& options) {
   return int(options.model_torque_input) + int(options.direction_input) +
-         int(options.torque_sign_input);
+         int(options.torque_sign_input) + 2 * int(options.transmission_error_input);
 }
 
 JointParameters neutral_joint_parameters(const std::string& name, double max_speed_rad_s,
@@ -389,6 +401,20 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
   if (options.torque_sign_input)
     out.parameters.torque_sign_scale_nm =
         torque_sign_scale_of(name, segments, model_torque_nm, options);
+  if (options.transmission_error_input) {
+    if (!(options.transmission_error_rad_per_rad > 0.0))
+      throw std::invalid_argument(
+          "identify_joint: the transmission-error inputs need a phase "
+          "rate > 0 (harmonic x gear ratio)");
+    if (!(options.transmission_error_compliance_rad_per_nm >= 0.0) ||
+        (options.transmission_error_compliance_rad_per_nm > 0.0 && model_torque_nm.size() != n))
+      throw std::invalid_argument(
+          "identify_joint: the transmission error's compliance must be "
+          ">= 0, and > 0 needs the model torque");
+    out.parameters.transmission_error_rad_per_rad = options.transmission_error_rad_per_rad;
+    out.parameters.transmission_error_compliance_rad_per_nm =
+        options.transmission_error_compliance_rad_per_nm;
+  }
   const FitSignals signals_of_fit =
       make_fit_signals(q_desired, output, segments, cycle_s, options, model_torque_nm,
                        out.parameters.torque_sign_scale_nm);
@@ -415,6 +441,9 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
       sweep_options.grid.extra_taps[std::size_t(e++)] = options.input_taps;
     if (options.torque_sign_input)
       sweep_options.grid.extra_taps[std::size_t(e++)] = options.torque_sign_taps;
+    if (options.transmission_error_input)
+      for (int pair = 0; pair < 2; ++pair)
+        sweep_options.grid.extra_taps[std::size_t(e++)] = options.transmission_error_taps;
   }
   sweep_options.criterion = options.criterion;
   sweep_options.min_relative_pivot = options.min_relative_pivot;
@@ -557,7 +586,10 @@ HeldOutReplay replay_held_out_fit(const JointIdentification& identified,
   const std::size_t n = q_desired.size();
   if (q_measured.size() != n || payload.size() != n)
     throw std::invalid_argument("replay_held_out_fit: signal lengths differ");
-  if ((options.model_torque_input || options.torque_sign_input) && model_torque_nm.size() != n)
+  if ((options.model_torque_input || options.torque_sign_input ||
+       (options.transmission_error_input &&
+        options.transmission_error_compliance_rad_per_nm > 0.0)) &&
+      model_torque_nm.size() != n)
     throw std::invalid_argument("replay_held_out_fit: the model's inputs need the model torque");
   HeldOutReplay out;
   if (std::none_of(identified.cells.begin(), identified.cells.end(),

@@ -94,15 +94,27 @@ struct JointIdentificationOptions {
   //    carrying torque sits on one flank, half its play off centre (a constant for a
   //    gravity-loaded joint, which the error form with its static gain of 1 cannot otherwise
   //    hold), and crosses the play where the torque changes sign. Needs the model torque.
-  // Taps: input_taps for the model torque and the direction, torque_sign_taps for the sign
-  // (identify_joint sets OrderGrid::extra_taps from them).
+  //  * the gear's angle-transmission error, periodic in the motor angle: the pair sin(f q),
+  //    cos(f q) with f = transmission_error_rad_per_rad (the harmonic per motor revolution x the
+  //    gear ratio). The link sits te(θ) off the motor, which the motor encoder cannot see (the
+  //    paper's reason for measuring with the IMS); the pair's coefficients hold its amplitude
+  //    and phase (the phase also takes the mean gear deflection), their taps the loop's response
+  //    at the error's frequency, which grows with the speed.
+  // Taps: input_taps for the model torque and the direction, torque_sign_taps for the sign,
+  // transmission_error_taps for each of the pair (identify_joint sets OrderGrid::extra_taps).
   bool model_torque_input = false;
   bool direction_input = false;
   bool torque_sign_input = false;
+  bool transmission_error_input = false;
   double direction_speed_scale_rad_s = 0.01;
   double torque_sign_scale_fraction = 0.01;
+  double transmission_error_rad_per_rad = 0.0;  // of this joint; > 0 with the input
+  // The gear's compliance 1 / k [rad/(N m)]: the motor sits τ / k ahead of the link under the
+  // model torque τ, so the error's phase is f (q + τ / k) (0: the link angle alone).
+  double transmission_error_compliance_rad_per_nm = 0.0;
   int input_taps = 32;
   int torque_sign_taps = 1;
+  int transmission_error_taps = 8;
   OrderGrid grid{1, 32, 1, 32, 0, 4};
   OrderCriterion criterion = OrderCriterion::kBic;
   double validation_fraction = 0.3;  // of every segment (or block), held out (its end)
@@ -154,7 +166,7 @@ JointParameters neutral_joint_parameters(const std::string& name, double max_spe
 JointIdentification neutral_joint_identification(const std::string& name, double max_speed_rad_s,
                                                  const std::string& reason, int extra_inputs = 0);
 
-// The number of further inputs the options switch on (model torque, direction).
+// The number of further inputs the options switch on (the transmission error counts twice).
 int extra_input_count(const JointIdentificationOptions& options);
 
 // segments: [begin, end) ranges of separate runs. model_torque_nm: the joint's model torque per

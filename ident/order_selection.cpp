@@ -119,6 +119,12 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
   Eigen::MatrixXd val_gram(q_max, q_max);
 
   for (int d = grid.dead_time_min; d <= grid.dead_time_max; ++d) {
+    // The columns are the further inputs' and the input's lags first, then the output's: the
+    // leading fixed + nb - 1 rows of nb's factor (and of z) are those of nb - 1's, so each nb
+    // factors only its last input column and the output block (bitwise the same rows: the same
+    // entries, the same sums).
+    int reused = 0;       // leading rows of the factor (and of z) valid from the last nb
+    int prefix_rank = 0;  // rank of the last nb's factor, where it stopped short of its prefix
     for (int nb = grid.nb_min; nb <= grid.nb_max; ++nb) {
       const int q = fixed + nb + grid.na_max;
       for (int e = 0, r = 0; e < extras; ++e)
@@ -133,7 +139,16 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
       // Left-looking Cholesky of the scaled block, with the forward substitution z = L⁻¹ rhs
       // carried along; stops at the first pivot that shows numerical dependence.
       int rank = q;
-      for (int j = 0; j < q; ++j) {
+      if (prefix_rank < reused) rank = prefix_rank;  // the shared prefix is already dependent
+      // Rows past the reused prefix against the prefix's columns.
+      for (int j = 0; j < std::min(reused, rank); ++j) {
+        const double l_jj = factor(j, j);
+        for (int i = reused; i < q; ++i) {
+          const double a_ij = scale(i) * scale(j) * est.gram(column[i], column[j]);
+          factor(i, j) = (a_ij - factor.row(i).head(j).dot(factor.row(j).head(j))) / l_jj;
+        }
+      }
+      for (int j = reused; j < rank; ++j) {
         const double a_jj = scale(j) * scale(j) * est.gram(column[j], column[j]);
         const double pivot = a_jj - factor.row(j).head(j).squaredNorm();
         if (!(pivot > options.min_relative_pivot)) {
@@ -148,6 +163,8 @@ OrderSweepResult sweep_arx_orders(std::span<const IoSegment> segments,
         }
         z(j) = (rhs(j) - factor.row(j).head(j).dot(z.head(j))) / l_jj;
       }
+      reused = fixed + nb;  // the next nb shares the columns up to this nb's last input lag
+      prefix_rank = rank;
       if (has_validation) {
         for (int r = 0; r < q; ++r) {
           val_rhs(r) = val.gram(column[r], 0);

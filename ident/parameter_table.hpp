@@ -15,8 +15,9 @@ namespace imscal::ident {
 
 // Version 2 added model_form, preview_cycles, the further inputs (extra_inputs,
 // direction_speed_scale_rad_s; per cell nx and c); version 1 tables are read as single-input
-// forward models without preview.
-inline constexpr int kParameterTableSchemaVersion = 2;
+// forward models without preview. Version 3 added the transmission-error inputs and the joints'
+// transmission_error_rad_per_rad (version 2 tables are read with 0).
+inline constexpr int kParameterTableSchemaVersion = 3;
 
 // What the cells' models are (ident/joint_identification.hpp): forward error models of the
 // loop (paper, eq. 2: the predicted error Δq̂ from q_d), or inverse models (the offset that makes
@@ -28,11 +29,22 @@ const char* to_string(TableForm form);
 // The further inputs of the cells' models (ident/joint_identification.hpp), in the order the
 // table lists them: the model torque of the joint [N m] from the caller, the direction of motion
 // tanh(q̇_x / direction_speed_scale) from the precontrol's own input x, and the side of the gear
-// the model torque presses on, tanh(torque / torque_sign_scale of the joint).
-enum class TableInput { kModelTorque, kDirection, kTorqueSign };
-inline constexpr TableInput kTableInputs[] = {TableInput::kModelTorque, TableInput::kDirection,
-                                              TableInput::kTorqueSign};
-const char* to_string(TableInput input);  // "model_torque", "direction", "torque_sign"
+// the model torque presses on, tanh(torque / torque_sign_scale of the joint), and the gear's
+// angle-transmission error as the pair sin(f x), cos(f x) of the precontrol's input x with the
+// joint's transmission_error_rad_per_rad f (harmonic x gear ratio: the phase of the error advances
+// f rad per rad of joint angle).
+enum class TableInput {
+  kModelTorque,
+  kDirection,
+  kTorqueSign,
+  kTransmissionErrorSin,
+  kTransmissionErrorCos
+};
+inline constexpr TableInput kTableInputs[] = {
+    TableInput::kModelTorque, TableInput::kDirection, TableInput::kTorqueSign,
+    TableInput::kTransmissionErrorSin, TableInput::kTransmissionErrorCos};
+// "model_torque", "direction", "torque_sign", "transmission_error_sin", "transmission_error_cos"
+const char* to_string(TableInput input);
 
 enum class CellStatus {
   kIdentified,  // fitted from this cell's own rows
@@ -82,6 +94,12 @@ struct JointParameters {
   std::size_t backlash_lag_samples = 0;  // lag used for the direction of motion
   // Scale of the torque-sign input [N m] (> 0 when the table has that input, else 0).
   double torque_sign_scale_nm = 0.0;
+  // Phase of the gear's transmission error per rad of joint angle [rad/rad]: harmonic per motor
+  // revolution x gear ratio (> 0 when the table has the transmission-error inputs, else 0).
+  double transmission_error_rad_per_rad = 0.0;
+  // The gear's compliance 1 / k [rad/(N m)]: the error's phase is f (x + compliance x model
+  // torque), the motor angle the deflected gear sits at (0: the joint angle alone).
+  double transmission_error_compliance_rad_per_nm = 0.0;
   // The largest joint error |q_d - q| and its largest rate (over 8 ms) in the identification
   // data [rad, rad/s]: what the models were identified on. The precontrol's supervisor derives
   // its default tolerances from them (ident/precontrol.hpp). 0: not known (version 1 tables).
@@ -101,6 +119,9 @@ struct JointParameters {
            x.backlash_identified == y.backlash_identified &&
            x.backlash_lag_samples == y.backlash_lag_samples &&
            x.torque_sign_scale_nm == y.torque_sign_scale_nm &&
+           x.transmission_error_rad_per_rad == y.transmission_error_rad_per_rad &&
+           x.transmission_error_compliance_rad_per_nm ==
+               y.transmission_error_compliance_rad_per_nm &&
            x.offset_envelope_rad == y.offset_envelope_rad &&
            x.offset_rate_envelope_rad_s == y.offset_rate_envelope_rad_s && x.cells == y.cells;
   }

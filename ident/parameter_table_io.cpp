@@ -42,6 +42,10 @@ const char* to_string(TableInput input) {
       return "direction";
     case TableInput::kTorqueSign:
       return "torque_sign";
+    case TableInput::kTransmissionErrorSin:
+      return "transmission_error_sin";
+    case TableInput::kTransmissionErrorCos:
+      return "transmission_error_cos";
   }
   return "?";
 }
@@ -282,13 +286,18 @@ CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time
 }
 
 // extra_inputs: the table's further inputs (-1: schema version 1); torque_sign: whether one of
-// them is the torque's sign (the joint then needs its scale).
-JointParameters read_joint(const Node& n, double sample_time_s, int extra_inputs,
-                           bool torque_sign) {
+// them is the torque's sign (the joint then needs its scale); transmission_error: whether the
+// transmission-error pair is (the joint then needs its phase rate; the key from version 3 on).
+JointParameters read_joint(const Node& n, double sample_time_s, int schema_version,
+                           int extra_inputs, bool torque_sign, bool transmission_error) {
   if (extra_inputs < 0)
     n.only_keys({"name", "backlash", "dimensions", "cells"});
-  else
+  else if (schema_version < 3)
     n.only_keys({"name", "backlash", "torque_sign_scale_nm", "offset_envelope_rad",
+                 "offset_rate_envelope_rad_s", "dimensions", "cells"});
+  else
+    n.only_keys({"name", "backlash", "torque_sign_scale_nm", "transmission_error_rad_per_rad",
+                 "transmission_error_compliance_rad_per_nm", "offset_envelope_rad",
                  "offset_rate_envelope_rad_s", "dimensions", "cells"});
   JointParameters j;
   j.name = n.child("name").string();
@@ -299,6 +308,22 @@ JointParameters read_joint(const Node& n, double sample_time_s, int extra_inputs
       n.child("torque_sign_scale_nm")
           .fail(torque_sign ? "the table has the torque-sign input: the scale must be > 0"
                             : "the table has no torque-sign input: the scale must be 0");
+    if (schema_version >= 3) {
+      const Node te = n.child("transmission_error_rad_per_rad");
+      j.transmission_error_rad_per_rad = te.number();
+      if (transmission_error ? !(j.transmission_error_rad_per_rad > 0.0)
+                             : j.transmission_error_rad_per_rad != 0.0)
+        te.fail(transmission_error
+                    ? "the table has the transmission-error inputs: the phase rate must be > 0"
+                    : "the table has no transmission-error input: the phase rate must be 0");
+      const Node compliance = n.child("transmission_error_compliance_rad_per_nm");
+      j.transmission_error_compliance_rad_per_nm = compliance.number();
+      if (!(j.transmission_error_compliance_rad_per_nm >= 0.0) ||
+          (!transmission_error && j.transmission_error_compliance_rad_per_nm != 0.0))
+        compliance.fail(transmission_error
+                            ? "must be >= 0 (0: the phase from the joint angle alone)"
+                            : "the table has no transmission-error input: must be 0");
+    }
     for (const auto& [key, value] :
          {std::pair{"offset_envelope_rad", &j.offset_envelope_rad},
           std::pair{"offset_rate_envelope_rad_s", &j.offset_rate_envelope_rad_s}}) {
@@ -351,17 +376,24 @@ std::string parameters_json_text(const ParameterTable& t) {
                       {"bounds", d.bounds}});
     json cells = json::array();
     for (const auto& c : j.cells) cells.push_back(cell_json(c));
-    joints.push_back({{"name", j.name},
-                      {"backlash",
-                       {{"l_rad", j.backlash_l_rad},
-                        {"l_sigma_rad", j.backlash_l_sigma_rad},
-                        {"identified", j.backlash_identified},
-                        {"lag_samples", j.backlash_lag_samples}}},
-                      {"torque_sign_scale_nm", j.torque_sign_scale_nm},
-                      {"offset_envelope_rad", j.offset_envelope_rad},
-                      {"offset_rate_envelope_rad_s", j.offset_rate_envelope_rad_s},
-                      {"dimensions", dims},
-                      {"cells", cells}});
+    json joint = {{"name", j.name},
+                  {"backlash",
+                   {{"l_rad", j.backlash_l_rad},
+                    {"l_sigma_rad", j.backlash_l_sigma_rad},
+                    {"identified", j.backlash_identified},
+                    {"lag_samples", j.backlash_lag_samples}}},
+                  {"torque_sign_scale_nm", j.torque_sign_scale_nm},
+                  {"offset_envelope_rad", j.offset_envelope_rad},
+                  {"offset_rate_envelope_rad_s", j.offset_rate_envelope_rad_s},
+                  {"dimensions", dims},
+                  {"cells", cells}};
+    // Version 3's key; a version 2 table read back is written as it was.
+    if (t.schema_version >= 3) {
+      joint["transmission_error_rad_per_rad"] = j.transmission_error_rad_per_rad;
+      joint["transmission_error_compliance_rad_per_nm"] =
+          j.transmission_error_compliance_rad_per_nm;
+    }
+    joints.push_back(std::move(joint));
   }
   json extra_names = json::array();
   for (const TableInput input : t.extra_inputs) extra_names.push_back(to_string(input));
@@ -475,9 +507,16 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
       const auto* kind = std::find_if(std::begin(kTableInputs), std::end(kTableInputs),
                                       [&](TableInput k) { return name == to_string(k); });
       if (kind == std::end(kTableInputs))
-        i.fail("expected 'model_torque', 'direction' or 'torque_sign', got '" + name + "'");
+        i.fail(
+            "expected 'model_torque', 'direction', 'torque_sign', 'transmission_error_sin' or "
+            "'transmission_error_cos', got '" +
+            name + "'");
       t.extra_inputs.push_back(*kind);
     }
+    for (std::size_t e = 0; e < t.extra_inputs.size(); ++e)
+      if (t.schema_version < 3 && (t.extra_inputs[e] == TableInput::kTransmissionErrorSin ||
+                                   t.extra_inputs[e] == TableInput::kTransmissionErrorCos))
+        inputs.fail("the transmission-error inputs need schema version 3");
     if (t.extra_inputs.size() > std::size_t(kMaxExtraInputs))
       inputs.fail(fmt::format("at most {} further inputs", kMaxExtraInputs));
     for (std::size_t a = 0; a < t.extra_inputs.size(); ++a)
@@ -511,10 +550,13 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
   const Node joints = r.child("joints");
   std::set<std::string> names;
   for (const Node& j : joints.items()) {
-    const bool torque_sign = std::find(t.extra_inputs.begin(), t.extra_inputs.end(),
-                                       TableInput::kTorqueSign) != t.extra_inputs.end();
+    const auto has = [&](TableInput input) {
+      return std::find(t.extra_inputs.begin(), t.extra_inputs.end(), input) != t.extra_inputs.end();
+    };
     t.joints.push_back(read_joint(
-        j, t.sample_time_s, t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1, torque_sign));
+        j, t.sample_time_s, t.schema_version,
+        t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1, has(TableInput::kTorqueSign),
+        has(TableInput::kTransmissionErrorSin) || has(TableInput::kTransmissionErrorCos)));
     if (!names.insert(t.joints.back().name).second)
       j.child("name").fail("joint '" + t.joints.back().name + "' given twice");
   }

@@ -79,6 +79,12 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
       case TableInput::kTorqueSign:
         p.torque_sign_input_ = e;
         break;
+      case TableInput::kTransmissionErrorSin:
+        p.te_sin_input_ = e;
+        break;
+      case TableInput::kTransmissionErrorCos:
+        p.te_cos_input_ = e;
+        break;
     }
   }
   if (p.torque_sign_input_ >= 0 && p.torque_input_ < 0)
@@ -140,6 +146,17 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
     joint.torque_sign_scale_nm = source.torque_sign_scale_nm;
     if (p.torque_sign_input_ >= 0 && !(joint.torque_sign_scale_nm > 0.0))
       return refuse(name + "the torque-sign input needs a scale > 0");
+    joint.transmission_error_rad_per_rad = source.transmission_error_rad_per_rad;
+    joint.transmission_error_compliance = source.transmission_error_compliance_rad_per_nm;
+    if (!(joint.transmission_error_compliance >= 0.0 &&
+          std::isfinite(joint.transmission_error_compliance)))
+      return refuse(name + "the transmission error's compliance must be finite and >= 0");
+    if (joint.transmission_error_compliance > 0.0 && p.torque_input_ < 0)
+      return refuse(name + "the transmission error's compliance needs the model torque input");
+    if ((p.te_sin_input_ >= 0 || p.te_cos_input_ >= 0) &&
+        !(joint.transmission_error_rad_per_rad > 0.0 &&
+          std::isfinite(joint.transmission_error_rad_per_rad)))
+      return refuse(name + "the transmission-error inputs need a phase rate > 0");
     for (int k = 0; k < joint.cells; ++k) {
       const CellParameters& cell = source.cells[k];
       ArxCellCoefficients& model = joint.model[k];
@@ -206,7 +223,7 @@ int Precontrol::read_events(PrecontrolEvent* out, int capacity) noexcept {
   return n;
 }
 
-std::array<double, kArxStepMaxExtras> Precontrol::extra_values(const JointModel& joint,
+std::array<double, kArxStepMaxExtras> Precontrol::extra_values(const JointModel& joint, double x,
                                                                double speed,
                                                                double torque) const noexcept {
   std::array<double, kArxStepMaxExtras> value{};
@@ -214,6 +231,12 @@ std::array<double, kArxStepMaxExtras> Precontrol::extra_values(const JointModel&
   if (direction_input_ >= 0) value[direction_input_] = std::tanh(speed / direction_scale_);
   if (torque_sign_input_ >= 0)
     value[torque_sign_input_] = std::tanh(torque / joint.torque_sign_scale_nm);
+  if (te_sin_input_ >= 0 || te_cos_input_ >= 0) {
+    const double phase =
+        joint.transmission_error_rad_per_rad * (x + joint.transmission_error_compliance * torque);
+    if (te_sin_input_ >= 0) value[te_sin_input_] = std::sin(phase);
+    if (te_cos_input_ >= 0) value[te_cos_input_] = std::cos(phase);
+  }
   return value;
 }
 
@@ -226,7 +249,7 @@ void Precontrol::restart_models(const std::array<double, kPrecontrolJoints>& q,
   for (int j = 0; j < kPrecontrolJoints; ++j) {
     JointModel& joint = joints_[j];
     joint.u.fill(q[j]);
-    const std::array<double, kArxStepMaxExtras> x = extra_values(joint, 0.0, torque[j]);
+    const std::array<double, kArxStepMaxExtras> x = extra_values(joint, q[j], 0.0, torque[j]);
     for (int e = 0; e < extra_count_; ++e) joint.x[e].fill(x[e]);
     for (int k = 0; k < joint.cells; ++k) {
       const ArxCellCoefficients& m = joint.model[k];
@@ -255,7 +278,7 @@ void Precontrol::model_step(JointModel& joint, double q_desired, double speed, d
                             double payload, double torque, bool& outside) noexcept {
   push_newest(joint.u, joint.u_pos, kInputRing, q_desired);
   const double* u = joint.u.data() + joint.u_pos;  // u[i] = q_d(k - i)
-  const std::array<double, kArxStepMaxExtras> x = extra_values(joint, speed, torque);
+  const std::array<double, kArxStepMaxExtras> x = extra_values(joint, q_desired, speed, torque);
   for (int e = 0; e < extra_count_; ++e) {
     joint.x[e][joint.u_pos] = x[e];
     joint.x[e][joint.u_pos + kInputRing] = x[e];

@@ -166,7 +166,9 @@ class Precontrol {
     std::array<int, 4> centre_count{};
     std::array<double, 4> lower{}, upper{};  // grid bounds (outside: event)
     double backlash_l_rad = 0.0;
-    double torque_sign_scale_nm = 0.0;  // of the torque-sign input [N m]
+    double torque_sign_scale_nm = 0.0;            // of the torque-sign input [N m]
+    double transmission_error_rad_per_rad = 0.0;  // phase rate of the transmission-error pair
+    double transmission_error_compliance = 0.0;   // 1 / k [rad/(N m)]
     // The identification's direction of motion is the desired velocity `backlash_lag` cycles
     // earlier (ident/backlash_identification.hpp): a ring of past speeds [rad/s].
     int backlash_lag = 0;
@@ -174,7 +176,7 @@ class Precontrol {
     int speed_pos = 0;
     std::array<double, 2 * kInputRing> u{};  // q_d history, newest at u[u_pos]
     int u_pos = 0;
-    // Further inputs' histories (model torque, direction), newest at x[e][u_pos].
+    // Further inputs' histories (table order), newest at x[e][u_pos].
     std::array<std::array<double, 2 * kInputRing>, kArxStepMaxExtras> x{};
     double last_error = 0.0;      // blended Δq̂ of the last model step
     double previous_error = 0.0;  // the one before (for output interpolation at T/m cycles)
@@ -184,9 +186,10 @@ class Precontrol {
 
   void model_step(JointModel& joint, double q_desired, double speed, double acceleration,
                   double payload, double torque, bool& outside) noexcept;
-  // The further inputs' values of a model step (model torque, direction), table order.
-  std::array<double, kArxStepMaxExtras> extra_values(const JointModel& joint, double speed,
-                                                     double torque) const noexcept;
+  // The further inputs' values of a model step at input x [rad] (model torque, direction,
+  // torque sign, transmission-error pair), table order.
+  std::array<double, kArxStepMaxExtras> extra_values(const JointModel& joint, double x,
+                                                     double speed, double torque) const noexcept;
   void restart_models(const std::array<double, kPrecontrolJoints>& q_desired,
                       const std::array<double, kPrecontrolJoints>& torque) noexcept;
   PrecontrolOutput run_cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
@@ -206,10 +209,12 @@ class Precontrol {
   std::array<double, kPrecontrolJoints> last_q_{};
   std::array<double, kPrecontrolJoints> last_torque_{};
   std::array<double, kPrecontrolJoints> last_speed_{};
-  int extra_count_ = 0;            // further inputs of every cell's model
-  int torque_input_ = -1;          // index of the model torque among them, -1: none
-  int direction_input_ = -1;       // index of the direction, -1: none
-  int torque_sign_input_ = -1;     // index of the torque's sign, -1: none
+  int extra_count_ = 0;         // further inputs of every cell's model
+  int torque_input_ = -1;       // index of the model torque among them, -1: none
+  int direction_input_ = -1;    // index of the direction, -1: none
+  int torque_sign_input_ = -1;  // index of the torque's sign, -1: none
+  int te_sin_input_ = -1;       // indices of the transmission-error pair, -1: none
+  int te_cos_input_ = -1;
   double direction_scale_ = 0.01;  // [rad/s]
   double last_payload_ = 0.0;
   bool started_ = false;

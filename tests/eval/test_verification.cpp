@@ -30,10 +30,10 @@ namespace fs = std::filesystem;
 bool sanitized() {
   return std::getenv("IMSCAL_SANITIZED") != nullptr;
 }
-// The issue's goals not yet met (>= 95 % reduction on seed-line, >= 90 % fit against the
-// IMS-measured errors) are asserted only with IMSCAL_VERIFY_GOALS set (printed figures and the
-// report say why); the always-on assertions check the measurement itself, and the ISO 9283 set's
-// >= 90 %, which is met, is asserted always in Release.
+// Goals not met are asserted only with IMSCAL_VERIFY_GOALS set (printed figures and the report
+// say why); the always-on assertions check the measurement itself, and issue 6's goals, which
+// are met (>= 95 % on seed-line since the twelfth round, >= 90 % on the ISO 9283 set), are
+// asserted always in Release.
 bool assert_goals() {
   return std::getenv("IMSCAL_VERIFY_GOALS") != nullptr;
 }
@@ -248,31 +248,39 @@ TEST(Verification, SeedLineWithAblation) {
   }
   if (!sanitized()) {
     // What the chain reaches today (Release, 10 cycles, look-ahead 4), as the IMS chain measures
-    // the attained path: 12.52 -> 0.654 mm (94.8 %); on the plant's true path 12.47 -> 0.635 mm
-    // (94.9 %). Ablation on the true path: paper form 49.0 %, without the model torque 39.3 %,
-    // with eq. 3's backlash term 91.9 %, with the operating-point grid 95.1 % (94.6 % as
-    // measured; it loses 8 %-points on the ISO set, ident-default.yaml). Asserted 3 %-points
-    // below (compiler differences; the simulator and every draw are deterministic), the
-    // precontrol active throughout, and each part of the default measured: the paper's form and
-    // the model without the torque stay far behind.
-    // Where the maximum arises (true path, per cycle): 0.49-0.56 mm in 9 of the 10 cycles, at the
-    // line's constant speed where A2 and A3 slow down towards their mid-line reversal (A2 0.37
-    // mrad off in every cycle, 0.46 mm: the model's own error); 0.635 mm in the cycle whose A2
-    // friction is drawn 13.9 % above nominal, 0.22 s into the line's acceleration from rest
-    // (run-to-run friction, which no model of the nominal robot predicts). The cycles' own
-    // scatter (PathFigures::scatter_floor_m) is 0.47 mm on the true path, 0.51 mm as measured:
-    // no precontrol fed the desired path gets below it (best reachable 95.9 % as measured).
-    // Split about the cycles' mean (eleventh round): the compensated run's systematic part (the
-    // mean's largest deviation, = AT_p) is 0.538 mm as measured, 0.513 mm true; the cycles' largest
-    // distance from their mean is 0.582 / 0.570 mm, so a model exact on average would reach
-    // 95.4 % (the worst cycle lies 0.36 mm off the mean 0.22 s into the line, where the mean is
-    // 0.27 mm off the path).
+    // the attained path: 12.52 -> 0.604 mm (95.2 %); on the plant's true path 12.47 -> 0.611 mm
+    // (95.1 %). Ablation on the true path: paper form 49.0 %, without the model torque 39.3 %,
+    // without the transmission-error inputs 94.9 % (94.8 % as measured: the eleventh round's
+    // default), with eq. 3's backlash term 92.5 %, with the operating-point grid 95.2 % (94.8 %
+    // as measured). Asserted 3 %-points below (compiler differences; the simulator and every
+    // draw are deterministic), the precontrol active throughout, and each part of the default
+    // measured: the paper's form and the model without the torque stay far behind. Issue 6's
+    // 95 % itself is asserted below (Release).
+    // Where the maximum arises (true path): the cycle whose A2 friction is drawn 13.9 % above
+    // nominal, 0.22 s into the line's acceleration from rest (run-to-run friction, which no model
+    // of the nominal robot predicts), 0.36 mm off the cycles' mean, which is 0.24 mm off the path
+    // there (0.27 mm without the transmission-error inputs). The cycles' own scatter
+    // (PathFigures::scatter_floor_m) is 0.47 mm on the true path, 0.51 mm as measured: no
+    // precontrol fed the desired path gets below it (best reachable 95.9 % as measured).
+    // Split about the cycles' mean: the compensated run's systematic part (the mean's largest
+    // deviation, = AT_p) is 0.467 mm as measured, 0.371 mm true (0.538 / 0.513 without the
+    // transmission-error inputs: the gear's 10 arcsec periodic error, which the motor encoders
+    // do not see, was the largest part of the model's own error); the cycles' largest distance
+    // from their mean is 0.583 / 0.571 mm, so a model exact on average would reach 95.3 %.
     EXPECT_EQ(r.after[0].inactive_cycles, 0u);
-    EXPECT_GE(reduction_percent(before, r.after[0].figures.max_path_deviation_m), 91.8);
+    EXPECT_GE(reduction_percent(before, r.after[0].figures.max_path_deviation_m), 92.2);
     const double before_true = r.before.true_figures.max_path_deviation_m;
     const double compensated =
         reduction_percent(before_true, r.after[0].true_figures.max_path_deviation_m);
-    EXPECT_GE(compensated, 91.9);
+    EXPECT_GE(compensated, 92.1);
+    // The transmission-error inputs' share: the systematic part (true path) falls by > 20 %
+    // (measured 0.513 -> 0.371 mm, 28 %).
+    for (std::size_t c = 1; c < r.after.size(); ++c) {
+      if (r.after[c].label == "without transmission error") {
+        EXPECT_LT(r.after[0].true_figures.systematic_max_m,
+                  0.8 * r.after[c].true_figures.systematic_max_m);
+      }
+    }
     // The floor lies under the maximum, and is the repeatability's order (RT_p 0.72 mm true).
     EXPECT_LE(r.after[0].figures.scatter_floor_m, r.after[0].figures.max_path_deviation_m);
     EXPECT_GT(r.after[0].true_figures.scatter_floor_m, 0.2 * r.after[0].true_figures.RT_p_m);
@@ -300,8 +308,8 @@ TEST(Verification, SeedLineWithAblation) {
     // The repeatability floor: the same table on the plant with its nominal friction (no
     // run-to-run draw, one cycle): what the model leaves, without what no model of the nominal
     // robot can predict (the 10 cycles' friction drawn anew, sigma 5 %: RT_p 0.72 mm). Measured:
-    // 12.43 -> 0.566 mm (95.4 %) through the IMS chain, 12.43 -> 0.522 mm (95.8 %) on the true
-    // path, against 0.635 mm true over the 10 drawn cycles: the draws cost ~0.1 mm.
+    // 12.43 -> 0.511 mm (95.9 %) through the IMS chain, 12.43 -> 0.371 mm (97.0 %) on the true
+    // path, against 0.611 mm true over the 10 drawn cycles: the draws cost ~0.24 mm.
     VerificationOptions nominal;
     nominal.cycles = 1;
     nominal.friction_sigma_fraction = 0.0;
@@ -321,7 +329,11 @@ TEST(Verification, SeedLineWithAblation) {
                           n.after[0].true_figures.max_path_deviation_m));
     EXPECT_LT(n.after[0].figures.max_path_deviation_m, r.after[0].figures.max_path_deviation_m);
   }
-  if (assert_goals() && !sanitized()) {
+  // Issue 6's goal on seed-line, met since the twelfth round's transmission-error inputs (95.2 %
+  // as the IMS chain measures it): asserted whenever the figures are (Release), so that a change
+  // that loses it fails here. Over other friction draws (imscal verify --seed 2, 3, 4, true
+  // path) 95.2, 95.4, 95.8 % (94.9-95.5 % without those inputs).
+  if (!sanitized()) {
     const double full = reduction_percent(before, r.after[0].figures.max_path_deviation_m);
     EXPECT_GE(full, 95.0) << "issue 6 goal on seed-line";
   }
@@ -332,9 +344,9 @@ TEST(Verification, Iso9283FullVelocity) {
   EXPECT_GT(r.before.figures.max_path_deviation_m, 0.001);
   if (!sanitized()) {
     // What the chain reaches today (Release, 10 cycles): as the IMS chain measures the attained
-    // paths 8.19 -> 0.69 mm (91.5 %), on the true paths 8.19 -> 0.73 mm (91.2 %; with 5 cycles
-    // 91.1 and 92.4 %: a longer series meets more of the drawn frictions; the cycles' scatter
-    // floor is 0.45 mm, best reachable 94.5 %), the precontrol
+    // paths 8.19 -> 0.676 mm (91.8 %), on the true paths 8.19 -> 0.676 mm (91.8 %; 91.5 and
+    // 91.2 % before the twelfth round's transmission-error inputs, AT_p 0.33 mm; the cycles'
+    // scatter floor is 0.45 mm, best reachable 94.5 %), the precontrol
     // active throughout (its default tolerances come from the identification data's envelope).
     // The planner keeps Cartesian moves within the joints' acceleration and jerk limits
     // (sim/cartesian_timing.hpp): the 100 % D 40 mm circle runs at 42 % of its programmed speed.
@@ -342,10 +354,10 @@ TEST(Verification, Iso9283FullVelocity) {
     EXPECT_EQ(r.after[0].inactive_cycles, 0u);
     EXPECT_GE(reduction_percent(r.before.figures.max_path_deviation_m,
                                 r.after[0].figures.max_path_deviation_m),
-              88.5);
+              88.8);
     EXPECT_GE(reduction_percent(r.before.true_figures.max_path_deviation_m,
                                 r.after[0].true_figures.max_path_deviation_m),
-              88.2);
+              88.8);
   }
   // Issue 6's goal on this path set, met since the eighth round's 60 input taps (90.8 % as the
   // IMS chain measures it): asserted whenever the figures are (Release), not only under
@@ -527,8 +539,9 @@ TEST(Verification, IdentifiedFromTheImsChain) {
   }
   // Issue 5's goal, >= 90 % held-out fit for every primary joint, met both ways (60 input taps,
   // positions corrected at the revisited poses, calib/revisited_poses.hpp). Measured: against
-  // the IMS-measured errors A1 96.2, A2 95.0, A3 94.3 %; against the true errors 96.3, 95.1,
-  // 94.4 % (identified from the truth itself: 96.2, 95.3, 94.5 %). The measurement's own error
+  // the IMS-measured errors A1 96.1, A2 95.1, A3 94.4 %; against the true errors 96.3, 95.1,
+  // 94.4 % (with the transmission-error inputs; identified from the truth itself: 96.2, 95.3,
+  // 94.5 % without them). The measurement's own error
   // in the held-out target (0.03-0.04 mrad RMS against a 3.5-3.7 mrad signal) caps a perfect
   // model at ~99 %. Before the eighth round that error was 0.21-0.31 mrad (cap ~94.4, 93.2,
   // 91.3 %) and the fits 93.5, 90.4, 84.4 % (95.7, 93.8, 93.0 % against the truth). Asserted in
@@ -547,15 +560,17 @@ TEST(Verification, IdentifiedFromTheImsChain) {
   print_case(r.before, r.before.figures, r.before.true_figures);
   print_case(r.after[0], r.before.figures, r.before.true_figures);
   EXPECT_EQ(r.after[0].inactive_cycles, 0u);
-  // Measured: 94.5 % as the IMS chain sees the path, 94.5 % on the true path (10 cycles; 92.4
-  // and 93.5 % before the tenth round's warm-up and rests, VerificationOptions); asserted
-  // 3 %-points below, as above.
+  // Measured: 12.52 -> 0.632 mm (94.95 %) as the IMS chain sees the path, 12.47 -> 0.626 mm
+  // (94.98 %) on the true path (10 cycles; 94.5 and 94.5 % before the twelfth round's
+  // transmission-error inputs, 92.4 and 93.5 % before the tenth round's warm-up and rests,
+  // VerificationOptions): just short of issue 6's 95 %, which the table identified from the
+  // simulator's truth reaches; asserted 3 %-points below, as above.
   EXPECT_GE(reduction_percent(r.before.figures.max_path_deviation_m,
                               r.after[0].figures.max_path_deviation_m),
-            91.5);
+            91.9);
   EXPECT_GE(reduction_percent(r.before.true_figures.max_path_deviation_m,
                               r.after[0].true_figures.max_path_deviation_m),
-            91.5);
+            91.9);
 }
 
 }  // namespace

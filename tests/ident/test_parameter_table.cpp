@@ -18,7 +18,7 @@ using nlohmann::json;
 
 // A two-joint table with random stable models, irregular numbers (to exercise the exact
 // round trip of doubles) and one filled cell.
-ident::ParameterTable sample_table() {
+ident::ParameterTable sample_table(bool transmission_error = true) {
   std::mt19937_64 rng(42);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   ident::ParameterTable t;
@@ -28,6 +28,11 @@ ident::ParameterTable sample_table() {
   t.model_form = ident::TableForm::kInverse;  // schema 2's keys in the round trip
   t.preview_cycles = 6;
   t.extra_inputs = {ident::TableInput::kModelTorque, ident::TableInput::kTorqueSign};
+  if (transmission_error) {  // schema 3's inputs and keys
+    t.extra_inputs.push_back(ident::TableInput::kTransmissionErrorSin);
+    t.extra_inputs.push_back(ident::TableInput::kTransmissionErrorCos);
+  }
+  const int inputs = int(t.extra_inputs.size());
   t.direction_speed_scale_rad_s = 0.0123;
   t.source = {"/tmp/joint_errors.csv", std::string(64, 'a'), 123456, "simulated"};
   for (const char* name : {"A1", "A2"}) {
@@ -40,11 +45,16 @@ ident::ParameterTable sample_table() {
     j.backlash_identified = true;
     j.backlash_lag_samples = 17;
     j.torque_sign_scale_nm = 10.0 * uniform(rng) + 0.1;
+    if (transmission_error) {
+      j.transmission_error_rad_per_rad = 160.0 * uniform(rng) + 1.0;
+      j.transmission_error_compliance_rad_per_nm = 1e-5 * uniform(rng);
+    }
     const ident::CellGrid grid(j.dimensions);
     for (int flat = 0; flat < grid.cell_count(); ++flat) {
       ident::CellParameters c;
       c.bands = grid.bands_of(flat);
-      c.structure = {2 + flat % 3, 1 + flat % 2, flat % 4, 2, {3 + flat % 2, 1}};
+      c.structure = {2 + flat % 3, 1 + flat % 2, flat % 4, inputs, {3 + flat % 2, 1}};
+      if (transmission_error) c.structure.nx = {3 + flat % 2, 1, 2, 1 + flat % 3};
       const auto model = imscal::test_support::random_multi_system(c.structure, rng);
       c.a.assign(model.a().data(), model.a().data() + model.a().size());
       c.b.assign(model.b().data(), model.b().data() + model.b().size());
@@ -94,7 +104,8 @@ TEST(ParameterTable, Version1TablesReadAsForwardModelsWithoutPreview) {
     j.erase(key);
   for (auto& joint : j["joints"]) {
     for (const char* key :
-         {"torque_sign_scale_nm", "offset_envelope_rad", "offset_rate_envelope_rad_s"})
+         {"torque_sign_scale_nm", "offset_envelope_rad", "offset_rate_envelope_rad_s",
+          "transmission_error_rad_per_rad", "transmission_error_compliance_rad_per_nm"})
       joint.erase(key);
     for (auto& cell : joint["cells"]) {
       cell.erase("nx");
@@ -105,6 +116,25 @@ TEST(ParameterTable, Version1TablesReadAsForwardModelsWithoutPreview) {
   EXPECT_EQ(back.model_form, ident::TableForm::kForward);
   EXPECT_EQ(back.preview_cycles, 0);
   EXPECT_EQ(back.joints.size(), 2u);
+}
+
+// A version 2 table (before the transmission-error inputs) reads with phase rate and compliance
+// 0, and is written back as version 2.
+TEST(ParameterTable, Version2TablesReadWithoutTheTransmissionError) {
+  const ident::ParameterTable v3 = sample_table(false);
+  json j = json::parse(ident::parameters_json_text(v3));
+  j["schema_version"] = 2;
+  for (auto& joint : j["joints"]) {
+    joint.erase("transmission_error_rad_per_rad");
+    joint.erase("transmission_error_compliance_rad_per_nm");
+  }
+  const auto back = ident::parse_parameters_json(j.dump(), "v2.json");
+  EXPECT_EQ(back.schema_version, 2);
+  for (const auto& joint : back.joints) {
+    EXPECT_EQ(joint.transmission_error_rad_per_rad, 0.0);
+    EXPECT_EQ(joint.transmission_error_compliance_rad_per_nm, 0.0);
+  }
+  EXPECT_EQ(json::parse(ident::parameters_json_text(back)), j);
 }
 
 TEST(ParameterTable, NotAvailableFiguresRoundTripAsNull) {
@@ -140,16 +170,24 @@ TEST_P(LoaderRefuses, WithPathAndMessage) {
 INSTANTIATE_TEST_SUITE_P(
     BadTables, LoaderRefuses,
     ::testing::Values(
-        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 3; }, "/schema_version",
-                "unknown schema version 3"},
+        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 4; }, "/schema_version",
+                "unknown schema version 4"},
         Refusal{"CountsForTheFurtherInputs",
                 [](json& j) { j["joints"][0]["cells"][0]["nx"] = json::array({3}); },
-                "/joints/0/cells/0/nx", "1 counts for the table's 2 further inputs"},
+                "/joints/0/cells/0/nx", "1 counts for the table's 4 further inputs"},
+        Refusal{"TransmissionErrorWithoutPhaseRate",
+                [](json& j) { j["joints"][1]["transmission_error_rad_per_rad"] = 0.0; },
+                "/joints/1/transmission_error_rad_per_rad", "the phase rate must be > 0"},
+        Refusal{"NegativeCompliance",
+                [](json& j) { j["joints"][0]["transmission_error_compliance_rad_per_nm"] = -1.0; },
+                "/joints/0/transmission_error_compliance_rad_per_nm", "must be >= 0"},
+        Refusal{"TransmissionErrorInVersion2", [](json& j) { j["schema_version"] = 2; },
+                "/extra_inputs", "the transmission-error inputs need schema version 3"},
         Refusal{"FurtherCoefficientsMissing",
                 [](json& j) { j["joints"][0]["cells"][0]["c"].erase(0); }, "/joints/0/cells/0/c",
                 "the further inputs' nx add up to"},
         Refusal{"UnknownFurtherInput", [](json& j) { j["extra_inputs"][1] = "temperature"; },
-                "/extra_inputs/1", "expected 'model_torque', 'direction' or 'torque_sign'"},
+                "/extra_inputs/1", "expected 'model_torque', 'direction', 'torque_sign', "},
         Refusal{"TorqueSignWithoutScale",
                 [](json& j) { j["joints"][1]["torque_sign_scale_nm"] = 0.0; },
                 "/joints/1/torque_sign_scale_nm", "the scale must be > 0"},

@@ -1,5 +1,6 @@
 // The precontrol (ident/precontrol.hpp) with the multi-input models of the default
-// identification (model torque, direction of motion, torque sign; ident/arx_structure.hpp):
+// identification (model torque, direction of motion, torque sign, the transmission-error pair;
+// ident/arx_structure.hpp):
 // its offsets against the all-cells reference (tests/support/reference_precontrol.hpp: every
 // sum an Eigen dot product over exactly its nx_e coefficients) on a 3 x 2 grid with blending and
 // the runtime's faults, and no heap allocation in the torque-fed cycle of an order-32 grid.
@@ -28,19 +29,29 @@ namespace {
 constexpr double kCycle = 0.002;
 
 // Static responses of the cells' further inputs: rad per N m of model torque, rad at full
-// direction, rad at full torque sign. Offsets of ~1e-4 rad each, like the shipped table's.
-constexpr double kTorqueGain = 1e-5, kDirectionGain = 1e-4, kSignGain = 5e-5;
+// direction, rad at full torque sign, rad per unit of the transmission-error pair. Offsets of
+// ~1e-4 rad each, like the shipped table's (its transmission error: 10 arcsec = 4.8e-5 rad).
+constexpr double kTorqueGain = 1e-5, kDirectionGain = 1e-4, kSignGain = 5e-5, kTeGain = 1e-4;
+// The pair's phase rate (harmonic 1 x gear ratio 160) and the gear's compliance (1 / 4.5e5 N m
+// per rad, the KR 16's A2): the test motion's 0.2 rad swings turn the phase by 32 rad.
+constexpr double kTeRadPerRad = 160.0, kTeCompliance = 1.0 / 4.5e5;
 
 // 6 joints, 3 speed x 2 payload cells of random stable models (na 5..8, nb 3..8, dead time
-// 0..3), each with the three further inputs in the default identification's order; the taps per
-// input vary between cells (1..12 for torque and direction, 1 for the torque sign), so that every
-// sum has its own length. with_inputs = false: the same table with zero further coefficients.
-ParameterTable multi_input_table(bool with_inputs) {
+// 0..3), each with the three further inputs in the default identification's order (and the
+// transmission-error pair with transmission_error); the taps per input vary between cells
+// (1..12 for torque and direction, 1 for the torque sign, 1..8 for the pair), so that every sum
+// has its own length. with_inputs = false: the same table with zero further coefficients.
+ParameterTable multi_input_table(bool with_inputs, bool transmission_error = false) {
   std::mt19937_64 rng(61);
   ParameterTable t;
   t.robot = "kr16";
   t.sample_time_s = kCycle;
   t.extra_inputs = {TableInput::kModelTorque, TableInput::kDirection, TableInput::kTorqueSign};
+  if (transmission_error) {
+    t.extra_inputs.push_back(TableInput::kTransmissionErrorSin);
+    t.extra_inputs.push_back(TableInput::kTransmissionErrorCos);
+  }
+  const int inputs = static_cast<int>(t.extra_inputs.size());
   for (int j = 0; j < 6; ++j) {
     JointParameters joint;
     joint.name = "A" + std::to_string(j + 1);
@@ -49,20 +60,25 @@ ParameterTable multi_input_table(bool with_inputs) {
     joint.backlash_l_rad = 1e-4;
     joint.backlash_lag_samples = static_cast<std::size_t>(j);
     joint.torque_sign_scale_nm = 3.0;
+    if (transmission_error) {
+      joint.transmission_error_rad_per_rad = kTeRadPerRad;
+      joint.transmission_error_compliance_rad_per_nm = kTeCompliance;
+    }
     for (int c = 0; c < 6; ++c) {
       CellParameters cp;
       cp.bands = {c / 2, c % 2};
       const int na = 5 + (c + j) % 4, nb = 3 + c % 6;
       cp.structure = {na, nb, (c + j) % 4};
-      cp.structure.extra_inputs = 3;
-      cp.structure.nx = {1 + (5 * c + j) % 12, 1 + (7 * c + 3 * j) % 12, 1};
+      cp.structure.extra_inputs = inputs;
+      cp.structure.nx = {1 + (5 * c + j) % 12, 1 + (7 * c + 3 * j) % 12, 1, 1 + (3 * c + j) % 8,
+                         1 + (c + 5 * j) % 8};
       const Eigen::VectorXd a =
           test_support::polynomial_from_poles(test_support::random_poles(na, rng));
       const double a_sum = 1.0 + a.sum();  // A(1): coefficients / A(1) give the static gains
       cp.a.assign(a.data(), a.data() + na);
       cp.b.assign(static_cast<std::size_t>(nb), a_sum * (1.0 + 0.002 * c) / nb);  // gains 1..1.01
-      const std::array<double, 3> gain{kTorqueGain, kDirectionGain, kSignGain};
-      for (int e = 0; e < 3; ++e) {
+      const std::array<double, 5> gain{kTorqueGain, kDirectionGain, kSignGain, kTeGain, kTeGain};
+      for (int e = 0; e < inputs; ++e) {
         const int nx = cp.structure.nx[std::size_t(e)];
         for (int i = 0; i < nx; ++i)
           cp.c.push_back(with_inputs ? a_sum * gain[std::size_t(e)] * (1.0 + 0.1 * i) / nx : 0.0);
@@ -74,8 +90,8 @@ ParameterTable multi_input_table(bool with_inputs) {
   return t;
 }
 
-TEST(PrecontrolFurtherInputs, SameOffsetsAsTheAllCellsReferenceWithBlendingAndFaults) {
-  const ParameterTable t = multi_input_table(true);
+void expect_same_offsets_as_the_reference(bool transmission_error) {
+  const ParameterTable t = multi_input_table(true, transmission_error);
   PrecontrolOptions o;
   o.offset_tolerance_rad.fill(0.05);
   // The offset's rate reaches the joint speed when a move starts (the models lag the command):
@@ -87,8 +103,8 @@ TEST(PrecontrolFurtherInputs, SameOffsetsAsTheAllCellsReferenceWithBlendingAndFa
   std::string why;
   ASSERT_TRUE(Precontrol::create(t, "kr16", o, &p, &why)) << why;
   ASSERT_TRUE(test_support::AllCellsPrecontrol::create(t, "kr16", o, &reference, &why)) << why;
-  ASSERT_TRUE(test_support::AllCellsPrecontrol::create(multi_input_table(false), "kr16", o,
-                                                       &without_inputs, &why))
+  ASSERT_TRUE(test_support::AllCellsPrecontrol::create(multi_input_table(false, transmission_error),
+                                                       "kr16", o, &without_inputs, &why))
       << why;
   ASSERT_TRUE(p.needs_model_torque());
   ASSERT_TRUE(reference.needs_model_torque());
@@ -155,15 +171,45 @@ TEST(PrecontrolFurtherInputs, SameOffsetsAsTheAllCellsReferenceWithBlendingAndFa
   EXPECT_GE(na, 7);  // 2 invalid inputs, lost cycles, missing torque, 3 re-activations
 }
 
-// The heaviest table of issue 6's benchmark (bench/bench_precontrol.cpp, the same table and
-// motion): order 32 in every cell of a 3 x 2 grid, the model torque and direction with 32 taps
-// and the torque sign with one.
+TEST(PrecontrolFurtherInputs, SameOffsetsAsTheAllCellsReferenceWithBlendingAndFaults) {
+  expect_same_offsets_as_the_reference(false);
+}
+
+// The transmission-error pair sin/cos(f (x + τ / k)) as the reference computes it from its
+// definition (tests/support/reference_precontrol.hpp): the same offsets, the same faults.
+TEST(PrecontrolFurtherInputs, TheTransmissionErrorPairGivesTheReferenceOffsets) {
+  expect_same_offsets_as_the_reference(true);
+}
+
+// A table with the pair needs each joint's phase rate (> 0), and the compliance the model torque.
+TEST(PrecontrolFurtherInputs, TransmissionErrorWithoutAPhaseRateIsRefused) {
+  PrecontrolOptions o;
+  static Precontrol p;
+  std::string why;
+  ParameterTable t = multi_input_table(true, true);
+  t.joints[2].transmission_error_rad_per_rad = 0.0;
+  EXPECT_FALSE(Precontrol::create(t, "kr16", o, &p, &why));
+  EXPECT_NE(why.find("joint A3: the transmission-error inputs need a phase rate > 0"),
+            std::string::npos)
+      << why;
+  t = multi_input_table(true, true);
+  t.joints[4].transmission_error_compliance_rad_per_nm = -1e-6;
+  EXPECT_FALSE(Precontrol::create(t, "kr16", o, &p, &why));
+  EXPECT_NE(why.find("joint A5: the transmission error's compliance must be finite and >= 0"),
+            std::string::npos)
+      << why;
+}
+
+// The heaviest table of issue 6's benchmark (bench/bench_precontrol.cpp, the same motion):
+// order 32 in every cell of a 3 x 2 grid, the model torque and direction with 32 taps, the
+// torque sign with one and the transmission-error pair with 32 each.
 ParameterTable order_32_grid_table() {
   std::mt19937_64 rng(32);
   ParameterTable t;
   t.robot = "kr16";
   t.sample_time_s = kCycle;
-  t.extra_inputs = {TableInput::kModelTorque, TableInput::kDirection, TableInput::kTorqueSign};
+  t.extra_inputs = {TableInput::kModelTorque, TableInput::kDirection, TableInput::kTorqueSign,
+                    TableInput::kTransmissionErrorSin, TableInput::kTransmissionErrorCos};
   for (int j = 0; j < 6; ++j) {
     JointParameters joint;
     joint.name = "A" + std::to_string(j + 1);
@@ -171,17 +217,19 @@ ParameterTable order_32_grid_table() {
                         CellDimension{OperatingQuantity::kPayload, {0.0, 8.0, 16.0}}};
     joint.backlash_l_rad = 1e-4;
     joint.torque_sign_scale_nm = 1.0;
+    joint.transmission_error_rad_per_rad = kTeRadPerRad;
+    joint.transmission_error_compliance_rad_per_nm = kTeCompliance;
     for (int c = 0; c < 6; ++c) {
       CellParameters cell;
       cell.bands = {c / 2, c % 2};
       cell.structure = {32, 32, 2};
-      cell.structure.extra_inputs = 3;
-      cell.structure.nx = {32, 32, 1};
+      cell.structure.extra_inputs = 5;
+      cell.structure.nx = {32, 32, 1, 32, 32};
       const Eigen::VectorXd a =
           test_support::polynomial_from_poles(test_support::random_poles(32, rng));
       cell.a.assign(a.data(), a.data() + a.size());
       cell.b.assign(32, (1.0 + a.sum()) / 32.0);  // static gain 1
-      cell.c.assign(65, 1e-7);
+      cell.c.assign(129, 1e-7);
       joint.cells.push_back(cell);
     }
     t.joints.push_back(joint);

@@ -9,7 +9,8 @@
 // them (commit 29523ed: model torque from the caller, direction tanh(q̇ / scale), torque sign
 // tanh(torque / joint scale); started at the steady state of the pose's torque; lost cycles
 // bridged with the last torque), written here again from that definition: Σ_j c_e,j x_e(k-d-j)
-// over the nx_e coefficients of input e, in the runtime's table order.
+// over the nx_e coefficients of input e, in the runtime's table order. And since the twelfth
+// round by the transmission-error pair sin(f (x + τ / k)), cos(f (x + τ / k)) of the input x.
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
@@ -108,6 +109,7 @@ class AllCellsPrecontrol {
     std::array<double, 4> lower{}, upper{};  // grid bounds (outside: event)
     double backlash_l_rad = 0.0;
     double torque_sign_scale_nm = 0.0;
+    double te_rad_per_rad = 0.0, te_compliance = 0.0;
     // The identification's direction of motion is the desired velocity `backlash_lag` cycles
     // earlier (ident/backlash_identification.hpp): a ring of past speeds [rad/s].
     int backlash_lag = 0;
@@ -125,7 +127,7 @@ class AllCellsPrecontrol {
 
   void model_step(JointModel& joint, double q_desired, double speed, double acceleration,
                   double payload, double torque, bool& outside) noexcept;
-  std::array<double, kMaxExtras> extra_values(const JointModel& joint, double speed,
+  std::array<double, kMaxExtras> extra_values(const JointModel& joint, double x, double speed,
                                               double torque) const noexcept;
   void restart_models(const std::array<double, kPrecontrolJoints>& q_desired,
                       const std::array<double, kPrecontrolJoints>& torque) noexcept;
@@ -147,7 +149,8 @@ class AllCellsPrecontrol {
   std::array<double, kPrecontrolJoints> last_torque_{};
   int extra_count_ = 0;
   int torque_input_ = -1, direction_input_ = -1, torque_sign_input_ = -1;  // -1: none
-  double direction_scale_ = 0.01;                                          // [rad/s]
+  int te_sin_input_ = -1, te_cos_input_ = -1;
+  double direction_scale_ = 0.01;  // [rad/s]
   double last_payload_ = 0.0;
   bool started_ = false;
   std::uint64_t last_cycle_ = 0;
@@ -183,6 +186,8 @@ inline bool AllCellsPrecontrol::create(const ParameterTable& table, const std::s
     if (input == TableInput::kModelTorque) p.torque_input_ = e;
     if (input == TableInput::kDirection) p.direction_input_ = e;
     if (input == TableInput::kTorqueSign) p.torque_sign_input_ = e;
+    if (input == TableInput::kTransmissionErrorSin) p.te_sin_input_ = e;
+    if (input == TableInput::kTransmissionErrorCos) p.te_cos_input_ = e;
   }
   if (p.torque_sign_input_ >= 0 && p.torque_input_ < 0) return refuse("sign without torque");
   p.direction_scale_ = table.direction_speed_scale_rad_s;
@@ -233,6 +238,8 @@ inline bool AllCellsPrecontrol::create(const ParameterTable& table, const std::s
     }
     joint.backlash_lag = static_cast<int>(source.backlash_lag_samples);
     joint.torque_sign_scale_nm = source.torque_sign_scale_nm;
+    joint.te_rad_per_rad = source.transmission_error_rad_per_rad;
+    joint.te_compliance = source.transmission_error_compliance_rad_per_nm;
     for (int k = 0; k < joint.cells; ++k) {
       const CellParameters& cell = source.cells[k];
       CellModel& model = joint.cell[k];
@@ -289,12 +296,15 @@ inline int AllCellsPrecontrol::read_events(PrecontrolEvent* out, int capacity) n
 }
 
 inline std::array<double, AllCellsPrecontrol::kMaxExtras> AllCellsPrecontrol::extra_values(
-    const JointModel& joint, double speed, double torque) const noexcept {
+    const JointModel& joint, double x, double speed, double torque) const noexcept {
   std::array<double, kMaxExtras> value{};
   if (torque_input_ >= 0) value[torque_input_] = torque;
   if (direction_input_ >= 0) value[direction_input_] = std::tanh(speed / direction_scale_);
   if (torque_sign_input_ >= 0)
     value[torque_sign_input_] = std::tanh(torque / joint.torque_sign_scale_nm);
+  const double motor_angle = x + joint.te_compliance * torque;
+  if (te_sin_input_ >= 0) value[te_sin_input_] = std::sin(joint.te_rad_per_rad * motor_angle);
+  if (te_cos_input_ >= 0) value[te_cos_input_] = std::cos(joint.te_rad_per_rad * motor_angle);
   return value;
 }
 
@@ -307,7 +317,7 @@ inline void AllCellsPrecontrol::restart_models(
   for (int j = 0; j < kPrecontrolJoints; ++j) {
     JointModel& joint = joints_[j];
     joint.u.fill(q[j]);
-    const std::array<double, kMaxExtras> x = extra_values(joint, 0.0, torque[j]);
+    const std::array<double, kMaxExtras> x = extra_values(joint, q[j], 0.0, torque[j]);
     for (int e = 0; e < extra_count_; ++e) joint.x[e].fill(x[e]);
     for (int k = 0; k < joint.cells; ++k) {
       CellModel& m = joint.cell[k];
@@ -334,7 +344,7 @@ inline void AllCellsPrecontrol::model_step(JointModel& joint, double q_desired, 
                                            bool& outside) noexcept {
   push_newest(joint.u, joint.u_pos, kInputRing, q_desired);
   const double* u = joint.u.data() + joint.u_pos;  // u[i] = q_d(k - i)
-  const std::array<double, kMaxExtras> x_now = extra_values(joint, speed, torque);
+  const std::array<double, kMaxExtras> x_now = extra_values(joint, q_desired, speed, torque);
   for (int e = 0; e < extra_count_; ++e) {
     joint.x[e][joint.u_pos] = x_now[e];
     joint.x[e][joint.u_pos + kInputRing] = x_now[e];

@@ -1,0 +1,45 @@
+// The shipped identification config carries numbers of the robot it is for (the joints' maximum
+// speeds, the nominal payload, and since the twelfth round the gear ratios and stiffnesses of the
+// transmission-error inputs): they must be the robot file's (datasets/robots/kr16.yaml), or the
+// speed bands and the error's phase would be those of another robot.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "calib/robot_description.hpp"
+#include "core/config_node.hpp"
+#include "ident/identification_config.hpp"
+
+namespace imscal {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(IdentConfigMatchesRobot, DefaultConfigHasTheKr16sDriveNumbers) {
+  const fs::path root(IMSCAL_SOURCE_DIR);
+  const calib::RobotDescription robot =
+      calib::load_robot_description(root / "datasets/robots/kr16.yaml");
+  const ident::IdentificationConfig config = ident::load_identification_config(
+      ConfigNode::load_file(root / "datasets/identification/ident-default.yaml"));
+  ASSERT_EQ(config.gear_ratio.size(), robot.joints.size());
+  ASSERT_EQ(config.gear_stiffness_nm_per_rad.size(), robot.joints.size());
+  ASSERT_EQ(config.max_speed_rad_s.size(), robot.joints.size());
+  EXPECT_EQ(config.nominal_payload_kg, robot.nominal_payload_kg);
+  for (std::size_t j = 0; j < robot.joints.size(); ++j) {
+    const auto& drive = robot.joints[j].drive;
+    // Ratios and stiffnesses are written with the same digits in both files: equal exactly.
+    EXPECT_EQ(config.gear_ratio[j], drive.gear_ratio) << robot.joints[j].name;
+    EXPECT_EQ(config.gear_stiffness_nm_per_rad[j], drive.stiffness_nm_per_rad)
+        << robot.joints[j].name;
+    // The speeds are whole degrees per second in the config: within 0.5 deg/s of the robot's.
+    EXPECT_NEAR(config.max_speed_rad_s[j], robot.joints[j].max_velocity_rad_s, 0.5 * M_PI / 180.0)
+        << robot.joints[j].name;
+  }
+  // The default takes the pair, with its phase from the deflected gear.
+  EXPECT_TRUE(config.options.transmission_error_input);
+  EXPECT_DOUBLE_EQ(config.joint_options(1).transmission_error_rad_per_rad, 160.0);
+  EXPECT_DOUBLE_EQ(config.joint_options(1).transmission_error_compliance_rad_per_nm, 1.0 / 4.5e5);
+}
+
+}  // namespace
+}  // namespace imscal
