@@ -93,7 +93,7 @@ void time_cycles(benchmark::State& state, int inputs) {
   PrecontrolOptions options;
   options.offset_tolerance_rad.fill(1.0);  // keep it active: measure the full work
   options.rate_tolerance_rad_s.fill(1e9);
-  static Runtime precontrol;  // ~420 kB of fixed state: not on the stack
+  static Runtime precontrol;  // ~540 kB of fixed state: not on the stack
   std::string why;
   if (!Runtime::create(table, "kr16", options, &precontrol, &why)) {
     state.SkipWithError(why.c_str());

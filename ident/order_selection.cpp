@@ -10,15 +10,22 @@
 namespace imscal::ident {
 namespace {
 
+std::string taps_text(const OrderGrid& g) {
+  std::string text;
+  for (const int n : g.extra_taps) text += (text.empty() ? "" : ",") + std::to_string(n);
+  return text;
+}
+
 void validate_grid(const OrderGrid& g) {
   if (g.na_min < 0 || g.na_max < g.na_min || g.nb_min < 1 || g.nb_max < g.nb_min ||
       g.dead_time_min < 0 || g.dead_time_max < g.dead_time_min ||
       std::any_of(g.extra_taps.begin(), g.extra_taps.end(), [](int n) { return n < 1; }))
-    throw std::invalid_argument("select_arx_order: invalid grid (na " + std::to_string(g.na_min) +
-                                ".." + std::to_string(g.na_max) + ", nb " +
-                                std::to_string(g.nb_min) + ".." + std::to_string(g.nb_max) +
-                                ", d " + std::to_string(g.dead_time_min) + ".." +
-                                std::to_string(g.dead_time_max) + ")");
+    throw std::invalid_argument(
+        "select_arx_order: invalid grid (na " + std::to_string(g.na_min) + ".." +
+        std::to_string(g.na_max) + ", nb " + std::to_string(g.nb_min) + ".." +
+        std::to_string(g.nb_max) + ", d " + std::to_string(g.dead_time_min) + ".." +
+        std::to_string(g.dead_time_max) + ", further inputs' taps " + taps_text(g) +
+        "; every tap count >= 1, also for the unused inputs)");
 }
 
 // Relative floor of the Gram-derived RSS: yᵀy - ‖z‖² loses digits to cancellation at about this

@@ -549,10 +549,10 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
   t.source.description = src.child("description").string();
   const Node joints = r.child("joints");
   std::set<std::string> names;
+  const auto has = [&](TableInput input) {
+    return std::find(t.extra_inputs.begin(), t.extra_inputs.end(), input) != t.extra_inputs.end();
+  };
   for (const Node& j : joints.items()) {
-    const auto has = [&](TableInput input) {
-      return std::find(t.extra_inputs.begin(), t.extra_inputs.end(), input) != t.extra_inputs.end();
-    };
     t.joints.push_back(read_joint(
         j, t.sample_time_s, t.schema_version,
         t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1, has(TableInput::kTorqueSign),

@@ -7,6 +7,7 @@
 #include <complex>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "ident/arx_fit.hpp"
@@ -157,6 +158,16 @@ TEST(OrderSelection, RejectsBadGridAndMissingValidation) {
   OrderSelectionOptions options;
   options.grid = {3, 2, 1, 2, 0, 1};
   EXPECT_THROW(select_arx_order(data, options), std::invalid_argument);
+  // A tap list shorter than kMaxExtraInputs leaves zeros: the message lists the taps.
+  options.grid = {1, 2, 1, 2, 0, 1};
+  options.grid.extra_taps = {4, 1, 1};
+  try {
+    select_arx_order(data, options);
+    ADD_FAILURE() << "accepted a zero tap count";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("further inputs' taps 4,1,1,0,0"), std::string::npos)
+        << e.what();
+  }
   options.grid = {1, 2, 1, 2, 0, 1};
   options.validation_fraction = 0.0;
   options.criterion = OrderCriterion::kValidation;

@@ -98,7 +98,7 @@ void expect_same_offsets_as_the_reference(bool transmission_error) {
   // above the 0.5 rad/s default on this test's motion, which would keep the runtime off.
   o.rate_tolerance_rad_s.fill(5.0);
   o.max_lost_cycles = 2;
-  static Precontrol p;  // ~400 kB each: not on the stack
+  static Precontrol p;  // ~540 kB each: not on the stack
   static test_support::AllCellsPrecontrol reference, without_inputs;
   std::string why;
   ASSERT_TRUE(Precontrol::create(t, "kr16", o, &p, &why)) << why;
