@@ -16,7 +16,8 @@ namespace imscal::ident {
 // Version 2 added model_form, preview_cycles, the further inputs (extra_inputs,
 // direction_speed_scale_rad_s; per cell nx and c); version 1 tables are read as single-input
 // forward models without preview. Version 3 added the transmission-error inputs and the joints'
-// transmission_error_rad_per_rad (version 2 tables are read with 0).
+// transmission_error_rad_per_rad and transmission_error_compliance_rad_per_nm (version 2 tables
+// are read with 0 for both).
 inline constexpr int kParameterTableSchemaVersion = 3;
 
 // What the cells' models are (ident/joint_identification.hpp): forward error models of the
