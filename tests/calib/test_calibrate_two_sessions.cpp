@@ -61,6 +61,7 @@
 #include "sim/scenario.hpp"
 #include "tests/support/frames_json.hpp"
 #include "tests/support/run_imscal.hpp"
+#include "tests/support/record_figure.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal {
@@ -318,6 +319,9 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   // 3.1 %-points or more.
   const std::array<double, 3> measured_against_truth = {96.1, 95.2, 93.1};
   for (std::size_t j = 0; j < 3; ++j) {
+    const std::string& joint = table.joints[j].parameters.name;
+    test_support::record_figure(joint + "_fit_against_truth_percent", against_truth[j]);
+    test_support::record_figure(joint + "_fit_against_measured_percent", fit[joint]);
     EXPECT_GE(against_truth[j], measured_against_truth[j] - 3.0) << table.joints[j].parameters.name;
     EXPECT_GE(against_truth[j], 90.0) << table.joints[j].parameters.name;
     EXPECT_GE(fit[table.joints[j].parameters.name], 90.0) << table.joints[j].parameters.name;

@@ -23,6 +23,7 @@
 #include "core/sha256.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "tests/support/frames_json.hpp"
+#include "tests/support/record_figure.hpp"
 #include "tests/support/scratch_dir.hpp"
 #include "tests/tools/browser_check.hpp"
 #include "tests/tools/run_campaign.hpp"
@@ -119,6 +120,9 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
   for (int j = 0; j < 6; ++j) std::printf(" A%d %.3f", j + 1, rms[j] * 1e3);
   std::printf("\n");
   for (int j = 0; j < 6; ++j) EXPECT_LT(rms[j], 0.5e-3) << "A" << j + 1;
+  for (int j = 0; j < 6; ++j)
+    imscal::test_support::record_figure(fmt::format("A{}_joint_angle_rms_mrad", j + 1),
+                                        rms[j] * 1e3);
 
   // The parameter table: every joint, from calibrate's joint errors, every cell with a model.
   const auto table = imscal::ident::read_parameters_json(out / "identify" / "parameters.json");
@@ -146,6 +150,9 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
       verification.at("cases")[1].at("reduction_of_max_path_deviation_percent").get<double>());
   EXPECT_GT(verification.at("cases")[1].at("reduction_of_max_path_deviation_percent").get<double>(),
             20.0);
+  imscal::test_support::record_figure(
+      "campaign_line_reduction_percent",
+      verification.at("cases")[1].at("reduction_of_max_path_deviation_percent").get<double>());
 
   // The report: every section, every figure drawn (gnuplot's SVG curves are <path> elements).
   const std::string html = read_file_text(out / "report" / "report.html");
