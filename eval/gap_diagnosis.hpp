@@ -1,5 +1,5 @@
 #pragma once
-// How far the sim-to-real gap shrinks once an effect is modelled ("how far", issue 7), and the
+// How far the sim-to-real gap shrinks once an effect is modelled ("how far"), and the
 // verdict. The record is cut into alternating blocks (training, held-out, training, ...) so that
 // both parts see every kind of motion; every candidate of eval/gap_candidates.hpp is fitted per
 // joint on the training blocks and judged on the held-out blocks only:

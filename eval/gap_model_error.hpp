@@ -1,5 +1,5 @@
 #pragma once
-// The model-error model of the gap (issue 7, "where" by frequency; Ljung, "Model validation and
+// The model-error model of the gap ("where" by frequency; Ljung, "Model validation and
 // model error modeling", 1999): per joint, a linear FIR model from the input of the error model,
 // the desired joint angle q_d, to the gap g,
 //
