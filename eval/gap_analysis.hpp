@@ -4,6 +4,8 @@
 // by direction of motion. Shares are fractions of the total (or of the joint's) gap energy; each
 // grouping also gives the fraction of time, so a share well above its time fraction points at
 // where the gap comes from.
+//
+// References (docs/references.md): [Welch1967] (power spectral density).
 #include <cstddef>
 #include <string>
 #include <vector>

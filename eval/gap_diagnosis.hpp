@@ -15,6 +15,8 @@
 // ambiguity groups (eval/gap_ambiguity.hpp), reported together with what would separate them,
 // overall and per joint (its candidates ranked on its own gap); the plain words are
 // eval/gap_verdict.hpp's.
+//
+// References (docs/references.md): [Kunsch1989] (moving-block bootstrap).
 #include <cstdint>
 #include <string>
 #include <vector>

@@ -11,6 +11,8 @@
 // joint torque of the robot's rigid-body model and the direction of motion,
 // ident/joint_identification.hpp), extra_inputs of them with nx coefficients each, lags from d
 // as the main input's. extra_inputs = 0 is the paper's single-input model.
+//
+// References (docs/references.md): [Paper] (eq. 2), [Ljung1999] (ARX models).
 #include <algorithm>
 #include <array>
 #include <span>
