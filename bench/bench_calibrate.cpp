@@ -1,4 +1,4 @@
-// Speed of the frame-and-bias bundle (issue 4 goal: a 10-minute record at 1 kHz calibrated in
+// Speed of the frame-and-bias bundle (goal: a 10-minute record at 1 kHz calibrated in
 // < 5 s on one core). The record is made once, outside the timed loop: the 14 poses of
 // datasets/programs/mounting.yaml cycled for 10 minutes (6 s rests, 3 s quintic joint moves, a
 // kinematic record as in tests/calib/frame_calibration_scenes.hpp), the navigation-grade IMS at

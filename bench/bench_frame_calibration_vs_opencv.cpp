@@ -1,5 +1,5 @@
 // imscal's frame bundle against OpenCV's closed-form peers on the same simulated mounting data
-// (issue 4: "imscal's rotation and translation errors at least 3x smaller"). Per seed: the
+// (goal: "imscal's rotation and translation errors at least 3x smaller"). Per seed: the
 // mounting program (tests/data/scenarios/mounting-rigid.yaml, planned joint motion, rigid arm),
 // random base heading / IMS mount / clock offset, the navigation-grade IMS with its turn-on
 // biases and noise (as tests/calib/test_frame_calibration.cpp). The peers get the rest poses:

@@ -4,7 +4,7 @@
 // Accuracy: mean rotation error [deg] and translation error [mm] of T_R_W (Z) and T_S_H (X) over
 // 50 random seeds (random true frames, 20 random KR 16 rest poses, IMS attitude noise 0.001 deg
 // and position noise 0.02 mm per axis: a navigation-grade IMS after ZUPT smoothing). This is the
-// baseline the full Ceres calibration has to beat by 3x (issue 4); the harness is
+// baseline the full Ceres calibration has to beat by 3x (its goal); the harness is
 // bench/hand_eye_comparison.hpp and takes any estimator.
 //
 // Run: build-<name>/bench/bench_hand_eye   (add --benchmark_filter=none for the table only)

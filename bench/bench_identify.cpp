@@ -7,13 +7,13 @@
 //   default  datasets/identification/ident-default.yaml: imscal's inverse form with the model
 //            torque, direction, torque-sign and transmission-error inputs (60 + 60 + 1 + 32 + 32
 //            further coefficients in every candidate of the same sweep; --summary also times it
-//            without the transmission-error pair, the eleventh round's default, in the same
+//            without the transmission-error pair, as the default was before it, in the same
 //            run), one cell, on the simulator's `identification` run
 //            (the plant's true joint errors and the KDL model torques, 130 s) repeated as
 //            separate runs up to 1 M samples, each repetition with its own white measurement
 //            noise of 0.03 mrad (the IMS chain's error on this record, test_verification.cpp):
 //            the regressors and their conditioning are those of a real identification.
-// Goal (issue 5): < 2 s for all 6 joints. Timed as `imscal identify` runs it
+// Goal: < 2 s for all 6 joints x 1 M samples. Timed as `imscal identify` runs it
 // (ident::identify_joints: the independent joints on the machine's cores), with the same work on
 // one thread in the same run as the baseline.
 //
@@ -182,12 +182,12 @@ int main(int argc, char** argv) {
       std::printf("%s\n",
                   config == Config::kPaper
                       ? "paper config (ident-paper.yaml: eq. 2 ARX, 3 x 2 cells, backlash) on "
-                        "known ARX joints; issue 5's goal < 2 s"
+                        "known ARX joints; goal < 2 s"
                   : config == Config::kDefault
                       ? "default config (ident-default.yaml: inverse form, 60-tap torque and "
                         "direction inputs, 32-tap transmission-error pair, one cell) on the "
-                        "simulated identification run, repeated; issue 5's goal < 2 s"
-                      : "the default without the transmission-error pair (the eleventh round's "
+                        "simulated identification run, repeated; goal < 2 s"
+                      : "the default without the transmission-error pair (the former "
                         "default), the same run");
       // All cores first: the first run also pays the first touches of memory, so the ratio to
       // the one-thread baseline after it is on the safe side.

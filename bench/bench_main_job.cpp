@@ -1,4 +1,4 @@
-// Speed of the main command (issue 8: `imscal run` on the shipped default campaign < 60 s on
+// Speed of the main command (goal: `imscal run` on the shipped default campaign < 60 s on
 // 2 cores, a second run with nothing changed < 5 s), timed as a user meets it: the imscal binary
 // as a child process, wall time (UseManualTime). The baseline in the same run is
 // `imscal simulate --scenario campaign`, which writes the campaign's raw files in the first

@@ -24,15 +24,15 @@ namespace {
 using namespace imscal::ident;
 
 // The default identification's coefficients per torque and direction input
-// (datasets/identification/ident-default.yaml, model.input_taps: 60 since the eighth round) and
-// per input of the transmission-error pair (model.transmission_error_taps: 32 since the twelfth).
+// (datasets/identification/ident-default.yaml, model.input_taps: 60) and
+// per input of the transmission-error pair (model.transmission_error_taps: 32).
 constexpr int kDefaultInputTaps = 60;
 constexpr int kDefaultTransmissionErrorTaps = 32;
 
 // inputs: 0, or every cell also takes the first 3 or all 5 further inputs of the default
 // identification (model torque and direction with kDefaultInputTaps coefficients each, the
 // torque's sign with one, the transmission-error pair with kDefaultTransmissionErrorTaps each;
-// 3 is the default before the twelfth round).
+// 3: the default without the transmission-error pair).
 ParameterTable order_32_table(int inputs) {
   const bool with_inputs = inputs > 0, transmission_error = inputs == 5;
   std::mt19937_64 rng(32);
@@ -145,7 +145,7 @@ BENCHMARK(BM_PrecontrolCycle6JointsOrder32FurtherInputs)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1);
 
-// The eleventh round's default, without the transmission-error pair: what the pair costs, in
+// The default without the transmission-error pair: what the pair costs, in
 // the same run.
 void BM_PrecontrolCycle6JointsOrder32ThreeFurtherInputs(benchmark::State& state) {
   time_cycles<Precontrol>(state, 3);
@@ -154,8 +154,8 @@ BENCHMARK(BM_PrecontrolCycle6JointsOrder32ThreeFurtherInputs)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1);
 
-// The same with the runtime as it was before issue 6's speed work (every cell runs every cycle):
-// the before/after comparison in one run, on the same machine load.
+// The same with the runtime as it was before the precontrol's speed work (every cell runs every
+// cycle): the before/after comparison in one run, on the same machine load.
 void BM_AllCellsReferenceCycle6JointsOrder32(benchmark::State& state) {
   time_cycles<imscal::test_support::AllCellsPrecontrol>(state, 0);
 }

@@ -1,4 +1,4 @@
-// Speed of `imscal simulate` (issue 3 goal: 60 s of the `identification` scenario with every
+// Speed of `imscal simulate` (goal: 60 s of the `identification` scenario with every
 // effect on in < 10 s wall time on one core): the whole run_simulation (plan, plant with RK4 at
 // 0.5 ms, FK of every 1 ms sample, spline, IMS synthesis at 1 kHz, sensor errors and noise),
 // without the file writing. Reported as real time per simulated 60 s.

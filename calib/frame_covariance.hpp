@@ -48,7 +48,7 @@ FrameCovariance compute_frame_covariance(ceres::Problem& problem,
                                          const std::vector<CovarianceBlock>& blocks);
 
 struct WeakDirectionLimits {
-  double rotation_sigma_rad = 0.005 * M_PI / 180.0;  // issue 4's goal for the frames
+  double rotation_sigma_rad = 0.005 * M_PI / 180.0;  // the accuracy goal for the frames
   double translation_sigma_m = 0.05e-3;
   double axis_spread_ratio = 0.05;  // smallest / largest eigenvalue of the axis scatter
 };

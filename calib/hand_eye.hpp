@@ -24,6 +24,8 @@
 //  5. Residuals per pose (rotation angle and translation distance) are reported.
 // A pose set that cannot determine the unknowns (fewer than 3 poses, no rotation, rotations about
 // one axis only) is refused with HandEyeUnobservable, naming the missing directions.
+//
+// References (docs/references.md): [ChouKamel1991] (hand-eye rotation by quaternions).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cmath>

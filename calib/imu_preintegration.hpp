@@ -35,6 +35,9 @@
 // vec(E), column-major (entry (r, c) of E at index 3 c + r, as Eigen::Map<Matrix3d> reads it).
 // Which of the 18 entries the data can separate from the frames is the bundle's business
 // (calib/frame_calibration.hpp: the gyro triad defines S, its antisymmetric part is R_S_H's).
+//
+// References (docs/references.md): [LuptonSukkarieh2012], [Forster2017] (preintegration, bias
+// Jacobians), [Savage1998] (coning term).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>

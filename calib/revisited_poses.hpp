@@ -11,7 +11,7 @@
 // show. So at the end of every commanded standstill at the first rest's pose and payload
 //   e_k = (p_IMS - p_FK(q_internal))_k - (p_IMS - p_FK(q_internal))_first rest
 // is the smoothed position's error there (the gear deflection, equal at every visit, cancels).
-// Eighth round, generalised to every pose the robot returns to: each settled standstill i gets an
+// Generalised to every pose the robot returns to: each settled standstill i gets an
 // error e_i, found by least squares (per axis) from
 //   e_first = 0                           the first rest defines W_T_S's position (its FK);
 //   e_k - e_j = d_k - d_j                 consecutive visits j, k of one pose with one payload,

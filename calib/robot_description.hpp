@@ -11,6 +11,8 @@
 // Units are SI inside (m, rad, kg, N m); the YAML file uses degrees where the key says so
 // (`alpha_deg`, `limit_deg`, `backlash_deg`, `rpy_deg`). See datasets/robots/kr16.yaml for the
 // file format; every key is checked, unknown keys are refused (InputError with file/line/key).
+//
+// References (docs/references.md): [DH1955], [Craig1986], [Spong2006].
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>

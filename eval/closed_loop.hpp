@@ -19,7 +19,7 @@
 // Δq̂(k) = q_d(k - d) - q̂(k) (paper, eq. 2): with L = d it refers to the desired value of the
 // cycle it is applied in.
 //
-// Inversion of the loop (issue 6): adding the predicted error once, q_c = q_d + Δq̂, leaves the
+// Inversion of the loop: adding the predicted error once, q_c = q_d + Δq̂, leaves the
 // plant's response to the offset itself: with G the loop (q_c -> q) the remainder is
 // (1 - G)^2 q_d instead of (1 - G) q_d. With inversion_iterations = n the offset is the n-th
 // fixed-point iterate of G(q_d + o) = q_d with the model in place of G,

@@ -1,5 +1,5 @@
 #pragma once
-// Candidate effects the data cannot tell apart (gap diagnosis, issue 7). Two candidates are
+// Candidate effects the data cannot tell apart (gap diagnosis). Two candidates are
 // ambiguous on a record when their modelled gaps on the held-out rows are the same within a
 // tenth of what neither explains:
 //

@@ -1,9 +1,11 @@
 #pragma once
-// Where the sim-to-real gap lies ("where", issue 7): shares of the gap energy (sum of g² over
+// Where the sim-to-real gap lies ("where"): shares of the gap energy (sum of g² over
 // samples, rad²) by joint, by path segment kind, by frequency band, by operating-point cell and
 // by direction of motion. Shares are fractions of the total (or of the joint's) gap energy; each
 // grouping also gives the fraction of time, so a share well above its time fraction points at
 // where the gap comes from.
+//
+// References (docs/references.md): [Welch1967] (power spectral density).
 #include <cstddef>
 #include <string>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// The library of candidate effects of the gap diagnosis ("which", issue 7): each candidate is a
+// The library of candidate effects of the gap diagnosis ("which"): each candidate is a
 // small parametric model of one joint's gap g (eval/gap_signals.hpp), linear in its parameters,
 // built from known signals only. Its nonlinear shape (a time constant, a resonance frequency, a
 // harmonic) is chosen from a small grid by the 2-fold validation inside the training rows

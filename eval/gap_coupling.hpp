@@ -1,6 +1,6 @@
 #pragma once
 // How one joint's effect spreads over the other joints through the arm's coupled dynamics (gap
-// diagnosis, issue 7). An effect that moves joint j's link (its modelled gap y_j, e.g. the link
+// diagnosis). An effect that moves joint j's link (its modelled gap y_j, e.g. the link
 // crossing its gear's play, or following a transmission error) accelerates it, and that
 // acceleration asks torque of every other joint through the mass matrix: tau_i = M_ij(q_d) ÿ_j.
 // Joint i's gear and loop deflect under that torque with their own, unknown, dynamics. So each

@@ -1,5 +1,5 @@
 #pragma once
-// How far the sim-to-real gap shrinks once an effect is modelled ("how far", issue 7), and the
+// How far the sim-to-real gap shrinks once an effect is modelled ("how far"), and the
 // verdict. The record is cut into alternating blocks (training, held-out, training, ...) so that
 // both parts see every kind of motion; every candidate of eval/gap_candidates.hpp is fitted per
 // joint on the training blocks and judged on the held-out blocks only:
@@ -15,6 +15,8 @@
 // ambiguity groups (eval/gap_ambiguity.hpp), reported together with what would separate them,
 // overall and per joint (its candidates ranked on its own gap); the plain words are
 // eval/gap_verdict.hpp's.
+//
+// References (docs/references.md): [Kunsch1989] (moving-block bootstrap).
 #include <cstdint>
 #include <string>
 #include <vector>

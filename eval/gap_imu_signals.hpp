@@ -1,5 +1,5 @@
 #pragma once
-// The sim-to-real gap of raw IMU signals (issue 7, "the IMS signals synthesised from the robot's
+// The sim-to-real gap of raw IMU signals ("the IMS signals synthesised from the robot's
 // reported motion"): on a tool-mounted IMU record (calib/tool_imu_record.hpp), "sim" is the
 // angular rate the robot's reported tool poses imply (calib::robot_tool_rate, in the tool frame
 // T), "real" is the gyro as read, and the gap per gyro sample is

@@ -1,5 +1,5 @@
 #pragma once
-// The model-error model of the gap (issue 7, "where" by frequency; Ljung, "Model validation and
+// The model-error model of the gap ("where" by frequency; Ljung, "Model validation and
 // model error modeling", 1999): per joint, a linear FIR model from the input of the error model,
 // the desired joint angle q_d, to the gap g,
 //
@@ -16,6 +16,8 @@
 // unmodelled dynamic effect of the error model. Where it includes zero at every frequency, the
 // gap is not a linear function of the input (noise, or a nonlinear effect such as backlash,
 // which the candidates test). The held-out share of the gap it explains says how much that is.
+//
+// References (docs/references.md): [Ljung1999MEM] (model error modelling).
 #include <cstddef>
 #include <utility>
 #include <vector>

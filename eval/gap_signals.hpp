@@ -1,5 +1,5 @@
 #pragma once
-// The data of a sim-to-real gap diagnosis (issue 7): per joint and controller cycle, the gap
+// The data of a sim-to-real gap diagnosis: per joint and controller cycle, the gap
 // between the measured ("real") joint error and the predicted ("sim") one, and the known signals
 // from which the candidate effects are built (desired joints and their derivatives, the rigid-
 // body torques of the desired motion, gear ratios, time).

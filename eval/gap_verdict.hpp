@@ -1,5 +1,5 @@
 #pragma once
-// The gap diagnosis in plain words (issue 7): where the gap lies, the most likely cause with its
+// The gap diagnosis in plain words: where the gap lies, the most likely cause with its
 // size (and the causes the data cannot tell apart from it), the expected gap once modelled, the
 // leading cause per joint, and what to measure next when the evidence is weak or ambiguous.
 #include "eval/gap_diagnosis.hpp"

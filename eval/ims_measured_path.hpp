@@ -1,12 +1,12 @@
 #pragma once
 // The attained joint angles as the IMS chain measures them (paper, section 4: "the actual paths
-// measured with the inertial measurement system"; issue 6): a plant run's link-side flange motion
+// measured with the inertial measurement system"): a plant run's link-side flange motion
 // recorded by the scenario's simulated IMS (sim::record_ims: sensor errors drawn from its spec,
 // noise), corrected by the unit's own calibration (scale factors and misalignments, as a lab
 // does with its IMS's calibration sheet), then mechanized, zero-velocity smoothed and turned into
 // joint angles by inverse kinematics (calib::joint_space_errors) with the frames, biases and
 // clock offset of the measurement setup. The frames are the simulation's own here: how well a
-// campaign finds them is the frame calibration's figure (issue 4, tests/calib).
+// campaign finds them is the frame calibration's figure (tests/calib).
 #include <cstdint>
 #include <vector>
 

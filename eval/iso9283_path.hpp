@@ -23,6 +23,8 @@
 //          counted on the outside of the corner (the side the first leg's motion carries on to)
 //   CR = max_j CR_j, CO = max_j CO_j.
 // With one cycle (n = 1) the repeatabilities are not defined and are reported as NaN.
+//
+// References (docs/references.md): [ISO9283] (clause 8).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <vector>

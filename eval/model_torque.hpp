@@ -13,6 +13,8 @@
 // robot file), the only payload datum the joint-error log and the precontrol's caller have (its
 // mass). Its lever and inertia, like the model's own inertial errors, are absorbed by the
 // identified torque coefficients.
+//
+// References (docs/references.md): [KDL], [Featherstone2008] (inverse dynamics).
 #include <Eigen/Core>
 #include <span>
 #include <utility>

@@ -10,6 +10,8 @@
 // Each actual point is compared only with the desired path within +-window_s of its own time,
 // so that paths that come back along themselves (the paper's line there and back) or cross
 // themselves are not matched to the wrong pass.
+//
+// References (docs/references.md): [ISO9283] (clause 8.2).
 #include <Eigen/Core>
 #include <cstddef>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// Verification of the dynamic calibration (paper, section 4; issue 6): the same path run by the
+// Verification of the dynamic calibration (paper, section 4): the same path run by the
 // uncalibrated robot and by the robot with the precontrol in the loop (eval/closed_loop.hpp), n
 // cycles each, compared by ISO 9283 path characteristics (eval/iso9283_path.hpp) and by the
 // maximum perpendicular path deviation (eval/path_deviation.hpp, the paper's Fig. 6).
@@ -49,7 +49,7 @@ ident::JointErrorLog simulate_truth_joint_errors(
 // scenario's simulated IMS and taken through the chain (eval/ims_measured_path.hpp), q_measured
 // the IMS's joint angles (samples the chain could not measure are left out: the log then has
 // gaps), q_internal the encoders. seed: the sensor's draw. The joint_errors.csv `imscal
-// calibrate` writes, with the frames known (their calibration: issue 4's figures).
+// calibrate` writes, with the frames known (their calibration: tests/calib's figures).
 ident::JointErrorLog simulate_ims_joint_errors(
     const sim::Scenario& scenario, std::uint64_t seed = 1,
     double max_duration_s = std::numeric_limits<double>::infinity());
@@ -76,7 +76,7 @@ IdentifiedTable identify_table(const ident::JointErrorLog& log,
                                const std::string& source_file = "simulator truth",
                                const ModelTorqueSource* torque_model = nullptr);
 
-// The ablation (issue 6): the config with one part changed at a time, so that the contribution
+// The ablation: the config with one part changed at a time, so that the contribution
 // of each part is measured on the same paths. Labels say what changed:
 //  * "paper form": the paper's model as it stands (eq. 2 in joint-error form, no further inputs,
 //    the operating-point grid of Table 2, the backlash term of eq. 3), for any config;

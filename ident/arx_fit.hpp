@@ -39,6 +39,9 @@
 //
 // The model has no constant term (as in the paper): signals with a large offset and little
 // motion make the regressors nearly collinear; the condition number in the result shows it.
+//
+// References (docs/references.md): [Ljung1999] (least squares), [Bjorck1996], [Higham2002]
+// (refinement, accuracy of least-squares solvers).
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>

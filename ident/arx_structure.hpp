@@ -7,10 +7,12 @@
 //
 // with y = q̂ (the joint angle the robot reaches), u = q_d (the desired joint angle), d the dead
 // time in samples and e(k) the equation error. na >= 0 (na = 0 is a FIR model), nb >= 1, d >= 0.
-// The x_e are optional further inputs of the multi-input form (imscal's extension, issue 6: the
+// The x_e are optional further inputs of the multi-input form (imscal's extension: the
 // joint torque of the robot's rigid-body model and the direction of motion,
 // ident/joint_identification.hpp), extra_inputs of them with nx coefficients each, lags from d
 // as the main input's. extra_inputs = 0 is the paper's single-input model.
+//
+// References (docs/references.md): [Paper] (eq. 2), [Ljung1999] (ARX models).
 #include <algorithm>
 #include <array>
 #include <span>

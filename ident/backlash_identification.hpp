@@ -27,6 +27,8 @@
 //     to the estimate (residuals inside one window are strongly correlated, so the regression's
 //     own σ would be far too small).
 // The linear ARX model is then fitted to q_m + l s(k) (the joint angle without the backlash).
+//
+// References (docs/references.md): [Paper] (eq. 3).
 #include <cstddef>
 #include <span>
 #include <string>

@@ -16,7 +16,7 @@
 //  5. cells that failed any step are filled with the model of the nearest identified cell (in
 //     band steps; ties: the lower cell number), with the reason — never silently.
 //
-// Model form (issue 6). The joint error is ~1e-3 of the joint angle, so a least-squares ARX fit
+// Model form. The joint error is ~1e-3 of the joint angle, so a least-squares ARX fit
 // of the angle q_m on q_d (ArxModelForm::kAngle, the paper's eq. 2 taken literally) is decided
 // by the angle: a model with 99.8 % angle fit can have a static gain of 1 ± 1e-3 and so predict a
 // joint error off by ~1 mrad per rad of travel (held-out joint-error fit 59 % down to -44 % on
@@ -36,8 +36,8 @@
 // once, q_c = q_d + Δq̂, leaves the loop's response to the offset itself: with G the loop
 // (q_c -> q) the remaining error is (1 - G)^2 q_d, i.e. the error is only cut by |1 - G|, and
 // for a joint controller of a few Hz bandwidth that is ~0.5 at the frequencies of a fast path
-// (issue 6). The inverse form identifies instead the command that made the link follow the
-// path it followed: in the identification runs the command was q_d and the (play-free) link
+// (eval/closed_loop.hpp). The inverse form identifies instead the command that made the link follow
+// the path it followed: in the identification runs the command was q_d and the (play-free) link
 // angle y, so q_d = y + e, and the same error-form ARX is fitted with the link's increments as
 // input, P cycles ahead (the controller's interpolator knows the path ahead):
 //
@@ -78,7 +78,7 @@ ArxModelForm arx_model_form_from_string(const std::string& text);
 struct JointIdentificationOptions {
   ArxModelForm form = ArxModelForm::kJointError;
   int preview_cycles = 0;  // P of the inverse form (>= 0; only with kInverse)
-  // Further inputs of the multi-input form (imscal's extension of eq. 2, issue 6), both taken
+  // Further inputs of the multi-input form (imscal's extension of eq. 2), both taken
   // along the path the model's input follows (q_d, or the link in the inverse form), P cycles
   // ahead like the increments, OrderGrid::extra_taps coefficients each:
   //  * the joint torque of the robot's rigid-body model (identify_joint's model_torque_nm, from

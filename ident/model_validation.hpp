@@ -20,6 +20,8 @@
 // family-wise band (Šidák: per-lag level 1 − (1 − α)^(1/lags)), so one gross violation — a
 // missing dead-time lag with correlation 0.9 — fails the test on its own. For a correct model
 // each rule fails with probability below α.
+//
+// References (docs/references.md): [Ljung1999] (residual tests), [Sidak1967] (family-wise band).
 #include <cstddef>
 #include <span>
 #include <vector>

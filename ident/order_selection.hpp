@@ -26,6 +26,8 @@
 //   AIC = N ln V + 2p,   BIC = N ln V + p ln N,   validation = mean squared one-step error.
 // BIC is the default: it is consistent (picks the true order with probability → 1 as N grows),
 // AIC tends to over-fit.
+//
+// References (docs/references.md): [Akaike1974] (AIC), [Schwarz1978] (BIC), [Ljung1999].
 #include <array>
 #include <cstddef>
 #include <span>

@@ -10,8 +10,8 @@
 //   2. every cell's ARX model (paper eq. 2) runs on the desired angle (free run: its own past
 //      outputs), giving Δq̂_c(k) = q_d(k-d) - q̂_c(k) (as ArxModel::predict_joint_error); the
 //      blend is Σ w_c Δq̂_c. The input history is one ring per joint (q_d is the same for all
-//      cells); the output history is per cell. Cells outside the blend run too, on purpose
-//      (issue 6): a cell entering the blend needs its own free-run state, which depends on the
+//      cells); the output history is per cell. Cells outside the blend run too, on purpose:
+//      a cell entering the blend needs its own free-run state, which depends on the
 //      whole past input through its own poles. Starting it instead from the blended past
 //      (q̂_c(k-i) = q_d(k-i-d_c) - Δq̂(k-i)) or from rest excites the cell's transient; in the
 //      companion form of an order-32 model (|a_i| up to ~1e8) that transient reached 2.3 rad in

@@ -44,6 +44,8 @@
 //   heading : clockwise from North of the Y (forward) axis = -yaw, in [0, 2 pi)
 //   pitch   : elevation of the Y axis above the horizontal (nose up > 0), in [-pi/2, pi/2]
 //   roll    : rotation about Y; > 0 when the X (right) axis points below the horizontal.
+//
+// References (docs/references.md): [Groves2013] (levelling, gyrocompassing), [Shuster1981] (TRIAD).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstddef>

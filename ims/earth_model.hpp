@@ -8,6 +8,8 @@
 //   g_W(p) = g_W(0) + G_W * p,
 // with the gradient G_W taken from GeographicLib by central differences. The neglected
 // second-order term is about 3 g / r^2 * |p|^2 ~ 7e-13 m/s^2 for |p| = 1 m.
+//
+// References (docs/references.md): [GeographicLib], [WGS84].
 #include <Eigen/Core>
 
 namespace imscal::ims {

@@ -18,6 +18,8 @@
 //   ddb/dt  = -db / tau + w_b       (first-order Gauss-Markov; tau = infinity: random walk)
 // G_W is the gravity gradient (ims/earth_model.hpp); n_g, n_a, w_b are white noises with the
 // power spectral densities in ErrorProcessNoise.
+//
+// References (docs/references.md): [Groves2013] (Earth-fixed-frame error model).
 #include <Eigen/Core>
 
 namespace imscal::ims {

@@ -34,6 +34,9 @@
 // per-sample code works on 3-vectors padded to 4 doubles (one AVX register) and is arranged for
 // short dependency chains; about 45 ns per sample on one core of the development machine
 // (bench/bench_strapdown.cpp, which also times the previous implementation in the same run).
+//
+// References (docs/references.md): [Bortz1971] (rotation vector, coning), [Savage1998] (coning and
+// sculling, position from increments), [Groves2013] (Earth-fixed-frame mechanization).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <vector>

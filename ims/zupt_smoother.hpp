@@ -25,6 +25,9 @@
 // attitude between rests, roll, pitch and the accelerometer biases observable. Heading is
 // observable only through the Earth rate (gyrocompassing, slow); position not at all: its error
 // is that of the initial position plus the integrated motion errors.
+//
+// References (docs/references.md): [Groves2013] (error-state filter, zero-velocity and
+// zero-angular-rate updates), [RTS1965] (backward pass).
 #include <Eigen/Core>
 #include <cstddef>
 #include <vector>

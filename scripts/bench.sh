@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds imscal (Release) and runs every benchmark and side-by-side comparison, printing the
-# figures quoted in the closing notes. Benchmarks report CPU time as well as wall time: on a
+# figures quoted in docs/results.md. Benchmarks report CPU time as well as wall time: on a
 # loaded machine, quote ratios measured in the same run.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -4,6 +4,8 @@
 // Newton-Euler pass with qdd = 0. Link-side joint coordinates [rad], torques [N m].
 // The potential energy is computed separately from our own forward kinematics (calib/), so the
 // energy check of the simulator does not rely on KDL alone.
+//
+// References (docs/references.md): [KDL], [Featherstone2008] (recursive Newton-Euler, mass matrix).
 #include <Eigen/Core>
 #include <kdl/chain.hpp>
 #include <kdl/chaindynparam.hpp>

@@ -1,4 +1,4 @@
-// `imscal diagnose`: the sim-to-real gap diagnosis (issue 7). "real": a joint_errors.csv (the
+// `imscal diagnose`: the sim-to-real gap diagnosis. "real": a joint_errors.csv (the
 // joint errors measured through the IMS chain); "sim": the identified error model
 // (parameters.json, run on the desired joints) or a second joint_errors.csv (e.g. the simulator
 // with a given set of effects, same time stamps). Writes report.json and report.txt, with

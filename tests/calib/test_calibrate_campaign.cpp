@@ -1,4 +1,4 @@
-// Issue 4's campaign figure with the plant effects on: simulation -> rest poses
+// The frame calibration's campaign figure with the plant effects on: simulation -> rest poses
 // (calib/rest_poses.hpp, from the raw IMS record and the robot log, as `imscal calibrate` does)
 // -> calibrate_frames, over N seeds (50 in Release, 2 under IMSCAL_SANITIZED), each with a random
 // base heading, a random IMS mount and a newly drawn IMS unit (biases, scale factors,
@@ -12,7 +12,7 @@
 // within 1/2/3 sigma: 68/95/99.7 % if the sigmas are honest). The accelerometer bias is compared
 // with the bias the record carries over the first rest (turn-on plus the unit's in-run drift,
 // ims::corrupt's InRunBias): the bundle models that drift and reports the first rest's bias.
-// Goal of issue 4: 0.005 deg / 0.05 mm, the rest within 3 sigma. Asserted is what the chain
+// Goal: 0.005 deg / 0.05 mm, the rest within 3 sigma. Asserted is what the chain
 // meets (see the comments at the asserts); the figures are printed for the report.
 //
 // Three scenarios: `mounting` as shipped (every plant effect), `mounting-rigid` (rigid drives)
@@ -396,7 +396,7 @@ TEST(CalibrateCampaign, MountingRigid) {
   // accelerometer bias is that of the first rest (the unit's in-run drift, 10 ug over 600 s,
   // moves it by ~5 ug over the record: against the turn-on bias alone it was 97 sigma off, and
   // 18 sigma against the first rest's bias while the bundle took the bias as constant).
-  // Asserted: issue 4's goals where met (T_S_H 0.005 deg / 0.05 mm; 3 sigma), the share within
+  // Asserted: the goals where met (T_S_H 0.005 deg / 0.05 mm; 3 sigma), the share within
   // 1 and 2 sigma with room for 80 draws (0.55, 0.85), the tilt at 0.01 deg (met at 0.0052 with
   // little margin) and the T_R_W translation at 0.2 mm (not met: the unloaded A1's play prior,
   // b / sqrt(12) = 8e-5 rad at the first rest, is 0.09 mm there, and no IMS measurement tells
@@ -452,7 +452,7 @@ TEST_F(CalibrateCampaignScratch, MountingWithoutBacklash) {
   // IMS is still), translation 0.121 mm, heading 2.1 sigma, gyro bias 1.6 sigma, acc bias 3.1
   // sigma, dt 0.84 sigma, no outlier block; within 1/2/3 sigma 0.79 / 0.95 / 0.99. Before the creep
   // and the bias drift were modelled: T_S_H 0.0043 deg / 0.108 mm, heading 6.2, gyro bias 4.9, acc
-  // bias 77 sigma, 15 of 27 blocks outliers. Asserted: issue 4's goals for T_S_H and the 3-sigma
+  // bias 77 sigma, 15 of 27 blocks outliers. Asserted: the goals for T_S_H and the 3-sigma
   // bounds where met, the sigma shares as for `rigid`, the tilt at 0.01 deg; the T_R_W translation
   // is not met (0.12 mm, the unloaded A1's play prior at the first rest, see `rigid`).
   EXPECT_LT(f.S_H_rotation_deg, 0.005);

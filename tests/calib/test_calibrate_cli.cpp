@@ -100,7 +100,7 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
   for (const auto& e : frames.at("estimates"))
     for (const auto& s : e.at("sigma")) EXPECT_GT(s.get<double>(), 0.0) << e.at("name");
 
-  // Frames against the truth. Tolerances: issue 4's goals (0.005 deg, 0.05 mm), which this
+  // Frames against the truth. Tolerances: the accuracy goals (0.005 deg, 0.05 mm), which this
   // deterministic record (scenario seed 1) meets: measured 0.0015 deg / 0.036 mm for T_S_H and
   // 0.0041 deg tilt of T_R_W. Without --unit-calibration the unit's accelerometer scale factors
   // (100 ppm) and misalignments (10 arcsec class) put T_S_H 0.02 deg off and tilt T_R_W by

@@ -1,4 +1,4 @@
-// Issue 5 on real files: the lab calibrates the IMS mount in one session and records the
+// Two sessions on real files: the lab calibrates the IMS mount in one session and records the
 // identification runs in another with the same robot, base, mount and unit
 // (tests/data/scenarios/two-sessions-*.yaml: same seed, so the simulator draws the same base
 // heading, mount and unit; see there). The chain, each step the `imscal` command:
@@ -16,7 +16,7 @@
 // against the TRUE joint errors of the held-out rows (eval::replay_held_out_fits, as
 // tests/eval/test_verification.cpp's IdentifiedFromTheImsChain): A1 96.1, A2 95.2, A3 93.1 %
 // (the shipped config's 60 input taps; 95.2/94.1/93.4 and 95.1/94.7/93.0 % with 32), asserted
-// 3 %-points below; issue 5's goal (>= 90 % per primary joint) is met both ways and asserted
+// 3 %-points below; the goal (>= 90 % per primary joint) is met both ways and asserted
 // (Release).
 // The clock offset: 0.033 ms off (asserted below), with session 1's link share of the drives'
 // friction as the prior (0.098 ms off without; it costs A1 0.02 mrad). The biases --frames finds
@@ -60,8 +60,8 @@
 #include "ims/sensor_error_model.hpp"
 #include "sim/scenario.hpp"
 #include "tests/support/frames_json.hpp"
-#include "tests/support/run_imscal.hpp"
 #include "tests/support/record_figure.hpp"
+#include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal {
@@ -146,7 +146,7 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   const fs::path cal = dir_ / "cal";
   int status = run(calibrate_arguments(cal_sim, unit, cal), dir_ / "cal.log");
   ASSERT_TRUE(status == 0 || status == 1) << read(dir_ / "cal.log");
-  // Session 2 alone has too few rests for the frames: refused (exit 2), as issue 5 says.
+  // Session 2 alone has too few rests for the frames: refused (exit 2).
   EXPECT_EQ(run(calibrate_arguments(id_sim, unit, dir_ / "refused"), dir_ / "refused.log"), 2);
   EXPECT_NE(read(dir_ / "refused.log").find("at least 3"), std::string::npos)
       << read(dir_ / "refused.log");
@@ -252,7 +252,7 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   std::map<std::string, double> fit;
   for (const auto& joint : ident_report.at("joints")) {
     double sum = 0.0, rows = 0.0;
-    std::string chosen;  // issue 5: the chosen order and dead time are reported
+    std::string chosen;  // the chosen order and dead time are reported
     for (const auto& cell : joint.at("cells")) {
       if (cell.at("status") != "identified") continue;
       EXPECT_TRUE(cell.contains("chosen")) << joint.at("joint");
@@ -315,7 +315,7 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   // Measured against the truth: A1 96.1, A2 95.2, A3 93.1 % (against the IMS-measured errors
   // 96.2, 95.1, 94.0 %). Asserted 3 %-points below, as IdentifiedFromTheImsChain (the chain is
   // deterministic; the margin covers other platforms' rounding through the order selection).
-  // Issue 5's goal, >= 90 % per primary joint both ways, asserted at the goal itself: met by
+  // The goal, >= 90 % per primary joint both ways, asserted at the goal itself: met by
   // 3.1 %-points or more.
   const std::array<double, 3> measured_against_truth = {96.1, 95.2, 93.1};
   for (std::size_t j = 0; j < 3; ++j) {

@@ -4,7 +4,7 @@
 //  - the mounting-rigid scenario (the `mounting` program with rigid drives) with the
 //    navigation-grade IMS over N seeds (random base heading, IMS mount, clock offset, sensor
 //    biases and noise), from automatic initial values (coarse alignment, hand-eye closed form,
-//    cross-correlation of rate magnitudes): issue 4's goals on roll/pitch of R_T_W and T_S_H,
+//    cross-correlation of rate magnitudes): the accuracy goals on roll/pitch of R_T_W and T_S_H,
 //    the heading, biases and time offset against their reported sigma.
 #include <gtest/gtest.h>
 
@@ -258,7 +258,7 @@ SeedOutcome run_mounting_seed(std::uint64_t seed) {
 }
 
 TEST(FrameCalibration, MountingRigidNavigationGradeOverSeeds) {
-  // 50 seeds in Release (issue 4); 3 under the sanitizers (IMSCAL_SANITIZED), 5-10x slower.
+  // 50 seeds in Release; 3 under the sanitizers (IMSCAL_SANITIZED), 5-10x slower.
   const int seeds = sanitized() ? 3 : 50;
   mounting_motion();  // planned once, before the threads
   std::vector<SeedOutcome> outcomes(seeds);
@@ -296,9 +296,9 @@ TEST(FrameCalibration, MountingRigidNavigationGradeOverSeeds) {
       seeds, converged, worst_rp, worst_rot, worst_pos_S_H, worst_pos_R_W, heading_sigma_mean,
       worst_heading, double(within[0]) / count, double(within[1]) / count,
       double(within[2]) / count);
-  EXPECT_EQ(converged, seeds);  // 100 % from automatic initial values (issue 4)
+  EXPECT_EQ(converged, seeds);  // 100 % from automatic initial values
   EXPECT_EQ(named, seeds);      // the heading is always named as a weak direction
-  // Issue 4's frame goals, on every seed.
+  // The frame accuracy goals, on every seed.
   EXPECT_LT(worst_rp, 0.005);
   EXPECT_LT(worst_rot, 0.005);
   EXPECT_LT(worst_pos_S_H, 0.05);

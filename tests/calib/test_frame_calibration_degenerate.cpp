@@ -1,4 +1,4 @@
-// Degenerate pose sets and records for the frame bundle (issue 9): each must be refused with the
+// Degenerate pose sets and records for the frame bundle: each must be refused with the
 // reason (InputError, or HandEyeUnobservable naming the missing directions) or give a result
 // whose weak directions name the problem — never a confident wrong answer. Records are noise-free
 // kinematic ones (tests/calib/frame_calibration_scenes.hpp), so nothing but the geometry is at

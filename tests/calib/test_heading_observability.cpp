@@ -4,7 +4,7 @@
 // gyro bias is estimated from the same rests). Measured here on the bundle's own covariance
 // (calib/frame_calibration.hpp) for the navigation-grade spec: the same 8 poses of the mounting
 // program held 8, 32 and 128 s each, a noise-free record (the covariance depends on the noise
-// model and the geometry, not on the draws). Issue 4's 0.005 deg for T_R_W then needs the rest
+// model and the geometry, not on the draws). The 0.005 deg goal for T_R_W then needs the rest
 // time printed below.
 #include <gtest/gtest.h>
 

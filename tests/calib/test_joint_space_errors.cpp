@@ -1,8 +1,8 @@
-// Joint-space errors from the IMS (calib/joint_space_errors.hpp), the key figure of issue 4: on
+// Joint-space errors from the IMS (calib/joint_space_errors.hpp), the chain's key figure: on
 // the simulated `seed-line` run (the paper's test path, KR 16 with every drive effect, 5 kg,
 // navigation-grade IMS), with the TRUE frames, biases and clock offset of the simulation (this
 // isolates the joint-space step from the frame calibration), the joint errors recovered from the
-// IMS match the simulator's true link-side errors q_desired - q_link. Goal of issue 4: 0.01 mrad
+// IMS match the simulator's true link-side errors q_desired - q_link. Goal: 0.01 mrad
 // RMS on the lines.
 //
 // What limits it, measured here: after every move the simulated arm does not come to rest. Its
@@ -280,11 +280,11 @@ TEST(JointSpaceErrors, MatchTheSimulatorsLinkSideErrorsOnSeedLine) {
               without.smoother.rest_intervals.size(), without_position * 1e3, without_at);
   print("  on the two lines:", without_lines.error, without_lines.count);
 
-  // Issue 4 asks for 0.01 mrad RMS on the lines: NOT MET here (see the top of the file).
+  // The goal is 0.01 mrad RMS on the lines: NOT MET here (see the top of the file).
   // Measured (Release): max position error 0.066 mm (IMS's own rests: 8.0 mm); on the lines A1
   // 0.015, A2 0.084, A3 0.132, A4 0.001, A5 0.052, A6 0.013 mrad RMS (IMS's own rests: 0.18,
   // 1.36, 5.71, 0.001, 4.37, 0.18), the smoother's sigma 0.051, 0.162, 0.305, 0.001, 0.164,
-  // 0.055 mrad. (Before the eighth round's correction at the revisited poses, here the line
+  // 0.055 mrad. (Without the correction at the revisited poses, here the line
   // start before and after the lines, calib/revisited_poses.hpp: 0.091 mm; A2 0.115, A3 0.163.)
   // Asserted: the chain without gross failure (IK branch, clock, frames: errors of 0.1 rad and
   // more); then what it reaches with ~1.5x margin, that the readings beat the IMS's own rests by

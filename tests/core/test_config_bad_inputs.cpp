@@ -1,4 +1,4 @@
-// The bad-config catalogue (issue 9): every file in tests/data/bad_inputs/configs/ is a YAML config
+// The bad-config catalogue: every file in tests/data/bad_inputs/configs/ is a YAML config
 // that a user could write by mistake (typo in a key, unit in the wrong key, text for a number,
 // NaN, a short vector, inverted bounds, a missing referenced file, tabs, an empty file, ...).
 // Each names, in its first line, what the refusal must say:

@@ -1,4 +1,4 @@
-// The withheld-effect harness of the gap diagnosis (issue 7): for effects the simulator can
+// The withheld-effect harness of the gap diagnosis: for effects the simulator can
 // switch (backlash, Coulomb friction, elastic gear, transmission error) and effects injected into
 // the "real" data another way (time offset of the measurement stream, joint zero offset, payload
 // mismatch via the path's payload, thermal drift and a structural resonance added to the
@@ -222,7 +222,7 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
   // joint located >= 90 %, false alarms <= 10 % of the controls, predicted shrinkage within
   // ±20 pp of the true one >= 90 % (measured 47/52; the misses: transmission error on A1 and A2,
   // whose response through the loop and the wrist modes the Laguerre bases follow only in part,
-  // backlash on A2 and the payload, ~21 pp under the truth each; see the report of issue 7).
+  // backlash on A2 and the payload, ~21 pp under the truth each).
   test_support::record_figure("ranked_first_percent", pct(first, effect_cases));
   test_support::record_figure("joint_located_percent", pct(located, effect_cases));
   test_support::record_figure("shrinkage_within_20pp_percent", pct(within, effect_cases));

@@ -1,4 +1,4 @@
-// The sim-to-real gap of real IMU signals (issue 7): the MEMS IMU (MPU9150) carried by an ABB
+// The sim-to-real gap of real IMU signals: the MEMS IMU (MPU9150) carried by an ABB
 // robot (tests/data/real/abb-mems/SOURCE.md), "sim" = the angular rate of the robot's reported
 // tool poses, "real" = the gyro as read. Trained on sequence 1, judged on sequence 3 (held out).
 // Independent truth: the dataset's own description (a time offset of roughly 0.1 s between the

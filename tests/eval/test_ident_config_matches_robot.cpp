@@ -1,5 +1,5 @@
 // The shipped identification config carries numbers of the robot it is for (the joints' maximum
-// speeds, the nominal payload, and since the twelfth round the gear ratios and stiffnesses of the
+// speeds, the nominal payload, and the gear ratios and stiffnesses of the
 // transmission-error inputs): they must be the robot file's (datasets/robots/kr16.yaml), or the
 // speed bands and the error's phase would be those of another robot.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// eval::measure_joints_with_ims, the verification's measurement of an attained path (issue 6):
+// eval::measure_joints_with_ims, the verification's measurement of an attained path:
 // the seed-line run of the plant recorded by the scenario's navigation-grade IMS and taken
 // through the chain must give the plant's true link-side flange path to a fraction of the
 // compensated path deviation it is used to judge (~1 mm), on every robot sample.

@@ -1,9 +1,9 @@
-// Issue 6 and 5 figures, measured against the simulator's truth: the ARX tables identified on the
-// `identification` scenario (joint errors q_d - q_link from the plant, a stand-in for the IMS
-// chain), verified on `seed-line` (the paper's line; backlash on A2, A3 and A5) and on the
-// 100 % velocity paths of `iso9283`, which were not used for identification. Prints the
-// before/after ISO 9283 table, the ablation (backlash term off, one cell instead of the grid) and
-// the held-out simulation fit per joint with the chosen orders and dead times.
+// The verification and identification figures, measured against the simulator's truth: the ARX
+// tables identified on the `identification` scenario (joint errors q_d - q_link from the plant, a
+// stand-in for the IMS chain), verified on `seed-line` (the paper's line; backlash on A2, A3 and
+// A5) and on the 100 % velocity paths of `iso9283`, which were not used for identification. Prints
+// the before/after ISO 9283 table, the ablation (backlash term off, one cell instead of the grid)
+// and the held-out simulation fit per joint with the chosen orders and dead times.
 //
 // Release: ~identification 130 s of plant + 3 identifications + 10 cycles x 4 runs of seed-line
 // + 10 x 2 runs of the iso9283 100 % part (~55 s). Under IMSCAL_SANITIZED: the first 60 s of the
@@ -33,8 +33,8 @@ bool sanitized() {
   return std::getenv("IMSCAL_SANITIZED") != nullptr;
 }
 // Goals not met are asserted only with IMSCAL_VERIFY_GOALS set (printed figures and the report
-// say why); the always-on assertions check the measurement itself, and issue 6's goals, which
-// are met (>= 95 % on seed-line since the twelfth round, >= 90 % on the ISO 9283 set), are
+// say why); the always-on assertions check the measurement itself, and the goals, which
+// are met (>= 95 % on seed-line, >= 90 % on the ISO 9283 set), are
 // asserted always in Release.
 bool assert_goals() {
   return std::getenv("IMSCAL_VERIFY_GOALS") != nullptr;
@@ -232,7 +232,7 @@ TEST(Verification, IdentificationFitPerJoint) {
           c.sweep->chosen.dead_time, f.simulation_fit_percent, f.joint_error_fit_percent);
     }
     if (assert_goals() && !sanitized() && joint.parameters.name <= "A3") {
-      // Issue 5 goal: simulation NRMSE fit >= 90 % on held-out runs for every primary joint.
+      // Goal: simulation NRMSE fit >= 90 % on held-out runs for every primary joint.
       EXPECT_GE(s.simulation_fit_percent, 90.0) << joint.parameters.name;
     }
   }
@@ -252,11 +252,11 @@ TEST(Verification, SeedLineWithAblation) {
     // What the chain reaches today (Release, 10 cycles, look-ahead 4), as the IMS chain measures
     // the attained path: 12.52 -> 0.604 mm (95.2 %); on the plant's true path 12.47 -> 0.611 mm
     // (95.1 %). Ablation on the true path: paper form 49.0 %, without the model torque 39.3 %,
-    // without the transmission-error inputs 94.9 % (94.8 % as measured: the eleventh round's
+    // without the transmission-error inputs 94.9 % (94.8 % as measured: the former
     // default), with eq. 3's backlash term 92.5 %, with the operating-point grid 95.2 % (94.8 %
     // as measured). Asserted 3 %-points below (compiler differences; the simulator and every
     // draw are deterministic), the precontrol active throughout, and each part of the default
-    // measured: the paper's form and the model without the torque stay far behind. Issue 6's
+    // measured: the paper's form and the model without the torque stay far behind. The goal of
     // 95 % itself is asserted below (Release).
     // Where the maximum arises (true path): the cycle whose A2 friction is drawn 13.9 % above
     // nominal, 0.22 s into the line's acceleration from rest (run-to-run friction, which no model
@@ -302,8 +302,8 @@ TEST(Verification, SeedLineWithAblation) {
         EXPECT_GE(reduction, 85.0) << r.after[c].label;
     }
     // The IMS chain measures the path to a fraction of the compensated deviation: the measured
-    // and true maximum deviations differ by < 0.15 mm (measured 0.019 mm; 0.23 mm before the
-    // tenth round gave the chain the rests before and after the line, VerificationOptions).
+    // and true maximum deviations differ by < 0.15 mm (measured 0.019 mm; 0.23 mm without
+    // the rests before and after the line, VerificationOptions::lead_in_s / lead_out_s).
     EXPECT_LT(std::abs(r.after[0].figures.max_path_deviation_m -
                        r.after[0].true_figures.max_path_deviation_m),
               0.15e-3);
@@ -331,13 +331,13 @@ TEST(Verification, SeedLineWithAblation) {
                           n.after[0].true_figures.max_path_deviation_m));
     EXPECT_LT(n.after[0].figures.max_path_deviation_m, r.after[0].figures.max_path_deviation_m);
   }
-  // Issue 6's goal on seed-line, met since the twelfth round's transmission-error inputs (95.2 %
+  // The goal on seed-line, met with the transmission-error inputs (95.2 %
   // as the IMS chain measures it): asserted whenever the figures are (Release), so that a change
   // that loses it fails here. Over other friction draws (imscal verify --seed 2, 3, 4, true
   // path) 95.2, 95.4, 95.8 % (94.9-95.5 % without those inputs).
   if (!sanitized()) {
     const double full = reduction_percent(before, r.after[0].figures.max_path_deviation_m);
-    EXPECT_GE(full, 95.0) << "issue 6 goal on seed-line";
+    EXPECT_GE(full, 95.0) << "goal on seed-line";
     record_figure("seed_line_before_mm", before * 1e3);
     record_figure("seed_line_after_mm", r.after[0].figures.max_path_deviation_m * 1e3);
     record_figure("seed_line_reduction_measured_percent", full);
@@ -353,7 +353,7 @@ TEST(Verification, Iso9283FullVelocity) {
   if (!sanitized()) {
     // What the chain reaches today (Release, 10 cycles): as the IMS chain measures the attained
     // paths 8.19 -> 0.676 mm (91.8 %), on the true paths 8.19 -> 0.676 mm (91.8 %; 91.5 and
-    // 91.2 % before the twelfth round's transmission-error inputs, AT_p 0.33 mm; the cycles'
+    // 91.2 % without the transmission-error inputs, AT_p 0.33 mm; the cycles'
     // scatter floor is 0.45 mm, best reachable 94.5 %), the precontrol
     // active throughout (its default tolerances come from the identification data's envelope).
     // The planner keeps Cartesian moves within the joints' acceleration and jerk limits
@@ -367,13 +367,13 @@ TEST(Verification, Iso9283FullVelocity) {
                                 r.after[0].true_figures.max_path_deviation_m),
               88.8);
   }
-  // Issue 6's goal on this path set, met since the eighth round's 60 input taps (90.8 % as the
+  // The goal on this path set, met with the 60 input taps (90.8 % as the
   // IMS chain measures it): asserted whenever the figures are (Release), not only under
   // IMSCAL_VERIFY_GOALS, so that a change that loses it fails here.
   if (!sanitized()) {
     const double full = reduction_percent(r.before.figures.max_path_deviation_m,
                                           r.after[0].figures.max_path_deviation_m);
-    EXPECT_GE(full, 90.0) << "issue 6 goal on the ISO 9283 path set at 100 % velocity";
+    EXPECT_GE(full, 90.0) << "goal on the ISO 9283 path set at 100 % velocity";
     record_figure("iso9283_100_reduction_measured_percent", full);
     record_figure("iso9283_100_reduction_true_percent",
                   reduction_percent(r.before.true_figures.max_path_deviation_m,
@@ -489,9 +489,9 @@ TEST(Verification, TrueJointErrorAsOffsetBound) {
 namespace imscal::eval {
 namespace {
 
-// Issues 5 and 6 the way the paper works: the identification runs MEASURED by the IMS chain (the
-// simulated navigation-grade IMS, mechanized, smoothed, through the frames and the inverse
-// kinematics; eval/ims_measured_path.hpp), not the simulator's truth; the default table
+// Identification and verification the way the paper works: the identification runs MEASURED by the
+// IMS chain (the simulated navigation-grade IMS, mechanized, smoothed, through the frames and the
+// inverse kinematics; eval/ims_measured_path.hpp), not the simulator's truth; the default table
 // identified from them; the held-out fits and the verification on seed-line.
 TEST(Verification, IdentifiedFromTheImsChain) {
   if (sanitized()) GTEST_SKIP() << "3 min of plant and IMS: Release only";
@@ -549,13 +549,13 @@ TEST(Verification, IdentifiedFromTheImsChain) {
         joint.parameters.name.c_str(), s.simulation_fit_percent, s.joint_error_fit_percent,
         against_truth[j], 100.0 * (1.0 - noise_rms / std::hypot(signal_rms, noise_rms)));
   }
-  // Issue 5's goal, >= 90 % held-out fit for every primary joint, met both ways (60 input taps,
+  // The goal, >= 90 % held-out fit for every primary joint, met both ways (60 input taps,
   // positions corrected at the revisited poses, calib/revisited_poses.hpp). Measured: against
   // the IMS-measured errors A1 96.1, A2 95.1, A3 94.4 %; against the true errors 96.3, 95.1,
   // 94.4 % (with the transmission-error inputs; identified from the truth itself: 96.2, 95.3,
   // 94.5 % without them). The measurement's own error
   // in the held-out target (0.03-0.04 mrad RMS against a 3.5-3.7 mrad signal) caps a perfect
-  // model at ~99 %. Before the eighth round that error was 0.21-0.31 mrad (cap ~94.4, 93.2,
+  // model at ~99 %. Without that correction the error was 0.21-0.31 mrad (cap ~94.4, 93.2,
   // 91.3 %) and the fits 93.5, 90.4, 84.4 % (95.7, 93.8, 93.0 % against the truth). Asserted in
   // Release at the goal itself: the chain is deterministic, the margin 4 %-points.
   for (std::size_t j = 0; j < 3; ++j) {
@@ -573,9 +573,9 @@ TEST(Verification, IdentifiedFromTheImsChain) {
   print_case(r.after[0], r.before.figures, r.before.true_figures);
   EXPECT_EQ(r.after[0].inactive_cycles, 0u);
   // Measured: 12.52 -> 0.632 mm (94.95 %) as the IMS chain sees the path, 12.47 -> 0.626 mm
-  // (94.98 %) on the true path (10 cycles; 94.5 and 94.5 % before the twelfth round's
-  // transmission-error inputs, 92.4 and 93.5 % before the tenth round's warm-up and rests,
-  // VerificationOptions): just short of issue 6's 95 %, which the table identified from the
+  // (94.98 %) on the true path (10 cycles; 94.5 and 94.5 % without the
+  // transmission-error inputs, 92.4 and 93.5 % without the warm-up and rests,
+  // VerificationOptions): just short of the 95 % goal, which the table identified from the
   // simulator's truth reaches; asserted 3 %-points below, as above.
   EXPECT_GE(reduction_percent(r.before.figures.max_path_deviation_m,
                               r.after[0].figures.max_path_deviation_m),

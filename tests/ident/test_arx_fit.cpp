@@ -403,7 +403,7 @@ using imscal::test_support::random_multi_system;
 using imscal::test_support::simulate_multi;
 
 TEST(ArxFit, RecoversNoiseFreeMultiInputSystemExactly) {
-  // Same bound as the single-input case (1e-9 relative, issue 5), both solver paths.
+  // Same bound as the single-input case (1e-9 relative), both solver paths.
   std::mt19937_64 rng(21);
   // Unequal tap counts per further input (e.g. a one-tap torque sign beside 8-tap inputs).
   for (const ArxStructure s :

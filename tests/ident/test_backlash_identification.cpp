@@ -100,7 +100,7 @@ TEST(Backlash, TooFewReversalsReported) {
 
 // The plausibility bound: per-reversal estimates beyond max_l_rad are refused and counted, and a
 // joint with none left gets no backlash with the reason, instead of an absurd l reaching the
-// table (issue 6: 7e3 rad was once "identified" on A5/A6 of the simulated KR 16). A 2 mrad play
+// table (7e3 rad was once "identified" on A5/A6 of the simulated KR 16). A 2 mrad play
 // with the bound set to 1 mrad: every estimate (~2 mrad) is beyond it.
 TEST(Backlash, ImplausibleWidthRefusedWithReason) {
   SimulatedJoint joint;

@@ -178,7 +178,7 @@ TEST(JointIdentification, TooLittleExcitationReported) {
   EXPECT_EQ(r.parameters.cells[2].status, ident::CellStatus::kIdentified);
 }
 
-// The joint-error form (the default, issue 6) fitted to the same noise-free cells recovers the
+// The joint-error form (the default) fitted to the same noise-free cells recovers the
 // same models: the per-cell equation A y = B u with static gain 1 is, in (w, e), the exact
 // equation A e = (1 - 0.812 z^-1) w (slow cells), so the least-squares solution is the truth up to
 // rounding, stored as the eq. 2 model with d = 0 (b = [0, b_0, b_1]).

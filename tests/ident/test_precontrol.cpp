@@ -106,7 +106,7 @@ TEST(Precontrol, OneCellEqualsTheOfflineFreeRunPrediction) {
   EXPECT_GT(largest, 1e-5);  // the model does predict a real error on this move
 }
 
-// A joint that could not be identified gets ident::neutral_joint_parameters (issue 6): the
+// A joint that could not be identified gets ident::neutral_joint_parameters: the
 // precontrol must then add exactly zero on any motion, from the first cycle on (a garbage table
 // once produced a 2.9 rad "offset" at cycle 0 and deactivated the whole compensation).
 TEST(Precontrol, NeutralJointModelAddsExactlyZero) {
@@ -304,8 +304,8 @@ TEST(Precontrol, A4msCallerGetsTheSameOffsetsAsA2msCaller) {
 }
 
 TEST(Precontrol, SameOffsetsAsTheAllCellsReferenceWithBlendingAndFaults) {
-  // The runtime before issue 6's speed work (tests/support/reference_precontrol.hpp: Eigen dot
-  // products) against the current one (padded SIMD partial sums, ident/arx_step_kernel.hpp) on
+  // The runtime before the precontrol's speed work (tests/support/reference_precontrol.hpp: Eigen
+  // dot products) against the current one (padded SIMD partial sums, ident/arx_step_kernel.hpp) on
   // a 3 x 2 table of random order-8 models, dead times 0..3, with blending in both dimensions,
   // backlash, smoothing, a NaN, a lost cycle and a re-activation.
   std::mt19937_64 rng(6);

@@ -1,4 +1,4 @@
-// The precontrol (ident/precontrol.hpp) under faults (issue 9): 10^7 cycles (3·10^6 when the
+// The precontrol (ident/precontrol.hpp) under faults: 10^7 cycles (3·10^6 when the
 // environment variable IMSCAL_SANITIZED is set: ASan/UBSan run 5-10x slower) of random valid
 // and invalid inputs: smooth motions, NaN bursts, Inf, skipped and repeated cycle counters,
 // jumps of the desired values (up to 1e300 rad, so that models overflow), operating points

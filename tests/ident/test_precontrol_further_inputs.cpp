@@ -200,7 +200,7 @@ TEST(PrecontrolFurtherInputs, TransmissionErrorWithoutAPhaseRateIsRefused) {
       << why;
 }
 
-// The heaviest table of issue 6's benchmark (bench/bench_precontrol.cpp, the same motion):
+// The heaviest table of the precontrol's benchmark (bench/bench_precontrol.cpp, the same motion):
 // order 32 in every cell of a 3 x 2 grid, the model torque and direction with 32 taps, the
 // torque sign with one and the transmission-error pair with 32 each.
 ParameterTable order_32_grid_table() {

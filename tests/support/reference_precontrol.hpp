@@ -1,5 +1,5 @@
 #pragma once
-// The precontrol cycle as it was before the speed work of issue 6 (ident/precontrol.* at commit
+// The precontrol cycle as it was before its speed work (ident/precontrol.* at commit
 // ef0e005): every cell's ARX model advances in every cycle, whether or not it is in the blend,
 // each sum an Eigen dot product over exactly its own coefficients. Kept (renamed) as the reference
 // that the faster runtime is compared with: by tests/ident/test_precontrol*.cpp (same offsets

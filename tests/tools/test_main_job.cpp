@@ -90,7 +90,7 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
     EXPECT_EQ(record.value("status", ""), "ok") << stage;
   }
 
-  // Frames against the truth. Tolerances: issue 4's goals for T_S_H (0.005 deg, 0.05 mm;
+  // Frames against the truth. Tolerances: the accuracy goals for T_S_H (0.005 deg, 0.05 mm;
   // measured 0.0026 deg, 0.021 mm) and the tilt of R in W (0.005 deg; measured 0.003 deg).
   // The heading of R in W is gyrocompass-limited (1-sigma 0.16 deg; measured 0.22 deg off): 3
   // sigma of the run's own estimate.
@@ -112,8 +112,8 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
 
   // Measured joint angles (IMS trajectory + inverse kinematics) against the link truth, printed
   // (RMS 0.030 / 0.045 / 0.059 / 0.040 / 0.038 / 0.035 mrad, A1..A6; 0.13 / 0.31 / 0.28 on A1..A3
-  // in the fifth round); the true joint errors are 0.1-2 mrad. Tolerance 0.5 mrad: a regression
-  // of the chain (frames, clock, inverse kinematics) shows as whole milliradians.
+  // in an earlier version of the chain); the true joint errors are 0.1-2 mrad. Tolerance 0.5 mrad:
+  // a regression of the chain (frames, clock, inverse kinematics) shows as whole milliradians.
   const auto rms = measured_joint_rms_error(out / "calibrate" / "joint_errors.csv",
                                             sim / "truth" / "joints.csv");
   std::printf("main job: measured joint angles against the link truth, RMS [mrad]:");
@@ -133,8 +133,8 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
   EXPECT_TRUE(fs::exists(out / "identify" / "parameters.csv"));
 
   // ISO 9283 figures with and without the precontrol on the paper's line, printed (10.42 ->
-  // 0.93 mm, -91.1 %; 10.31 -> 5.51 mm, -46.5 % in the fifth round). A precontrol that no longer
-  // helps (< 20 % reduction) is a regression of identify or verify.
+  // 0.93 mm, -91.1 %; 10.31 -> 5.51 mm, -46.5 % with the paper's forward form). A precontrol that
+  // no longer helps (< 20 % reduction) is a regression of identify or verify.
   const json verification =
       json::parse(read_file_text(out / "verify" / "campaign-line" / "verification.json"));
   ASSERT_EQ(verification.at("cases").size(), 2u);

@@ -86,7 +86,7 @@ TEST_F(RunCli, RunsTheChainThenSkipsItThenRerunsWhatChanged) {
   for (const char* stage : {"validate", "identify", "report"})
     EXPECT_NE(stage_line(log(), stage).find("skipped"), std::string::npos) << log();
   EXPECT_EQ(fs::last_write_time(out / "identify" / "stage.json"), record_time);
-  // Issue 8's "second run < 5 s" is a speed goal: printed here, not asserted (a timed assertion
+  // The goal "second run < 5 s" is a speed goal: printed here, not asserted (a timed assertion
   // fails on a loaded machine or under the sanitizers, 7.8 s seen under ASan with -j2). What
   // this test asserts is the cause of the speed: every stage skipped, no record rewritten.
   std::printf("second run with nothing changed: %.2f s\n", second_s);
