@@ -94,7 +94,10 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
   Eigen::Vector3d scale = Eigen::Vector3d::Constant(analysis.gyro_scale_ratio);
 
   // Windows of samples, skipping gaps, rails and spans without valid robot poses (with a margin
-  // of 0.15 s for the offset to move).
+  // of 0.15 s for the offset to move, probed every 5 ms: shorter than any pose gap that
+  // robot_orientation_at refuses, 0.2 s).
+  constexpr double kOffsetMargin_s = 0.15;
+  constexpr double kOffsetProbeStep_s = 0.005;
   std::vector<std::pair<std::size_t, std::size_t>> windows;
   const auto& t = record.t_s;
   std::size_t first = 0;
@@ -118,8 +121,13 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
         }
       }
     }
+    // Robot poses at both ends for every offset within the margin, not only at its two limits:
+    // a gap of invalid poses between them (interpolated across a quaternion sign flip, up to
+    // 0.2 s) would leave the window without a residual at the initial offset, and the solve
+    // could not start.
     Eigen::Quaterniond q;
-    for (double margin : {-0.15, 0.15}) {
+    for (double margin = -kOffsetMargin_s; margin <= kOffsetMargin_s + 1e-9 && usable;
+         margin += kOffsetProbeStep_s) {
       if (!robot_orientation_at(record, t[first] - offset + margin, q) ||
           !robot_orientation_at(record, t[last] - offset + margin, q)) {
         usable = false;
@@ -157,16 +165,22 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
   problem.SetManifold(q_param, new ceres::EigenQuaternionManifold);
   if (!options.estimate_scale) problem.SetParameterBlockConstant(scale_param);
 
-  auto rms_of_windows = [&]() {
-    double sum = 0.0;
-    for (const auto& [a, b] : windows) {
-      double r[3];
-      WindowCost{&record, a, b}(q_param, bias_param, scale_param, offset_param, r);
-      sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  // Every window has a finite residual at the initial values (else the solve cannot start:
+  // name the first that has none).
+  double initial_sum = 0.0;
+  for (const auto& [a, b] : windows) {
+    double r[3];
+    if (!WindowCost{&record, a, b}(q_param, bias_param, scale_param, offset_param, r) ||
+        !std::isfinite(r[0] + r[1] + r[2])) {
+      throw InputError(record.file, record.lines[a], "gyro_x_dps",
+                       fmt::format("the rotation calibration's window of lines {}-{} has no "
+                                   "finite residual at the initial values (R_T_S, bias, scale "
+                                   "{:.4g}, time offset {:.4f} s)",
+                                   record.lines[a], record.lines[b], scale.x(), offset));
     }
-    return std::sqrt(sum / (3.0 * windows.size()));
-  };
-  result.initial_rms_residual_rad = rms_of_windows();
+    initial_sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  }
+  result.initial_rms_residual_rad = std::sqrt(initial_sum / (3.0 * windows.size()));
 
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_QR;
@@ -176,6 +190,13 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
   ceres::Solve(solver_options, &problem, &summary);
   result.summary = summary.BriefReport();
   result.iterations = static_cast<int>(summary.iterations.size());
+  // A failed solve has no estimate and no covariance (ceres::Covariance on it aborts).
+  if (!summary.IsSolutionUsable()) {
+    throw InputError(
+        record.file, 0, "gyro_x_dps",
+        fmt::format("the rotation calibration's solve failed ({}): {}",
+                    ceres::TerminationTypeToString(summary.termination_type), summary.message));
+  }
 
   result.q_T_S = Eigen::Quaterniond(q_param[3], q_param[0], q_param[1], q_param[2]).normalized();
   result.gyro_bias_rad_s = Eigen::Vector3d(bias_param);
@@ -185,7 +206,8 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
 
   double sum = 0.0;
   for (const auto& [a, b] : windows) {
-    double r[3];
+    double r[3] = {0.0, 0.0, 0.0};
+    // The solver accepts only steps where every window evaluates; this holds at its result.
     WindowCost{&record, a, b}(q_param, bias_param, scale_param, offset_param, r);
     const double norm_sq = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
     sum += norm_sq;
