@@ -55,6 +55,10 @@ nlohmann::json calibration_json(const RotationCalibration& c) {
   j["sigma_gyro_scale"] = vector_json(c.sigma_scale);
   j["time_offset_s"] = c.time_offset_s;
   j["sigma_time_offset_s"] = c.sigma_time_offset_s;
+  j["sigma_method"] = c.sigma_from_bootstrap ? "moving-block bootstrap" : "covariance";
+  j["bootstrap_replicates"] = c.bootstrap_replicates;
+  j["covariance_sigma_rotation_deg"] = vector_json(c.covariance_sigma_rotation_rad, kDeg);
+  j["covariance_sigma_time_offset_s"] = c.covariance_sigma_time_offset_s;
   j["covariance_ok"] = c.covariance_ok;
   j["window_count"] = c.window_count;
   j["rms_residual_deg"] = c.rms_residual_rad * kDeg;
@@ -64,11 +68,12 @@ nlohmann::json calibration_json(const RotationCalibration& c) {
 
 void print_calibration(const std::string& title, const RotationCalibration& c) {
   std::cout << fmt::format(
-      "{}: R_T_S angle {:.3f} deg (1 sigma {:.3f} {:.3f} {:.3f} deg), time offset {:.4f} +- "
+      "{}: R_T_S angle {:.3f} deg (1 sigma {:.3f} {:.3f} {:.3f} deg, {}), time offset {:.4f} +- "
       "{:.4f} s,\n  gyro bias {:.4g} {:.4g} {:.4g} deg/s (as labelled), scale {:.5g} {:.5g} "
       "{:.5g}, window residual RMS {:.3f} deg over {} windows\n",
       title, Eigen::AngleAxisd(c.q_T_S).angle() * kDeg, c.sigma_rotation_rad.x() * kDeg,
-      c.sigma_rotation_rad.y() * kDeg, c.sigma_rotation_rad.z() * kDeg, c.time_offset_s,
+      c.sigma_rotation_rad.y() * kDeg, c.sigma_rotation_rad.z() * kDeg,
+      c.sigma_from_bootstrap ? "block bootstrap" : "covariance", c.time_offset_s,
       c.sigma_time_offset_s, c.gyro_bias_rad_s.x() * kDeg, c.gyro_bias_rad_s.y() * kDeg,
       c.gyro_bias_rad_s.z() * kDeg, c.gyro_scale.x(), c.gyro_scale.y(), c.gyro_scale.z(),
       c.rms_residual_rad * kDeg, c.window_count);

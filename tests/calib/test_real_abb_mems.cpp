@@ -21,6 +21,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -125,15 +126,38 @@ TEST_P(RealAbbMems, CalibrateOnOneSequenceTrackTheOther) {
   const Calibrated cal3 = calibrate(kSeq3, sensor);
   const double rotation_difference =
       ims::rotation_angle_between(cal1.calibration.q_T_S, cal3.calibration.q_T_S);
-  fmt::print("{}: R_T_S from the two sequences differ by {:.3f} deg\n", sensor,
-             rotation_difference * kDeg);
+  // The difference about each T axis against the two sequences' combined 1 sigma.
+  const Eigen::Vector3d difference = ims::quat_log(
+      Eigen::Quaterniond(cal1.calibration.q_T_S * cal3.calibration.q_T_S.conjugate()));
+  const Eigen::Vector3d combined_sigma = (cal1.calibration.sigma_rotation_rad.cwiseAbs2() +
+                                          cal3.calibration.sigma_rotation_rad.cwiseAbs2())
+                                             .cwiseSqrt();
+  const Eigen::Vector3d covariance_sigma =
+      (cal1.calibration.covariance_sigma_rotation_rad.cwiseAbs2() +
+       cal3.calibration.covariance_sigma_rotation_rad.cwiseAbs2())
+          .cwiseSqrt();
+  fmt::print(
+      "{}: R_T_S from the two sequences differ by {:.3f} deg, about T x, y, z {} deg; combined 1 "
+      "sigma {} deg (block bootstrap, at least the covariance), {} deg (covariance of independent "
+      "windows)\n",
+      sensor, rotation_difference * kDeg, v3(difference, kDeg), v3(combined_sigma, kDeg),
+      v3(covariance_sigma, kDeg));
   const SplitResult on3 = evaluate(cal1, kSeq3, sensor);
   const SplitResult on1 = evaluate(cal3, kSeq1, sensor);
 
   // Repeatability of the calibration between the two sequences (same mount): measured 2.0 deg
-  // (MPU9150) and 3.3 deg (LSM9DS0), larger than the reported 1 sigma (0.1-0.35 deg): the
-  // residuals are dominated by the poses' timing jitter, not white noise. Bound: 5 deg.
+  // (MPU9150) and 3.3 deg (LSM9DS0). Bound: 5 deg. The covariance of independent windows puts
+  // the combined 1 sigma at 0.24-0.36 deg per axis (the difference about T y is 7.6 and 11.7 of
+  // them); the windows' residuals are correlated in time, and the sigma reported now (moving-
+  // block bootstrap, 2 s blocks, 40 replicates, at least the covariance's) is 0.27-0.85 deg.
+  // About T x and z the differences lie within 3 of it (measured 1.3 and 0.9 sigma MPU9150, 0.6
+  // and 0.4 LSM9DS0); about T y they do not (3.3 and 3.9 sigma): a difference between path 1 and
+  // path 3 that resampling one record cannot see (a motion-dependent error the model lacks).
+  // Asserted: x and z within 3 sigma, y within 5.
   EXPECT_LT(rotation_difference * kDeg, 5.0);
+  EXPECT_LT(std::abs(difference.x()), 3.0 * combined_sigma.x());
+  EXPECT_LT(std::abs(difference.z()), 3.0 * combined_sigma.z());
+  EXPECT_LT(std::abs(difference.y()), 5.0 * combined_sigma.y());
   for (const auto* cal : {&cal1, &cal3}) {
     const auto& c = cal->calibration;
     // The calibrated fit explains the windows to about a degree (measured 0.7-1.2 deg RMS per
