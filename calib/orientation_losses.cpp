@@ -71,11 +71,13 @@ OrientationLossCheck find_orientation_losses(const ToolImuRecord& record,
                        options.min_segment_angle_rad)) {
     std::size_t first = 0, last = 0;
     if (!samples_inside(record.t_s, motion.begin_s, motion.end_s, first, last)) continue;
+    // A segment cut by the record's ends (the robot already moving at the first sample) is
+    // judged from the first to the last sample with a robot pose.
     Eigen::Quaterniond q_a, q_b;
-    if (!robot_orientation_at(record, record.t_s[first] - calibration.time_offset_s, q_a) ||
-        !robot_orientation_at(record, record.t_s[last] - calibration.time_offset_s, q_b)) {
-      continue;  // no robot pose at an end: the segment cannot be judged
-    }
+    const double offset = calibration.time_offset_s;
+    while (first < last && !robot_orientation_at(record, record.t_s[first] - offset, q_a)) ++first;
+    while (last > first && !robot_orientation_at(record, record.t_s[last] - offset, q_b)) --last;
+    if (first == last) continue;  // no robot pose in it: the segment cannot be judged
     const Eigen::Quaterniond robot_T = q_a.conjugate() * q_b;
     const Eigen::Quaterniond gyro_T =
         gyro_rotation_T(record, calibration, first, last, filter_defaults.max_step_s);
