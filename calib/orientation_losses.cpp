@@ -93,11 +93,17 @@ OrientationLossCheck find_orientation_losses(const ToolImuRecord& record,
     // return turn undoes).
     const Eigen::Vector3d difference =
         ims::quat_log(Eigen::Quaterniond(robot_T.conjugate() * gyro_T));
-    const Eigen::Vector3d robot_axis = ims::quat_log(robot_T).normalized();
-    const double along = difference.dot(robot_axis);
+    // A segment that turns out and back has almost no net rotation and no axis to split about;
+    // there an axis error tilts little (2 sin(angle / 2) x the error) and all of the difference
+    // counts as lost.
+    const Eigen::Vector3d robot_rotation = ims::quat_log(robot_T);
+    const bool has_axis = robot_rotation.norm() >= options.min_axis_angle_rad;
+    const Eigen::Vector3d robot_axis =
+        has_axis ? Eigen::Vector3d(robot_rotation.normalized()) : Eigen::Vector3d::Zero();
+    const double along = has_axis ? difference.dot(robot_axis) : difference.norm();
     segment.difference_rad = difference.norm();
     segment.loss_rad = std::abs(along);
-    segment.axis_tilt_rad = (difference - along * robot_axis).norm();
+    segment.axis_tilt_rad = has_axis ? (difference - along * robot_axis).norm() : 0.0;
     check.segments.push_back(segment);
     if (segment.loss_rad >= options.min_loss_rad) check.losses.push_back(segment);
   }

@@ -39,6 +39,8 @@ struct OrientationLossOptions {
   double min_loss_rad = 5.0 * M_PI / 180.0;           // a segment losing this much is listed
   double segment_rate_rad_s = 0.05;                   // robot |omega| above which the tool moves
   double min_segment_angle_rad = 5.0 * M_PI / 180.0;  // smaller motions are not judged
+  // Net rotations below this are not split about their axis (all of the difference is loss).
+  double min_axis_angle_rad = 20.0 * M_PI / 180.0;
 };
 
 struct SegmentRotation {
