@@ -144,5 +144,24 @@ TEST(OrientationLosses, EveryMissedMotionSpanIsALoss) {
   }
 }
 
+// A segment whose net rotation is below min_axis_angle_rad (a motion out and back) has no
+// axis to split about: all of the difference counts as loss, no tilt. Forced here on the
+// 90 deg turns by a threshold above them: the 18 deg dropped in the second turn is the whole
+// difference (+- the trapezoid's two half samples, 0.9 deg each).
+TEST(OrientationLosses, WithoutANetAxisTheWholeDifferenceIsLoss) {
+  ToolImuRecord record = turning_record();
+  for (std::size_t k = 0; k < record.t_s.size(); ++k) {
+    if (record.t_s[k] >= 3.4 && record.t_s[k] < 3.6) record.gyro_rad_s[k].setZero();
+  }
+  OrientationLossOptions options;
+  options.min_axis_angle_rad = M_PI;
+  const OrientationLossCheck check =
+      find_orientation_losses(record, RotationCalibration{}, options);
+  ASSERT_EQ(check.losses.size(), 1u);
+  EXPECT_NEAR(check.losses.front().loss_rad * kDeg, 18.0, 2.0);
+  EXPECT_DOUBLE_EQ(check.losses.front().loss_rad, check.losses.front().difference_rad);
+  EXPECT_EQ(check.losses.front().axis_tilt_rad, 0.0);
+}
+
 }  // namespace
 }  // namespace imscal::calib
