@@ -150,9 +150,9 @@ nlohmann::json report_orientation(const ToolImuRecord& record, const ToolImuAnal
   if (restart) {
     std::cout << fmt::format(
         "  restarted from the robot's pose after each of {} lost spans (the spans left out): RMS "
-        "{:.3f} deg, max {:.3f} deg over {} samples\n",
+        "{:.3f} deg, max {:.3f} deg over {} of the {} samples\n",
         spans.size(), error.with_restarts.rms_rad * kDeg, error.with_restarts.max_rad * kDeg,
-        error.with_restarts.sample_count);
+        error.with_restarts.sample_count, error.from_start.sample_count);
     out["with_restarts"] = error_json(error.with_restarts);
     out["restart_times_s"] = error.restart_times_s;
   }
