@@ -16,6 +16,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "calib/attitude_filter.hpp"
@@ -159,11 +160,10 @@ nlohmann::json report_orientation(const ToolImuRecord& record, const ToolImuAnal
   return out;
 }
 
-// The AHRS's own orientation error, or the reason its record was refused (the IMU's results
-// stand without it).
-nlohmann::json report_ahrs(const std::string& file) {
+// The AHRS's own orientation error, or the reason it is refused as a reference (its rates do
+// not follow the robot's; the IMU's results stand without it).
+nlohmann::json report_ahrs(const ToolImuRecord& ahrs) {
   try {
-    const ToolImuRecord ahrs = read_tool_imu_record(file);
     const AhrsAlignment alignment = align_ahrs_to_robot(ahrs);
     const OrientationErrorStats error =
         orientation_error(ahrs, alignment.time_offset_s, alignment.t_s, alignment.q_B_T);
@@ -177,14 +177,18 @@ nlohmann::json report_ahrs(const std::string& file) {
     out["time_offset_s"] = alignment.time_offset_s;
     return out;
   } catch (const imscal::InputError& e) {
-    std::cout << fmt::format("AHRS {} REFUSED as a reference: {}\n", file, e.what());
-    return {{"file", file}, {"refused", true}, {"reason", e.what()}};
+    std::cout << fmt::format("AHRS {} REFUSED as a reference: {}\n", ahrs.file, e.what());
+    return {{"file", ahrs.file}, {"refused", true}, {"reason", e.what()}};
   }
 }
 
 void run(const Args& args) {
   nlohmann::json report;
   const ToolImuRecord record = read_tool_imu_record(args.imu);
+  // An unreadable AHRS file is bad input (exit 2) before any work; one that reads but does not
+  // follow the robot is refused as a reference below, beside the IMU's results.
+  std::optional<ToolImuRecord> ahrs;
+  if (!args.xsens.empty()) ahrs = read_tool_imu_record(args.xsens);
   const ToolImuAnalysis analysis = check_tool_imu_record(record);
   std::cout << fmt::format("{}: {} rows\n", record.file, record.t_s.size());
   report["file"] = record.file;
@@ -207,7 +211,7 @@ void run(const Args& args) {
     gyro_bias_at_rest(record, applied.time_offset_s, 0.01, applied.gyro_bias_rad_s, 3.0);
   }
   report["orientation"] = report_orientation(record, analysis, applied, source, !args.no_restart);
-  if (!args.xsens.empty()) report["ahrs_orientation_error"] = report_ahrs(args.xsens);
+  if (ahrs) report["ahrs_orientation_error"] = report_ahrs(*ahrs);
   if (!args.out.empty()) imscal::write_file_atomically(args.out, report.dump(2) + "\n");
 }
 

@@ -107,6 +107,18 @@ TEST_F(CheckToolImuCli, PartialLossIsListedAndARefusedReferenceIsReported) {
   EXPECT_FALSE(ahrs.at("reason").get<std::string>().empty());
   EXPECT_TRUE(report.contains("calibration"));
 
+  // An AHRS file that cannot be read is bad input, not a refused reference: exit 2 naming it,
+  // nothing written.
+  const fs::path missing_out = dir_ / "missing.json";
+  EXPECT_EQ(
+      run_imscal("check-tool-imu --imu " +
+                     (kDir / "V_800_Sequencia3" / "MPU6050RM3100.csv").string() + " --xsens " +
+                     (dir_ / "no_such_xsens.csv").string() + " --out " + missing_out.string(),
+                 dir_ / "missing.log"),
+      2);
+  EXPECT_NE(read_file_text(dir_ / "missing.log").find("no_such_xsens.csv"), std::string::npos);
+  EXPECT_FALSE(fs::exists(missing_out));
+
   // --no-restart: the error from the start only.
   const fs::path plain = dir_ / "plain.json";
   ASSERT_EQ(run_imscal("check-tool-imu --no-restart --imu " +
