@@ -717,7 +717,13 @@ FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
     blocks.push_back(
         {"play_scale_deviation", x.m_p, static_cast<int>(play_names.size()), 1.0, play_names});
   if (link_share_estimated) blocks.push_back({"link_share", x.link_share, 1, 1.0, {"s"}});
-  FrameCovariance cov = compute_frame_covariance(problem, blocks);
+  // A failed solve has no estimate to take a covariance at (ceres::Covariance on it aborts).
+  FrameCovariance cov;
+  if (stage.summary.IsSolutionUsable()) {
+    cov = compute_frame_covariance(problem, blocks);
+  } else {
+    cov.message = "no covariance: the solve failed (" + stage.summary.message + ")";
+  }
   if (frames_known && cov.computed) {
     // The held frames have no covariance from this problem (constant blocks: zero); theirs is
     // the earlier session's, reported as it is (the other unknowns are conditional on them).

@@ -3,7 +3,9 @@
 #include <ceres/ceres.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "core/input_error.hpp"
@@ -54,6 +56,95 @@ struct WindowCost {
   }
 };
 
+using Window = std::pair<std::size_t, std::size_t>;  // first and last sample of a window
+
+// The calibration's unknowns in Ceres' layout (quaternion x, y, z, w).
+struct Unknowns {
+  double q[4];
+  double bias[3];
+  double scale[3];
+  double offset[1];
+};
+
+// Solves the window residuals from `x` (updated in place); the problem as calibrate_rotation
+// builds it.
+bool solve_windows(const ToolImuRecord& record, const std::vector<Window>& windows,
+                   const RotationCalibrationOptions& options, Unknowns& x) {
+  ceres::Problem problem;
+  for (const auto& [a, b] : windows) {
+    auto* cost = new ceres::NumericDiffCostFunction<WindowCost, ceres::CENTRAL, 3, 4, 3, 3, 1>(
+        new WindowCost{&record, a, b});
+    problem.AddResidualBlock(cost, new ceres::CauchyLoss(options.cauchy_scale_rad), x.q, x.bias,
+                             x.scale, x.offset);
+  }
+  problem.SetManifold(x.q, new ceres::EigenQuaternionManifold);
+  if (!options.estimate_scale) problem.SetParameterBlockConstant(x.scale);
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  return summary.IsSolutionUsable();
+}
+
+Eigen::Quaterniond rotation_of(const Unknowns& x) {
+  return Eigen::Quaterniond(x.q[3], x.q[0], x.q[1], x.q[2]).normalized();
+}
+
+// Moving-block bootstrap (Kuensch 1989; Lahiri, "Resampling Methods for Dependent Data", 2003):
+// the windows' residuals are correlated in time (overlapping windows, the poses' timing jitter,
+// motion-dependent model errors), so the covariance of independent windows is too small. Blocks
+// of consecutive windows, drawn with replacement until the count is reached, are re-solved from
+// the estimate; the spread of the estimates over the replicates is the 1 sigma. Rotation
+// deviations as small angles about the T axes, log(q_b * q^-1).
+void block_bootstrap_sigma(const ToolImuRecord& record, const std::vector<Window>& windows,
+                           const RotationCalibrationOptions& options, const Unknowns& estimate,
+                           RotationCalibration& result) {
+  const std::size_t n = windows.size();
+  const std::size_t block = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::lround(options.bootstrap_block_s / options.window_stride_s)), 1,
+      n);
+  std::mt19937 random(options.bootstrap_seed);
+  std::uniform_int_distribution<std::size_t> pick(0, n - block);
+  std::vector<Eigen::Matrix<double, 10, 1>> deviations;
+  for (int replicate = 0; replicate < options.bootstrap_replicates; ++replicate) {
+    std::vector<Window> sample;
+    while (sample.size() < n) {
+      const std::size_t start = pick(random);
+      for (std::size_t i = start; i < start + block && sample.size() < n; ++i) {
+        sample.push_back(windows[i]);
+      }
+    }
+    Unknowns x = estimate;
+    if (!solve_windows(record, sample, options, x)) continue;  // counted in bootstrap_replicates
+    Eigen::Matrix<double, 10, 1> d;
+    d.head<3>() =
+        ims::quat_log(Eigen::Quaterniond(rotation_of(x) * rotation_of(estimate).conjugate()));
+    for (int i = 0; i < 3; ++i) {
+      d[3 + i] = x.bias[i] - estimate.bias[i];
+      d[6 + i] = x.scale[i] - estimate.scale[i];
+    }
+    d[9] = x.offset[0] - estimate.offset[0];
+    deviations.push_back(d);
+  }
+  result.bootstrap_replicates = deviations.size();
+  if (deviations.size() < 10) return;  // too few to tell a spread: keep the covariance's
+  Eigen::Matrix<double, 10, 1> mean = Eigen::Matrix<double, 10, 1>::Zero();
+  for (const auto& d : deviations) mean += d;
+  mean /= static_cast<double>(deviations.size());
+  Eigen::Matrix<double, 10, 1> variance = Eigen::Matrix<double, 10, 1>::Zero();
+  for (const auto& d : deviations) variance += (d - mean).cwiseAbs2();
+  const Eigen::Matrix<double, 10, 1> sigma =
+      (variance / static_cast<double>(deviations.size() - 1)).cwiseSqrt();
+  // Per component the larger of the two: a few blocks may miss a motion's spread, and the
+  // covariance is the floor that white residuals alone would give.
+  result.sigma_rotation_rad = result.sigma_rotation_rad.cwiseMax(sigma.head<3>());
+  result.sigma_bias_rad_s = result.sigma_bias_rad_s.cwiseMax(sigma.segment<3>(3));
+  if (options.estimate_scale) result.sigma_scale = result.sigma_scale.cwiseMax(sigma.segment<3>(6));
+  result.sigma_time_offset_s = std::max(result.sigma_time_offset_s, sigma[9]);
+  result.sigma_from_bootstrap = true;
+}
 }  // namespace
 
 bool gyro_bias_at_rest(const ToolImuRecord& record, double time_offset_s, double rest_rate_rad_s,
@@ -94,7 +185,10 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
   Eigen::Vector3d scale = Eigen::Vector3d::Constant(analysis.gyro_scale_ratio);
 
   // Windows of samples, skipping gaps, rails and spans without valid robot poses (with a margin
-  // of 0.15 s for the offset to move).
+  // of 0.15 s for the offset to move, probed every 5 ms: shorter than any pose gap that
+  // robot_orientation_at refuses, 0.2 s).
+  constexpr double kOffsetMargin_s = 0.15;
+  constexpr double kOffsetProbeStep_s = 0.005;
   std::vector<std::pair<std::size_t, std::size_t>> windows;
   const auto& t = record.t_s;
   std::size_t first = 0;
@@ -118,8 +212,13 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
         }
       }
     }
+    // Robot poses at both ends for every offset within the margin, not only at its two limits:
+    // a gap of invalid poses between them (interpolated across a quaternion sign flip, up to
+    // 0.2 s) would leave the window without a residual at the initial offset, and the solve
+    // could not start.
     Eigen::Quaterniond q;
-    for (double margin : {-0.15, 0.15}) {
+    for (double margin = -kOffsetMargin_s; margin <= kOffsetMargin_s + 1e-9 && usable;
+         margin += kOffsetProbeStep_s) {
       if (!robot_orientation_at(record, t[first] - offset + margin, q) ||
           !robot_orientation_at(record, t[last] - offset + margin, q)) {
         usable = false;
@@ -157,16 +256,22 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
   problem.SetManifold(q_param, new ceres::EigenQuaternionManifold);
   if (!options.estimate_scale) problem.SetParameterBlockConstant(scale_param);
 
-  auto rms_of_windows = [&]() {
-    double sum = 0.0;
-    for (const auto& [a, b] : windows) {
-      double r[3];
-      WindowCost{&record, a, b}(q_param, bias_param, scale_param, offset_param, r);
-      sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  // Every window has a finite residual at the initial values (else the solve cannot start:
+  // name the first that has none).
+  double initial_sum = 0.0;
+  for (const auto& [a, b] : windows) {
+    double r[3];
+    if (!WindowCost{&record, a, b}(q_param, bias_param, scale_param, offset_param, r) ||
+        !std::isfinite(r[0] + r[1] + r[2])) {
+      throw InputError(record.file, record.lines[a], "gyro_x_dps",
+                       fmt::format("the rotation calibration's window of lines {}-{} has no "
+                                   "finite residual at the initial values (R_T_S, bias, scale "
+                                   "{:.4g}, time offset {:.4f} s)",
+                                   record.lines[a], record.lines[b], scale.x(), offset));
     }
-    return std::sqrt(sum / (3.0 * windows.size()));
-  };
-  result.initial_rms_residual_rad = rms_of_windows();
+    initial_sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  }
+  result.initial_rms_residual_rad = std::sqrt(initial_sum / (3.0 * windows.size()));
 
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_QR;
@@ -176,6 +281,13 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
   ceres::Solve(solver_options, &problem, &summary);
   result.summary = summary.BriefReport();
   result.iterations = static_cast<int>(summary.iterations.size());
+  // A failed solve has no estimate and no covariance (ceres::Covariance on it aborts).
+  if (!summary.IsSolutionUsable()) {
+    throw InputError(
+        record.file, 0, "gyro_x_dps",
+        fmt::format("the rotation calibration's solve failed ({}): {}",
+                    ceres::TerminationTypeToString(summary.termination_type), summary.message));
+  }
 
   result.q_T_S = Eigen::Quaterniond(q_param[3], q_param[0], q_param[1], q_param[2]).normalized();
   result.gyro_bias_rad_s = Eigen::Vector3d(bias_param);
@@ -185,7 +297,8 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
 
   double sum = 0.0;
   for (const auto& [a, b] : windows) {
-    double r[3];
+    double r[3] = {0.0, 0.0, 0.0};
+    // The solver accepts only steps where every window evaluates; this holds at its result.
     WindowCost{&record, a, b}(q_param, bias_param, scale_param, offset_param, r);
     const double norm_sq = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
     sum += norm_sq;
@@ -225,6 +338,17 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
     result.covariance_ok = result.covariance_ok && result.sigma_bias_rad_s.allFinite() &&
                            result.sigma_scale.allFinite() &&
                            std::isfinite(result.sigma_time_offset_s);
+  }
+
+  result.covariance_sigma_rotation_rad = result.sigma_rotation_rad;
+  result.covariance_sigma_time_offset_s = result.sigma_time_offset_s;
+  if (options.bootstrap_replicates > 0) {
+    Unknowns estimate;
+    std::copy(q_param, q_param + 4, estimate.q);
+    std::copy(bias_param, bias_param + 3, estimate.bias);
+    std::copy(scale_param, scale_param + 3, estimate.scale);
+    estimate.offset[0] = offset_param[0];
+    block_bootstrap_sigma(record, windows, options, estimate, result);
   }
 
   // Gravity's direction in B from the still samples.

@@ -384,17 +384,24 @@ std::string axis_words(const Eigen::Matrix3d& R_T_S) {
   return out;
 }
 
-struct MotionSegment {
-  double begin_s = 0.0;  // sensor clock, with a 0.15 s margin on both sides
-  double end_s = 0.0;
-  double robot_angle_rad = 0.0;
-  double gyro_angle_raw_rad = 0.0;  // integral of |gyro| as labelled (not scaled)
-  std::size_t first_line = 0;
-  std::size_t last_line = 0;
-};
+// Median over the segments of gyro angle / robot angle, and the segments off it by more than
+// `fraction`.
+double segment_ratio(const std::vector<MotionSegment>& segments, double fraction,
+                     std::vector<MotionSegment>& off) {
+  std::vector<double> ratios;
+  for (const auto& s : segments) ratios.push_back(s.gyro_angle_raw_rad / s.robot_angle_rad);
+  const double median = median_of(ratios);
+  off.clear();
+  for (const auto& s : segments) {
+    if (std::abs(s.gyro_angle_raw_rad / s.robot_angle_rad / median - 1.0) > fraction) {
+      off.push_back(s);
+    }
+  }
+  return median;
+}
 
-// Segments of robot motion (|omega| above rate_threshold) turning more than min_angle, with the
-// robot's turned angle and the gyro's integrated |rate| over the same span of the sensor clock.
+}  // namespace
+
 std::vector<MotionSegment> motion_segments(const ToolImuRecord& record,
                                            const RobotRateSeries& robot, double offset_s,
                                            double rate_threshold, double min_angle) {
@@ -428,24 +435,6 @@ std::vector<MotionSegment> motion_segments(const ToolImuRecord& record,
   }
   return segments;
 }
-
-// Median over the segments of gyro angle / robot angle, and the segments off it by more than
-// `fraction`.
-double segment_ratio(const std::vector<MotionSegment>& segments, double fraction,
-                     std::vector<MotionSegment>& off) {
-  std::vector<double> ratios;
-  for (const auto& s : segments) ratios.push_back(s.gyro_angle_raw_rad / s.robot_angle_rad);
-  const double median = median_of(ratios);
-  off.clear();
-  for (const auto& s : segments) {
-    if (std::abs(s.gyro_angle_raw_rad / s.robot_angle_rad / median - 1.0) > fraction) {
-      off.push_back(s);
-    }
-  }
-  return median;
-}
-
-}  // namespace
 
 ToolImuAnalysis check_tool_imu_record(const ToolImuRecord& record,
                                       const ToolImuCheckOptions& options) {

@@ -107,6 +107,23 @@ RobotRateSeries robot_tool_rate(const ToolImuRecord& record, double step_s = 0.0
 // Linear interpolation of the robot rate series at t; false outside it.
 bool robot_rate_at(const RobotRateSeries& series, double t_s, Eigen::Vector3d& omega_T_rad_s);
 
+// A span of robot motion between two stops: the robot's |omega| stays above a threshold.
+struct MotionSegment {
+  double begin_s = 0.0;  // sensor clock, with a 0.15 s margin on both sides
+  double end_s = 0.0;
+  double robot_angle_rad = 0.0;     // integral of the robot's |omega| over the span
+  double gyro_angle_raw_rad = 0.0;  // integral of |gyro| as labelled (not scaled)
+  std::size_t first_line = 0;       // file lines of the first and last sensor sample inside
+  std::size_t last_line = 0;
+};
+
+// Segments of robot motion (|omega| above rate_threshold_rad_s) turning more than
+// min_angle_rad, with the robot's turned angle and the gyro's integrated |rate| over the same
+// span of the sensor clock (t_sensor = t_robot + offset_s).
+std::vector<MotionSegment> motion_segments(const ToolImuRecord& record,
+                                           const RobotRateSeries& robot, double offset_s,
+                                           double rate_threshold_rad_s, double min_angle_rad);
+
 struct ToolImuCheckOptions {
   double max_abs_time_offset_s = 0.5;
   // Only samples where the robot turns faster than this enter the scale and axis fits [rad/s].
