@@ -299,15 +299,16 @@ void run(const VerifyArgs& args) {
     throw imscal::InputError("", 0, "--table",
                              "give --table, --joint-errors or --identify-scenario");
   }
-  // The robot's rigid-body model for multi-input tables: that of the identification scenario,
-  // else of the first verified scenario (the joint errors' robot must be the same).
+  // The rigid-body model for multi-input tables: the nominal robot (never the plant) of the
+  // identification scenario, else of the first verified scenario (the joint errors' robot must
+  // be the same).
   const eval::ModelTorqueSource torque_model =
       eval::scenario_model_torque(imscal::sim::load_scenario(imscal::sim::resolve_scenario(
           args.identify_scenario.empty() ? args.scenarios.front() : args.identify_scenario)));
   if (log && log->robot != torque_model.robot.name)
     throw imscal::InputError(source, 0, "robot",
                              fmt::format("the joint errors are of robot '{}', the scenarios' "
-                                         "robot is '{}'",
+                                         "nominal robot is '{}'",
                                          log->robot, torque_model.robot.name));
   std::optional<ident::IdentificationConfig> config;
   if (log) {

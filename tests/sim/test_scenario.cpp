@@ -25,7 +25,7 @@ TEST(Scenario, EveryShippedScenarioLoadsAndPlans) {
     SCOPED_TRACE(name);
     const Scenario s = load_scenario(resolve_scenario(name));
     EXPECT_EQ(s.name, name);
-    const calib::RobotDescription robot = calib::load_robot_description(s.robot_file);
+    const calib::RobotDescription robot = sim::load_plant_robot(s);
     const DesiredJointPath path = plan_motion(robot, load_motion_program(s.program_file));
     EXPECT_GT(path.samples.size(), 1000u);
     EXPECT_EQ(path.cycle_s, robot.controller_cycle_s);
