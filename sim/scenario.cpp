@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <string>
+#include <string_view>
 
 #include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
