@@ -21,7 +21,8 @@ const fs::path kScenarios = fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "scenario
 
 TEST(Scenario, EveryShippedScenarioLoadsAndPlans) {
   int count = 0;
-  for (const char* name : {"seed-line", "identification", "mounting", "iso9283"}) {
+  for (const char* name : {"seed-line", "identification", "mounting", "iso9283",
+                           "deviating-identification", "deviating-seed-line"}) {
     SCOPED_TRACE(name);
     const Scenario s = load_scenario(resolve_scenario(name));
     EXPECT_EQ(s.name, name);
@@ -31,7 +32,7 @@ TEST(Scenario, EveryShippedScenarioLoadsAndPlans) {
     EXPECT_EQ(path.cycle_s, robot.controller_cycle_s);
     ++count;
   }
-  EXPECT_EQ(count, 4);
+  EXPECT_EQ(count, 6);
 }
 
 TEST(Scenario, ValuesAreReadAsWritten) {
