@@ -22,6 +22,7 @@
 #include "core/atomic_file.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
 #include "ident/joint_error_io.hpp"
@@ -44,8 +45,35 @@ struct VerifyArgs {
   double offset_tolerance_rad = 0.0;  // 0: from the table's envelope
   bool measure_with_ims = true;
   bool ablation = true;
+  bool search_order = false;  // the transmission error's order per joint from the data
   bool force = false;
 };
+
+// The order search's candidates: 0.5 .. 4 per motor revolution in steps of 0.5 (a gear's error
+// repeats at its stages' tooth and lobe counts over the motor revolution; halves for a stage
+// that turns at half the motor's speed).
+const std::vector<double> kOrderCandidates{0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0};
+
+// Replaces the config's harmonic per joint by the one the identification record fits best.
+void search_orders(const ident::JointErrorLog& log, const eval::ModelTorqueSource& torque_model,
+                   ident::IdentificationConfig& config) {
+  spdlog::info("verify: searching the transmission error's order per motor revolution ({} .. {})",
+               kOrderCandidates.front(), kOrderCandidates.back());
+  const eval::TransmissionErrorOrderSearch search =
+      eval::search_transmission_error_orders(log, config, kOrderCandidates, &torque_model);
+  for (std::size_t j = 0; j < search.chosen_harmonic.size(); ++j) {
+    std::string fits;
+    for (std::size_t c = 0; c < search.candidates.size(); ++c)
+      fits += fmt::format(" {}:{:.2f}", search.candidates[c], search.fit_percent[c][j]);
+    spdlog::info(
+        "verify: {}: {} per motor revolution (config {}; best {}, {:+.2f} points of "
+        "held-out fit over the config's); fits [%]{}",
+        j < log.joint_names.size() ? log.joint_names[j] : std::to_string(j + 1),
+        search.chosen_harmonic[j], config.transmission_error_harmonic(j), search.best_harmonic[j],
+        search.gain_points[j], fits);
+  }
+  config = eval::with_searched_orders(std::move(config), search);
+}
 
 constexpr double kMm = 1e3, kDeg = 180.0 / M_PI;
 
@@ -320,6 +348,12 @@ void run(const VerifyArgs& args) {
             : args.ident_config;
     config = ident::load_identification_config(imscal::ConfigNode::load_file(config_file));
   }
+  if (args.search_order) {
+    if (!config || !config->options.transmission_error_input)
+      throw imscal::InputError(args.ident_config, 0, "--search-transmission-error-order",
+                               "needs joint errors and a config with the transmission error");
+    search_orders(*log, torque_model, *config);
+  }
   if (!args.table.empty()) {
     tables.push_back({"compensated", ident::read_parameters_json(args.table)});
   } else {
@@ -388,6 +422,9 @@ imscal::tools::CommandRegistration registration{
                      "supervisor tolerance on |offset| per joint [rad] (default: 1.5 x the table's "
                      "envelope of the identification data)");
       sub.add_flag("!--no-ablation", args->ablation, "skip the ablation tables");
+      sub.add_flag("--search-transmission-error-order", args->search_order,
+                   "find each joint's transmission-error harmonic per motor revolution (0.5 .. "
+                   "4) from the joint errors' held-out fit instead of the config's");
       sub.add_flag("!--true-path", args->measure_with_ims,
                    "evaluate the plant's true link-side path instead of the IMS chain's "
                    "measurement (faster; the IMS chain is the default)");
