@@ -21,8 +21,9 @@ const fs::path kScenarios = fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "scenario
 
 TEST(Scenario, EveryShippedScenarioLoadsAndPlans) {
   int count = 0;
-  for (const char* name : {"seed-line", "identification", "mounting", "iso9283",
-                           "deviating-identification", "deviating-seed-line"}) {
+  for (const char* name :
+       {"seed-line", "identification", "mounting", "iso9283", "deviating-identification",
+        "deviating-seed-line", "deviating-iso9283"}) {
     SCOPED_TRACE(name);
     const Scenario s = load_scenario(resolve_scenario(name));
     EXPECT_EQ(s.name, name);
@@ -32,7 +33,7 @@ TEST(Scenario, EveryShippedScenarioLoadsAndPlans) {
     EXPECT_EQ(path.cycle_s, robot.controller_cycle_s);
     ++count;
   }
-  EXPECT_EQ(count, 6);
+  EXPECT_EQ(count, 7);
 }
 
 TEST(Scenario, ValuesAreReadAsWritten) {
