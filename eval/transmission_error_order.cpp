@@ -64,7 +64,10 @@ TransmissionErrorOrderSearch search_transmission_error_orders(
       const double fit = search.fit_percent[c][j];
       if (!std::isfinite(fit)) continue;
       if (candidates[c] == prior) prior_fit = fit;
-      if (fit > best) best = fit, best_h = candidates[c];
+      if (fit > best) {
+        best = fit;
+        best_h = candidates[c];
+      }
     }
     const double gain = best - prior_fit;  // NaN when the prior was not fitted
     search.best_harmonic.push_back(best_h);
