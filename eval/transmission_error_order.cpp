@@ -1,5 +1,7 @@
 #include "eval/transmission_error_order.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -70,6 +72,7 @@ TransmissionErrorOrderSearch search_transmission_error_orders(
       }
     }
     const double gain = best - prior_fit;  // NaN when the prior was not fitted
+    search.prior_harmonic.push_back(prior);
     search.best_harmonic.push_back(best_h);
     search.gain_points.push_back(std::isfinite(best) ? gain
                                                      : std::numeric_limits<double>::quiet_NaN());
@@ -78,6 +81,21 @@ TransmissionErrorOrderSearch search_transmission_error_orders(
         !std::isfinite(best) || (prior_fitted && !(gain > kMinGainPoints)) ? prior : best_h);
   }
   return search;
+}
+
+std::vector<double> default_order_candidates() {
+  return {0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0};
+}
+
+std::string describe_order_search(const TransmissionErrorOrderSearch& search, std::size_t joint) {
+  std::string fits;
+  for (std::size_t c = 0; c < search.candidates.size(); ++c)
+    fits += fmt::format(" {}:{:.2f}", search.candidates[c], search.fit_percent[c][joint]);
+  return fmt::format(
+      "{} per motor revolution (config {}; best {}, {:+.2f} points of held-out fit over the "
+      "config's); fits [%]{}",
+      search.chosen_harmonic[joint], search.prior_harmonic[joint], search.best_harmonic[joint],
+      search.gain_points[joint], fits);
 }
 
 ident::IdentificationConfig with_searched_orders(ident::IdentificationConfig config,

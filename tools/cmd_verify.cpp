@@ -49,29 +49,14 @@ struct VerifyArgs {
   bool force = false;
 };
 
-// The order search's candidates: 0.5 .. 4 per motor revolution in steps of 0.5 (a gear's error
-// repeats at its stages' tooth and lobe counts over the motor revolution; halves for a stage
-// that turns at half the motor's speed).
-const std::vector<double> kOrderCandidates{0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0};
-
 // Replaces the config's harmonic per joint by the one the identification record fits best.
 void search_orders(const ident::JointErrorLog& log, const eval::ModelTorqueSource& torque_model,
                    ident::IdentificationConfig& config) {
-  spdlog::info("verify: searching the transmission error's order per motor revolution ({} .. {})",
-               kOrderCandidates.front(), kOrderCandidates.back());
-  const eval::TransmissionErrorOrderSearch search =
-      eval::search_transmission_error_orders(log, config, kOrderCandidates, &torque_model);
-  for (std::size_t j = 0; j < search.chosen_harmonic.size(); ++j) {
-    std::string fits;
-    for (std::size_t c = 0; c < search.candidates.size(); ++c)
-      fits += fmt::format(" {}:{:.2f}", search.candidates[c], search.fit_percent[c][j]);
-    spdlog::info(
-        "verify: {}: {} per motor revolution (config {}; best {}, {:+.2f} points of "
-        "held-out fit over the config's); fits [%]{}",
-        j < log.joint_names.size() ? log.joint_names[j] : std::to_string(j + 1),
-        search.chosen_harmonic[j], config.transmission_error_harmonic(j), search.best_harmonic[j],
-        search.gain_points[j], fits);
-  }
+  spdlog::info("verify: searching the transmission error's order per motor revolution");
+  const eval::TransmissionErrorOrderSearch search = eval::search_transmission_error_orders(
+      log, config, eval::default_order_candidates(), &torque_model);
+  for (std::size_t j = 0; j < search.chosen_harmonic.size(); ++j)
+    spdlog::info("verify: {}: {}", log.joint_names[j], eval::describe_order_search(search, j));
   config = eval::with_searched_orders(std::move(config), search);
 }
 
