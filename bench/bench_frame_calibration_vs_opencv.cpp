@@ -39,7 +39,7 @@ struct SeedData {
 SeedData make_seed(std::uint64_t seed) {
   const sim::Scenario scenario = sim::load_scenario(std::filesystem::path(IMSCAL_SOURCE_DIR) /
                                                     "tests/data/scenarios/mounting-rigid.yaml");
-  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
+  const calib::RobotDescription robot = sim::load_plant_robot(scenario);
   const ims::SensorSpec spec = ims::load_sensor_spec(scenario.sensor_file);
   const sim::DesiredJointPath path =
       sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));

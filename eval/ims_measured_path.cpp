@@ -13,17 +13,18 @@
 namespace imscal::eval {
 
 ImsJointMeasurement measure_joints_with_ims(const sim::Scenario& scenario,
-                                            const calib::RobotDescription& robot,
+                                            const calib::RobotDescription& plant_robot,
+                                            const sim::NominalRobot& nominal,
                                             const sim::DesiredJointPath& desired,
                                             const sim::PlantLog& plant, double lead_in_s,
                                             std::uint64_t seed) {
   // The measurement setup: the scenario's base and nominal mount, its IMS and clock offset.
   const ims::SensorSpec spec = ims::load_sensor_spec(scenario.sensor_file);
   const Eigen::Isometry3d T_W_R = scenario.T_W_R;
-  const Eigen::Isometry3d T_H_S = robot.tool.T_H_T * scenario.mount_offset;
+  const Eigen::Isometry3d T_H_S = plant_robot.tool.T_H_T * scenario.mount_offset;
   std::mt19937_64 rng(seed);
   const sim::ImsRecording recording =
-      sim::record_ims(scenario, robot, spec, plant, T_W_R, T_H_S, rng);
+      sim::record_ims(scenario, plant_robot, spec, plant, T_W_R, T_H_S, rng);
   // The unit's calibration sheet: its scale factors and misalignments (the biases stay; the
   // smoother starts from the setup's bias values and estimates what drifts).
   ims::SensorErrorModel unit = recording.sensor_errors;
@@ -33,7 +34,7 @@ ImsJointMeasurement measure_joints_with_ims(const sim::Scenario& scenario,
 
   // The controller's log of the run: its desired angles, what its encoders read.
   calib::RobotLog log;
-  log.robot_name = robot.name;
+  log.robot_name = nominal.description.name;
   log.cycle_s = desired.cycle_s;
   const std::size_t n = std::min(desired.samples.size(), plant.samples.size());
   for (std::size_t k = 0; k < n; ++k) {
@@ -49,7 +50,7 @@ ImsJointMeasurement measure_joints_with_ims(const sim::Scenario& scenario,
   input.imu = &imu;
   input.log = &log;
   input.site = scenario.site;
-  input.kinematics = robot.kinematics;
+  input.kinematics = nominal.description.kinematics;
   input.frames.T_R_W = T_W_R.inverse();
   input.frames.T_S_H = T_H_S.inverse();
   // The biases as the record carries them at its start (turn-on plus in-run part: what a

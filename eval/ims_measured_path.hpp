@@ -31,8 +31,11 @@ struct ImsJointMeasurement {
 // sample per controller cycle, starting at rest (its first lead_in_s are the smoother's first
 // rest). seed: the sensor errors' and noise's draw. Throws InputError (from the chain) when the
 // record cannot be used.
+// plant_robot: the simulated world's (the IMS rides on its flange); nominal: the chain's (the
+// controller's log names it, the inverse kinematics use its geometry).
 ImsJointMeasurement measure_joints_with_ims(const sim::Scenario& scenario,
-                                            const calib::RobotDescription& robot,
+                                            const calib::RobotDescription& plant_robot,
+                                            const sim::NominalRobot& nominal,
                                             const sim::DesiredJointPath& desired,
                                             const sim::PlantLog& plant, double lead_in_s,
                                             std::uint64_t seed);

@@ -21,13 +21,17 @@
 namespace imscal::eval {
 namespace {
 
-// The scenario's plant, feeling the site's normal gravity in R (as sim::run_simulation does).
-sim::PlantConfig scenario_plant(const sim::Scenario& scenario,
-                                const calib::RobotDescription& robot) {
-  sim::PlantConfig config = sim::make_plant_config(robot, scenario);
+// The site's normal gravity in the robot base R [m/s²] (as sim::run_simulation computes it).
+Eigen::Vector3d gravity_in_base(const sim::Scenario& scenario) {
   const ims::EarthModel earth(scenario.site);
-  config.gravity_in_base_m_s2 =
-      scenario.T_W_R.linear().transpose() * earth.gravity_W(scenario.T_W_R.translation());
+  return scenario.T_W_R.linear().transpose() * earth.gravity_W(scenario.T_W_R.translation());
+}
+
+// The scenario's plant (plant_robot: sim::load_plant_robot), feeling the site's gravity.
+sim::PlantConfig scenario_plant(const sim::Scenario& scenario,
+                                const calib::RobotDescription& plant_robot) {
+  sim::PlantConfig config = sim::make_plant_config(plant_robot, scenario);
+  config.gravity_in_base_m_s2 = gravity_in_base(scenario);
   return config;
 }
 
@@ -205,21 +209,25 @@ Eigen::Matrix<double, 8, 1> pose_row(const PathPose& p) {
 
 namespace {
 
-// The scenario's program (cut at max_duration_s), its plant run and the robot.
+// The scenario's program (cut at max_duration_s) planned by the plant's controller, the plant's
+// run, and the nominal robot that the joint-error log is written for.
 struct ScenarioRun {
-  calib::RobotDescription robot;
+  calib::RobotDescription plant_robot;
+  sim::NominalRobot nominal;
   sim::DesiredJointPath path;
   sim::PlantLog plant;
 };
 
 ScenarioRun run_scenario(const sim::Scenario& scenario, double max_duration_s) {
   ScenarioRun run;
-  run.robot = calib::load_robot_description(scenario.robot_file);
-  run.path = sim::plan_motion(run.robot, sim::load_motion_program(scenario.program_file));
+  run.plant_robot = sim::load_plant_robot(scenario);
+  run.nominal = sim::load_nominal_robot(scenario);
+  run.path = sim::plan_motion(run.plant_robot, sim::load_motion_program(scenario.program_file));
   while (run.path.samples.size() > 2 && run.path.samples.back().t_s > max_duration_s) {
     run.path.samples.pop_back();
   }
-  run.plant = sim::simulate_plant(scenario_plant(scenario, run.robot), run.path, run.path.cycle_s);
+  run.plant =
+      sim::simulate_plant(scenario_plant(scenario, run.plant_robot), run.path, run.path.cycle_s);
   return run;
 }
 
@@ -229,10 +237,10 @@ ident::JointErrorLog joint_error_log(const ScenarioRun& run,
                                      const std::vector<std::optional<calib::JointVector>>& measured,
                                      std::string source) {
   ident::JointErrorLog log;
-  log.robot = run.robot.name;
+  log.robot = run.nominal.description.name;
   log.cycle_s = run.path.cycle_s;
   log.source = std::move(source);
-  for (const auto& joint : run.robot.joints) log.joint_names.push_back(joint.name);
+  for (const auto& joint : run.nominal.description.joints) log.joint_names.push_back(joint.name);
   log.q_desired_rad.assign(calib::kJointCount, {});
   log.q_measured_rad.assign(calib::kJointCount, {});
   log.q_internal_rad.assign(calib::kJointCount, {});
@@ -271,8 +279,8 @@ ident::JointErrorLog simulate_ims_joint_errors(const sim::Scenario& scenario, st
     if (sample.qd_rad_s.norm() != 0.0 || sample.qdd_rad_s2.norm() != 0.0) break;
     standstill_s = sample.t_s;
   }
-  const ImsJointMeasurement m =
-      measure_joints_with_ims(scenario, run.robot, run.path, run.plant, standstill_s, seed);
+  const ImsJointMeasurement m = measure_joints_with_ims(scenario, run.plant_robot, run.nominal,
+                                                        run.path, run.plant, standstill_s, seed);
   std::vector<std::optional<calib::JointVector>> ims(
       std::min(run.path.samples.size(), run.plant.samples.size()));
   for (std::size_t k = 0; k < ims.size(); ++k)
@@ -283,11 +291,20 @@ ident::JointErrorLog simulate_ims_joint_errors(const sim::Scenario& scenario, st
                   scenario.name));
 }
 
+ModelTorqueSource nominal_model_torque(const sim::NominalRobot& nominal,
+                                       const sim::Scenario& scenario) {
+  return {nominal.description, gravity_in_base(scenario)};
+}
+
 ModelTorqueSource scenario_model_torque(const sim::Scenario& scenario) {
-  ModelTorqueSource model;
-  model.robot = calib::load_robot_description(scenario.robot_file);
-  model.gravity_in_base_m_s2 = scenario_plant(scenario, model.robot).gravity_in_base_m_s2;
-  return model;
+  return nominal_model_torque(sim::load_nominal_robot(scenario), scenario);
+}
+
+CompensationOptions verification_compensation(const sim::Scenario& scenario,
+                                              const VerificationOptions& options) {
+  CompensationOptions compensation = options.compensation;
+  if (!compensation.model_torque) compensation.model_torque = scenario_model_torque(scenario);
+  return compensation;
 }
 
 namespace {
@@ -437,9 +454,12 @@ VerificationResult verify_scenario(const sim::Scenario& scenario,
                                    const std::vector<NamedTable>& tables,
                                    const VerificationOptions& options) {
   if (options.cycles < 1) throw std::invalid_argument("verify: at least one cycle");
-  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
+  // The simulated world (the plant's controller plans, the plant runs, its link angles are the
+  // truth) and the chain (the IMS chain's kinematics, the model torque and the precontrol).
+  const calib::RobotDescription plant_robot = sim::load_plant_robot(scenario);
+  const sim::NominalRobot nominal = sim::load_nominal_robot(scenario);
   const sim::DesiredJointPath full =
-      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
+      sim::plan_motion(plant_robot, sim::load_motion_program(scenario.program_file));
   const double T = full.cycle_s;
 
   // The evaluated segments and the part of the program that is run.
@@ -472,23 +492,22 @@ VerificationResult verify_scenario(const sim::Scenario& scenario,
   for (const auto& s : evaluated) result.segments.push_back(s.label);
 
   // The commands: one per table (the precontrol does not depend on the plant's draw). Tables
-  // whose models take the model torque get it from the scenario's robot unless the caller gave
-  // a model.
-  CompensationOptions compensation = options.compensation;
-  if (!compensation.model_torque) compensation.model_torque = scenario_model_torque(scenario);
+  // whose models take the model torque get it from the scenario's nominal robot unless the
+  // caller gave a model.
+  const CompensationOptions compensation = verification_compensation(scenario, options);
   std::vector<CompensationRun> compensations;
   std::vector<sim::DesiredJointPath> commands;
   for (const NamedTable& t : tables) {
-    compensations.push_back(run_precontrol(t.table, robot.name, path, compensation));
+    compensations.push_back(run_precontrol(t.table, nominal.description.name, path, compensation));
     commands.push_back(command_path(path, compensations.back().offset_rad));
   }
 
   std::vector<double> t_s;
   std::vector<calib::JointVector> q_d;
   for (const auto& s : path.samples) t_s.push_back(s.t_s), q_d.push_back(s.q_rad);
-  const std::vector<PathPose> desired = flange_path(robot, t_s, q_d);
+  const std::vector<PathPose> desired = flange_path(plant_robot, t_s, q_d);
 
-  const sim::PlantConfig base = scenario_plant(scenario, robot);
+  const sim::PlantConfig base = scenario_plant(scenario, plant_robot);
   std::mt19937_64 rng(options.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   // Per case and cycle: the attained path as measured, and the true one.
@@ -511,20 +530,21 @@ VerificationResult verify_scenario(const sim::Scenario& scenario,
     for (std::size_t c = 0; c <= commands.size(); ++c) {
       const sim::DesiredJointPath& command = c == 0 ? path : commands[c - 1];
       const sim::PlantLog plant = sim::simulate_plant(config, command, T);
-      true_cycles[c].push_back(attained_path(robot, plant));
+      true_cycles[c].push_back(attained_path(plant_robot, plant));
       if (!options.measure_with_ims) {
         cycles[c].push_back(true_cycles[c].back());
         continue;
       }
       // The controller's log holds the interpolator's desired angles (the offset is added after
       // it): the chain finds the program's standstills there.
-      const ImsJointMeasurement m = measure_joints_with_ims(
-          scenario, robot, path, plant, standstill_s, options.ims_seed + std::uint64_t(j));
+      const ImsJointMeasurement m =
+          measure_joints_with_ims(scenario, plant_robot, nominal, path, plant, standstill_s,
+                                  options.ims_seed + std::uint64_t(j));
       std::vector<double> t;
       std::vector<calib::JointVector> q;
       for (std::size_t k = 0; k < m.q_rad.size(); ++k)
         if (m.valid[k]) t.push_back(plant.samples[k].t_s), q.push_back(m.q_rad[k]);
-      cycles[c].push_back(flange_path(robot, t, q));
+      cycles[c].push_back(flange_path(nominal.description, t, q));
     }
   }
 

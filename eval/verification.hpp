@@ -40,7 +40,8 @@ namespace imscal::eval {
 // ---- Identification from the simulator's truth --------------------------------------------
 
 // Runs the scenario's program through its plant and returns q_d and q_link (as q_measured and,
-// for lack of an encoder model here, q_internal = motor angle / N) every controller cycle.
+// for lack of an encoder model here, q_internal = motor angle / N) every controller cycle, in a
+// log of the scenario's nominal robot (its name and joints: what the chain is given).
 // max_duration_s cuts the program (lighter runs under sanitizers).
 ident::JointErrorLog simulate_truth_joint_errors(
     const sim::Scenario& scenario, double max_duration_s = std::numeric_limits<double>::infinity());
@@ -63,8 +64,11 @@ struct IdentifiedTable {
   std::vector<std::string> failed_joints;
 };
 
-// The rigid-body model of a scenario's robot, with the site's normal gravity in R (as the
-// plant feels it): the model torques of multi-input tables (eval/model_torque.hpp).
+// The rigid-body model of the nominal robot, with the scenario site's normal gravity in R: the
+// model torques of multi-input tables (eval/model_torque.hpp). Never the plant's masses.
+ModelTorqueSource nominal_model_torque(const sim::NominalRobot& nominal,
+                                       const sim::Scenario& scenario);
+// The same for the scenario's nominal robot (sim::load_nominal_robot).
 ModelTorqueSource scenario_model_torque(const sim::Scenario& scenario);
 
 // identify_joint for every joint of the log (as `imscal identify`). source_file names the data.
@@ -222,8 +226,15 @@ struct VerificationResult {
   std::vector<Eigen::Matrix<double, 8, 1>> desired_poses;  // t, x, y, z, qw, qx, qy, qz
 };
 
-// Throws InputError for a scenario that cannot be loaded, std::invalid_argument when no segment
-// matches the filter or a table is refused.
+// The precontrol's options in verify_scenario: options.compensation, with the scenario's nominal
+// model torque (scenario_model_torque) unless it holds one.
+CompensationOptions verification_compensation(const sim::Scenario& scenario,
+                                              const VerificationOptions& options);
+
+// The closed loop: the scenario's plant (sim::load_plant_robot) plans, runs and gives the true
+// path; the chain's side (the IMS chain's kinematics, the model torque, the precontrol) uses its
+// nominal robot only. Throws InputError for a scenario that cannot be loaded,
+// std::invalid_argument when no segment matches the filter or a table is refused.
 VerificationResult verify_scenario(const sim::Scenario& scenario,
                                    const std::vector<NamedTable>& tables,
                                    const VerificationOptions& options = {});

@@ -65,6 +65,12 @@ CellGrid IdentificationConfig::joint_grid(std::size_t joint) const {
   return CellGrid(std::move(dims));
 }
 
+double IdentificationConfig::transmission_error_harmonic(std::size_t joint) const {
+  return joint < transmission_error_harmonic_per_joint.size()
+             ? transmission_error_harmonic_per_joint[joint]
+             : transmission_error_harmonic_per_motor_rev;
+}
+
 JointIdentificationOptions IdentificationConfig::joint_options(std::size_t joint) const {
   JointIdentificationOptions o = options;
   if (o.transmission_error_input) {
@@ -72,8 +78,7 @@ JointIdentificationOptions IdentificationConfig::joint_options(std::size_t joint
       throw std::invalid_argument(fmt::format(
           "identification config: no gear ratio for joint {} (joints.gear_ratio has {})", joint + 1,
           gear_ratio.size()));
-    o.transmission_error_rad_per_rad =
-        transmission_error_harmonic_per_motor_rev * gear_ratio[joint];
+    o.transmission_error_rad_per_rad = transmission_error_harmonic(joint) * gear_ratio[joint];
     if (joint < gear_stiffness_nm_per_rad.size())
       o.transmission_error_compliance_rad_per_nm = 1.0 / gear_stiffness_nm_per_rad[joint];
   }
@@ -188,10 +193,20 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
           .fail(
               "the transmission error's phase with the gear's deflection (joints."
               "gear_stiffness_nm_per_rad) needs model_torque: true");
-    c.transmission_error_harmonic_per_motor_rev = model->get_double(
-        "transmission_error_harmonic_per_motor_rev", c.transmission_error_harmonic_per_motor_rev);
-    if (!(c.transmission_error_harmonic_per_motor_rev > 0.0))
-      model->child("transmission_error_harmonic_per_motor_rev").fail("must be > 0");
+    // One harmonic for every joint, or a list with one per joint.
+    if (const auto harmonic = model->optional_child("transmission_error_harmonic_per_motor_rev")) {
+      if (harmonic->is_sequence()) {
+        c.transmission_error_harmonic_per_joint = harmonic->as_doubles();
+        if (c.transmission_error_harmonic_per_joint.size() != c.max_speed_rad_s.size())
+          harmonic->fail(
+              fmt::format("expected one harmonic per joint ({})", c.max_speed_rad_s.size()));
+        for (double h : c.transmission_error_harmonic_per_joint)
+          if (!(h > 0.0)) harmonic->fail("every harmonic must be > 0");
+      } else {
+        c.transmission_error_harmonic_per_motor_rev = harmonic->as_double();
+        if (!(c.transmission_error_harmonic_per_motor_rev > 0.0)) harmonic->fail("must be > 0");
+      }
+    }
     o.transmission_error_taps =
         int(model->get_int("transmission_error_taps", o.transmission_error_taps));
     if (o.transmission_error_taps < 1 || o.transmission_error_taps > 64)

@@ -24,6 +24,11 @@ struct IdentificationConfig {
   std::vector<double> gear_ratio;
   std::vector<double> gear_stiffness_nm_per_rad;  // per joint; empty: the phase from q alone
   double transmission_error_harmonic_per_motor_rev = 1.0;
+  // Per joint, when given (a list in the config, or found from the data by an order search):
+  // replaces transmission_error_harmonic_per_motor_rev for that joint.
+  std::vector<double> transmission_error_harmonic_per_joint;
+  // The harmonic per motor revolution of one joint's transmission error.
+  double transmission_error_harmonic(std::size_t joint) const;
   double nominal_payload_kg = 16.0;
   std::vector<double> speed_fraction_bounds{0.0, 0.2, 0.8, 1.0};  // of max speed (paper, Table 2)
   std::vector<double> payload_fraction_bounds{0.0, 0.5, 1.0};     // of nominal payload

@@ -1,7 +1,11 @@
 #include "sim/scenario.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 #include <cstdlib>
+#include <string>
+#include <string_view>
 
 #include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
@@ -23,13 +27,69 @@ double non_negative(const ConfigNode& node) {
   return value;
 }
 
+// A plant deviation factor: > 0 and finite (a factor 0 would remove the part from the plant, which
+// the effects switch does explicitly).
+double factor(const ConfigNode& node, std::string_view key, double fallback) {
+  if (!node.has(key)) return fallback;
+  const double value = node.child(key).as_double();
+  if (!(value > 0.0)) node.child(key).fail("must be a factor > 0");
+  return value;
+}
+
+// The factors of one joint (or `all`), each multiplying the robot file's value; 1 = as in it.
+struct DeviationFactors {
+  double link_mass = 1.0;  // the link's mass and its inertia tensor (centre of mass kept)
+  double gear_stiffness = 1.0;
+  double backlash = 1.0;
+  double coulomb_friction = 1.0;
+  double viscous_friction = 1.0;
+};
+
+DeviationFactors read_factors(const ConfigNode& node, const DeviationFactors& fallback) {
+  node.require_only_keys(
+      {"link_mass", "gear_stiffness", "backlash", "coulomb_friction", "viscous_friction"});
+  DeviationFactors f;
+  f.link_mass = factor(node, "link_mass", fallback.link_mass);
+  f.gear_stiffness = factor(node, "gear_stiffness", fallback.gear_stiffness);
+  f.backlash = factor(node, "backlash", fallback.backlash);
+  f.coulomb_friction = factor(node, "coulomb_friction", fallback.coulomb_friction);
+  f.viscous_friction = factor(node, "viscous_friction", fallback.viscous_friction);
+  return f;
+}
+
+void apply(const DeviationFactors& f, calib::JointDescription& joint) {
+  joint.link.mass_kg *= f.link_mass;
+  joint.link.inertia_kg_m2 *= f.link_mass;
+  joint.drive.stiffness_nm_per_rad *= f.gear_stiffness;
+  joint.drive.backlash_rad *= f.backlash;
+  joint.drive.coulomb_nm *= f.coulomb_friction;
+  joint.drive.viscous_nm_s_per_rad *= f.viscous_friction;
+}
+
+// `plant_deviations:` on the robot file's description: `all` first, then each joint's own keys
+// (a joint's key replaces the `all` value).
+void apply_deviations(const ConfigNode& node, calib::RobotDescription& robot) {
+  if (!node.is_map()) node.fail("expected a map: all, <joint name>");
+  for (const std::string& key : node.keys()) {
+    bool known = key == "all";
+    for (const auto& joint : robot.joints) known = known || key == joint.name;
+    if (!known) node.child(key).fail("unknown key: expected all or a joint name of the robot");
+  }
+  DeviationFactors common;
+  if (const auto all = node.optional_child("all")) common = read_factors(*all, common);
+  for (auto& joint : robot.joints) {
+    const auto own = node.optional_child(joint.name);
+    apply(own ? read_factors(*own, common) : common, joint);
+  }
+}
+
 }  // namespace
 
 Scenario load_scenario(const fs::path& file) {
   const ConfigNode root = ConfigNode::load_file(file);
-  root.require_only_keys({"imscal-scenario", "name", "description", "robot", "program", "sensor",
-                          "imu", "site", "base_in_world", "sensor_mount", "effects", "plant",
-                          "seed"});
+  root.require_only_keys({"imscal-scenario", "name", "description", "robot", "nominal_robot",
+                          "plant_deviations", "program", "sensor", "imu", "site", "base_in_world",
+                          "sensor_mount", "effects", "plant", "seed"});
   if (root.child("imscal-scenario").as_int() != 1) {
     root.child("imscal-scenario").fail("unknown scenario version (this reader: 1)");
   }
@@ -37,7 +97,11 @@ Scenario load_scenario(const fs::path& file) {
   s.file = file;
   s.name = root.child("name").as_string();
   s.description = root.get_string("description", "");
-  s.robot_file = root.child("robot").as_existing_file();
+  s.plant_robot_file = root.child("robot").as_existing_file();
+  s.nominal_robot_given = root.has("nominal_robot");
+  s.nominal_robot_file =
+      s.nominal_robot_given ? root.child("nominal_robot").as_existing_file() : s.plant_robot_file;
+  s.plant_deviations = root.optional_child("plant_deviations");
   s.program_file = root.child("program").as_existing_file();
   s.sensor_file = root.child("sensor").as_existing_file();
 
@@ -103,7 +167,25 @@ Scenario load_scenario(const fs::path& file) {
     if (seed < 0) root.child("seed").fail("must not be negative");
     s.seed = static_cast<std::uint64_t>(seed);
   }
+  load_plant_robot(s);  // the deviations' keys and factors checked here, with the file's lines
+  if (!s.nominal_robot_given) {
+    spdlog::info(
+        "scenario {}: no nominal_robot given; the chain believes the plant's robot file "
+        "{}{}",
+        s.name, s.plant_robot_file.string(),
+        s.plant_deviations ? " (without the plant_deviations)" : "");
+  }
   return s;
+}
+
+calib::RobotDescription load_plant_robot(const Scenario& scenario) {
+  calib::RobotDescription robot = calib::load_robot_description(scenario.plant_robot_file);
+  if (scenario.plant_deviations) apply_deviations(*scenario.plant_deviations, robot);
+  return robot;
+}
+
+NominalRobot load_nominal_robot(const Scenario& scenario) {
+  return {calib::load_robot_description(scenario.nominal_robot_file)};
 }
 
 fs::path resolve_scenario(const std::string& name_or_file) {
@@ -132,8 +214,9 @@ fs::path resolve_scenario(const std::string& name_or_file) {
   return file;
 }
 
-PlantConfig make_plant_config(const calib::RobotDescription& robot, const Scenario& scenario) {
-  return make_plant_config(robot, scenario.effects ? &*scenario.effects : nullptr,
+PlantConfig make_plant_config(const calib::RobotDescription& plant_robot,
+                              const Scenario& scenario) {
+  return make_plant_config(plant_robot, scenario.effects ? &*scenario.effects : nullptr,
                            scenario.integration_step ? &*scenario.integration_step : nullptr);
 }
 

@@ -3,12 +3,19 @@
 // runs which motion program with which plant effects, where the robot stands in W, how the IMS is
 // mounted on its flange, which IMS (sensor spec) records at what rate, and the seed of every
 // random draw. `imscal simulate` turns it into robot.csv, imu.csv and the truth.
+//
+// Two robots: the plant (the robot that is: `robot:` with the optional `plant_deviations:`
+// factors), which only the simulator reads, and the nominal robot (`nominal_robot:`, the data
+// sheet and model the lab believes), the only robot the calibration chain is given. They are
+// different types here (calib::RobotDescription inside sim::PlantConfig for the plant,
+// sim::NominalRobot for the chain) so that no chain function can be handed the plant by mistake.
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
 
+#include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "ims/earth_model.hpp"
 #include "sim/plant_config.hpp"
@@ -19,7 +26,11 @@ struct Scenario {
   std::string name;
   std::string description;
   std::filesystem::path file;  // the scenario file; relative paths below are resolved against it
-  std::filesystem::path robot_file;
+  // `robot:` the plant's robot file (before plant_deviations); read by the simulator only.
+  std::filesystem::path plant_robot_file;
+  // `nominal_robot:` the robot the lab believes; the plant's robot file when not given.
+  std::filesystem::path nominal_robot_file;
+  bool nominal_robot_given = false;
   std::filesystem::path program_file;
   std::filesystem::path sensor_file;  // IMS sensor spec (datasets/sensors/*.yaml)
 
@@ -39,22 +50,39 @@ struct Scenario {
   double mount_random_position_sigma_m = 0.0;
   double mount_random_rotation_sigma_rad = 0.0;
 
+  // How the plant differs from its robot file: factors per joint (`plant_deviations:`, checked
+  // by load_scenario; applied by load_plant_robot).
+  std::optional<ConfigNode> plant_deviations;
   std::optional<ConfigNode> effects;           // the plant's effects section (sim/plant_config.hpp)
   std::optional<ConfigNode> integration_step;  // the plant's step (sim/plant_config.hpp)
   double plant_output_interval_s = 0.001;      // link-side truth and the IMS's pose samples
   std::uint64_t seed = 1;
 };
 
-// InputError (file, line, key) on any problem; unknown keys are refused.
+// The robot the lab believes: its data sheet and nominal model. The calibration chain (model
+// torque, identification, precontrol, the IMS chain's kinematics) takes only this.
+struct NominalRobot {
+  calib::RobotDescription description;
+};
+
+// InputError (file, line, key) on any problem; unknown keys are refused. Says in a log line when
+// the scenario names no nominal robot (the chain then believes the plant's robot file).
 Scenario load_scenario(const std::filesystem::path& file);
+
+// The plant's robot: the `robot:` file with the `plant_deviations:` factors applied. For the
+// simulator only. InputError on a bad factor.
+calib::RobotDescription load_plant_robot(const Scenario& scenario);
+
+// The nominal robot of a scenario (`nominal_robot:`, else the `robot:` file without deviations).
+NominalRobot load_nominal_robot(const Scenario& scenario);
 
 // `--scenario NAME|FILE`: a path to an existing file, or the name of a shipped scenario looked up
 // as <datasets>/scenarios/NAME.yaml, where <datasets> is $IMSCAL_DATASETS if set, else the
 // repository's datasets/ folder this binary was built from.
 std::filesystem::path resolve_scenario(const std::string& name_or_file);
 
-// The plant of a scenario: its `effects` and `integration_step_s` sections on `robot` (the
-// scenario's robot file, loaded by the caller). InputError on a bad key/value.
-PlantConfig make_plant_config(const calib::RobotDescription& robot, const Scenario& scenario);
+// The plant of a scenario: its `effects` and `integration_step_s` sections on `plant_robot`
+// (load_plant_robot, loaded by the caller). InputError on a bad key/value.
+PlantConfig make_plant_config(const calib::RobotDescription& plant_robot, const Scenario& scenario);
 
 }  // namespace imscal::sim

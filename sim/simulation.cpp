@@ -103,7 +103,7 @@ SimulationResult run_simulation(const Scenario& scenario, std::uint64_t seed,
     if (progress) progress(stage, fraction);
   };
   SimulationResult result;
-  result.robot = calib::load_robot_description(scenario.robot_file);
+  result.robot = load_plant_robot(scenario);  // the simulated world: the plant
   result.sensor_spec = ims::load_sensor_spec(scenario.sensor_file);
   const MotionProgram program = load_motion_program(scenario.program_file);
   report("plan", 0.0);

@@ -21,7 +21,7 @@
 namespace imscal::sim {
 
 struct SimulationResult {
-  calib::RobotDescription robot;
+  calib::RobotDescription robot;  // the plant's (load_plant_robot): the simulated world
   ims::SensorSpec sensor_spec;
   DesiredJointPath path;  // robot clock
   PlantLog plant;         // robot clock, every Scenario::plant_output_interval_s

@@ -18,6 +18,7 @@
 #include "core/input_error.hpp"
 #include "core/version.hpp"
 #include "eval/model_torque.hpp"
+#include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
 #include "ident/identify_joints.hpp"
@@ -37,6 +38,7 @@ struct IdentifyArgs {
   std::string config;
   imscal::tools::ModelTorqueOption model_torque;  // for configs with the model-torque input
   std::string out;
+  bool search_order = false;  // the transmission error's order per joint from the data
   bool force = false;
 };
 
@@ -54,6 +56,36 @@ void attach_model_torques(ident::JointErrorLog& log, const ident::Identification
 
 json number_or_null(double v) {
   return std::isfinite(v) ? json(v) : json(nullptr);
+}
+
+// `--search-transmission-error-order`: each joint's harmonic found from the data replaces the
+// config's (eval/transmission_error_order.hpp); the search for the report.
+json search_orders(const ident::JointErrorLog& log, const IdentifyArgs& args,
+                   ident::IdentificationConfig& config) {
+  if (!config.options.transmission_error_input)
+    throw imscal::InputError(args.config, 0, "model.transmission_error",
+                             "--search-transmission-error-order needs the transmission-error "
+                             "inputs (model.transmission_error: true)");
+  spdlog::info("identify: searching the transmission error's order per motor revolution");
+  const imscal::eval::TransmissionErrorOrderSearch search =
+      imscal::eval::search_transmission_error_orders(log, config,
+                                                     imscal::eval::default_order_candidates());
+  json joints = json::array();
+  for (std::size_t j = 0; j < search.chosen_harmonic.size(); ++j) {
+    spdlog::info("identify: {}: {}", log.joint_names[j],
+                 imscal::eval::describe_order_search(search, j));
+    json fits = json::array();
+    for (const auto& per_candidate : search.fit_percent)
+      fits.push_back(number_or_null(per_candidate[j]));
+    joints.push_back({{"name", log.joint_names[j]},
+                      {"config_harmonic_per_motor_rev", search.prior_harmonic[j]},
+                      {"best_harmonic_per_motor_rev", search.best_harmonic[j]},
+                      {"gain_points", number_or_null(search.gain_points[j])},
+                      {"chosen_harmonic_per_motor_rev", search.chosen_harmonic[j]},
+                      {"held_out_joint_error_fit_percent", fits}});
+  }
+  config = imscal::eval::with_searched_orders(std::move(config), search);
+  return {{"candidates_per_motor_rev", search.candidates}, {"joints", joints}};
 }
 
 json correlation_json(const ident::CorrelationTest& t) {
@@ -161,7 +193,7 @@ void run(const IdentifyArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   ident::JointErrorLog log = ident::read_joint_errors_csv(args.joint_errors);
   const imscal::ConfigNode config_node = imscal::ConfigNode::load_file(args.config);
-  const ident::IdentificationConfig config = ident::load_identification_config(config_node);
+  ident::IdentificationConfig config = ident::load_identification_config(config_node);
   attach_model_torques(log, config, args);
   if (config.max_speed_rad_s.size() != log.joint_count())
     throw imscal::InputError(
@@ -178,6 +210,7 @@ void run(const IdentifyArgs& args) {
       if (fs::exists(p))
         throw imscal::InputError(p.string(), 0, "", "output exists; use --force to overwrite it");
   fs::create_directories(out_dir);
+  const json order_search = args.search_order ? search_orders(log, args, config) : json(nullptr);
 
   const auto segments = log.segments();
   ident::ParameterTable table =
@@ -231,6 +264,7 @@ void run(const IdentifyArgs& args) {
       {"segments", segments.size()},
       {"sample_time_s", log.cycle_s},
       {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
+      {"transmission_error_order_search", order_search},
       {"joints", joints_report}};
   // An inverse-form table does not predict the joint error from q_d (the gap diagnosis's "sim"):
   // the paper's forward error model from the same data is written beside it.
@@ -263,6 +297,9 @@ imscal::tools::CommandRegistration registration{
           ->required();
       args->model_torque.add_to(sub);
       sub.add_option("--out", args->out, "Output folder")->required();
+      sub.add_flag("--search-transmission-error-order", args->search_order,
+                   "find each joint's transmission-error harmonic per motor revolution (0.5 .. "
+                   "4) from the joint errors' held-out fit; the config's is the prior");
       sub.add_flag("--force", args->force, "Overwrite existing outputs");
       sub.callback([args] { run(*args); });
     }};

@@ -22,6 +22,7 @@
 #include "core/atomic_file.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
 #include "ident/joint_error_io.hpp"
@@ -44,8 +45,20 @@ struct VerifyArgs {
   double offset_tolerance_rad = 0.0;  // 0: from the table's envelope
   bool measure_with_ims = true;
   bool ablation = true;
+  bool search_order = false;  // the transmission error's order per joint from the data
   bool force = false;
 };
+
+// Replaces the config's harmonic per joint by the one the identification record fits best.
+void search_orders(const ident::JointErrorLog& log, const eval::ModelTorqueSource& torque_model,
+                   ident::IdentificationConfig& config) {
+  spdlog::info("verify: searching the transmission error's order per motor revolution");
+  const eval::TransmissionErrorOrderSearch search = eval::search_transmission_error_orders(
+      log, config, eval::default_order_candidates(), &torque_model);
+  for (std::size_t j = 0; j < search.chosen_harmonic.size(); ++j)
+    spdlog::info("verify: {}: {}", log.joint_names[j], eval::describe_order_search(search, j));
+  config = eval::with_searched_orders(std::move(config), search);
+}
 
 constexpr double kMm = 1e3, kDeg = 180.0 / M_PI;
 
@@ -299,15 +312,16 @@ void run(const VerifyArgs& args) {
     throw imscal::InputError("", 0, "--table",
                              "give --table, --joint-errors or --identify-scenario");
   }
-  // The robot's rigid-body model for multi-input tables: that of the identification scenario,
-  // else of the first verified scenario (the joint errors' robot must be the same).
+  // The rigid-body model for multi-input tables: the nominal robot (never the plant) of the
+  // identification scenario, else of the first verified scenario (the joint errors' robot must
+  // be the same).
   const eval::ModelTorqueSource torque_model =
       eval::scenario_model_torque(imscal::sim::load_scenario(imscal::sim::resolve_scenario(
           args.identify_scenario.empty() ? args.scenarios.front() : args.identify_scenario)));
   if (log && log->robot != torque_model.robot.name)
     throw imscal::InputError(source, 0, "robot",
                              fmt::format("the joint errors are of robot '{}', the scenarios' "
-                                         "robot is '{}'",
+                                         "nominal robot is '{}'",
                                          log->robot, torque_model.robot.name));
   std::optional<ident::IdentificationConfig> config;
   if (log) {
@@ -318,6 +332,12 @@ void run(const VerifyArgs& args) {
                   .string()
             : args.ident_config;
     config = ident::load_identification_config(imscal::ConfigNode::load_file(config_file));
+  }
+  if (args.search_order) {
+    if (!config || !config->options.transmission_error_input)
+      throw imscal::InputError(args.ident_config, 0, "--search-transmission-error-order",
+                               "needs joint errors and a config with the transmission error");
+    search_orders(*log, torque_model, *config);
   }
   if (!args.table.empty()) {
     tables.push_back({"compensated", ident::read_parameters_json(args.table)});
@@ -387,6 +407,9 @@ imscal::tools::CommandRegistration registration{
                      "supervisor tolerance on |offset| per joint [rad] (default: 1.5 x the table's "
                      "envelope of the identification data)");
       sub.add_flag("!--no-ablation", args->ablation, "skip the ablation tables");
+      sub.add_flag("--search-transmission-error-order", args->search_order,
+                   "find each joint's transmission-error harmonic per motor revolution (0.5 .. "
+                   "4) from the joint errors' held-out fit instead of the config's");
       sub.add_flag("!--true-path", args->measure_with_ims,
                    "evaluate the plant's true link-side path instead of the IMS chain's "
                    "measurement (faster; the IMS chain is the default)");

@@ -166,7 +166,7 @@ const MountingMotion& mounting_motion() {
     MountingMotion m;
     m.scenario = sim::load_scenario(std::filesystem::path(IMSCAL_TEST_DATA_DIR) / "scenarios" /
                                     "mounting-rigid.yaml");
-    m.robot = load_robot_description(m.scenario.robot_file);
+    m.robot = sim::load_plant_robot(m.scenario);
     m.spec = ims::load_sensor_spec(m.scenario.sensor_file);
     m.path = sim::plan_motion(m.robot, sim::load_motion_program(m.scenario.program_file));
     return m;

@@ -102,7 +102,7 @@ PlantRun run_plant(const std::string& scenario_name, double max_duration_s) {
   const sim::Scenario scenario =
       sim::load_scenario(kDatasets / "scenarios" / (scenario_name + ".yaml"));
   PlantRun run;
-  run.robot = load_robot_description(scenario.robot_file);
+  run.robot = sim::load_plant_robot(scenario);
   sim::DesiredJointPath path =
       sim::plan_motion(run.robot, sim::load_motion_program(scenario.program_file));
   while (path.samples.size() > 1 && path.samples.back().t_s > max_duration_s) {

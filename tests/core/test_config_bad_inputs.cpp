@@ -21,6 +21,7 @@
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "ident/identification_config.hpp"
+#include "sim/scenario.hpp"
 #include "tests/support/scratch_dir.hpp"
 #include "tests/tools/run_campaign.hpp"
 
@@ -62,8 +63,10 @@ void load_by_kind(const fs::path& file) {
     calib::load_calibration_config(file);
   } else if (name.rfind("identification-", 0) == 0) {
     ident::load_identification_config(ConfigNode::load_file(file));
+  } else if (name.rfind("scenario-", 0) == 0) {
+    sim::load_scenario(file);
   } else {
-    FAIL() << "no loader for " << name << " (prefix calibration- or identification-)";
+    FAIL() << "no loader for " << name << " (prefix calibration-, identification- or scenario-)";
   }
 }
 

@@ -48,7 +48,7 @@ ident::ParameterTable zero_error_table() {
 TEST(ClosedLoop, ZeroErrorTableLeavesTheSimulatorRunUnchanged) {
   const sim::Scenario scenario =
       sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets/scenarios/seed-line.yaml");
-  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
+  const calib::RobotDescription robot = sim::load_plant_robot(scenario);
   sim::DesiredJointPath path =
       sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
   // The first 8 s: the initial rest and most of the PTP move to the line (every joint moves).

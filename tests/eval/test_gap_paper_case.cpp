@@ -48,7 +48,7 @@ TEST(GapPaperCase, NamesTheOperatingPointMismatchAndJoint2Backlash) {
       sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets/scenarios/seed-line.yaml");
   const ident::JointErrorLog real = simulate_truth_joint_errors(seed_line);
   const auto sim_errors = predict_table_joint_errors(identified.table, real);
-  const calib::RobotDescription robot = calib::load_robot_description(seed_line.robot_file);
+  const calib::RobotDescription robot = sim::load_nominal_robot(seed_line).description;
   const GapSignals signals = make_gap_signals(real, sim_errors, robot, &identified.table);
   const Diagnosis d = diagnose_gap(signals);
 

@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 TEST(ImsMeasuredPath, GivesThePlantsFlangePathOnSeedLine) {
   const sim::Scenario scenario =
       sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets/scenarios/seed-line.yaml");
-  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
+  const calib::RobotDescription robot = sim::load_plant_robot(scenario);
   sim::DesiredJointPath path =
       sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
   // The initial rest, the approach, the rest before the line and the first line (to ~13 s);
@@ -32,7 +32,8 @@ TEST(ImsMeasuredPath, GivesThePlantsFlangePathOnSeedLine) {
   sim::PlantConfig config = sim::make_plant_config(robot, scenario);
   config.gravity_in_base_m_s2 = scenario_model_torque(scenario).gravity_in_base_m_s2;
   const sim::PlantLog plant = sim::simulate_plant(config, path, path.cycle_s);
-  const ImsJointMeasurement m = measure_joints_with_ims(scenario, robot, path, plant, 5.9, 1);
+  const ImsJointMeasurement m = measure_joints_with_ims(
+      scenario, robot, sim::load_nominal_robot(scenario), path, plant, 5.9, 1);
   ASSERT_EQ(m.q_rad.size(), plant.samples.size());
   std::size_t valid = 0;
   double worst_m = 0.0;

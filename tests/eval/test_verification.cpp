@@ -386,7 +386,7 @@ TEST(Verification, Iso9283FullVelocity) {
 // (1 - G) applied twice instead of once: a second-order remainder.
 TEST(Verification, TrueJointErrorAsOffsetBound) {
   const sim::Scenario s = scenario("seed-line");
-  const calib::RobotDescription robot = calib::load_robot_description(s.robot_file);
+  const calib::RobotDescription robot = sim::load_plant_robot(s);
   const sim::DesiredJointPath path =
       sim::plan_motion(robot, sim::load_motion_program(s.program_file));
   const sim::PlantConfig config = sim::make_plant_config(robot, s);

@@ -109,7 +109,7 @@ TEST_F(VerifyCli, ZeroTableVerifiesUnchangedAndEvaluateAgrees) {
 
 TEST_F(VerifyCli, CompensateWritesOffsetsOrRefusesAnotherRobotsTable) {
   const sim::Scenario scenario = sim::load_scenario(sim::resolve_scenario("seed-line"));
-  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
+  const calib::RobotDescription robot = sim::load_nominal_robot(scenario).description;
   const sim::DesiredJointPath path =
       sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
   calib::RobotLog log;

@@ -33,7 +33,7 @@ TEST_P(ShippedScenario, StaysBelowEveryDrivesTorqueLimit) {
   if (long_run && std::getenv("IMSCAL_SANITIZED")) GTEST_SKIP() << "minutes under sanitizers";
   const Scenario scenario = load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "scenarios" /
                                           (GetParam() + ".yaml"));
-  const calib::RobotDescription robot = calib::load_robot_description(scenario.robot_file);
+  const calib::RobotDescription robot = sim::load_plant_robot(scenario);
   const DesiredJointPath path = plan_motion(robot, load_motion_program(scenario.program_file));
   const PlantConfig config = make_plant_config(robot, scenario);
   const PlantLog log = simulate_plant(config, path, path.cycle_s);

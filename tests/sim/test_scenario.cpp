@@ -21,17 +21,19 @@ const fs::path kScenarios = fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "scenario
 
 TEST(Scenario, EveryShippedScenarioLoadsAndPlans) {
   int count = 0;
-  for (const char* name : {"seed-line", "identification", "mounting", "iso9283"}) {
+  for (const char* name :
+       {"seed-line", "identification", "mounting", "iso9283", "deviating-identification",
+        "deviating-seed-line", "deviating-iso9283"}) {
     SCOPED_TRACE(name);
     const Scenario s = load_scenario(resolve_scenario(name));
     EXPECT_EQ(s.name, name);
-    const calib::RobotDescription robot = calib::load_robot_description(s.robot_file);
+    const calib::RobotDescription robot = sim::load_plant_robot(s);
     const DesiredJointPath path = plan_motion(robot, load_motion_program(s.program_file));
     EXPECT_GT(path.samples.size(), 1000u);
     EXPECT_EQ(path.cycle_s, robot.controller_cycle_s);
     ++count;
   }
-  EXPECT_EQ(count, 4);
+  EXPECT_EQ(count, 7);
 }
 
 TEST(Scenario, ValuesAreReadAsWritten) {

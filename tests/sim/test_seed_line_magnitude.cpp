@@ -43,7 +43,7 @@ const SeedLineRun& seed_line() {
             "seed-line with every effect")
             .child("effects");
     SeedLineRun r;
-    r.robot = calib::load_robot_description(scenario.robot_file);
+    r.robot = sim::load_plant_robot(scenario);
     r.path = plan_motion(r.robot, load_motion_program(scenario.program_file));
     const PlantConfig config = make_plant_config(r.robot, scenario);
     r.plant = simulate_plant(config, r.path, r.path.cycle_s);
