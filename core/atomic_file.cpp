@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
 #include <system_error>
 
@@ -18,11 +20,29 @@ fs::path temporary_name(const fs::path& target) {
          fmt::format(".{}.tmp-{}-{}", target.filename().string(), ::getpid(), counter++);
 }
 
-void sync_file(const fs::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY);
-  if (fd < 0) return;
-  ::fsync(fd);
+// fsync: on some file systems a full disk shows only here. Returns errno, 0 on success.
+int sync_file(const fs::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return errno;
+  const int result = ::fsync(fd) == 0 ? 0 : errno;
   ::close(fd);
+  return result;
+}
+
+std::string reason(int error) {
+  return error != 0 ? std::strerror(error) : "unknown reason";
+}
+
+// The target's folder, created when missing (as every command's --out folder is).
+void create_parent_folder(const fs::path& target) {
+  const fs::path parent = target.parent_path();
+  std::error_code error;
+  if (parent.empty() || fs::is_directory(parent, error)) return;
+  fs::create_directories(parent, error);
+  if (error) {
+    throw std::runtime_error(fmt::format("{}: cannot create the output folder {}: {}",
+                                         target.string(), parent.string(), error.message()));
+  }
 }
 }  // namespace
 
@@ -32,12 +52,14 @@ AtomicFile::AtomicFile(fs::path target, Overwrite overwrite, bool binary)
     throw std::runtime_error(fmt::format(
         "{}: output exists already; refusing to overwrite it (use --force)", target_.string()));
   }
+  create_parent_folder(target_);
   auto mode = std::ios::out | std::ios::trunc;
   if (binary) mode |= std::ios::binary;
+  errno = 0;
   out_.open(temporary_, mode);
   if (!out_) {
     throw std::runtime_error(
-        fmt::format("{}: cannot create temporary output file", temporary_.string()));
+        fmt::format("{}: cannot write the output file: {}", target_.string(), reason(errno)));
   }
 }
 
@@ -50,12 +72,19 @@ AtomicFile::~AtomicFile() {
 }
 
 void AtomicFile::commit() {
+  errno = 0;
   out_.flush();
-  if (!out_) {
-    throw std::runtime_error(fmt::format("{}: write failed", temporary_.string()));
-  }
+  int flush_error = errno;
   out_.close();
-  sync_file(temporary_);
+  if (flush_error == 0) flush_error = errno;
+  if (!out_) {
+    throw std::runtime_error(
+        fmt::format("{}: writing the output failed: {}", target_.string(), reason(flush_error)));
+  }
+  if (const int error = sync_file(temporary_); error != 0) {
+    throw std::runtime_error(
+        fmt::format("{}: writing the output failed: {}", target_.string(), reason(error)));
+  }
   if (overwrite_ == Overwrite::kRefuse && fs::exists(target_)) {
     throw std::runtime_error(fmt::format(
         "{}: output appeared while writing; refusing to overwrite it", target_.string()));

@@ -1,5 +1,6 @@
 #include "core/output_folder.hpp"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,26 @@ namespace imscal {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// The output folder and the staging folder inside it: an existing file of that name is a
+// mistake on the command line (InputError), a folder the system refuses to create an I/O failure
+// with its reason.
+void create_folder(const fs::path& folder) {
+  std::error_code error;
+  if (fs::exists(folder, error) && !fs::is_directory(folder, error)) {
+    throw InputError(folder.string(), 0, "--out",
+                     "is a file, not a folder; --out names the folder for the outputs");
+  }
+  fs::create_directories(folder, error);
+  if (error) {
+    throw std::runtime_error(
+        fmt::format("{}: cannot create the output folder: {}", folder.string(), error.message()));
+  }
+}
+
+}  // namespace
+
 OutputFolder::OutputFolder(fs::path folder, std::vector<fs::path> outputs, Overwrite overwrite)
     : folder_(std::move(folder)), outputs_(std::move(outputs)) {
   for (const fs::path& relative : outputs_) {
@@ -23,10 +44,11 @@ OutputFolder::OutputFolder(fs::path folder, std::vector<fs::path> outputs, Overw
       throw InputError(target.string(), 0, "", "exists already (use --force to replace it)");
     }
   }
-  fs::create_directories(folder_);
+  create_folder(folder_);
   staging_ = folder_ / (".imscal-staging-" + std::to_string(::getpid()));
-  fs::remove_all(staging_);
-  fs::create_directories(staging_);
+  std::error_code ignored;
+  fs::remove_all(staging_, ignored);
+  create_folder(staging_);
 }
 
 OutputFolder::~OutputFolder() {

@@ -13,6 +13,7 @@
 
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 
 namespace imscal::ims {
 namespace {
@@ -91,8 +92,7 @@ void write_trajectory_tum(const std::filesystem::path& file, const std::vector<N
 
 NavTrajectory read_trajectory_csv(const std::filesystem::path& file) {
   const std::string name = file.string();
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(name, 0, "", "cannot open the trajectory file");
+  std::ifstream in = open_input_stream(file);
 
   std::string line;
   std::size_t line_number = 0;

@@ -19,6 +19,7 @@
 #include "calib/rotation_calibration.hpp"
 #include "calib/tool_imu_record.hpp"
 #include "core/atomic_file.hpp"
+#include "core/json_output.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
@@ -122,7 +123,8 @@ void run(const Args& args) {
                                         {"samples", error.sample_count},
                                         {"time_offset_s", alignment.time_offset_s}};
   }
-  if (!args.out.empty()) imscal::write_file_atomically(args.out, report.dump(2) + "\n");
+  if (!args.out.empty())
+    imscal::write_file_atomically(args.out, imscal::json_text(report, 2, args.out));
 }
 
 imscal::tools::CommandRegistration registration{

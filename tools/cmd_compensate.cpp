@@ -63,8 +63,8 @@ void run(const CompensateArgs& args) {
     throw imscal::InputError(args.out, 0, "", "output exists; use --force to overwrite it");
   }
   const ident::ParameterTable table = ident::read_parameters_json(args.table);
-  const imscal::calib::RobotLog log =
-      imscal::calib::read_robot_log_csv(args.robot_log, table.robot);
+  const imscal::calib::RobotLog log = imscal::calib::read_robot_log_csv(
+      args.robot_log, table.robot, "the parameter table " + args.table);
   ident::PrecontrolOptions options;
   options.caller_cycle_s = log.cycle_s;
   if (args.offset_tolerance_rad > 0.0) options.offset_tolerance_rad.fill(args.offset_tolerance_rad);

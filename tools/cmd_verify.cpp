@@ -22,6 +22,7 @@
 #include "core/atomic_file.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
 #include "ident/joint_error_io.hpp"
@@ -211,7 +212,9 @@ void write_scenario(const fs::path& dir, const eval::VerificationResult& r, cons
                     {"table", args.table.empty() ? json(nullptr) : json(args.table)},
                     {"measured_by", args.measure_with_ims ? "ims chain" : "true link angles"},
                     {"cases", cases}};
-  imscal::write_file_atomically(dir / "verification.json", doc.dump(1) + "\n", overwrite);
+  imscal::write_file_atomically(dir / "verification.json",
+                                imscal::json_text(doc, 1, (dir / "verification.json").string()),
+                                overwrite);
   imscal::write_file_atomically(dir / "verification.csv", csv, overwrite);
   imscal::write_file_atomically(dir / "verification.txt", text, overwrite);
   std::cout << text;

@@ -120,6 +120,9 @@ TEST_F(JointErrorFiles, BadInputsRefused) {
   expect_refused(kHeader + row + "0.002,5,0.1,0.2,0.1,0.2,0.1,0.2,9\n", 6, "",
                  "more than the 8 columns");
   expect_refused(kHeader + row + "0,5,0.1,0.2,0.1,0.2,0.1,0.2\n", 6, "t_s", "does not increase");
+  // Jitter: a step of 0.4 cycles (the robot log's rule, so compensate refuses the same log).
+  expect_refused(kHeader + row + "0.0008,5,0.1,0.2,0.1,0.2,0.1,0.2\n", 6, "t_s",
+                 "less than half the cycle");
   expect_refused(kHeader + row + "0.002,-1,0.1,0.2,0.1,0.2,0.1,0.2\n", 6, "payload_kg",
                  "negative payload");
   expect_refused(kHeader, 4, "", "no samples");

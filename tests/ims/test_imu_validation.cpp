@@ -66,6 +66,7 @@ const char* const kBadCases[] = {
     "acc_in_mg",
     "increments_holding_rates",
     "gyro_in_deg_s",
+    "byte_order_mark_bad_quantity",
 };
 
 struct Expected {
@@ -163,6 +164,30 @@ ImuSeries rest_series(std::size_t n, double dt, double gravity_m_s2) {
                                   Eigen::Vector3d(0, 1e-3 * std::cos(k), gravity_m_s2)});
   }
   return s;
+}
+
+// A UTF-8 byte-order mark (some editors write one) is skipped with a warning: the record reads as
+// the same file without it, sample for sample.
+TEST(ImuValidation, ByteOrderMarkIsSkippedWithAWarning) {
+  const ImuSeries series = rest_series(200, 0.01, 9.80665);
+  const fs::path folder =
+      fs::temp_directory_path() / fmt::format("imscal-test-imu-bom-{}", ::getpid());
+  fs::create_directories(folder);
+  const std::string text = imscal::ims::format_imu_csv(series);
+  std::ofstream(folder / "plain.csv", std::ios::binary) << text;
+  std::ofstream(folder / "marked.csv", std::ios::binary) << "\xEF\xBB\xBF" << text;
+  ImuReadReport report;
+  const ImuSeries plain = imscal::ims::read_imu_csv(folder / "plain.csv");
+  const ImuSeries marked = imscal::ims::read_imu_csv(folder / "marked.csv", {}, &report);
+  fs::remove_all(folder);
+  ASSERT_EQ(marked.samples.size(), plain.samples.size());
+  for (std::size_t i = 0; i < plain.samples.size(); ++i) {
+    EXPECT_EQ(marked.samples[i].t_s, plain.samples[i].t_s);
+    EXPECT_EQ(marked.samples[i].gyro, plain.samples[i].gyro);
+    EXPECT_EQ(marked.samples[i].acc, plain.samples[i].acc);
+  }
+  ASSERT_FALSE(report.warnings.empty());
+  EXPECT_NE(report.warnings.front().find("byte-order mark"), std::string::npos);
 }
 
 TEST(ImuValidation, StatisticsOfAJitteredRecord) {
