@@ -61,7 +61,8 @@ ident::JointErrorLog random_log() {
     log.payload_kg.push_back(5.0);
     for (std::size_t j = 0; j < 3; ++j) {
       log.q_desired_rad[j].push_back(normal(rng));
-      log.q_measured_rad[j].push_back(normal(rng) * 1e-7);
+      // Joint errors of a robot: about 1e-3 rad (the reader refuses beyond 0.1 rad).
+      log.q_measured_rad[j].push_back(log.q_desired_rad[j].back() + normal(rng) * 1e-3);
       log.q_internal_rad[j].push_back(std::ldexp(normal(rng), -40));
     }
   }
