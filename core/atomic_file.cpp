@@ -41,7 +41,8 @@ void create_parent_folder(const fs::path& target) {
   fs::create_directories(parent, error);
   if (error) {
     throw std::runtime_error(fmt::format("{}: cannot create the output folder {}: {}",
-                                         target.string(), parent.string(), error.message()));
+                                         published_path(target).string(),
+                                         published_path(parent).string(), error.message()));
   }
 }
 }  // namespace
@@ -58,8 +59,8 @@ AtomicFile::AtomicFile(fs::path target, Overwrite overwrite, bool binary)
   errno = 0;
   out_.open(temporary_, mode);
   if (!out_) {
-    throw std::runtime_error(
-        fmt::format("{}: cannot write the output file: {}", target_.string(), reason(errno)));
+    throw std::runtime_error(fmt::format("{}: cannot write the output file: {}",
+                                         published_path(target_).string(), reason(errno)));
   }
 }
 
@@ -72,18 +73,25 @@ AtomicFile::~AtomicFile() {
 }
 
 void AtomicFile::commit() {
-  errno = 0;
-  out_.flush();
-  int flush_error = errno;
-  out_.close();
-  if (flush_error == 0) flush_error = errno;
-  if (!out_) {
-    throw std::runtime_error(
-        fmt::format("{}: writing the output failed: {}", target_.string(), reason(flush_error)));
+  // A write that failed earlier left its reason in errno (later writes to a failed stream make no
+  // system call); else flush and close report their own.
+  int write_error = out_ ? 0 : errno;
+  if (out_) {
+    errno = 0;
+    out_.flush();
+    if (!out_) write_error = errno;
   }
-  if (const int error = sync_file(temporary_); error != 0) {
-    throw std::runtime_error(
-        fmt::format("{}: writing the output failed: {}", target_.string(), reason(error)));
+  const bool written = static_cast<bool>(out_);
+  errno = 0;
+  out_.close();
+  if (written && !out_) write_error = errno;
+  if (!out_) {
+    throw std::runtime_error(fmt::format("{}: writing the output failed: {}",
+                                         published_path(target_).string(), reason(write_error)));
+  }
+  if (const int sync_error = sync_file(temporary_); sync_error != 0) {
+    throw std::runtime_error(fmt::format("{}: writing the output failed: {}",
+                                         published_path(target_).string(), reason(sync_error)));
   }
   if (overwrite_ == Overwrite::kRefuse && fs::exists(target_)) {
     throw std::runtime_error(fmt::format(
@@ -92,10 +100,17 @@ void AtomicFile::commit() {
   std::error_code error;
   fs::rename(temporary_, target_, error);
   if (error) {
-    throw std::runtime_error(
-        fmt::format("{}: cannot rename temporary output: {}", target_.string(), error.message()));
+    throw std::runtime_error(fmt::format("{}: cannot rename temporary output: {}",
+                                         published_path(target_).string(), error.message()));
   }
   committed_ = true;
+}
+
+fs::path published_path(const fs::path& path) {
+  fs::path visible;
+  for (const fs::path& part : path)
+    if (!part.string().starts_with(kStagingFolderPrefix)) visible /= part;
+  return visible;
 }
 
 void write_file_atomically(const fs::path& target, std::string_view content, Overwrite overwrite) {

@@ -45,7 +45,7 @@ OutputFolder::OutputFolder(fs::path folder, std::vector<fs::path> outputs, Overw
     }
   }
   create_folder(folder_);
-  staging_ = folder_ / (".imscal-staging-" + std::to_string(::getpid()));
+  staging_ = folder_ / (std::string(kStagingFolderPrefix) + std::to_string(::getpid()));
   std::error_code ignored;
   fs::remove_all(staging_, ignored);
   create_folder(staging_);
