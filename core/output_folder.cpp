@@ -13,12 +13,10 @@ namespace imscal {
 
 namespace fs = std::filesystem;
 
-namespace {
-
 // The output folder and the staging folder inside it: an existing file of that name is a
 // mistake on the command line (InputError), a folder the system refuses to create an I/O failure
 // with its reason.
-void create_folder(const fs::path& folder) {
+void create_output_folder(const fs::path& folder) {
   std::error_code error;
   if (fs::exists(folder, error) && !fs::is_directory(folder, error)) {
     throw InputError(folder.string(), 0, "--out",
@@ -31,8 +29,6 @@ void create_folder(const fs::path& folder) {
   }
 }
 
-}  // namespace
-
 OutputFolder::OutputFolder(fs::path folder, std::vector<fs::path> outputs, Overwrite overwrite)
     : folder_(std::move(folder)), outputs_(std::move(outputs)) {
   for (const fs::path& relative : outputs_) {
@@ -44,11 +40,11 @@ OutputFolder::OutputFolder(fs::path folder, std::vector<fs::path> outputs, Overw
       throw InputError(target.string(), 0, "", "exists already (use --force to replace it)");
     }
   }
-  create_folder(folder_);
+  create_output_folder(folder_);
   staging_ = folder_ / (std::string(kStagingFolderPrefix) + std::to_string(::getpid()));
   std::error_code ignored;
   fs::remove_all(staging_, ignored);
-  create_folder(staging_);
+  create_output_folder(staging_);
 }
 
 OutputFolder::~OutputFolder() {

@@ -23,6 +23,7 @@
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "core/output_folder.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
 #include "ident/joint_error_io.hpp"
@@ -127,7 +128,7 @@ std::vector<const eval::VerificationCase*> all_cases(const eval::VerificationRes
 
 void write_scenario(const fs::path& dir, const eval::VerificationResult& r, const VerifyArgs& args,
                     imscal::Overwrite overwrite) {
-  fs::create_directories(dir);
+  imscal::create_output_folder(dir);
   const auto& before = r.before.figures;
   json cases = json::array();
   std::string csv = kCsvHeader, text;
@@ -294,7 +295,7 @@ void run(const VerifyArgs& args) {
     spdlog::info("verify: simulating {} for the truth joint errors", args.identify_scenario);
     log = eval::simulate_truth_joint_errors(
         imscal::sim::load_scenario(imscal::sim::resolve_scenario(args.identify_scenario)));
-    fs::create_directories(out);
+    imscal::create_output_folder(out);
     source = (out / "joint_errors_truth.csv").string();
     ident::write_joint_errors_csv(source, *log, overwrite);
   }
