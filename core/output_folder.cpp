@@ -67,6 +67,13 @@ void OutputFolder::commit() {
       throw std::logic_error("OutputFolder: '" + relative.string() + "' was not written");
     }
   }
+  // A target that is a folder would stop the renames half way: refused before the first.
+  for (const fs::path& relative : outputs_) {
+    std::error_code error;
+    if (fs::is_directory(folder_ / relative, error))
+      throw InputError((folder_ / relative).string(), 0, "",
+                       "is a folder; an output file of this name cannot replace it");
+  }
   // Renames within one file system are atomic per file; the set is complete before the first.
   for (const fs::path& relative : outputs_) {
     const fs::path target = folder_ / relative;
