@@ -70,8 +70,7 @@ TEST(AtomicFile, FailureNamesTheTargetAndTheReason) {
   } catch (const std::runtime_error& e) {
     const std::string message = e.what();
     EXPECT_EQ(message.find(".imscal-staging-"), std::string::npos) << message;
-    EXPECT_NE(message.find((dir / "plain" / "report.json").string()), std::string::npos)
-        << message;
+    EXPECT_NE(message.find((dir / "plain" / "report.json").string()), std::string::npos) << message;
     EXPECT_NE(message.find("Not a directory"), std::string::npos) << message;
   }
   imscal::write_file_atomically(dir / "new" / "sub" / "out.txt", "made");
