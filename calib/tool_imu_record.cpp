@@ -139,6 +139,8 @@ ToolImuRecord read_tool_imu_record(const std::filesystem::path& path,
                      "expected");
   }
   line_number = 1;
+  if (strip_byte_order_mark(line))
+    spdlog::warn("{}: a UTF-8 byte-order mark at the start was skipped", record.file);
   std::vector<std::string> columns;
   for (auto field : csv::split(csv::trim(line), ',')) columns.emplace_back(csv::trim(field));
   auto find_column = [&](const std::string& name) -> std::optional<std::size_t> {

@@ -1,6 +1,7 @@
 #include "ims/nav_trajectory_io.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <array>
 #include <charconv>
@@ -104,6 +105,8 @@ NavTrajectory read_trajectory_csv(const std::filesystem::path& file) {
 
   while (std::getline(in, line)) {
     ++line_number;
+    if (line_number == 1 && strip_byte_order_mark(line))
+      spdlog::warn("{}: a UTF-8 byte-order mark at the start was skipped", name);
     const std::string_view text = trim(line);
     if (!have_header) {
       if (text.empty() || text.front() == '#') continue;
