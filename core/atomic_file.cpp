@@ -33,18 +33,6 @@ std::string reason(int error) {
   return error != 0 ? std::strerror(error) : "unknown reason";
 }
 
-// The target's folder, created when missing (as every command's --out folder is).
-void create_parent_folder(const fs::path& target) {
-  const fs::path parent = target.parent_path();
-  std::error_code error;
-  if (parent.empty() || fs::is_directory(parent, error)) return;
-  fs::create_directories(parent, error);
-  if (error) {
-    throw std::runtime_error(fmt::format("{}: cannot create the output folder {}: {}",
-                                         published_path(target).string(),
-                                         published_path(parent).string(), error.message()));
-  }
-}
 }  // namespace
 
 AtomicFile::AtomicFile(fs::path target, Overwrite overwrite, bool binary)
@@ -53,7 +41,6 @@ AtomicFile::AtomicFile(fs::path target, Overwrite overwrite, bool binary)
     throw std::runtime_error(fmt::format(
         "{}: output exists already; refusing to overwrite it (use --force)", target_.string()));
   }
-  create_parent_folder(target_);
   auto mode = std::ios::out | std::ios::trunc;
   if (binary) mode |= std::ios::binary;
   errno = 0;
