@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/config_node.hpp"
+#include "calib/urdf_robot.hpp"
 #include "core/input_error.hpp"
 
 namespace imscal::calib {
@@ -189,7 +190,15 @@ RobotDescription parse_robot_description(const ConfigNode& root) {
 }
 
 RobotDescription load_robot_description(const std::filesystem::path& file) {
+  if (file.extension() == ".urdf") return load_urdf_robot(file);
   return parse_robot_description(ConfigNode::load_file(file));
 }
+
+DriveParameters read_drive_parameters(const ConfigNode& node) { return read_drive(node); }
+JointControllerGains read_controller_gains(const ConfigNode& node) {
+  return read_controller(node);
+}
+RigidBodyParameters read_rigid_body(const ConfigNode& node) { return read_body(node); }
+Eigen::Isometry3d read_pose_xyz_rpy_deg(const ConfigNode& node) { return read_pose(node); }
 
 }  // namespace imscal::calib

@@ -1,0 +1,221 @@
+// URDF robots: the DH model made from a URDF against three truths: the hand-transcribed DH file
+// of the same arm (KR 16), the URDF's own joint chain (KR 16, UR10, UR10e) and a laser-tracker
+// data set whose goal poses were computed from the UR10's nominal kinematics.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "calib/forward_kinematics.hpp"
+#include "calib/robot_description.hpp"
+#include "calib/urdf_robot.hpp"
+#include "core/input_error.hpp"
+
+namespace imscal::calib {
+namespace {
+
+const std::filesystem::path kRobots = std::filesystem::path(IMSCAL_SOURCE_DIR) / "datasets/robots";
+const std::filesystem::path kTracker =
+    std::filesystem::path(IMSCAL_TEST_DATA_DIR) / "real/ipa-ur10";
+
+JointVector random_joints(const KinematicModel& model, std::mt19937& rng) {
+  JointVector q;
+  for (int i = 0; i < kJointCount; ++i) {
+    std::uniform_real_distribution<double> within(model.lower_limit_rad(i),
+                                                  model.upper_limit_rad(i));
+    q(i) = within(rng);
+  }
+  return q;
+}
+
+struct PoseGap {
+  double position_m = 0.0;
+  double angle_rad = 0.0;
+};
+PoseGap gap(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return {(a.translation() - b.translation()).norm(),
+          Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle()};
+}
+
+// Largest gap over `count` random joint sets within the limits of `limits`.
+template <typename PoseA, typename PoseB>
+PoseGap largest_gap(const KinematicModel& limits, int count, PoseA pose_a, PoseB pose_b) {
+  std::mt19937 rng(27);
+  PoseGap worst;
+  for (int n = 0; n < count; ++n) {
+    const JointVector q = random_joints(limits, rng);
+    const PoseGap g = gap(pose_a(q), pose_b(q));
+    worst.position_m = std::max(worst.position_m, g.position_m);
+    worst.angle_rad = std::max(worst.angle_rad, g.angle_rad);
+  }
+  return worst;
+}
+
+// Both files describe the KR 16-2 with R = base_link and H = tool0 and q = the KUKA axis angles,
+// so no fixed transform lies between them. Tolerance 1e-12 m / rad: both are exact products of
+// the same numbers; what remains is double rounding (~1e-16 per operation).
+TEST(UrdfRobot, Kr16UrdfMatchesTheDhFile) {
+  const RobotDescription dh = load_robot_description(kRobots / "kr16.yaml");
+  const RobotDescription urdf = load_robot_description(kRobots / "kr16.urdf");
+  const PoseGap worst = largest_gap(
+      dh.kinematics, 10000,
+      [&](const JointVector& q) { return forward_kinematics<double>(dh.kinematics, q); },
+      [&](const JointVector& q) { return forward_kinematics<double>(urdf.kinematics, q); });
+  RecordProperty("kr16_position_gap_m", std::to_string(worst.position_m));
+  std::printf("KR 16 URDF vs DH file over 10000 joint sets: %.3g m, %.3g rad\n",
+              worst.position_m, worst.angle_rad);
+  EXPECT_LT(worst.position_m, 1e-12);
+  EXPECT_LT(worst.angle_rad, 1e-12);
+  for (int i = 0; i < kJointCount; ++i) {
+    EXPECT_DOUBLE_EQ(urdf.kinematics.lower_limit_rad(i), dh.kinematics.lower_limit_rad(i));
+    EXPECT_DOUBLE_EQ(urdf.kinematics.upper_limit_rad(i), dh.kinematics.upper_limit_rad(i));
+    EXPECT_NEAR(urdf.joints[i].max_velocity_rad_s, dh.joints[i].max_velocity_rad_s, 1e-12);
+  }
+}
+
+// The DH conversion against the URDF's joint chain itself, for arms with offset wrists and
+// parallel axes (UR) as well. Tolerance 1e-12 m / rad as above.
+class UrdfChainTest : public ::testing::TestWithParam<const char*> {};
+TEST_P(UrdfChainTest, DhModelEqualsTheUrdfChain) {
+  const std::filesystem::path file = kRobots / GetParam();
+  const RobotDescription robot = load_urdf_robot(file);
+  const UrdfChain chain = read_urdf_chain(file, "", "tool0");
+  const PoseGap worst = largest_gap(
+      robot.kinematics, 2000,
+      [&](const JointVector& q) { return forward_kinematics<double>(robot.kinematics, q); },
+      [&](const JointVector& q) { return urdf_chain_pose(chain, q); });
+  std::printf("%s: DH model vs URDF chain over 2000 joint sets: %.3g m, %.3g rad\n", GetParam(),
+              worst.position_m, worst.angle_rad);
+  EXPECT_LT(worst.position_m, 1e-12);
+  EXPECT_LT(worst.angle_rad, 1e-12);
+}
+INSTANTIATE_TEST_SUITE_P(Robots, UrdfChainTest,
+                         ::testing::Values("kr16.urdf", "ur10.urdf", "ur10e.urdf"));
+
+// --- the UR10 against the laser-tracker data set's goal poses --------------------------------
+
+std::vector<std::vector<double>> read_csv_numbers(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);  // header
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::stringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+Eigen::Isometry3d read_matrix_mm(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  Eigen::Matrix4d m;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) in >> m(r, c);
+  }
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = m.topLeftCorner<3, 3>();
+  pose.translation() = m.topRightCorner<3, 1>() / 1000.0;
+  return pose;
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+// goal = T(base_link <- tool0)(q) * inverse(T_TMac_flange) (data set's SOURCE.md). The data set
+// computed its goals from the same nominal UR10 kinematics; the residual (~0.1 mm median) is
+// larger than the columns' rounding, so the joint columns are likely measured angles. Tolerances:
+// median 0.15 mm, worst 0.7 mm (the whole series D: median 0.08-0.10, max 0.6 mm); orientation
+// median 0.02 deg (series D: 0.01 deg).
+TEST(UrdfRobot, Ur10ReproducesTheTrackerDataSetsGoalPoses) {
+  const RobotDescription robot = load_robot_description(kRobots / "ur10.urdf");
+  EXPECT_EQ(robot.name, "ur10");
+  EXPECT_DOUBLE_EQ(robot.controller_cycle_s, 0.008);
+  const Eigen::Isometry3d T_flange_tmac = read_matrix_mm(kTracker / "Trafo_TM_F_init.txt").inverse();
+  std::vector<double> position_mm;
+  std::vector<double> angle_deg;
+  for (const std::vector<double>& row : read_csv_numbers(kTracker / "measurements_iso_cubes_head60.csv")) {
+    const JointVector q = Eigen::Map<const JointVector>(&row[7]);
+    const Eigen::Isometry3d goal = pose_from_xyz_rpy(Eigen::Vector3d(row[1], row[2], row[3]),
+                                                     Eigen::Vector3d(row[4], row[5], row[6]));
+    const PoseGap g = gap(forward_kinematics<double>(robot.kinematics, q) * T_flange_tmac, goal);
+    position_mm.push_back(g.position_m * 1000.0);
+    angle_deg.push_back(g.angle_rad * 180.0 / M_PI);
+  }
+  ASSERT_EQ(position_mm.size(), 60u);
+  const double worst_mm = *std::max_element(position_mm.begin(), position_mm.end());
+  std::printf("UR10 vs tracker goals (60 poses): median %.3f mm, max %.3f mm, median %.4f deg\n",
+              median(position_mm), worst_mm, median(angle_deg));
+  EXPECT_LT(median(position_mm), 0.15);
+  EXPECT_LT(worst_mm, 0.7);
+  EXPECT_LT(median(angle_deg), 0.02);
+}
+
+// The UR10e's link masses (physical_parameters.yaml of the UR description) reach the model.
+TEST(UrdfRobot, Ur10eCarriesTheUrdfsInertials) {
+  const RobotDescription robot = load_robot_description(kRobots / "ur10e.urdf");
+  const std::array<double, kJointCount> masses{7.369, 13.051, 3.989, 2.1, 1.98, 0.615};
+  for (int i = 0; i < kJointCount; ++i) {
+    EXPECT_DOUBLE_EQ(robot.joints[i].link.mass_kg, masses[i]) << "link " << i + 1;
+    EXPECT_GT(robot.joints[i].link.inertia_kg_m2.trace(), 0.0);
+  }
+  EXPECT_EQ(robot.joints[0].name, "shoulder_pan_joint");
+}
+
+// --- bad input -------------------------------------------------------------------------------
+
+std::filesystem::path write_temp(const std::string& name, const std::string& text) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "imscal_urdf_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / name) << text;
+  return dir / name;
+}
+
+InputError load_error(const std::filesystem::path& file) {
+  try {
+    load_robot_description(file);
+  } catch (const InputError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no InputError for " << file;
+  return InputError("", 0, "", "");
+}
+
+TEST(UrdfRobot, RefusesAChainWithAPrismaticJoint) {
+  std::ifstream in(kRobots / "kr16.urdf");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string revolute = "<joint name=\"joint_a3\" type=\"revolute\"";
+  text.replace(text.find(revolute), revolute.size(), "<joint name=\"joint_a3\" type=\"prismatic\"");
+  const InputError e = load_error(write_temp("prismatic.urdf", text));
+  EXPECT_EQ(e.field(), "joint_a3");
+  EXPECT_EQ(e.line(), 90u);
+  EXPECT_NE(e.problem().find("revolute"), std::string::npos);
+}
+
+TEST(UrdfRobot, RefusesAMissingTipLinkAndAnUnknownSideKey) {
+  std::filesystem::copy_file(kRobots / "kr16.urdf", write_temp("kr16.urdf", ""),
+                             std::filesystem::copy_options::overwrite_existing);
+  const std::filesystem::path side = write_temp("kr16.imscal.yaml", "tip_link: tool9\n");
+  EXPECT_EQ(load_error(side.parent_path() / "kr16.urdf").field(), "tool9");
+  write_temp("kr16.imscal.yaml", "name: kr16\ncycle_s: 0.002\n");
+  const InputError e = load_error(side.parent_path() / "kr16.urdf");
+  EXPECT_EQ(e.line(), 2u);
+  EXPECT_NE(e.file().find("kr16.imscal.yaml"), std::string::npos);
+}
+
+TEST(UrdfRobot, RefusesAFileThatIsNoUrdf) {
+  const InputError e = load_error(write_temp("broken.urdf", "<robot name=\"x\"><link></robot>"));
+  EXPECT_NE(e.file().find("broken.urdf"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace imscal::calib
