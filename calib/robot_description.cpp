@@ -5,8 +5,8 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
-#include "core/config_node.hpp"
 #include "calib/urdf_robot.hpp"
+#include "core/config_node.hpp"
 #include "core/input_error.hpp"
 
 namespace imscal::calib {
@@ -194,11 +194,17 @@ RobotDescription load_robot_description(const std::filesystem::path& file) {
   return parse_robot_description(ConfigNode::load_file(file));
 }
 
-DriveParameters read_drive_parameters(const ConfigNode& node) { return read_drive(node); }
+DriveParameters read_drive_parameters(const ConfigNode& node) {
+  return read_drive(node);
+}
 JointControllerGains read_controller_gains(const ConfigNode& node) {
   return read_controller(node);
 }
-RigidBodyParameters read_rigid_body(const ConfigNode& node) { return read_body(node); }
-Eigen::Isometry3d read_pose_xyz_rpy_deg(const ConfigNode& node) { return read_pose(node); }
+RigidBodyParameters read_rigid_body(const ConfigNode& node) {
+  return read_body(node);
+}
+Eigen::Isometry3d read_pose_xyz_rpy_deg(const ConfigNode& node) {
+  return read_pose(node);
+}
 
 }  // namespace imscal::calib

@@ -118,7 +118,7 @@ RobotDescription parse_robot_description(const ConfigNode& root);
 // Readers of the parts of a robot file, shared with the URDF side file (same keys and checks).
 DriveParameters read_drive_parameters(const ConfigNode& node);
 JointControllerGains read_controller_gains(const ConfigNode& node);
-RigidBodyParameters read_rigid_body(const ConfigNode& node);  // mass_kg, com_m, inertia_kg_m2
+RigidBodyParameters read_rigid_body(const ConfigNode& node);      // mass_kg, com_m, inertia_kg_m2
 Eigen::Isometry3d read_pose_xyz_rpy_deg(const ConfigNode& node);  // xyz_m, rpy_deg
 
 // x-y-z fixed-axis roll/pitch/yaw as in URDF: R = Rz(yaw) Ry(pitch) Rx(roll) [rad].

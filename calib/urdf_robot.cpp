@@ -2,11 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <urdf_parser/urdf_parser.h>
 #include <algorithm>
 #include <fstream>
 #include <optional>
 #include <sstream>
-#include <urdf_parser/urdf_parser.h>
 #include <vector>
 
 #include "core/config_node.hpp"
@@ -38,10 +38,10 @@ std::string read_text(const std::filesystem::path& file) {
 
 Eigen::Isometry3d to_isometry(const urdf::Pose& pose) {
   Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
-  out.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y,
-                                    pose.rotation.z)
-                     .normalized()
-                     .toRotationMatrix();
+  out.linear() =
+      Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+          .normalized()
+          .toRotationMatrix();
   out.translation() << pose.position.x, pose.position.y, pose.position.z;
   return out;
 }
@@ -66,8 +66,7 @@ class UrdfReader {
     model_ = urdf::parseURDF(text_);
     if (!model_) fail(0, "", "urdfdom could not parse it as a URDF (its message is above)");
   }
-  [[noreturn]] void fail(std::size_t line, const std::string& field,
-                         const std::string& why) const {
+  [[noreturn]] void fail(std::size_t line, const std::string& field, const std::string& why) const {
     throw InputError(file_.string(), line, field, why);
   }
   [[noreturn]] void fail_at(const std::string& name, const std::string& why) const {
@@ -83,8 +82,8 @@ class UrdfReader {
 
 // The joints from base_link down to tip_link, base first.
 std::vector<urdf::JointConstSharedPtr> joints_between(const UrdfReader& reader,
-                                                       const std::string& base_link,
-                                                       const std::string& tip_link) {
+                                                      const std::string& base_link,
+                                                      const std::string& tip_link) {
   urdf::LinkConstSharedPtr link = reader.model().getLink(tip_link);
   if (!link) reader.fail(0, tip_link, "the chain's tip link is not in the URDF");
   if (!reader.model().getLink(base_link)) {
@@ -93,8 +92,8 @@ std::vector<urdf::JointConstSharedPtr> joints_between(const UrdfReader& reader,
   std::vector<urdf::JointConstSharedPtr> joints;
   while (link->name != base_link) {
     if (!link->parent_joint) {
-      reader.fail_at(tip_link, fmt::format("link '{}' does not hang below '{}'", tip_link,
-                                           base_link));
+      reader.fail_at(tip_link,
+                     fmt::format("link '{}' does not hang below '{}'", tip_link, base_link));
     }
     joints.push_back(link->parent_joint);
     link = reader.model().getLink(link->parent_joint->parent_link_name);
@@ -107,8 +106,8 @@ std::vector<urdf::JointConstSharedPtr> joints_between(const UrdfReader& reader,
 void add_moving_joint(const UrdfReader& reader, const urdf::Joint& joint, int index,
                       const Eigen::Isometry3d& origin, ChainWalk& walk) {
   if (index >= kJointCount) {
-    reader.fail_at(joint.name, fmt::format("the chain has more than {} moving joints",
-                                           kJointCount));
+    reader.fail_at(joint.name,
+                   fmt::format("the chain has more than {} moving joints", kJointCount));
   }
   const Eigen::Vector3d axis(joint.axis.x, joint.axis.y, joint.axis.z);
   if (!(axis.norm() > 0.5)) reader.fail_at(joint.name, "the joint axis is not a unit vector");
@@ -207,7 +206,8 @@ DhFrame next_dh_frame(const DhFrame& prev, const AxisLine& axis, DhParameters& r
   const bool parallel = normal.norm() < kParallelSine;
   // Closest points of the two lines (for parallel lines: the foot of prev.origin).
   const double t = parallel ? 0.0 : (cosine * z1.dot(w) - z0.dot(w)) / (1.0 - cosine * cosine);
-  const double u = parallel ? z1.dot(w) : (z1.dot(w) - cosine * z0.dot(w)) / (1.0 - cosine * cosine);
+  const double u =
+      parallel ? z1.dot(w) : (z1.dot(w) - cosine * z0.dot(w)) / (1.0 - cosine * cosine);
   const Eigen::Vector3d on_prev = prev.origin + t * z0;
   const Eigen::Vector3d on_next = axis.point + u * z1;
   const Eigen::Vector3d gap = on_next - on_prev;

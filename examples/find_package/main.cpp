@@ -22,9 +22,10 @@ int main(int argc, char** argv) {
     }
     const Eigen::Isometry3d T_R_H = imscal::calib::forward_kinematics<double>(robot.kinematics, q);
     const Eigen::Quaterniond rotation(T_R_H.linear());
-    std::printf("robot %s\nflange xyz_m %.6f %.6f %.6f\nflange quaternion_wxyz %.6f %.6f %.6f %.6f\n",
-                robot.name.c_str(), T_R_H.translation().x(), T_R_H.translation().y(),
-                T_R_H.translation().z(), rotation.w(), rotation.x(), rotation.y(), rotation.z());
+    std::printf(
+        "robot %s\nflange xyz_m %.6f %.6f %.6f\nflange quaternion_wxyz %.6f %.6f %.6f %.6f\n",
+        robot.name.c_str(), T_R_H.translation().x(), T_R_H.translation().y(),
+        T_R_H.translation().z(), rotation.w(), rotation.x(), rotation.y(), rotation.z());
   } catch (const imscal::InputError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 1;

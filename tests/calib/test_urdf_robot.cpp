@@ -68,8 +68,8 @@ TEST(UrdfRobot, Kr16UrdfMatchesTheDhFile) {
       [&](const JointVector& q) { return forward_kinematics<double>(dh.kinematics, q); },
       [&](const JointVector& q) { return forward_kinematics<double>(urdf.kinematics, q); });
   RecordProperty("kr16_position_gap_m", std::to_string(worst.position_m));
-  std::printf("KR 16 URDF vs DH file over 10000 joint sets: %.3g m, %.3g rad\n",
-              worst.position_m, worst.angle_rad);
+  std::printf("KR 16 URDF vs DH file over 10000 joint sets: %.3g m, %.3g rad\n", worst.position_m,
+              worst.angle_rad);
   EXPECT_LT(worst.position_m, 1e-12);
   EXPECT_LT(worst.angle_rad, 1e-12);
   for (int i = 0; i < kJointCount; ++i) {
@@ -140,10 +140,12 @@ TEST(UrdfRobot, Ur10ReproducesTheTrackerDataSetsGoalPoses) {
   const RobotDescription robot = load_robot_description(kRobots / "ur10.urdf");
   EXPECT_EQ(robot.name, "ur10");
   EXPECT_DOUBLE_EQ(robot.controller_cycle_s, 0.008);
-  const Eigen::Isometry3d T_flange_tmac = read_matrix_mm(kTracker / "Trafo_TM_F_init.txt").inverse();
+  const Eigen::Isometry3d T_flange_tmac =
+      read_matrix_mm(kTracker / "Trafo_TM_F_init.txt").inverse();
   std::vector<double> position_mm;
   std::vector<double> angle_deg;
-  for (const std::vector<double>& row : read_csv_numbers(kTracker / "measurements_iso_cubes_head60.csv")) {
+  for (const std::vector<double>& row :
+       read_csv_numbers(kTracker / "measurements_iso_cubes_head60.csv")) {
     const JointVector q = Eigen::Map<const JointVector>(&row[7]);
     const Eigen::Isometry3d goal = pose_from_xyz_rpy(Eigen::Vector3d(row[1], row[2], row[3]),
                                                      Eigen::Vector3d(row[4], row[5], row[6]));
