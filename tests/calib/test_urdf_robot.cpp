@@ -3,6 +3,7 @@
 // data set whose goal poses were computed from the UR10's nominal kinematics.
 #include <gtest/gtest.h>
 
+#include <urdf_parser/urdf_parser.h>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -171,6 +172,44 @@ TEST(UrdfRobot, Ur10eCarriesTheUrdfsInertials) {
     EXPECT_GT(robot.joints[i].link.inertia_kg_m2.trace(), 0.0);
   }
   EXPECT_EQ(robot.joints[0].name, "shoulder_pan_joint");
+}
+
+// Each link's centre of mass and inertia tensor, turned into the base at random q, against the
+// URDF's own <inertial> placed by the URDF's joint chain (read with urdfdom here). In the UR
+// URDFs the child link of joint k sits at the joint frame, so its pose is the chain's product up
+// to joint k. Tolerance 1e-12 (m, kg m^2): two products of the same numbers.
+TEST(UrdfRobot, Ur10eInertialsLandWhereTheUrdfPutsThem) {
+  const std::filesystem::path file = kRobots / "ur10e.urdf";
+  const RobotDescription robot = load_urdf_robot(file);
+  const UrdfChain chain = read_urdf_chain(file, "", "tool0");
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(file.string());
+  std::mt19937 rng(5);
+  for (int n = 0; n < 50; ++n) {
+    const JointVector q = random_joints(robot.kinematics, rng);
+    const ChainPoses<double> poses = chain_poses<double>(robot.kinematics, q);
+    Eigen::Isometry3d T_R_link = Eigen::Isometry3d::Identity();
+    for (int k = 0; k < kJointCount; ++k) {
+      T_R_link = T_R_link * chain.fixed[k] * Eigen::AngleAxisd(q(k), chain.axis[k]);
+      const urdf::Inertial& inertial =
+          *model->getLink(model->getJoint(chain.joint_names[k])->child_link_name)->inertial;
+      const Eigen::Vector3d com_urdf =
+          T_R_link * Eigen::Vector3d(inertial.origin.position.x, inertial.origin.position.y,
+                                     inertial.origin.position.z);
+      const Eigen::Vector3d com_dh = poses.T_R_link[k + 1] * robot.joints[k].link.com_m;
+      EXPECT_LT((com_urdf - com_dh).norm(), 1e-12) << "link " << k + 1;
+      const urdf::Rotation& r = inertial.origin.rotation;
+      const Eigen::Matrix3d R_R_inertial =
+          T_R_link.linear() * Eigen::Quaterniond(r.w, r.x, r.y, r.z).toRotationMatrix();
+      Eigen::Matrix3d tensor;
+      tensor << inertial.ixx, inertial.ixy, inertial.ixz, inertial.ixy, inertial.iyy, inertial.iyz,
+          inertial.ixz, inertial.iyz, inertial.izz;
+      const Eigen::Matrix3d R_R_dh = poses.T_R_link[k + 1].linear();
+      const Eigen::Matrix3d in_base_dh =
+          R_R_dh * robot.joints[k].link.inertia_kg_m2 * R_R_dh.transpose();
+      const Eigen::Matrix3d in_base_urdf = R_R_inertial * tensor * R_R_inertial.transpose();
+      EXPECT_LT((in_base_dh - in_base_urdf).cwiseAbs().maxCoeff(), 1e-12) << "link " << k + 1;
+    }
+  }
 }
 
 // --- bad input -------------------------------------------------------------------------------
