@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 #include <algorithm>
 #include <fstream>
@@ -60,11 +61,34 @@ struct ChainWalk {
   std::array<bool, kJointCount> continuous{};
 };
 
+// urdfdom reports through console_bridge; its errors are collected for the InputError instead of
+// going to stderr, its warnings and notes are dropped.
+class CollectErrors : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level < console_bridge::CONSOLE_BRIDGE_LOG_ERROR) return;
+    if (!errors.empty()) errors += "; ";
+    errors += text;
+  }
+  std::string errors;
+};
+
+urdf::ModelInterfaceSharedPtr parse_collecting_errors(const std::string& text,
+                                                      std::string& errors) {
+  CollectErrors collect;
+  console_bridge::useOutputHandler(&collect);
+  urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(text);
+  console_bridge::restorePreviousOutputHandler();
+  errors = collect.errors;
+  return model;
+}
+
 class UrdfReader {
  public:
   explicit UrdfReader(const std::filesystem::path& file) : file_(file), text_(read_text(file)) {
-    model_ = urdf::parseURDF(text_);
-    if (!model_) fail(0, "", "urdfdom could not parse it as a URDF (its message is above)");
+    std::string errors;
+    model_ = parse_collecting_errors(text_, errors);
+    if (!model_) fail(0, "", "urdfdom could not parse it as a URDF: " + errors);
   }
   [[noreturn]] void fail(std::size_t line, const std::string& field, const std::string& why) const {
     throw InputError(file_.string(), line, field, why);
