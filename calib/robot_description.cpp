@@ -127,8 +127,12 @@ void read_joint(const ConfigNode& node, int index, KinematicModel& kinematics,
   const ConfigNode link = node.child("link");
   link.require_only_keys({"mass_kg", "com_m", "inertia_kg_m2"});
   joint.link = read_body(link);
-  joint.drive = read_drive(node.child("drive"));
-  joint.controller = read_controller(node.child("controller"));
+  // Drive and controller only the simulator's plant needs (sim::load_plant_robot checks them):
+  // a nominal robot for kinematics, calibration and the model torque may leave them out.
+  if (const auto drive = node.optional_child("drive")) joint.drive = read_drive(*drive);
+  if (const auto controller = node.optional_child("controller")) {
+    joint.controller = read_controller(*controller);
+  }
 }
 
 }  // namespace
