@@ -760,8 +760,9 @@ tools::CommandRegistration registration{
       sub.add_option("--imu", args->imu, "Raw IMS record (.csv, .imsb, .imu)")->required();
       sub.add_option("--robot-log", args->robot_log, "Robot controller log (robot.csv)")
           ->required();
-      sub.add_option("--robot", args->robot,
-                     "Robot description (datasets/robots/*.yaml); default: the config's");
+      sub.add_option(
+          "--robot", args->robot,
+          "Robot description (datasets/robots/*.yaml or a .urdf); default: the config's");
       sub.add_option("--sensor", args->sensor,
                      "IMS sensor spec (datasets/sensors/*.yaml); default: the config's");
       sub.add_option("--config", args->config,
