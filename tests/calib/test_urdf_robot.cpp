@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "calib/forward_kinematics.hpp"
+#include "calib/inverse_kinematics.hpp"
 #include "calib/robot_description.hpp"
 #include "calib/urdf_robot.hpp"
 #include "core/input_error.hpp"
@@ -98,6 +99,24 @@ TEST_P(UrdfChainTest, DhModelEqualsTheUrdfChain) {
 }
 INSTANTIATE_TEST_SUITE_P(Robots, UrdfChainTest,
                          ::testing::Values("kr16.urdf", "ur10.urdf", "ur10e.urdf"));
+
+// The closed-form IK works from the joint screws, not the DH numbers, so the converted KR 16
+// solves as the DH file does: FK(q) -> IK(configuration of q) returns q. Tolerance 1e-9 rad:
+// the solver's Newton refinement stops at its default tolerances (far below 1e-9).
+TEST(UrdfRobot, Kr16UrdfSolvesTheInverseKinematics) {
+  const RobotDescription robot = load_robot_description(kRobots / "kr16.urdf");
+  const InverseKinematics ik(robot.kinematics);
+  std::mt19937 rng(3);
+  int solved = 0;
+  for (int n = 0; n < 200; ++n) {
+    const JointVector q = random_joints(robot.kinematics, rng);
+    const IkResult result = ik.solve_nearest(forward_kinematics<double>(robot.kinematics, q), q);
+    if (!result.ok()) continue;  // near a singularity or a limit: the solver says so
+    ++solved;
+    EXPECT_LT((result.q - q).cwiseAbs().maxCoeff(), 1e-9) << result.reason;
+  }
+  EXPECT_GT(solved, 150);
+}
 
 // --- the UR10 against the laser-tracker data set's goal poses --------------------------------
 
