@@ -272,6 +272,35 @@ TEST(UrdfRobot, RefusesAMissingTipLinkAndAnUnknownSideKey) {
   EXPECT_NE(e.file().find("kr16.imscal.yaml"), std::string::npos);
 }
 
+// The side file's joints give each joint its drive and controller, in the URDF's order.
+std::string side_joints(const std::string& third_name) {
+  std::string text = "joints:\n";
+  for (int i = 1; i <= kJointCount; ++i) {
+    const std::string name = i == 3 ? third_name : "joint_a" + std::to_string(i);
+    text += "  - name: " + name + "\n    drive: {gear_ratio: " + std::to_string(100 + i) +
+            ", motor_inertia_kg_m2: 1e-4, stiffness_nm_per_rad: 1e5, damping_nm_s_per_rad: 100,"
+            " backlash_deg: 0.01, coulomb_nm: 10, viscous_nm_s_per_rad: 5}\n"
+            "    controller: {kp_position_1_s: 12, kp_velocity_nm_s_per_rad: 1000,"
+            " ki_velocity_nm_per_rad: 5000, velocity_feedforward: 1, torque_limit_nm: 900}\n";
+  }
+  return text;
+}
+
+TEST(UrdfRobot, SideFileGivesDrivesAndControllers) {
+  std::filesystem::copy_file(kRobots / "kr16.urdf", write_temp("kr16.urdf", ""),
+                             std::filesystem::copy_options::overwrite_existing);
+  const std::filesystem::path side = write_temp("kr16.imscal.yaml", side_joints("joint_a3"));
+  const RobotDescription robot = load_robot_description(side.parent_path() / "kr16.urdf");
+  EXPECT_DOUBLE_EQ(robot.joints[2].drive.gear_ratio, 103.0);
+  EXPECT_DOUBLE_EQ(robot.joints[5].controller.torque_limit_nm, 900.0);
+  EXPECT_NEAR(robot.joints[0].drive.backlash_rad, 0.01 * M_PI / 180.0, 1e-15);
+
+  write_temp("kr16.imscal.yaml", side_joints("joint_a4"));
+  const InputError e = load_error(side.parent_path() / "kr16.urdf");
+  EXPECT_EQ(e.line(), 8u) << e.what();  // the third entry's name (3 lines per entry)
+  EXPECT_NE(e.problem().find("joint_a3"), std::string::npos) << e.what();
+}
+
 TEST(UrdfRobot, RefusesAFileThatIsNoUrdf) {
   const InputError e = load_error(write_temp("broken.urdf", "<robot name=\"x\"><link></robot>"));
   EXPECT_NE(e.file().find("broken.urdf"), std::string::npos);
