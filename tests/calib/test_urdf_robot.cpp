@@ -18,6 +18,7 @@
 #include "calib/robot_description.hpp"
 #include "calib/urdf_robot.hpp"
 #include "core/input_error.hpp"
+#include "tests/support/scratch_dir.hpp"
 
 namespace imscal::calib {
 namespace {
@@ -233,12 +234,14 @@ TEST(UrdfRobot, Ur10eInertialsLandWhereTheUrdfPutsThem) {
 
 // --- bad input -------------------------------------------------------------------------------
 
-std::filesystem::path write_temp(const std::string& name, const std::string& text) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "imscal_urdf_test";
-  std::filesystem::create_directories(dir);
-  std::ofstream(dir / name) << text;
-  return dir / name;
-}
+// Tests that write files get a folder of their own (ctest runs cases in parallel).
+class UrdfFiles : public test_support::ScratchDirTest {
+ protected:
+  std::filesystem::path write_temp(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name) << text;
+    return dir_ / name;
+  }
+};
 
 InputError load_error(const std::filesystem::path& file) {
   try {
@@ -250,7 +253,7 @@ InputError load_error(const std::filesystem::path& file) {
   return InputError("", 0, "", "");
 }
 
-TEST(UrdfRobot, RefusesAChainWithAPrismaticJoint) {
+TEST_F(UrdfFiles, RefusesAChainWithAPrismaticJoint) {
   std::ifstream in(kRobots / "kr16.urdf");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string revolute = "<joint name=\"joint_a3\" type=\"revolute\"";
@@ -261,7 +264,7 @@ TEST(UrdfRobot, RefusesAChainWithAPrismaticJoint) {
   EXPECT_NE(e.problem().find("revolute"), std::string::npos);
 }
 
-TEST(UrdfRobot, RefusesAMissingTipLinkAndAnUnknownSideKey) {
+TEST_F(UrdfFiles, RefusesAMissingTipLinkAndAnUnknownSideKey) {
   std::filesystem::copy_file(kRobots / "kr16.urdf", write_temp("kr16.urdf", ""),
                              std::filesystem::copy_options::overwrite_existing);
   const std::filesystem::path side = write_temp("kr16.imscal.yaml", "tip_link: tool9\n");
@@ -286,7 +289,7 @@ std::string side_joints(const std::string& third_name) {
   return text;
 }
 
-TEST(UrdfRobot, SideFileGivesDrivesAndControllers) {
+TEST_F(UrdfFiles, SideFileGivesDrivesAndControllers) {
   std::filesystem::copy_file(kRobots / "kr16.urdf", write_temp("kr16.urdf", ""),
                              std::filesystem::copy_options::overwrite_existing);
   const std::filesystem::path side = write_temp("kr16.imscal.yaml", side_joints("joint_a3"));
@@ -301,7 +304,7 @@ TEST(UrdfRobot, SideFileGivesDrivesAndControllers) {
   EXPECT_NE(e.problem().find("joint_a3"), std::string::npos) << e.what();
 }
 
-TEST(UrdfRobot, RefusesAFileThatIsNoUrdf) {
+TEST_F(UrdfFiles, RefusesAFileThatIsNoUrdf) {
   const InputError e = load_error(write_temp("broken.urdf", "<robot name=\"x\"><link></robot>"));
   EXPECT_NE(e.file().find("broken.urdf"), std::string::npos);
 }

@@ -12,6 +12,7 @@
 #include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
 #include "sim/scenario.hpp"
+#include "tests/support/scratch_dir.hpp"
 
 namespace imscal::sim {
 namespace {
@@ -19,11 +20,18 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kRobots = fs::path(IMSCAL_SOURCE_DIR) / "datasets/robots";
 
+// The test's own folder (ctest runs cases in parallel), from the scratch fixture.
+fs::path scratch_dir;
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "imscal_kinematics_only_robot";
-  fs::create_directories(dir);
-  return dir / name;
+  return scratch_dir / name;
 }
+class KinematicsOnlyRobot : public test_support::ScratchDirTest {
+ protected:
+  void SetUp() override {
+    ScratchDirTest::SetUp();
+    scratch_dir = dir_;
+  }
+};
 
 // kr16.yaml without its joints' `drive:` and `controller:` blocks (4-space keys whose content
 // is indented deeper).
@@ -59,7 +67,7 @@ fs::path scenario_with(const fs::path& plant, const fs::path& nominal) {
 }
 
 // The same numbers as kr16.yaml, so the model is identical bit for bit.
-TEST(KinematicsOnlyRobot, LoadsWithTheSameKinematicsAndMasses) {
+TEST_F(KinematicsOnlyRobot, LoadsWithTheSameKinematicsAndMasses) {
   const calib::RobotDescription full = calib::load_robot_description(kRobots / "kr16.yaml");
   const calib::RobotDescription bare = calib::load_robot_description(kr16_without_drives());
   const calib::JointVector q = (calib::JointVector() << 0.1, -1.2, 1.4, 0.3, -0.5, 2.0).finished();
@@ -71,7 +79,7 @@ TEST(KinematicsOnlyRobot, LoadsWithTheSameKinematicsAndMasses) {
   }
 }
 
-TEST(KinematicsOnlyRobot, ServesAsNominalRobotButNotAsPlant) {
+TEST_F(KinematicsOnlyRobot, ServesAsNominalRobotButNotAsPlant) {
   const fs::path bare = kr16_without_drives();
   const Scenario scenario = load_scenario(scenario_with(kRobots / "kr16.yaml", bare));
   EXPECT_EQ(load_nominal_robot(scenario).description.name, "kr16");
