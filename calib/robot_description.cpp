@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
+#include "calib/urdf_robot.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 
@@ -126,8 +127,12 @@ void read_joint(const ConfigNode& node, int index, KinematicModel& kinematics,
   const ConfigNode link = node.child("link");
   link.require_only_keys({"mass_kg", "com_m", "inertia_kg_m2"});
   joint.link = read_body(link);
-  joint.drive = read_drive(node.child("drive"));
-  joint.controller = read_controller(node.child("controller"));
+  // Drive and controller only the simulator's plant needs (sim::load_plant_robot checks them):
+  // a nominal robot for kinematics, calibration and the model torque may leave them out.
+  if (const auto drive = node.optional_child("drive")) joint.drive = read_drive(*drive);
+  if (const auto controller = node.optional_child("controller")) {
+    joint.controller = read_controller(*controller);
+  }
 }
 
 }  // namespace
@@ -189,7 +194,21 @@ RobotDescription parse_robot_description(const ConfigNode& root) {
 }
 
 RobotDescription load_robot_description(const std::filesystem::path& file) {
+  if (file.extension() == ".urdf") return load_urdf_robot(file);
   return parse_robot_description(ConfigNode::load_file(file));
+}
+
+DriveParameters read_drive_parameters(const ConfigNode& node) {
+  return read_drive(node);
+}
+JointControllerGains read_controller_gains(const ConfigNode& node) {
+  return read_controller(node);
+}
+RigidBodyParameters read_rigid_body(const ConfigNode& node) {
+  return read_body(node);
+}
+Eigen::Isometry3d read_pose_xyz_rpy_deg(const ConfigNode& node) {
+  return read_pose(node);
 }
 
 }  // namespace imscal::calib

@@ -110,9 +110,16 @@ struct RobotDescription {
 };
 
 // Reads and validates a robot description; any problem -> InputError(file, line, key, why).
+// A file ending in `.urdf` is read as a URDF (calib/urdf_robot.hpp) with its optional side file.
 RobotDescription load_robot_description(const std::filesystem::path& file);
 // The same from a parsed YAML root (lets tests feed text through ConfigNode::load_string).
 RobotDescription parse_robot_description(const ConfigNode& root);
+
+// Readers of the parts of a robot file, shared with the URDF side file (same keys and checks).
+DriveParameters read_drive_parameters(const ConfigNode& node);
+JointControllerGains read_controller_gains(const ConfigNode& node);
+RigidBodyParameters read_rigid_body(const ConfigNode& node);      // mass_kg, com_m, inertia_kg_m2
+Eigen::Isometry3d read_pose_xyz_rpy_deg(const ConfigNode& node);  // xyz_m, rpy_deg
 
 // x-y-z fixed-axis roll/pitch/yaw as in URDF: R = Rz(yaw) Ry(pitch) Rx(roll) [rad].
 Eigen::Isometry3d pose_from_xyz_rpy(const Eigen::Vector3d& xyz_m, const Eigen::Vector3d& rpy_rad);

@@ -1,5 +1,6 @@
 #include "sim/scenario.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <cmath>
@@ -178,8 +179,25 @@ Scenario load_scenario(const fs::path& file) {
   return s;
 }
 
+namespace {
+// A plant needs every joint's drive and controller; a robot file may leave them out (a nominal
+// robot, a URDF without its side file's joints). Given, both have a stiffness and a position gain
+// > 0 (robot_description.cpp), so zero means absent.
+void require_drives(const calib::RobotDescription& robot) {
+  for (const calib::JointDescription& joint : robot.joints) {
+    const bool drive = joint.drive.stiffness_nm_per_rad > 0.0;
+    if (drive && joint.controller.kp_position_1_s > 0.0) continue;
+    throw InputError(robot.source, 0,
+                     fmt::format("{}.{}", joint.name, drive ? "controller" : "drive"),
+                     "the simulator's plant needs a drive and a controller for every joint; this "
+                     "robot file describes kinematics and masses only (use it as nominal_robot)");
+  }
+}
+}  // namespace
+
 calib::RobotDescription load_plant_robot(const Scenario& scenario) {
   calib::RobotDescription robot = calib::load_robot_description(scenario.plant_robot_file);
+  require_drives(robot);
   if (scenario.plant_deviations) apply_deviations(*scenario.plant_deviations, robot);
   return robot;
 }

@@ -288,6 +288,20 @@ struct Inputs {
   std::optional<PreviousFrames> previous;  // --frames
 };
 
+// A robot file without drive stiffness (a kinematics-only URDF, say) makes the bundle treat the
+// arm as rigid: no gear wind-up, backlash or friction terms, and sigmas that do not contain them.
+void warn_if_rigid(const calib::RobotDescription& robot) {
+  std::string rigid;
+  for (const calib::JointDescription& joint : robot.joints) {
+    if (joint.drive.stiffness_nm_per_rad <= 0.0) rigid += (rigid.empty() ? "" : ", ") + joint.name;
+  }
+  if (rigid.empty()) return;
+  spdlog::warn(
+      "calibrate: robot {} ({}) gives no drive for {}: the arm is taken as rigid there (no gear "
+      "wind-up or backlash at rest, no friction at the link); the sigmas do not include them",
+      robot.name, robot.source, rigid);
+}
+
 Inputs read_inputs(const CalibrateArgs& args) {
   Inputs in;
   if (!args.config.empty()) in.config = calib::load_calibration_config(args.config);
@@ -302,6 +316,7 @@ Inputs read_inputs(const CalibrateArgs& args) {
   in.robot_file = pick(args.robot, in.config.robot_file, "--robot");
   in.sensor_file = pick(args.sensor, in.config.sensor_file, "--sensor");
   in.robot = calib::load_robot_description(in.robot_file);
+  warn_if_rigid(in.robot);
   in.spec = ims::load_sensor_spec(in.sensor_file);
   // The earlier session's frames before the (long) records: a wrong file fails fast.
   if (!args.frames.empty()) in.previous = read_previous_frames(args.frames, in.robot.name);
@@ -762,8 +777,9 @@ tools::CommandRegistration registration{
       sub.add_option("--imu", args->imu, "Raw IMS record (.csv, .imsb, .imu)")->required();
       sub.add_option("--robot-log", args->robot_log, "Robot controller log (robot.csv)")
           ->required();
-      sub.add_option("--robot", args->robot,
-                     "Robot description (datasets/robots/*.yaml); default: the config's");
+      sub.add_option(
+          "--robot", args->robot,
+          "Robot description (datasets/robots/*.yaml or a .urdf); default: the config's");
       sub.add_option("--sensor", args->sensor,
                      "IMS sensor spec (datasets/sensors/*.yaml); default: the config's");
       sub.add_option("--config", args->config,

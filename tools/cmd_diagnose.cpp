@@ -203,7 +203,8 @@ imscal::tools::CommandRegistration registration{
                                  "joint_errors.csv of the sim (same time stamps)");
       table->excludes(sim);
       sim->excludes(table);
-      sub.add_option("--robot", args->robot, "robot description (datasets/robots/*.yaml)")
+      sub.add_option("--robot", args->robot,
+                     "robot description (datasets/robots/*.yaml or a .urdf)")
           ->required();
       sub.add_option("--out", args->out, "output folder (report.json, report.txt)")->required();
       sub.add_flag("--force", args->force, "overwrite existing outputs");

@@ -8,9 +8,10 @@
 namespace imscal::tools {
 
 void ModelTorqueOption::add_to(CLI::App& command) {
-  command.add_option("--robot", robot,
-                     "Robot description (datasets/robots/kr16.yaml): the rigid-body model of the "
-                     "model-torque input");
+  command.add_option(
+      "--robot", robot,
+      "Robot description (datasets/robots/kr16.yaml or a .urdf): the rigid-body model of the "
+      "model-torque input");
   command
       .add_option("--gravity-m-s2", gravity_m_s2,
                   "Gravity in the robot base R [m/s²] (default 0 0 -9.80665: a level base)")

@@ -5,7 +5,8 @@
 //   # expect: line N, field F, "words"
 // and the loader of its kind (the file name's prefix) must refuse it with an InputError that
 // names that file, that line and that field (the words: a substring of the message). A file
-// without an expectation line (the empty file) must be refused naming the file.
+// without an expectation line (the empty file) must be refused naming the file. URDF robots
+// (`robot-*.urdf`) carry the same line inside an XML comment: <!-- # expect: ... -->.
 // The run config of `imscal run` is checked through the binary: exit code 2, the message with
 // file and line, and no run folder left behind. Every reader refuses at once a path that is not
 // a regular file (a named pipe would block it forever), naming the file and what it is.
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "calib/calibration_config.hpp"
+#include "calib/robot_description.hpp"
 #include "calib/robot_log.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
@@ -56,6 +58,12 @@ Expectation expectation_of(const fs::path& file) {
   std::string first;
   std::getline(in, first);
   strip_byte_order_mark(first);  // a case with a byte-order mark is read past it
+  const std::string xml_open = "<!-- ";
+  const std::string xml_close = " -->";
+  if (first.rfind(xml_open, 0) == 0 && first.size() > xml_open.size() + xml_close.size() &&
+      first.compare(first.size() - xml_close.size(), xml_close.size(), xml_close) == 0) {
+    first = first.substr(xml_open.size(), first.size() - xml_open.size() - xml_close.size());
+  }
   Expectation e;
   const std::string head = "# expect: line ";
   if (first.rfind(head, 0) != 0) return e;
@@ -77,15 +85,20 @@ void load_by_kind(const fs::path& file) {
     ident::load_identification_config(ConfigNode::load_file(file));
   } else if (name.rfind("scenario-", 0) == 0) {
     sim::load_scenario(file);
+  } else if (name.rfind("robot-", 0) == 0) {
+    calib::load_robot_description(file);
   } else {
-    FAIL() << "no loader for " << name << " (prefix calibration-, identification- or scenario-)";
+    FAIL() << "no loader for " << name
+           << " (prefix calibration-, identification-, scenario- or robot-)";
   }
 }
 
 TEST(ConfigBadInputs, EveryCaseIsRefusedNamingFileLineAndField) {
   std::vector<fs::path> cases;
   for (const auto& entry : fs::directory_iterator(kCases))
-    if (entry.path().extension() == ".yaml") cases.push_back(entry.path());
+    if (entry.path().extension() == ".yaml" || entry.path().extension() == ".urdf") {
+      cases.push_back(entry.path());
+    }
   std::sort(cases.begin(), cases.end());
   ASSERT_GE(cases.size(), 20u);
   for (const fs::path& file : cases) {
