@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "calib/calibration_config.hpp"
+#include "calib/frames_json.hpp"
 #include "calib/robot_description.hpp"
 #include "calib/robot_log.hpp"
 #include "calib/tool_imu_record.hpp"
@@ -79,6 +80,8 @@ inline void read_with(std::string_view target, const std::filesystem::path& file
       ims::read_trajectory_csv(file);
     } else if (target == "joint_errors") {
       ident::read_joint_errors_csv(file);
+    } else if (target == "frames_json") {
+      calib::read_frames_json(file, "kr16");
     } else if (target == "parameter_table") {
       ident::read_parameters_json(file);
     } else if (target == "yaml_configs") {

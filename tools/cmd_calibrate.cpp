@@ -28,6 +28,7 @@
 
 #include "calib/calibration_config.hpp"
 #include "calib/frame_calibration.hpp"
+#include "calib/frames_json.hpp"
 #include "calib/joint_space_errors.hpp"
 #include "calib/mounting_validation.hpp"
 #include "calib/rest_poses.hpp"
@@ -35,8 +36,6 @@
 #include "calib/robot_log.hpp"
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
-#include "core/input_file.hpp"
-#include "core/json_input.hpp"
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
 #include "core/progress.hpp"
@@ -158,125 +157,6 @@ json input_json(const std::string& file) {
   return {{"path", file}, {"sha256", sha256_hex_of_file(file)}};
 }
 
-// The frames of an earlier session (--frames), with where they came from.
-struct PreviousFrames {
-  calib::KnownFrames frames;
-  std::string path;
-  std::string sha256;
-  std::string robot;
-  // The link share of the drives' viscous friction that session found, with its 1-sigma (a
-  // property of the robot's drives, like the frames of its mount); absent in files without it.
-  std::optional<double> link_share, link_share_sigma;
-};
-
-// Reads T_R_W's rotation, T_S_H and their covariance from an earlier frames.json (§16.2 of
-// datasets/FORMAT.md); refuses (InputError naming the file and the field) a file of another
-// format version, of another robot, or with a missing or non-finite value (frames.json writes
-// NaN as null).
-PreviousFrames read_previous_frames(const std::string& file, const std::string& robot_name) {
-  const std::string text = read_input_file(file);
-  json j;
-  try {
-    j = parse_json_refusing_duplicate_keys(text, file);
-  } catch (const json::parse_error& e) {
-    throw InputError(file, 0, "", fmt::format("not a JSON file: {}", e.what()));
-  }
-  if (!j.is_object() || !j.contains("imscal-frames"))
-    throw InputError(file, 0, "imscal-frames",
-                     "not an imscal frames.json (no 'imscal-frames' version key)");
-  if (!(j["imscal-frames"].is_number_integer() && j["imscal-frames"].get<long long>() == 1))
-    throw InputError(file, 0, "imscal-frames",
-                     fmt::format("unknown format version {} (this imscal reads version 1)",
-                                 j["imscal-frames"].dump()));
-  if (!j.contains("robot") || !j["robot"].is_string())
-    throw InputError(file, 0, "robot",
-                     "no robot name: the file does not say which robot it was calibrated on "
-                     "(written by an imscal before --frames existed); recalibrate the frames");
-  const std::string robot = j["robot"].get<std::string>();
-  if (robot != robot_name)
-    throw InputError(file, 0, "robot",
-                     fmt::format("the frames are for robot '{}', this record is of robot '{}'",
-                                 robot, robot_name));
-  // A finite number at a JSON path, or InputError naming it.
-  auto number = [&](const json& node, const std::string& field) {
-    if (!node.is_number())
-      throw InputError(file, 0, field,
-                       node.is_null() ? std::string("not a finite number (NaN or missing)")
-                                      : "not a number: " + node.dump());
-    const double v = node.get<double>();
-    if (!std::isfinite(v)) throw InputError(file, 0, field, "not a finite number");
-    return v;
-  };
-  auto at = [&](const json& node, const std::string& key, const std::string& field) -> const json& {
-    if (!node.is_object() || !node.contains(key)) throw InputError(file, 0, field, "missing");
-    return node[key];
-  };
-  auto vector_at = [&](const json& node, std::size_t n, const std::string& field) {
-    if (!node.is_array() || node.size() != n)
-      throw InputError(file, 0, field, fmt::format("not a list of {} numbers", n));
-    Eigen::VectorXd v(static_cast<Eigen::Index>(n));
-    for (std::size_t k = 0; k < n; ++k)
-      v[Eigen::Index(k)] = number(node[k], fmt::format("{}[{}]", field, k));
-    return v;
-  };
-  auto rotation_at = [&](const std::string& frame) {
-    const std::string field = frame + ".quaternion_wxyz";
-    const Eigen::VectorXd q =
-        vector_at(at(at(j, frame, frame), "quaternion_wxyz", field), 4, field);
-    if (std::abs(q.norm() - 1.0) > 1e-6)
-      throw InputError(file, 0, field, fmt::format("not a unit quaternion (norm {})", q.norm()));
-    return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
-  };
-  PreviousFrames out;
-  out.path = file;
-  out.sha256 = sha256_hex_of_file(file);
-  out.robot = robot;
-  out.frames.source = file;
-  out.frames.R_W_R = rotation_at("T_R_W").transpose();
-  out.frames.T_S_H.linear() = rotation_at("T_S_H");
-  out.frames.T_S_H.translation() =
-      vector_at(at(j["T_S_H"], "xyz_mm", "T_S_H.xyz_mm"), 3, "T_S_H.xyz_mm") * 1e-3;
-  // The covariance of the frames: the first nine parameters, in the bundle's order.
-  const std::vector<std::string> names = {"R_W_R.east", "R_W_R.north", "R_W_R.up",
-                                          "R_S_H.x",    "R_S_H.y",     "R_S_H.z",
-                                          "p_S_H.x",    "p_S_H.y",     "p_S_H.z"};
-  const json& listed = at(j, "parameter_names", "parameter_names");
-  for (std::size_t k = 0; k < names.size(); ++k)
-    if (!listed.is_array() || listed.size() <= k || listed[k] != names[k])
-      throw InputError(file, 0, "parameter_names",
-                       fmt::format("parameter {} is not '{}': not the bundle's covariance layout",
-                                   k + 1, names[k]));
-  const json& covariance = at(j, "covariance_si", "covariance_si");
-  if (!covariance.is_array() || covariance.size() < names.size())
-    throw InputError(file, 0, "covariance_si", fmt::format("fewer than {} rows", names.size()));
-  for (std::size_t r = 0; r < names.size(); ++r) {
-    const std::string row = fmt::format("covariance_si[{}]", r);
-    if (!covariance[r].is_array() || covariance[r].size() < names.size())
-      throw InputError(file, 0, row, fmt::format("fewer than {} columns", names.size()));
-    for (std::size_t c = 0; c < names.size(); ++c)
-      out.frames.covariance(Eigen::Index(r), Eigen::Index(c)) =
-          number(covariance[r][c], fmt::format("{}[{}]", row, c));
-  }
-  for (Eigen::Index k = 0; k < 9; ++k)
-    if (out.frames.covariance(k, k) < 0.0)
-      throw InputError(file, 0, fmt::format("covariance_si[{}][{}]", k, k), "negative variance");
-  // Optional: estimates[].name "link_share (...)" with value[0] and sigma[0].
-  if (j.contains("estimates") && j["estimates"].is_array()) {
-    for (std::size_t k = 0; k < j["estimates"].size(); ++k) {
-      const json& e = j["estimates"][k];
-      if (!e.is_object() || !e.contains("name") || !e["name"].is_string() ||
-          e["name"].get<std::string>().rfind("link_share", 0) != 0)
-        continue;
-      const std::string field = fmt::format("estimates[{}]", k);
-      out.link_share = vector_at(at(e, "value", field + ".value"), 1, field + ".value")[0];
-      out.link_share_sigma = vector_at(at(e, "sigma", field + ".sigma"), 1, field + ".sigma")[0];
-      if (!(*out.link_share_sigma > 0.0))
-        throw InputError(file, 0, field + ".sigma[0]", "not a positive 1-sigma");
-    }
-  }
-  return out;
-}
-
 struct Inputs {
   calib::CalibrationConfig config;
   fs::path robot_file, sensor_file;
@@ -285,7 +165,7 @@ struct Inputs {
   ims::SensorSpec spec;
   ims::ImuSeries imu;
   calib::RobotLog log;
-  std::optional<PreviousFrames> previous;  // --frames
+  std::optional<calib::SessionFrames> previous;  // --frames
 };
 
 // A robot file without drive stiffness (a kinematics-only URDF, say) makes the bundle treat the
@@ -319,7 +199,7 @@ Inputs read_inputs(const CalibrateArgs& args) {
   warn_if_rigid(in.robot);
   in.spec = ims::load_sensor_spec(in.sensor_file);
   // The earlier session's frames before the (long) records: a wrong file fails fast.
-  if (!args.frames.empty()) in.previous = read_previous_frames(args.frames, in.robot.name);
+  if (!args.frames.empty()) in.previous = calib::read_frames_json(args.frames, in.robot.name);
   ims::ImuReadOptions read_options;
   if (in.spec.gyro.range > 0.0) read_options.gyro_range_rad_s = in.spec.gyro.range;
   if (in.spec.acc.range > 0.0) read_options.acc_range_m_s2 = in.spec.acc.range;
@@ -455,7 +335,7 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
 calib::MountingValidation previous_frames_validation(const calib::FrameCalibrationResult& result,
                                                      const calib::MountingThresholds& thresholds,
                                                      double outlier_threshold_sigma,
-                                                     const PreviousFrames& previous) {
+                                                     const calib::SessionFrames& previous) {
   calib::MountingValidation v = calib::assess_mounting(result, {}, {}, thresholds);
   double worst = 0.0;
   for (const auto* list : {&result.rest_residuals, &result.motion_residuals})
