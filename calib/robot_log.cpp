@@ -60,22 +60,23 @@ void write_robot_log_csv(const std::filesystem::path& file, const RobotLog& log,
   write_file_atomically(file, format_robot_log_csv(log), overwrite);
 }
 
-RobotLog read_robot_log_csv(const std::filesystem::path& file, const std::string& expected_robot) {
+RobotLog read_robot_log_csv(const std::filesystem::path& file, const std::string& expected_robot,
+                            const std::string& expected_by) {
   const NumericTable table = read_numeric_table(file);
   if (table.meta("imscal-robot-log") != "1") {
-    throw InputError(table.file, 0, "imscal-robot-log",
+    throw InputError(table.file, table.meta_line("imscal-robot-log"), "imscal-robot-log",
                      "unknown version '" + table.meta("imscal-robot-log") + "' (this reader: 1)");
   }
   RobotLog log;
   log.robot_name = table.meta("robot");
   if (!expected_robot.empty() && log.robot_name != expected_robot) {
-    throw InputError(table.file, 0, "robot",
-                     fmt::format("the log is of robot '{}', the robot description is '{}'",
-                                 log.robot_name, expected_robot));
+    throw InputError(table.file, table.meta_line("robot"), "robot",
+                     fmt::format("the log is of robot '{}', {} is for robot '{}'", log.robot_name,
+                                 expected_by, expected_robot));
   }
   if (!csv::parse_number(table.meta("cycle_s"), log.cycle_s) || !(log.cycle_s > 0.0) ||
       log.cycle_s > 1.0) {
-    throw InputError(table.file, 0, "cycle_s",
+    throw InputError(table.file, table.meta_line("cycle_s"), "cycle_s",
                      "'" + table.meta("cycle_s") + "' is not a cycle time in s (0 < cycle <= 1)");
   }
   // Joint names: from the q_desired_<name>_rad|deg columns, in file order.

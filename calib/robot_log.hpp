@@ -41,8 +41,9 @@ std::string format_robot_log_csv(const RobotLog& log);
 // finite numbers, time strictly increasing, no step longer than 1.5 cycles (a gap: the controller
 // lost cycles, the log cannot be used as one run), steps shorter than 0.5 cycle (jitter beyond
 // what a real-time controller produces), a negative payload. `expected_robot`, when not empty,
-// must match the file's robot.
+// must match the file's robot; `expected_by` names where it comes from, for the message.
 RobotLog read_robot_log_csv(const std::filesystem::path& file,
-                            const std::string& expected_robot = "");
+                            const std::string& expected_robot = "",
+                            const std::string& expected_by = "the robot description");
 
 }  // namespace imscal::calib

@@ -13,6 +13,7 @@
 #include "calib/time_offset.hpp"
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::calib {
@@ -127,8 +128,7 @@ ToolImuRecord read_tool_imu_record(const std::filesystem::path& path,
   ToolImuRecord record;
   record.file = path.string();
   record.robot_quaternion_conjugated = options.robot_quaternion_is_base_in_tool;
-  std::ifstream in(path);
-  if (!in) throw InputError(record.file, 0, "", "cannot open the file");
+  std::ifstream in = open_input_stream(path);
 
   std::string line;
   std::size_t line_number = 0;
@@ -139,6 +139,8 @@ ToolImuRecord read_tool_imu_record(const std::filesystem::path& path,
                      "expected");
   }
   line_number = 1;
+  if (strip_byte_order_mark(line))
+    spdlog::warn("{}: a UTF-8 byte-order mark at the start was skipped", record.file);
   std::vector<std::string> columns;
   for (auto field : csv::split(csv::trim(line), ',')) columns.emplace_back(csv::trim(field));
   auto find_column = [&](const std::string& name) -> std::optional<std::size_t> {

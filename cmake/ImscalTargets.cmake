@@ -7,9 +7,15 @@ if(IMSCAL_WERROR)
   target_compile_options(imscal_build_options INTERFACE -Werror)
 endif()
 if(IMSCAL_SANITIZE)
+  # The ignorelist by its path from the build folder (Ninja compiles there), so that the command
+  # line is the same in every checkout and a compiler cache can reuse the objects.
+  set(ubsan_ignorelist ${PROJECT_SOURCE_DIR}/cmake/ubsan-ignorelist.txt)
+  if(CMAKE_GENERATOR MATCHES "Ninja")
+    file(RELATIVE_PATH ubsan_ignorelist ${CMAKE_BINARY_DIR} ${ubsan_ignorelist})
+  endif()
   target_compile_options(imscal_build_options INTERFACE
     -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
-    -fsanitize-ignorelist=${PROJECT_SOURCE_DIR}/cmake/ubsan-ignorelist.txt)
+    -fsanitize-ignorelist=${ubsan_ignorelist})
   target_link_options(imscal_build_options INTERFACE -fsanitize=address,undefined)
 endif()
 

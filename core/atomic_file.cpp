@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
 #include <system_error>
 
@@ -18,12 +20,19 @@ fs::path temporary_name(const fs::path& target) {
          fmt::format(".{}.tmp-{}-{}", target.filename().string(), ::getpid(), counter++);
 }
 
-void sync_file(const fs::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY);
-  if (fd < 0) return;
-  ::fsync(fd);
+// fsync: on some file systems a full disk shows only here. Returns errno, 0 on success.
+int sync_file(const fs::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return errno;
+  const int result = ::fsync(fd) == 0 ? 0 : errno;
   ::close(fd);
+  return result;
 }
+
+std::string reason(int error) {
+  return error != 0 ? std::strerror(error) : "unknown reason";
+}
+
 }  // namespace
 
 AtomicFile::AtomicFile(fs::path target, Overwrite overwrite, bool binary)
@@ -34,10 +43,11 @@ AtomicFile::AtomicFile(fs::path target, Overwrite overwrite, bool binary)
   }
   auto mode = std::ios::out | std::ios::trunc;
   if (binary) mode |= std::ios::binary;
+  errno = 0;
   out_.open(temporary_, mode);
   if (!out_) {
-    throw std::runtime_error(
-        fmt::format("{}: cannot create temporary output file", temporary_.string()));
+    throw std::runtime_error(fmt::format("{}: cannot write the output file: {}",
+                                         published_path(target_).string(), reason(errno)));
   }
 }
 
@@ -50,12 +60,26 @@ AtomicFile::~AtomicFile() {
 }
 
 void AtomicFile::commit() {
-  out_.flush();
-  if (!out_) {
-    throw std::runtime_error(fmt::format("{}: write failed", temporary_.string()));
+  // A write that failed earlier left its reason in errno (later writes to a failed stream make no
+  // system call); else flush and close report their own.
+  int write_error = out_ ? 0 : errno;
+  if (out_) {
+    errno = 0;
+    out_.flush();
+    if (!out_) write_error = errno;
   }
+  const bool written = static_cast<bool>(out_);
+  errno = 0;
   out_.close();
-  sync_file(temporary_);
+  if (written && !out_) write_error = errno;
+  if (!out_) {
+    throw std::runtime_error(fmt::format("{}: writing the output failed: {}",
+                                         published_path(target_).string(), reason(write_error)));
+  }
+  if (const int sync_error = sync_file(temporary_); sync_error != 0) {
+    throw std::runtime_error(fmt::format("{}: writing the output failed: {}",
+                                         published_path(target_).string(), reason(sync_error)));
+  }
   if (overwrite_ == Overwrite::kRefuse && fs::exists(target_)) {
     throw std::runtime_error(fmt::format(
         "{}: output appeared while writing; refusing to overwrite it", target_.string()));
@@ -63,10 +87,17 @@ void AtomicFile::commit() {
   std::error_code error;
   fs::rename(temporary_, target_, error);
   if (error) {
-    throw std::runtime_error(
-        fmt::format("{}: cannot rename temporary output: {}", target_.string(), error.message()));
+    throw std::runtime_error(fmt::format("{}: cannot rename temporary output: {}",
+                                         published_path(target_).string(), error.message()));
   }
   committed_ = true;
+}
+
+fs::path published_path(const fs::path& path) {
+  fs::path visible;
+  for (const fs::path& part : path)
+    if (!part.string().starts_with(kStagingFolderPrefix)) visible /= part;
+  return visible;
 }
 
 void write_file_atomically(const fs::path& target, std::string_view content, Overwrite overwrite) {

@@ -34,6 +34,13 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+// OutputFolder stages a command's outputs in <folder>/.imscal-staging-<pid>/ (output_folder.hpp).
+inline constexpr std::string_view kStagingFolderPrefix = ".imscal-staging-";
+
+// The path a staged output will have once published (the staging folder left out), for messages:
+// the user looks for the target, never for a temporary file.
+std::filesystem::path published_path(const std::filesystem::path& path);
+
 // Convenience: the whole content at once.
 void write_file_atomically(const std::filesystem::path& target, std::string_view content,
                            Overwrite overwrite = Overwrite::kAllow);

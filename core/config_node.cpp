@@ -1,12 +1,15 @@
 #include "core/config_node.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 #include "core/path_checks.hpp"
+#include "core/yaml_duplicate_keys.hpp"
 
 namespace imscal {
 
@@ -14,20 +17,16 @@ ConfigNode::ConfigNode(YAML::Node node, std::string file, std::string path)
     : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
 
 ConfigNode ConfigNode::load_file(const std::filesystem::path& file) {
-  if (!path_exists(file)) {
-    throw InputError(file.string(), 0, "", "file does not exist");
+  std::string text = read_input_file(file);
+  if (text.starts_with(kUtf8ByteOrderMark)) {
+    text.erase(0, kUtf8ByteOrderMark.size());
+    spdlog::warn("{}: a UTF-8 byte-order mark at the start was skipped", file.string());
   }
-  try {
-    YAML::Node root = YAML::LoadFile(file.string());
-    if (!root || root.IsNull()) throw InputError(file.string(), 0, "", "empty YAML document");
-    return ConfigNode(root, file.string(), "");
-  } catch (const YAML::Exception& e) {
-    throw InputError(file.string(), static_cast<std::size_t>(e.mark.line + 1), "",
-                     "YAML syntax error: " + e.msg);
-  }
+  return load_string(text, file.string());
 }
 
 ConfigNode ConfigNode::load_string(const std::string& text, const std::string& origin) {
+  refuse_duplicate_yaml_keys(text, origin);
   try {
     YAML::Node root = YAML::Load(text);
     if (!root || root.IsNull()) throw InputError(origin, 0, "", "empty YAML document");

@@ -1,6 +1,7 @@
 #include "core/numeric_table.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <cmath>
 #include <fstream>
@@ -8,6 +9,7 @@
 
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 
 namespace imscal {
 
@@ -26,15 +28,21 @@ const std::string& NumericTable::meta(const std::string& key) const {
   return it->second;
 }
 
+std::size_t NumericTable::meta_line(const std::string& key) const {
+  const auto it = metadata_lines.find(key);
+  return it == metadata_lines.end() ? 0 : it->second;
+}
+
 NumericTable read_numeric_table(const std::filesystem::path& path) {
   NumericTable table;
   table.file = path.string();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(table.file, 0, "", "cannot open the file");
+  std::ifstream in = open_input_stream(path);
   std::string line;
   std::size_t line_number = 0;
   while (std::getline(in, line)) {
     ++line_number;
+    if (line_number == 1 && strip_byte_order_mark(line))
+      spdlog::warn("{}: a UTF-8 byte-order mark at the start was skipped", table.file);
     const std::string_view text = csv::trim(line);
     if (text.empty()) {
       if (table.columns.empty()) continue;
@@ -45,8 +53,9 @@ NumericTable read_numeric_table(const std::filesystem::path& path) {
         const std::string_view body = csv::trim(text.substr(1));
         const auto colon = body.find(':');
         if (colon != std::string_view::npos) {
-          table.metadata[std::string(csv::trim(body.substr(0, colon)))] =
-              std::string(csv::trim(body.substr(colon + 1)));
+          const std::string key(csv::trim(body.substr(0, colon)));
+          table.metadata[key] = std::string(csv::trim(body.substr(colon + 1)));
+          table.metadata_lines[key] = line_number;
         }
         continue;
       }
@@ -85,6 +94,7 @@ NumericTable read_numeric_table(const std::filesystem::path& path) {
     }
     table.lines.push_back(line_number);
   }
+  throw_if_read_failed(in, path);
   if (table.columns.empty()) {
     throw InputError(table.file, line_number, "",
                      line_number == 0 ? "the file is empty" : "no header line with column names");

@@ -14,9 +14,10 @@
 namespace imscal {
 
 struct NumericTable {
-  std::string file;                             // as given, for messages
-  std::map<std::string, std::string> metadata;  // from the '# key: value' lines
-  std::size_t header_line = 0;                  // 1-based
+  std::string file;                                   // as given, for messages
+  std::map<std::string, std::string> metadata;        // from the '# key: value' lines
+  std::map<std::string, std::size_t> metadata_lines;  // 1-based line of each metadata key
+  std::size_t header_line = 0;                        // 1-based
   std::vector<std::string> columns;
   std::vector<double> values;      // row-major, rows() x columns.size()
   std::vector<std::size_t> lines;  // 1-based file line of each row
@@ -29,11 +30,14 @@ struct NumericTable {
   std::size_t column(const std::string& name) const;
   // The metadata value; InputError when it is missing.
   const std::string& meta(const std::string& key) const;
+  // The line of a metadata key (0 when it is missing), for messages about its value.
+  std::size_t meta_line(const std::string& key) const;
 };
 
 // InputError (file, line, field) for: a missing or empty file, no header, a row with a wrong
 // number of fields, a field that is not a number or is NaN/Inf, duplicate column names, an
-// empty line among the rows.
+// empty line among the rows. A UTF-8 byte-order mark before the first line is skipped with a
+// warning.
 NumericTable read_numeric_table(const std::filesystem::path& file);
 
 }  // namespace imscal

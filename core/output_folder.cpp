@@ -1,5 +1,6 @@
 #include "core/output_folder.hpp"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,22 @@ namespace imscal {
 
 namespace fs = std::filesystem;
 
+// The output folder and the staging folder inside it: an existing file of that name is a
+// mistake on the command line (InputError), a folder the system refuses to create an I/O failure
+// with its reason.
+void create_output_folder(const fs::path& folder) {
+  std::error_code error;
+  if (fs::exists(folder, error) && !fs::is_directory(folder, error)) {
+    throw InputError(folder.string(), 0, "--out",
+                     "is a file, not a folder; --out names the folder for the outputs");
+  }
+  fs::create_directories(folder, error);
+  if (error) {
+    throw std::runtime_error(
+        fmt::format("{}: cannot create the output folder: {}", folder.string(), error.message()));
+  }
+}
+
 OutputFolder::OutputFolder(fs::path folder, std::vector<fs::path> outputs, Overwrite overwrite)
     : folder_(std::move(folder)), outputs_(std::move(outputs)) {
   for (const fs::path& relative : outputs_) {
@@ -23,10 +40,11 @@ OutputFolder::OutputFolder(fs::path folder, std::vector<fs::path> outputs, Overw
       throw InputError(target.string(), 0, "", "exists already (use --force to replace it)");
     }
   }
-  fs::create_directories(folder_);
-  staging_ = folder_ / (".imscal-staging-" + std::to_string(::getpid()));
-  fs::remove_all(staging_);
-  fs::create_directories(staging_);
+  create_output_folder(folder_);
+  staging_ = folder_ / (std::string(kStagingFolderPrefix) + std::to_string(::getpid()));
+  std::error_code ignored;
+  fs::remove_all(staging_, ignored);
+  create_output_folder(staging_);
 }
 
 OutputFolder::~OutputFolder() {
@@ -48,6 +66,13 @@ void OutputFolder::commit() {
     if (!fs::is_regular_file(staging_ / relative)) {
       throw std::logic_error("OutputFolder: '" + relative.string() + "' was not written");
     }
+  }
+  // A target that is a folder would stop the renames half way: refused before the first.
+  for (const fs::path& relative : outputs_) {
+    std::error_code error;
+    if (fs::is_directory(folder_ / relative, error))
+      throw InputError((folder_ / relative).string(), 0, "",
+                       "is a folder; an output file of this name cannot replace it");
   }
   // Renames within one file system are atomic per file; the set is complete before the first.
   for (const fs::path& relative : outputs_) {

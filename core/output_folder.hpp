@@ -11,6 +11,11 @@
 
 namespace imscal {
 
+// Creates an output folder (and its parents). InputError when the path names a file (a mistake on
+// the command line, exit 2 in every command); std::runtime_error with the system's reason when
+// the folder cannot be created.
+void create_output_folder(const std::filesystem::path& folder);
+
 class OutputFolder {
  public:
   // `outputs`: the files this command will write, relative to `folder`. With Overwrite::kRefuse

@@ -1,4 +1,5 @@
 #include "core/run_stage.hpp"
+#include "core/json_output.hpp"
 
 #include <fcntl.h>
 #include <spdlog/sinks/basic_file_sink.h>
@@ -190,14 +191,25 @@ class RunLog {
   std::vector<spdlog::level::level_enum> sink_levels_;
 };
 
-void prepare_folder(const RunOptions& options) {
+std::string config_identity(const RunOptions& options) {
+  return options.config_file.empty() ? std::string()
+                                     : fs::weakly_canonical(options.config_file).string();
+}
+
+// True when the folder holds nothing but (possibly) our lock file.
+bool holds_nothing_but_lock(const fs::path& folder) {
+  for (const auto& entry : fs::directory_iterator(folder))
+    if (entry.path().filename() != kLockName) return false;
+  return true;
+}
+
+// Whether run.json must be written; InputError when the folder is no run folder of this config.
+bool run_record_needed(const RunOptions& options) {
   const fs::path& folder = options.folder;
   const fs::path record = folder / kRunRecordName;
-  const std::string config = options.config_file.empty()
-                                 ? std::string()
-                                 : fs::weakly_canonical(options.config_file).string();
+  const std::string config = config_identity(options);
   if (fs::exists(folder) && !fs::is_directory(folder))
-    throw InputError(folder.string(), 0, "", "exists and is not a folder");
+    throw InputError(folder.string(), 0, "--out", "exists and is not a folder");
   if (fs::exists(record)) {
     const std::optional<json> run = read_json_file(record);
     const std::string made_by =
@@ -206,18 +218,23 @@ void prepare_folder(const RunOptions& options) {
       throw InputError(record.string(), 0, "config",
                        "this run folder was made by '" + made_by + "', not by '" + config +
                            "'; use another --out, or --force to rerun it with this config");
-    if (made_by == config) return;
-  } else if (fs::exists(folder) && !fs::is_empty(folder) && !options.force) {
+    return made_by != config;
+  }
+  if (fs::exists(folder) && !holds_nothing_but_lock(folder) && !options.force) {
     throw InputError(folder.string(), 0, "",
                      "exists, is not empty and is not an imscal run folder (no run.json); use "
                      "another --out, or --force to use it anyway");
   }
-  fs::create_directories(folder);
+  return true;
+}
+
+void write_run_record(const RunOptions& options) {
+  const fs::path record = options.folder / kRunRecordName;
   const json run = {{"schema", "imscal-run-folder"},
                     {"schema_version", 1},
-                    {"config", config},
+                    {"config", config_identity(options)},
                     {"created_by", options.tool_version}};
-  write_file_atomically(record, run.dump(1) + "\n");
+  write_file_atomically(record, json_text(run, 1, record.string()));
 }
 
 void remove_leftovers(const fs::path& folder) {
@@ -254,9 +271,13 @@ RunSummary run_stages(const std::vector<std::unique_ptr<Stage>>& stages,
         !names.insert(stage->name()).second)
       throw std::logic_error("run_stages: bad or repeated stage name '" + stage->name() + "'");
   }
-  prepare_folder(options);
+  // Checked before anything is created, and again under the lock: a run refused because another
+  // holds the folder must not rewrite its run.json.
+  run_record_needed(options);
   const fs::path& run_dir = options.folder;
+  fs::create_directories(run_dir);
   FolderLock lock(run_dir);
+  if (run_record_needed(options)) write_run_record(options);
   RunLog log(run_dir / "run.log");
   spdlog::info("run in {} ({}, config {}){}", run_dir.string(), options.tool_version,
                options.config_file.string(), options.force ? ", --force: every stage reruns" : "");
@@ -348,7 +369,8 @@ RunSummary run_stages(const std::vector<std::unique_ptr<Stage>>& stages,
                                  {"inputs", inputs},
                                  {"outputs", outputs},
                                  {"summary", outcome.summary}};
-      write_file_atomically(staging / kStageRecordName, stage_record.dump(1) + "\n");
+      write_file_atomically(staging / kStageRecordName,
+                            json_text(stage_record, 1, (stage_dir / kStageRecordName).string()));
       commit_stage_folder(staging, stage_dir,
                           run_dir / (kOldPrefix + name + "-" + std::to_string(::getpid())));
       result.what = StageRun::What::kRan;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 
 namespace imscal {
 namespace {
@@ -112,8 +113,7 @@ std::string sha256_hex(std::string_view bytes) {
 }
 
 std::string sha256_hex_of_file(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), 0, "", "cannot open the file to compute its checksum");
+  std::ifstream in = open_input_stream(file);
   Sha256 hash;
   std::vector<char> buffer(1 << 16);
   while (in) {
@@ -121,7 +121,7 @@ std::string sha256_hex_of_file(const std::filesystem::path& file) {
     hash.feed(reinterpret_cast<const unsigned char*>(buffer.data()),
               static_cast<std::size_t>(in.gcount()));
   }
-  if (in.bad()) throw InputError(file.string(), 0, "", "read error while computing its checksum");
+  throw_if_read_failed(in, file);
   return hash.finish();
 }
 

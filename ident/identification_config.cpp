@@ -41,11 +41,15 @@ std::vector<double> per_joint_positive(const ConfigNode& joints, const char* key
   return v;
 }
 
-std::pair<int, int> range(const ConfigNode& node, int lowest) {
+// An order range [min, max] of integers in [lowest, highest]; the bounds are checked before the
+// integer test so that 1e300 is refused, not converted.
+std::pair<int, int> range(const ConfigNode& node, int lowest, int highest) {
   const std::vector<double> v = node.as_doubles();
-  if (v.size() != 2 || v[0] != double(long(v[0])) || v[1] != double(long(v[1])) || v[0] < lowest ||
-      v[1] < v[0])
-    node.fail(fmt::format("expected [min, max], integers, {} <= min <= max", lowest));
+  const auto in_bounds = [&](double x) { return x >= lowest && x <= highest; };
+  if (v.size() != 2 || !in_bounds(v[0]) || !in_bounds(v[1]) || v[0] != double(long(v[0])) ||
+      v[1] != double(long(v[1])) || v[1] < v[0])
+    node.fail(
+        fmt::format("expected [min, max], integers, {} <= min <= max <= {}", lowest, highest));
   return {int(v[0]), int(v[1])};
 }
 
@@ -217,10 +221,12 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
   }
   if (auto order = root.optional_child("order")) {
     order->require_only_keys({"na", "nb", "dead_time", "criterion"});
-    if (auto n = order->optional_child("na")) std::tie(o.grid.na_min, o.grid.na_max) = range(*n, 0);
-    if (auto n = order->optional_child("nb")) std::tie(o.grid.nb_min, o.grid.nb_max) = range(*n, 1);
+    if (auto n = order->optional_child("na"))
+      std::tie(o.grid.na_min, o.grid.na_max) = range(*n, 0, kMaxPrecontrolOrder);
+    if (auto n = order->optional_child("nb"))
+      std::tie(o.grid.nb_min, o.grid.nb_max) = range(*n, 1, kMaxPrecontrolOrder);
     if (auto n = order->optional_child("dead_time"))
-      std::tie(o.grid.dead_time_min, o.grid.dead_time_max) = range(*n, 0);
+      std::tie(o.grid.dead_time_min, o.grid.dead_time_max) = range(*n, 0, kMaxPrecontrolOrder);
     if (auto n = order->optional_child("criterion")) {
       const std::string name = n->as_string();
       if (name == "aic")

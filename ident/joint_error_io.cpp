@@ -14,6 +14,7 @@
 
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 #include "core/sha256.hpp"
 
 namespace imscal::ident {
@@ -26,6 +27,28 @@ constexpr double kGapCycles = 1.5;
 
 using csv::parse_number;
 using csv::trim;
+
+// A joint error (q_desired - q_measured) beyond this is no calibration residual but a corrupted
+// sample (controller logs hold such words): the simulated KR 16 at full speed lags by at most
+// 0.031 rad, and one corrupted sample would become the table's offset envelope, the
+// supervisor's tolerance.
+constexpr double kMaxJointError_rad = 0.5;
+
+// Row layout: t_s, payload_kg, q_desired per joint, q_measured per joint, q_internal per joint.
+void check_joint_errors_plausible(const std::vector<double>& row,
+                                  const std::vector<std::string>& joint_names,
+                                  const std::string& file, std::size_t line) {
+  const std::size_t joints = joint_names.size();
+  for (std::size_t j = 0; j < joints; ++j) {
+    const double error = row[2 + j] - row[2 + joints + j];
+    if (std::abs(error) > kMaxJointError_rad)
+      throw InputError(
+          file, line, "q_measured_" + joint_names[j] + "_rad",
+          fmt::format("joint error q_desired - q_measured = {:.6g} rad exceeds {} rad: "
+                      "a corrupted sample (remove it, or split the log there)",
+                      error, kMaxJointError_rad));
+  }
+}
 
 std::vector<std::string> expected_columns(const std::vector<std::string>& joints) {
   std::vector<std::string> names{"t_s", "payload_kg"};
@@ -72,8 +95,7 @@ void split_at_gaps(JointErrorLog& log) {
 
 JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::ifstream in(path);
-  if (!in) throw InputError(file, 0, "", "cannot open the file");
+  std::ifstream in = open_input_stream(path);
   JointErrorLog log;
   std::map<std::string, std::size_t, std::less<>> seen;
   std::string text;
@@ -82,6 +104,8 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
   // Header comments, then the column line.
   while (std::getline(in, text)) {
     ++line;
+    if (line == 1 && strip_byte_order_mark(text))
+      spdlog::warn("{}: a UTF-8 byte-order mark at the start was skipped", file);
     const std::string_view t = trim(text);
     if (t.empty()) continue;
     if (t.front() != '#') {
@@ -173,7 +197,15 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
       throw InputError(file, line, "t_s",
                        fmt::format("time {} s does not increase (previous sample {} s)", row[0],
                                    log.time_s.back()));
+    // The robot log's rule (calib/robot_log.hpp): a step under half a cycle is jitter no
+    // real-time controller produces, so `identify` and `compensate` refuse the same logs.
+    if (!log.time_s.empty() && row[0] - log.time_s.back() < 0.5 * log.cycle_s)
+      throw InputError(file, line, "t_s",
+                       fmt::format("step of {:.6g} s is less than half the cycle of {} s "
+                                   "(time stamps jitter or the cycle_s header is wrong)",
+                                   row[0] - log.time_s.back(), log.cycle_s));
     if (row[1] < 0.0) throw InputError(file, line, "payload_kg", "negative payload");
+    check_joint_errors_plausible(row, log.joint_names, file, line);
     log.time_s.push_back(row[0]);
     log.payload_kg.push_back(row[1]);
     for (std::size_t j = 0; j < joints; ++j) {

@@ -14,6 +14,9 @@
 #include <string_view>
 
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
+#include "core/json_input.hpp"
+#include "core/json_output.hpp"
 #include "ident/model_stability.hpp"
 
 namespace imscal::ident {
@@ -410,7 +413,7 @@ std::string parameters_json_text(const ParameterTable& t) {
                        {"samples", t.source.samples},
                        {"description", t.source.description}}},
                      {"joints", joints}};
-  return root.dump(1) + "\n";
+  return json_text(root, 1, "parameters.json");
 }
 
 namespace {
@@ -470,7 +473,7 @@ void write_parameters_csv(const std::filesystem::path& file, const ParameterTabl
 ParameterTable parse_parameters_json(const std::string& text, const std::string& origin) {
   json root;
   try {
-    root = json::parse(text);
+    root = parse_json_refusing_duplicate_keys(text, origin);
   } catch (const json::exception& e) {  // syntax errors, and numbers beyond double (1e648)
     throw InputError(origin, 0, "/", fmt::format("not valid JSON: {}", e.what()));
   }
@@ -552,11 +555,7 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
 }
 
 ParameterTable read_parameters_json(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string(), 0, "", "cannot open the file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return parse_parameters_json(s.str(), file.string());
+  return parse_parameters_json(read_input_file(file), file.string());
 }
 
 }  // namespace imscal::ident

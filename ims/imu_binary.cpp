@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 
 namespace imscal::ims {
 namespace fs = std::filesystem;
@@ -105,12 +106,8 @@ ImuSeries read_imu_binary(const fs::path& path, const ImuReadOptions& options,
   const std::string file = path.string();
   std::error_code error;
   const std::uint64_t file_size = fs::file_size(path, error);
-  std::ifstream in(path, std::ios::binary);
-  if (error || !in) {
-    throw InputError(
-        file, 0, "",
-        fmt::format("cannot open the file: {}", error ? error.message() : "open failed"));
-  }
+  std::ifstream in = open_input_stream(path);
+  if (error) throw InputError(file, 0, "", "cannot open the file: " + error.message());
   if (file_size == 0) {
     throw InputError(file, 0, "magic", "the file is empty; expected an imscal IMU binary file");
   }
@@ -186,7 +183,9 @@ ImuSeries read_imu_binary(const fs::path& path, const ImuReadOptions& options,
 
   // Records, decoded chunk by chunk so that the buffer stays in cache, and validated while the
   // decoded samples are still in cache.
-  ImuValidator validator(series, options, report);
+  ImuSourceInfo info;
+  info.record_count = static_cast<std::size_t>(n_records);
+  ImuValidator validator(series, options, report, info);
   series.samples.reserve(n_records);
   advise_huge_pages(series.samples.data(), n_records * sizeof(ImuSample));
   constexpr std::size_t kChunkRecords = 4096;

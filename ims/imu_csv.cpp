@@ -21,6 +21,7 @@
 
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 
 namespace imscal::ims {
 namespace fs = std::filesystem;
@@ -132,26 +133,44 @@ double column_factor(const std::string& file, std::size_t line, std::size_t colu
 // ---------------------------------------------------------------------------------------------
 // The file, mapped read-only (the input is never modified).
 
+// Before the file is mapped (and paged in): a file whose first byte, after a byte-order mark,
+// is not the '#' of '# imscal-imu: 1' is refused without reading further.
+void check_first_byte(int fd, const fs::path& path) {
+  char start[4] = {};
+  const ssize_t got = ::pread(fd, start, sizeof start, 0);
+  if (got <= 0) return;  // empty (refused later with its own message) or unreadable
+  const std::string_view head(start, static_cast<std::size_t>(got));
+  const std::size_t skip = head.starts_with(kUtf8ByteOrderMark) ? kUtf8ByteOrderMark.size() : 0;
+  if (head.size() > skip && head[skip] != '#') {
+    throw InputError(path.string(), 1, "imscal-imu",
+                     "not an imscal IMU CSV file: the first line must be '# imscal-imu: 1'");
+  }
+}
+
 class MappedFile {
  public:
-  explicit MappedFile(const fs::path& path) {
-    fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd_ < 0) {
-      throw InputError(path.string(), 0, "",
-                       fmt::format("cannot open the file: {}", std::strerror(errno)));
-    }
+  explicit MappedFile(const fs::path& path) : fd_(open_regular_file(path)) {
     struct stat status {};
-    if (::fstat(fd_, &status) != 0 || !S_ISREG(status.st_mode)) {
+    if (::fstat(fd_, &status) != 0) {
+      const int error = errno;
       ::close(fd_);
-      throw InputError(path.string(), 0, "", "not a regular file");
+      throw InputError(path.string(), 0, "",
+                       fmt::format("cannot read the file's status: {}", std::strerror(error)));
     }
     size_ = static_cast<std::size_t>(status.st_size);
     if (size_ == 0) return;
+    try {
+      check_first_byte(fd_, path);
+    } catch (...) {
+      ::close(fd_);
+      throw;
+    }
     void* mapped = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd_, 0);
     if (mapped == MAP_FAILED) {
+      const int error = errno;
       ::close(fd_);
       throw InputError(path.string(), 0, "",
-                       fmt::format("cannot map the file: {}", std::strerror(errno)));
+                       fmt::format("cannot map the file: {}", std::strerror(error)));
     }
     data_ = static_cast<const char*>(mapped);
     ::madvise(mapped, size_, MADV_SEQUENTIAL);
@@ -350,9 +369,15 @@ ImuSeries read_imu_csv(const fs::path& path, const ImuReadOptions& options, ImuR
   if (report != nullptr) *report = ImuReadReport{};
   const std::string file = path.string();
   const MappedFile mapped(path);
-  const char* const begin = mapped.data();
-  const char* const end = begin + mapped.size();
-  if (mapped.size() == 0) {
+  const std::string_view whole(mapped.data(), mapped.size());
+  const std::size_t mark = whole.starts_with(kUtf8ByteOrderMark) ? kUtf8ByteOrderMark.size() : 0;
+  if (mark > 0) {
+    add_imu_warning(report,
+                    fmt::format("{}: a UTF-8 byte-order mark at the start was skipped", file));
+  }
+  const char* const begin = mapped.data() + mark;
+  const char* const end = mapped.data() + mapped.size();
+  if (begin == end) {
     throw InputError(file, 1, "imscal-imu",
                      "the file is empty; expected the header line '# imscal-imu: 1'");
   }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 #include "ims/imu_binary.hpp"
 #include "ims/imu_csv.hpp"
 #include "ims/psins_reader.hpp"
@@ -30,8 +31,7 @@ ImuFileKind imu_file_kind(const fs::path& file) {
   if (extension == ".csv") return ImuFileKind::kCsv;
   if (extension == kImuBinaryExtension) return ImuFileKind::kBinary;
   if (extension == ".imu") return ImuFileKind::kPsins;
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), 0, "", "cannot open the file");
+  std::ifstream in = open_input_stream(file);
   std::string start(16, '\0');
   in.read(start.data(), static_cast<std::streamsize>(start.size()));
   start.resize(static_cast<std::size_t>(in.gcount()));

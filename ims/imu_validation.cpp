@@ -15,8 +15,9 @@ namespace {
 // Locates sample i in messages: a text line, or a binary record (1-based).
 class Locator {
  public:
-  Locator(const ImuSeries& series, const ImuColumnNames& columns)
-      : series_(series), columns_(columns) {}
+  // record_count: the records the file holds (0: the series is complete, its size counts).
+  Locator(const ImuSeries& series, const ImuColumnNames& columns, std::size_t record_count)
+      : series_(series), columns_(columns), record_count_(record_count) {}
 
   std::size_t line(std::size_t i) const {
     return series_.first_data_line > 0 ? series_.first_data_line + i : 0;
@@ -30,15 +31,18 @@ class Locator {
   // Binary files have no lines: the record number goes into the problem text.
   [[noreturn]] void fail(std::size_t i, std::size_t column_index,
                          const std::string& problem) const {
-    const std::string prefix = series_.first_data_line > 0 ? std::string()
-                                                           : fmt::format("record {} of {}: ", i + 1,
-                                                                         series_.samples.size());
+    const std::string prefix = series_.first_data_line > 0
+                                   ? std::string()
+                                   : fmt::format("record {} of {}: ", i + 1, records());
     throw InputError(series_.source, line(i), columns_[column_index], prefix + problem);
   }
 
  private:
+  // While a reader streams, the series holds only the records decoded so far.
+  std::size_t records() const { return record_count_ > 0 ? record_count_ : series_.samples.size(); }
   const ImuSeries& series_;
   const ImuColumnNames& columns_;
+  std::size_t record_count_;
 };
 
 double value_of(const ImuSample& s, std::size_t column) {
@@ -137,7 +141,7 @@ class ImuValidator::Scan {
         options_(options),
         columns_(info.columns ? *info.columns : si_column_names(series.quantity)),
         nominal_dt_line_(info.nominal_dt_line),
-        where_(series, columns_),
+        where_(series, columns_, info.record_count),
         report_(report),
         rates_(series.quantity == ImuQuantity::kRates),
         nominal_(series.nominal_dt_s),

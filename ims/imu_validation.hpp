@@ -88,6 +88,7 @@ std::array<double, 7> finite_sample_values(const ImuSeries& series, std::size_t 
 struct ImuSourceInfo {
   std::optional<ImuColumnNames> columns;  // names as written in the file (e.g. "acc_x_g")
   std::size_t nominal_dt_line = 0;        // line of the nominal_dt_s header (0 if none)
+  std::size_t record_count = 0;           // records a binary file announces (0: the series' size)
 };
 
 // The same checks, run by a reader while it parses: construct it once the header is known

@@ -1,6 +1,7 @@
 #include "ims/nav_trajectory_io.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <array>
 #include <charconv>
@@ -13,6 +14,7 @@
 
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 
 namespace imscal::ims {
 namespace {
@@ -91,8 +93,7 @@ void write_trajectory_tum(const std::filesystem::path& file, const std::vector<N
 
 NavTrajectory read_trajectory_csv(const std::filesystem::path& file) {
   const std::string name = file.string();
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(name, 0, "", "cannot open the trajectory file");
+  std::ifstream in = open_input_stream(file);
 
   std::string line;
   std::size_t line_number = 0;
@@ -104,6 +105,8 @@ NavTrajectory read_trajectory_csv(const std::filesystem::path& file) {
 
   while (std::getline(in, line)) {
     ++line_number;
+    if (line_number == 1 && strip_byte_order_mark(line))
+      spdlog::warn("{}: a UTF-8 byte-order mark at the start was skipped", name);
     const std::string_view text = trim(line);
     if (!have_header) {
       if (text.empty() || text.front() == '#') continue;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
 
 namespace imscal::ims {
 namespace {
@@ -88,11 +89,7 @@ void require_range(double value, double low, double high, const LineError& error
 }
 
 std::string read_all(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), 0, "", "cannot open the file for reading");
-  std::ostringstream content;
-  content << in.rdbuf();
-  return content.str();
+  return read_input_file(path);
 }
 
 }  // namespace

@@ -3,7 +3,7 @@
 # Idempotent: re-running it on a machine that has everything is quick.
 set -euo pipefail
 packages=(
-  build-essential cmake ninja-build pkg-config git
+  build-essential cmake ninja-build pkg-config git ccache
   libeigen3-dev libceres-dev libsuitesparse-dev libgeographiclib-dev liborocos-kdl-dev
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev libopencv-calib3d-dev

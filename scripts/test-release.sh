@@ -10,8 +10,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build-release}
 jobs=$(nproc)
+source scripts/compiler-cache.sh
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DIMSCAL_WERROR=ON \
-  -DIMSCAL_BUILD_BENCH=OFF >/dev/null
+  -DIMSCAL_BUILD_BENCH=OFF "${compiler_cache_args[@]}" >/dev/null
 cmake --build "$build" -j "$jobs" --target headline_tests
 rm -rf "$build/test-results"
 status=0

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "core/csv_text.hpp"
+#include "core/json_output.hpp"
 #include "core/output_folder.hpp"
 #include "ims/imu_file.hpp"
 #include "ims/nav_trajectory_io.hpp"
@@ -124,7 +125,7 @@ std::string frames_json(const Scenario& scenario, const SimulationResult& r) {
         {"longitude_deg", scenario.site.longitude_deg},
         {"height_m", scenario.site.height_m}}},
       {"units", "m, deg; quaternion_wxyz: unit quaternion of the rotation part"}};
-  return json.dump(2) + "\n";
+  return imscal::json_text(json, 2, "truth.json");
 }
 
 std::string scenario_yaml(const Scenario& scenario, std::uint64_t seed, const SimulationResult& r) {

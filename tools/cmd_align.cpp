@@ -15,6 +15,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
 #include "ims/coarse_alignment.hpp"
 #include "ims/imu_file.hpp"
 #include "tools/command_registry.hpp"
@@ -205,7 +206,7 @@ void run(const AlignArgs& args) {
           spread["roll_std_deg"].get<double>());
     }
   }
-  imscal::write_file_atomically(args.out, out.dump(2) + "\n");
+  imscal::write_file_atomically(args.out, imscal::json_text(out, 2, args.out));
   std::cout << text << "written: " << args.out << "\n";
 }
 

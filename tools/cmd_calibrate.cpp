@@ -35,6 +35,9 @@
 #include "calib/robot_log.hpp"
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/input_file.hpp"
+#include "core/json_input.hpp"
+#include "core/json_output.hpp"
 #include "core/output_folder.hpp"
 #include "core/progress.hpp"
 #include "core/sha256.hpp"
@@ -171,13 +174,10 @@ struct PreviousFrames {
 // format version, of another robot, or with a missing or non-finite value (frames.json writes
 // NaN as null).
 PreviousFrames read_previous_frames(const std::string& file, const std::string& robot_name) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file, 0, "", "cannot open the earlier session's frames.json");
-  std::stringstream text;
-  text << in.rdbuf();
+  const std::string text = read_input_file(file);
   json j;
   try {
-    j = json::parse(text.str());
+    j = parse_json_refusing_duplicate_keys(text, file);
   } catch (const json::parse_error& e) {
     throw InputError(file, 0, "", fmt::format("not a JSON file: {}", e.what()));
   }
@@ -728,8 +728,10 @@ void run(const CalibrateArgs& args) {
                        {"inputs", inputs}};
 
   OutputFolder folder(args.out, outputs, overwrite);
-  write_file_atomically(folder.staged("frames.json"), frames.dump(1) + "\n");
-  write_file_atomically(folder.staged("mounting_report.json"), report.dump(1) + "\n");
+  write_file_atomically(folder.staged("frames.json"),
+                        json_text(frames, 1, (folder.folder() / "frames.json").string()));
+  write_file_atomically(folder.staged("mounting_report.json"),
+                        json_text(report, 1, (folder.folder() / "mounting_report.json").string()));
   write_file_atomically(
       folder.staged("summary.txt"),
       summary_text(args, result, validation, rests, dt0, joint_errors ? &*joint_errors : nullptr));

@@ -26,6 +26,7 @@
 #include "calib/tool_imu_record.hpp"
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
@@ -212,7 +213,8 @@ void run(const Args& args) {
   }
   report["orientation"] = report_orientation(record, analysis, applied, source, !args.no_restart);
   if (ahrs) report["ahrs_orientation_error"] = report_ahrs(*ahrs);
-  if (!args.out.empty()) imscal::write_file_atomically(args.out, report.dump(2) + "\n");
+  if (!args.out.empty())
+    imscal::write_file_atomically(args.out, imscal::json_text(report, 2, args.out));
 }
 
 imscal::tools::CommandRegistration registration{

@@ -8,6 +8,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
 #include "ims/trajectory_comparison.hpp"
 #include "tools/command_registry.hpp"
 
@@ -53,7 +54,8 @@ void run(const CompareArgs& args) {
                                  {"velocity", {n[3], n[4], n[5]}},
                                  {"position", {n[6], n[7], n[8]}}};
   }
-  if (!args.json_out.empty()) imscal::write_file_atomically(args.json_out, j.dump(2) + "\n");
+  if (!args.json_out.empty())
+    imscal::write_file_atomically(args.json_out, imscal::json_text(j, 2, args.json_out));
   if (args.max_position_rms_mm >= 0.0 && 1e3 * c.position_rms_m > args.max_position_rms_mm) {
     throw imscal::tools::CheckFailed(
         fmt::format("position error RMS {:.4f} mm exceeds --max-position-rms-mm {:.4f}",

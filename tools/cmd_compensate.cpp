@@ -12,6 +12,7 @@
 #include "calib/robot_log.hpp"
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/output_folder.hpp"
 #include "eval/model_torque.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "ident/precontrol.hpp"
@@ -63,8 +64,8 @@ void run(const CompensateArgs& args) {
     throw imscal::InputError(args.out, 0, "", "output exists; use --force to overwrite it");
   }
   const ident::ParameterTable table = ident::read_parameters_json(args.table);
-  const imscal::calib::RobotLog log =
-      imscal::calib::read_robot_log_csv(args.robot_log, table.robot);
+  const imscal::calib::RobotLog log = imscal::calib::read_robot_log_csv(
+      args.robot_log, table.robot, "the parameter table " + args.table);
   ident::PrecontrolOptions options;
   options.caller_cycle_s = log.cycle_s;
   if (args.offset_tolerance_rad > 0.0) options.offset_tolerance_rad.fill(args.offset_tolerance_rad);
@@ -115,6 +116,9 @@ void run(const CompensateArgs& args) {
                    ident::to_string(events[std::size_t(i)].cause), events[std::size_t(i)].value);
     }
   }
+  // A missing folder of --out is created, as every command creates its output folder.
+  const std::filesystem::path folder = std::filesystem::path(args.out).parent_path();
+  if (!folder.empty()) imscal::create_output_folder(folder);
   imscal::write_file_atomically(
       args.out, csv.str(), args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
   spdlog::info("compensate: {} cycles, {} active, {} events; wrote {}", log.samples.size(), active,

@@ -14,6 +14,7 @@
 #include "calib/robot_description.hpp"
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
 #include "core/output_folder.hpp"
 #include "eval/gap_analysis.hpp"
 #include "eval/gap_report.hpp"
@@ -165,9 +166,10 @@ void run(const DiagnoseArgs& args) {
                signals.joint_count());
   const eval::Diagnosis d = eval::diagnose_gap(signals);
   const std::string text = eval::diagnosis_text(signals, d);
-  imscal::write_file_atomically(folder.staged("report.json"),
-                                eval::diagnosis_json(signals, d).dump(1) + "\n",
-                                imscal::Overwrite::kAllow);
+  imscal::write_file_atomically(
+      folder.staged("report.json"),
+      imscal::json_text(eval::diagnosis_json(signals, d), 1, "diagnosis.json"),
+      imscal::Overwrite::kAllow);
   imscal::write_file_atomically(folder.staged("report.txt"), text, imscal::Overwrite::kAllow);
   if (args.figures) {
     imscal::tools::GnuplotRenderer gnuplot(args.gnuplot_timeout_s);

@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
 #include "core/numeric_table.hpp"
 #include "eval/iso9283_path.hpp"
 #include "eval/path_deviation.hpp"
@@ -128,7 +129,7 @@ void run(const EvaluateArgs& args) {
       max_dev * 1e3);
   if (!args.out.empty()) {
     imscal::write_file_atomically(
-        args.out, out.dump(1) + "\n",
+        args.out, imscal::json_text(out, 1, args.out),
         args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
   }
 }

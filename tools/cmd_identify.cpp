@@ -16,6 +16,8 @@
 #include "core/atomic_file.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
+#include "core/output_folder.hpp"
 #include "core/version.hpp"
 #include "eval/model_torque.hpp"
 #include "eval/transmission_error_order.hpp"
@@ -189,6 +191,106 @@ json joint_report(const ident::JointIdentification& r, double seconds) {
           {"cells", cells}};
 }
 
+// The outputs of this config, relative to --out; written all or nothing.
+std::vector<fs::path> output_names(const ident::IdentificationConfig& config) {
+  std::vector<fs::path> names = {"identification_report.json", "parameters.csv", "parameters.json"};
+  if (config.options.form == ident::ArxModelForm::kInverse)
+    names.emplace_back("forward_parameters.json");
+  return names;
+}
+
+// The order sweep's longest model must leave rows to fit it: a segment needs more samples than
+// the longest lag plus the coefficients, or every cell fits from no rows and corrects nothing.
+void check_orders_fit_record(const ident::JointErrorLog& log,
+                             const ident::IdentificationConfig& config,
+                             const imscal::ConfigNode& config_node, const std::string& file,
+                             const std::string& log_file) {
+  const auto& grid = config.options.grid;
+  const std::size_t longest_lag =
+      std::size_t(std::max(grid.na_max, grid.nb_max + grid.dead_time_max));
+  const std::size_t coefficients = std::size_t(grid.na_max + grid.nb_max);
+  std::size_t longest_segment = 0;
+  for (const auto& [begin, end] : log.segments())
+    longest_segment = std::max(longest_segment, end - begin);
+  if (longest_segment > longest_lag + coefficients) return;
+  const auto order = config_node.optional_child("order");
+  throw imscal::InputError(
+      file, order ? order->line() : 0, "order",
+      fmt::format("the largest model (na {}, nb {}, dead time {}) needs more than {} samples in "
+                  "one segment; the longest segment of {} has {}",
+                  grid.na_max, grid.nb_max, grid.dead_time_max, longest_lag + coefficients,
+                  log_file, longest_segment));
+}
+
+// A payload far above the robot's rating is a wrong column or unit, not a load the robot can
+// carry: the payload cells (fractions of the rating) would hold nothing the precontrol meets.
+constexpr double kMaxPayloadOfRating = 1.5;
+
+void check_payload_plausible(const ident::JointErrorLog& log,
+                             const ident::IdentificationConfig& config,
+                             const std::string& log_file) {
+  const double limit_kg = kMaxPayloadOfRating * config.nominal_payload_kg;
+  for (std::size_t k = 0; k < log.sample_count(); ++k) {
+    if (log.payload_kg[k] <= limit_kg) continue;
+    throw imscal::InputError(
+        log_file, 0, "payload_kg",
+        fmt::format("payload {} kg at t = {} s exceeds {} x the robot's rated {} kg "
+                    "(joints.nominal_payload_kg); is the column in another unit?",
+                    log.payload_kg[k], log.time_s[k], kMaxPayloadOfRating,
+                    config.nominal_payload_kg));
+  }
+}
+
+// A table in which no joint was identified corrects nothing: a failed check, not a result.
+void check_some_joint_identified(const std::vector<ident::JointOutcome>& outcomes,
+                                 const ident::JointErrorLog& log, const std::string& log_file) {
+  std::string reasons;
+  for (std::size_t j = 0; j < outcomes.size(); ++j) {
+    if (outcomes[j].failure.empty()) return;
+    reasons += fmt::format("{}joint {}: {}", reasons.empty() ? "" : "; ", log.joint_names[j],
+                           outcomes[j].failure);
+  }
+  throw imscal::tools::CheckFailed(fmt::format(
+      "{}: no joint could be identified, the table would correct nothing ({})", log_file, reasons));
+}
+
+void print_joint(const ident::JointOutcome& outcome, const std::string& name) {
+  const ident::JointIdentification& r = outcome.result;
+  if (!outcome.failure.empty()) {
+    // No cell of this joint could be identified (e.g. it did not move): the other joints'
+    // models are still good, so this joint has the neutral model (zero correction) and the
+    // table says why, instead of the whole run failing.
+    spdlog::warn("joint {}: not identified, its table holds the neutral model (no correction): {}",
+                 name, outcome.failure);
+  }
+  int identified = 0;
+  for (const auto& c : r.cells) identified += c.status == ident::CellStatus::kIdentified;
+  spdlog::info("joint {}: {}/{} cells identified, backlash l = {:.3g} ± {:.2g} rad, {:.2f} s", name,
+               identified, r.cells.size(), r.parameters.backlash_l_rad,
+               r.parameters.backlash_l_sigma_rad, outcome.seconds);
+  for (const auto& c : r.cells)
+    std::cout << fmt::format(
+        "{:>4} cell {:>2} {:<40} {:<10} {:>14} sim fit {:>7.2f} %  joint error fit {:>7.2f} %\n",
+        name, c.cell, c.label, ident::to_string(c.status),
+        c.sweep ? ident::to_string(c.sweep->chosen) : "-",
+        r.parameters.cells[std::size_t(c.cell)].figures.simulation_fit_percent,
+        r.parameters.cells[std::size_t(c.cell)].figures.joint_error_fit_percent);
+}
+
+// An inverse-form table does not predict the joint error from q_d (the gap diagnosis's "sim"):
+// the paper's forward error model from the same data is written beside it.
+std::optional<ident::ParameterTable> forward_table_of(const ident::JointErrorLog& log,
+                                                      const ident::IdentificationConfig& config,
+                                                      const ident::ParameterTable& table) {
+  if (config.options.form != ident::ArxModelForm::kInverse) return std::nullopt;
+  spdlog::info("identify: the forward error model (paper form) for the gap diagnosis");
+  const ident::IdentificationConfig forward = imscal::eval::paper_form(config);
+  ident::ParameterTable forward_table = ident::parameter_table_header(log, forward, table.source);
+  for (auto& outcome : ident::identify_joints(log, forward))
+    forward_table.joints.push_back(std::move(outcome.result.parameters));
+  return forward_table;
+}
+
 void run(const IdentifyArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   ident::JointErrorLog log = ident::read_joint_errors_csv(args.joint_errors);
@@ -201,15 +303,10 @@ void run(const IdentifyArgs& args) {
         "joints.max_speed_deg_s",
         fmt::format("{} maximum speeds, but {} has {} joints ({})", config.max_speed_rad_s.size(),
                     args.joint_errors, log.joint_count(), fmt::join(log.joint_names, ", ")));
-  const fs::path out_dir(args.out);
-  const fs::path json_path = out_dir / "parameters.json", csv_path = out_dir / "parameters.csv",
-                 report_path = out_dir / "identification_report.json";
-  const auto overwrite = args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse;
-  if (!args.force)
-    for (const auto& p : {json_path, csv_path, report_path, out_dir / "forward_parameters.json"})
-      if (fs::exists(p))
-        throw imscal::InputError(p.string(), 0, "", "output exists; use --force to overwrite it");
-  fs::create_directories(out_dir);
+  check_orders_fit_record(log, config, config_node, args.config, args.joint_errors);
+  check_payload_plausible(log, config, args.joint_errors);
+  imscal::OutputFolder folder(args.out, output_names(config),
+                              args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
   const json order_search = args.search_order ? search_orders(log, args, config) : json(nullptr);
 
   const auto segments = log.segments();
@@ -230,31 +327,11 @@ void run(const IdentifyArgs& args) {
         spdlog::info("joint {} ({}/{}) done", log.joint_names[joint], done, log.joint_count());
       });
   for (std::size_t j = 0; j < log.joint_count(); ++j) {
-    const ident::JointIdentification& r = outcomes[j].result;
-    const double seconds = outcomes[j].seconds;
-    if (!outcomes[j].failure.empty()) {
-      // No cell of this joint could be identified (e.g. it did not move): the other joints'
-      // models are still good, so this joint has the neutral model (zero correction) and the
-      // table says why, instead of the whole run failing.
-      spdlog::warn(
-          "joint {}: not identified, its table holds the neutral model (no correction): {}",
-          log.joint_names[j], outcomes[j].failure);
-    }
-    int identified = 0;
-    for (const auto& c : r.cells) identified += c.status == ident::CellStatus::kIdentified;
-    spdlog::info("joint {}: {}/{} cells identified, backlash l = {:.3g} ± {:.2g} rad, {:.2f} s",
-                 log.joint_names[j], identified, r.cells.size(), r.parameters.backlash_l_rad,
-                 r.parameters.backlash_l_sigma_rad, seconds);
-    for (const auto& c : r.cells)
-      std::cout << fmt::format(
-          "{:>4} cell {:>2} {:<40} {:<10} {:>14} sim fit {:>7.2f} %  joint error fit {:>7.2f} %\n",
-          log.joint_names[j], c.cell, c.label, ident::to_string(c.status),
-          c.sweep ? ident::to_string(c.sweep->chosen) : "-",
-          r.parameters.cells[std::size_t(c.cell)].figures.simulation_fit_percent,
-          r.parameters.cells[std::size_t(c.cell)].figures.joint_error_fit_percent);
-    joints_report.push_back(joint_report(r, seconds));
-    table.joints.push_back(r.parameters);
+    print_joint(outcomes[j], log.joint_names[j]);
+    joints_report.push_back(joint_report(outcomes[j].result, outcomes[j].seconds));
+    table.joints.push_back(outcomes[j].result.parameters);
   }
+  check_some_joint_identified(outcomes, log, args.joint_errors);
   const json report = {
       {"created_by", table.created_by},
       {"joint_errors", args.joint_errors},
@@ -266,23 +343,17 @@ void run(const IdentifyArgs& args) {
       {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
       {"transmission_error_order_search", order_search},
       {"joints", joints_report}};
-  // An inverse-form table does not predict the joint error from q_d (the gap diagnosis's "sim"):
-  // the paper's forward error model from the same data is written beside it.
-  std::optional<ident::ParameterTable> forward_table;
-  if (config.options.form == ident::ArxModelForm::kInverse) {
-    spdlog::info("identify: the forward error model (paper form) for the gap diagnosis");
-    const ident::IdentificationConfig forward = imscal::eval::paper_form(config);
-    forward_table = ident::parameter_table_header(log, forward, table.source);
-    for (auto& outcome : ident::identify_joints(log, forward))
-      forward_table->joints.push_back(std::move(outcome.result.parameters));
-  }
-  // The table last: a reader that sees parameters.json sees a finished run.
-  imscal::write_file_atomically(report_path, report.dump(1) + "\n", overwrite);
+  const std::optional<ident::ParameterTable> forward_table = forward_table_of(log, config, table);
+  const fs::path report_path = folder.folder() / "identification_report.json";
+  imscal::write_file_atomically(folder.staged("identification_report.json"),
+                                imscal::json_text(report, 1, report_path.string()));
   if (forward_table)
-    ident::write_parameters_json(out_dir / "forward_parameters.json", *forward_table, overwrite);
-  ident::write_parameters_csv(csv_path, table, overwrite);
-  ident::write_parameters_json(json_path, table, overwrite);
-  spdlog::info("wrote {}, {}, {}", json_path.string(), csv_path.string(), report_path.string());
+    ident::write_parameters_json(folder.staged("forward_parameters.json"), *forward_table);
+  ident::write_parameters_csv(folder.staged("parameters.csv"), table);
+  ident::write_parameters_json(folder.staged("parameters.json"), table);
+  folder.commit();
+  spdlog::info("wrote {}, {}, {}", (folder.folder() / "parameters.json").string(),
+               (folder.folder() / "parameters.csv").string(), report_path.string());
 }
 
 imscal::tools::CommandRegistration registration{

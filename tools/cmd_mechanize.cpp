@@ -23,6 +23,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/output_folder.hpp"
 #include "ims/coarse_alignment.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/imu_conversion.hpp"
@@ -212,11 +213,14 @@ Outputs check_outputs(const MechanizeArgs& args) {
 
 void write_outputs(const Outputs& o, const std::vector<ims::NavState>& states,
                    const std::vector<ims::NavSigma>* sigmas, bool force) {
-  fs::create_directories(o.csv.parent_path());
-  const imscal::Overwrite overwrite =
-      force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse;
-  ims::write_trajectory_csv(o.csv, states, sigmas, overwrite);
-  ims::write_trajectory_tum(o.tum, states, overwrite);
+  // Both or neither: staged together and published together.
+  const fs::path dir = o.csv.parent_path().empty() ? fs::path(".") : o.csv.parent_path();
+  imscal::OutputFolder folder(dir, {o.csv.filename(), o.tum.filename()},
+                              force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
+  ims::write_trajectory_csv(folder.staged(o.csv.filename()), states, sigmas,
+                            imscal::Overwrite::kAllow);
+  ims::write_trajectory_tum(folder.staged(o.tum.filename()), states, imscal::Overwrite::kAllow);
+  folder.commit();
 }
 
 // --smooth: zero-velocity-aided smoothing instead of the plain mechanization; starts at rest

@@ -19,6 +19,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/output_folder.hpp"
 #include "ims/analytic_trajectory.hpp"
 #include "ims/imu_file.hpp"
 #include "ims/imu_noise.hpp"
@@ -88,19 +89,14 @@ void run(const SynthesizeArgs& args) {
   }
   const fs::path out(args.out);
   const fs::path imu_file = out / ("imu." + args.imu_format);
-  const fs::path trajectory_file = out / "truth" / "trajectory.csv";
-  const fs::path errors_file = out / "truth" / "sensor_errors.yaml";
-  const Overwrite overwrite = args.force ? Overwrite::kAllow : Overwrite::kRefuse;
-  if (!args.force) {
-    for (const fs::path& f : {imu_file, trajectory_file, errors_file}) {
-      if (fs::exists(f)) {
-        throw InputError(f.string(), 0, "", "exists already (use --force to replace it)");
-      }
-    }
-  }
   const auto motion = ims::load_motion_file(args.motion);
   const ims::SensorSpec spec = ims::load_sensor_spec(args.sensor);
   const ims::EarthModel earth(parse_site(args.site));
+  // All three or none: staged, then published together.
+  OutputFolder folder(out,
+                      {imu_file.filename(), fs::path("truth") / "trajectory.csv",
+                       fs::path("truth") / "sensor_errors.yaml"},
+                      args.force ? Overwrite::kAllow : Overwrite::kRefuse);
 
   const ims::ImuSeries ideal = ims::synthesize_ideal_increments(*motion, earth, args.rate_hz);
   // One generator: first the unit's errors, then the seed of its noise.
@@ -112,14 +108,14 @@ void run(const SynthesizeArgs& args) {
                   {"seed", std::to_string(args.seed)},
                   {"generator", "imscal synthesize"}};
 
-  fs::create_directories(out / "truth");
-  ims::write_imu_file(imu_file, raw, overwrite);
-  ims::write_trajectory_csv(trajectory_file, truth_states(*motion, ideal), nullptr, overwrite);
+  ims::write_imu_file(folder.staged(imu_file.filename()), raw, Overwrite::kAllow);
+  ims::write_trajectory_csv(folder.staged(fs::path("truth") / "trajectory.csv"),
+                            truth_states(*motion, ideal), nullptr, Overwrite::kAllow);
   write_file_atomically(
-      errors_file,
+      folder.staged(fs::path("truth") / "sensor_errors.yaml"),
       fmt::format("# Drawn errors of the synthesised unit '{}', seed {}\n", spec.name, args.seed) +
-          ims::to_yaml(errors),
-      overwrite);
+          ims::to_yaml(errors));
+  folder.commit();
   spdlog::info("synthesised {} samples ({:.3f} s at {} Hz) of '{}' into {}", raw.samples.size(),
                motion->end_s() - motion->begin_s(), args.rate_hz, spec.name, out.string());
 }

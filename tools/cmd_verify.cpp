@@ -22,6 +22,8 @@
 #include "core/atomic_file.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
+#include "core/output_folder.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
@@ -139,7 +141,7 @@ std::vector<const eval::VerificationCase*> all_cases(const eval::VerificationRes
 
 void write_scenario(const fs::path& dir, const eval::VerificationResult& r, const VerifyArgs& args,
                     imscal::Overwrite overwrite) {
-  fs::create_directories(dir);
+  imscal::create_output_folder(dir);
   const auto& before = r.before.figures;
   json cases = json::array();
   std::string csv = kCsvHeader, text;
@@ -224,7 +226,9 @@ void write_scenario(const fs::path& dir, const eval::VerificationResult& r, cons
                     {"table", args.table.empty() ? json(nullptr) : json(args.table)},
                     {"measured_by", args.measure_with_ims ? "ims chain" : "true link angles"},
                     {"cases", cases}};
-  imscal::write_file_atomically(dir / "verification.json", doc.dump(1) + "\n", overwrite);
+  imscal::write_file_atomically(dir / "verification.json",
+                                imscal::json_text(doc, 1, (dir / "verification.json").string()),
+                                overwrite);
   imscal::write_file_atomically(dir / "verification.csv", csv, overwrite);
   imscal::write_file_atomically(dir / "verification.txt", text, overwrite);
   std::cout << text;
@@ -304,7 +308,7 @@ void run(const VerifyArgs& args) {
     spdlog::info("verify: simulating {} for the truth joint errors", args.identify_scenario);
     log = eval::simulate_truth_joint_errors(
         imscal::sim::load_scenario(imscal::sim::resolve_scenario(args.identify_scenario)));
-    fs::create_directories(out);
+    imscal::create_output_folder(out);
     source = (out / "joint_errors_truth.csv").string();
     ident::write_joint_errors_csv(source, *log, overwrite);
   }

@@ -18,6 +18,22 @@ fs::path imscal_binary() {
   return fs::read_symlink("/proc/self/exe");
 }
 
+namespace {
+
+// The subcommand names its --out, the stage's hidden staging folder, which is renamed when the
+// stage ends: the message names the folder the user will find.
+std::string with_stage_folder(std::string text, const StageWorkspace& workspace,
+                              const std::string& stage_name) {
+  const std::string staging = workspace.output_dir().string();
+  const std::string visible = (workspace.run_dir() / stage_name).string();
+  for (auto at = text.find(staging); at != std::string::npos;
+       at = text.find(staging, at + visible.size()))
+    text.replace(at, staging.size(), visible);
+  return text;
+}
+
+}  // namespace
+
 StageOutcome SubcommandStage::run(StageWorkspace& workspace) {
   std::vector<std::string> argv = {imscal_binary().string(), spec_.subcommand};
   for (std::string& a : spec_.arguments(workspace, workspace.output_dir()))
@@ -37,7 +53,10 @@ StageOutcome SubcommandStage::run(StageWorkspace& workspace) {
   };
   spdlog::info("{}: {}", tag, fmt::join(argv, " "));
   const SubprocessResult result = run_subprocess(argv, options);
-  const std::string why = last_error.empty() ? result.output : last_error;
+  last_error = with_stage_folder(last_error, workspace, spec_.stage_name);
+  const std::string why = last_error.empty()
+                              ? with_stage_folder(result.output, workspace, spec_.stage_name)
+                              : last_error;
   if (result.timed_out)
     throw std::runtime_error(fmt::format("{}: `imscal {}` did not finish within {} s", tag,
                                          spec_.subcommand, spec_.timeout_s));

@@ -8,6 +8,7 @@
 #include "calib/robot_log.hpp"
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
 #include "ims/imu_file.hpp"
 
 namespace imscal::tools {
@@ -111,7 +112,8 @@ StageOutcome ValidateStage::run(StageWorkspace& workspace) {
                                : "robot log read (no IMS record to overlap)";
   }
   result["check"] = {{"status", to_string(outcome.status)}, {"message", outcome.message}};
-  write_file_atomically(workspace.output_dir() / "validation.json", result.dump(1) + "\n");
+  write_file_atomically(workspace.output_dir() / "validation.json",
+                        imscal::json_text(result, 1, "validation.json"));
   outcome.summary = result.contains("overlap") ? result["overlap"] : json::object();
   return outcome;
 }

@@ -136,6 +136,13 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
       << read(dir_ / "again.log");
   EXPECT_EQ(read(out / "frames.json"), before);
 
+  // --out naming an existing file: bad input (exit 2, as `imscal run` gives), before any work.
+  std::ofstream(dir_ / "a_file") << "not a folder\n";
+  EXPECT_EQ(run(calibrate_arguments(sim, dir_ / "a_file", unit), dir_ / "file_out.log"), 2)
+      << read(dir_ / "file_out.log");
+  EXPECT_NE(read(dir_ / "file_out.log").find("is a file, not a folder"), std::string::npos)
+      << read(dir_ / "file_out.log");
+
   // Bad input: a robot log with a non-numeric joint angle on line 10 -> exit 2 naming the file,
   // the line and the column; nothing written.
   {

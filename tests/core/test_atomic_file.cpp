@@ -56,3 +56,21 @@ TEST(AtomicFile, RefusesToOverwriteWithoutPermission) {
   imscal::write_file_atomically(dir / "out.txt", "second", Overwrite::kAllow);
   EXPECT_EQ(slurp(dir / "out.txt"), "second");
 }
+
+// An output that cannot be written names the target a user will look for (never the hidden
+// staging copy) and the system's reason.
+TEST(AtomicFile, FailureNamesTheTargetAndTheReason) {
+  const fs::path dir = fresh_dir("atomic_reason");
+  std::ofstream(dir / "plain") << "a file, not a folder";
+  const fs::path staged = dir / "plain" / ".imscal-staging-42" / "report.json";
+  EXPECT_EQ(imscal::published_path(staged), dir / "plain" / "report.json");
+  try {
+    imscal::write_file_atomically(staged, "{}");
+    ADD_FAILURE() << "written below a plain file";
+  } catch (const std::runtime_error& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find(".imscal-staging-"), std::string::npos) << message;
+    EXPECT_NE(message.find((dir / "plain" / "report.json").string()), std::string::npos) << message;
+    EXPECT_NE(message.find("Not a directory"), std::string::npos) << message;
+  }
+}

@@ -72,5 +72,24 @@ TEST_F(OutputFolderTest, CommitRefusesAMissingOutputAndUndeclaredFiles) {
   EXPECT_FALSE(fs::exists(dir_ / "a.txt"));  // nothing moved: the set was incomplete
 }
 
+// A folder in the place of the second output (with --force): refused before the first rename, so
+// the command leaves neither output, not one new and one old.
+TEST_F(OutputFolderTest, AFolderInPlaceOfAnOutputStopsTheCommitBeforeAnyRename) {
+  write(dir_ / "a.txt", "old A");
+  fs::create_directories(dir_ / "b.txt" / "inside");
+  OutputFolder out(dir_, {"a.txt", "b.txt"}, Overwrite::kAllow);
+  write(out.staged("a.txt"), "new A");
+  write(out.staged("b.txt"), "new B");
+  EXPECT_THROW(out.commit(), InputError);
+  EXPECT_EQ(read(dir_ / "a.txt"), "old A");
+}
+
+// --out naming a file is a mistake on the command line (exit 2 in every command).
+TEST_F(OutputFolderTest, AFileAsTheFolderIsBadInput) {
+  write(dir_ / "plain", "a file");
+  EXPECT_THROW(OutputFolder(dir_ / "plain", {"a.txt"}, Overwrite::kAllow), InputError);
+  EXPECT_THROW(create_output_folder(dir_ / "plain"), InputError);
+}
+
 }  // namespace
 }  // namespace imscal

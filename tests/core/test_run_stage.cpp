@@ -288,6 +288,14 @@ TEST_F(RunStageTest, KilledMidStageResumesToTheSameBytesAsAnUninterruptedRun) {
   {
     auto c = chain();
     EXPECT_THROW(imscal::run_stages(c.stages, options(run)), imscal::InputError);
+    // Refused with another config and --force too, and without touching run.json (the record of
+    // the run that holds the folder).
+    const std::string record = read_text(run / "run.json");
+    write_text(dir_ / "other.yaml", "# another config\n");
+    RunOptions other = options(run, /*force=*/true);
+    other.config_file = dir_ / "other.yaml";
+    EXPECT_THROW(imscal::run_stages(c.stages, other), imscal::InputError);
+    EXPECT_EQ(read_text(run / "run.json"), record);
   }
   ::kill(child, SIGKILL);
   int status = 0;

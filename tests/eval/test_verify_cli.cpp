@@ -142,6 +142,17 @@ TEST_F(VerifyCli, CompensateWritesOffsetsOrRefusesAnotherRobotsTable) {
             2)
       << read(dir_ / "other.log");
   EXPECT_FALSE(fs::exists(dir_ / "other.csv"));
+  // The refusal names the table as the robot's source, not "the robot description".
+  EXPECT_NE(read(dir_ / "other.log").find("the parameter table"), std::string::npos)
+      << read(dir_ / "other.log");
+  // A missing output folder is created, as every command creates its --out folder.
+  EXPECT_EQ(run("compensate --table " + (dir_ / "zero.json").string() + " --robot-log " +
+                    (dir_ / "robot.csv").string() + " --out " +
+                    (dir_ / "new" / "folder" / "offsets.csv").string(),
+                dir_ / "new_folder.log"),
+            0)
+      << read(dir_ / "new_folder.log");
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "new" / "folder" / "offsets.csv"));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // the held-out data; existing outputs are refused without --force; a bad config is refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -171,6 +172,75 @@ TEST_F(IdentifyCli, JointThatCannotBeIdentifiedGetsTheNeutralModel) {
   ASSERT_EQ(neutral.cells.size(), 1u);
   EXPECT_EQ(neutral.cells[0].status, ident::CellStatus::kNeutral);
   EXPECT_FALSE(neutral.cells[0].reason.empty());
+}
+
+// A log in which no joint moved: a table of neutral models corrects nothing, so identify fails
+// the check (exit 1), names the reason per joint and writes none of its outputs.
+TEST_F(IdentifyCli, NoJointIdentifiedIsAFailedCheckWithoutOutput) {
+  ident::JointErrorLog log = ident::read_joint_errors_csv(dir_ / "joint_errors.csv");
+  for (std::size_t j = 0; j < log.joint_count(); ++j) {
+    std::fill(log.q_desired_rad[j].begin(), log.q_desired_rad[j].end(), 0.25);
+    std::fill(log.q_internal_rad[j].begin(), log.q_internal_rad[j].end(), 0.25);
+    std::fill(log.q_measured_rad[j].begin(), log.q_measured_rad[j].end(), 0.2501);
+  }
+  std::filesystem::remove(dir_ / "joint_errors.csv");
+  ident::write_joint_errors_csv(dir_ / "joint_errors.csv", log);
+  EXPECT_EQ(identify(), 1) << log_text();
+  EXPECT_NE(log_text().find("no joint could be identified"), std::string::npos) << log_text();
+  EXPECT_NE(log_text().find("joint A2:"), std::string::npos) << log_text();
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "out" / "parameters.json"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "out" / "identification_report.json"));
+}
+
+// A '# source:' line in Latin-1 (not UTF-8): the outputs are written, the invalid byte as U+FFFD,
+// with a warning naming the output, instead of a JSON library error after all the work.
+TEST_F(IdentifyCli, LatinOneSourceLineIsWrittenAsReplacementCharacter) {
+  ident::JointErrorLog log = ident::read_joint_errors_csv(dir_ / "joint_errors.csv");
+  log.source =
+      "Messung in der Halle S\xfc"
+      "d";
+  std::filesystem::remove(dir_ / "joint_errors.csv");
+  ident::write_joint_errors_csv(dir_ / "joint_errors.csv", log);
+  ASSERT_EQ(identify(), 0) << log_text();
+  EXPECT_NE(log_text().find("not valid UTF-8"), std::string::npos) << log_text();
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "out" / "identification_report.json"));
+  const ident::ParameterTable table = ident::read_parameters_json(dir_ / "out" / "parameters.json");
+  EXPECT_EQ(table.source.description,
+            "Messung in der Halle S\xef\xbf\xbd"
+            "d");  // U+FFFD
+}
+
+// Plausibility against the record: orders a short record cannot fit (every cell would fit from
+// no rows and correct nothing) and a payload far above the robot's rating are refused (exit 2),
+// naming the field, before any output.
+TEST_F(IdentifyCli, OrdersBeyondTheRecordAndAbsurdPayloadRefused) {
+  ident::JointErrorLog log = ident::read_joint_errors_csv(dir_ / "joint_errors.csv");
+  const std::size_t keep = 150;  // one segment of 150 samples
+  log.time_s.resize(keep);
+  log.payload_kg.resize(keep);
+  for (std::size_t j = 0; j < log.joint_count(); ++j) {
+    log.q_desired_rad[j].resize(keep);
+    log.q_measured_rad[j].resize(keep);
+    log.q_internal_rad[j].resize(keep);
+  }
+  std::filesystem::remove(dir_ / "joint_errors.csv");
+  ident::write_joint_errors_csv(dir_ / "joint_errors.csv", log);
+  std::ofstream(dir_ / "long.yaml")
+      << "imscal-identification-config: 1\n"
+         "joints: {max_speed_deg_s: [60, 60], nominal_payload_kg: 16}\n"
+         "order: {na: [1, 64], nb: [1, 64], dead_time: [0, 8]}\n";
+  EXPECT_EQ(identify("", "long.yaml"), 2) << log_text();
+  EXPECT_NE(log_text().find("long.yaml:3: field 'order'"), std::string::npos) << log_text();
+  EXPECT_NE(log_text().find("has 150"), std::string::npos) << log_text();
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "out"));
+
+  log.payload_kg.assign(keep, 5000.0);
+  std::filesystem::remove(dir_ / "joint_errors.csv");
+  ident::write_joint_errors_csv(dir_ / "joint_errors.csv", log);
+  EXPECT_EQ(identify(), 2) << log_text();
+  EXPECT_NE(log_text().find("field 'payload_kg': payload 5000 kg"), std::string::npos)
+      << log_text();
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "out"));
 }
 
 TEST_F(IdentifyCli, BadConfigRefusedWithoutOutput) {

@@ -61,7 +61,8 @@ ident::JointErrorLog random_log() {
     log.payload_kg.push_back(5.0);
     for (std::size_t j = 0; j < 3; ++j) {
       log.q_desired_rad[j].push_back(normal(rng));
-      log.q_measured_rad[j].push_back(normal(rng) * 1e-7);
+      // Joint errors of a robot: about 1e-3 rad (the reader refuses beyond 0.5 rad).
+      log.q_measured_rad[j].push_back(log.q_desired_rad[j].back() + normal(rng) * 1e-3);
       log.q_internal_rad[j].push_back(std::ldexp(normal(rng), -40));
     }
   }
@@ -120,6 +121,15 @@ TEST_F(JointErrorFiles, BadInputsRefused) {
   expect_refused(kHeader + row + "0.002,5,0.1,0.2,0.1,0.2,0.1,0.2,9\n", 6, "",
                  "more than the 8 columns");
   expect_refused(kHeader + row + "0,5,0.1,0.2,0.1,0.2,0.1,0.2\n", 6, "t_s", "does not increase");
+  // Corrupted but finite samples, as real controller logs hold: refused with line and column
+  // instead of becoming the table's offset envelope or turning the joint neutral.
+  expect_refused(kHeader + row + "0.002,5,0.1,0.2,253,0.2,0.1,0.2\n", 6, "q_measured_A1_rad",
+                 "a corrupted sample");
+  expect_refused(kHeader + row + "0.002,5,0.1,1e282,0.1,0.2,0.1,0.2\n", 6, "q_measured_A2_rad",
+                 "a corrupted sample");
+  // Jitter: a step of 0.4 cycles (the robot log's rule, so compensate refuses the same log).
+  expect_refused(kHeader + row + "0.0008,5,0.1,0.2,0.1,0.2,0.1,0.2\n", 6, "t_s",
+                 "less than half the cycle");
   expect_refused(kHeader + row + "0.002,-1,0.1,0.2,0.1,0.2,0.1,0.2\n", 6, "payload_kg",
                  "negative payload");
   expect_refused(kHeader, 4, "", "no samples");

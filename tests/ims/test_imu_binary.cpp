@@ -227,6 +227,21 @@ TEST_F(ImuBinary, NanRecordNamesRecordAndField) {
   EXPECT_EQ(field, "dv_y_m_s");
 }
 
+// Records are decoded in chunks of 4096: the total in the message is the file's, not the chunk's.
+TEST_F(ImuBinary, NanRecordOfALongFileNamesTheFileTotal) {
+  const fs::path whole = dir_ / "long.imsb";
+  write_imu_binary(whole, make_series(10000, 0.002, ImuQuantity::kIncrements, 9),
+                   Overwrite::kAllow);
+  std::string b = bytes_of(whole);
+  const std::size_t header = b.size() - 10000 * 56;
+  const double nan = std::nan("");
+  std::memcpy(b.data() + header + 101 * 56 + 1 * 8, &nan, 8);  // record 102, dtheta_x
+  write_bytes(dir_ / "nan.imsb", b);
+  std::string field;
+  const std::string message = error_of(dir_ / "nan.imsb", &field);
+  EXPECT_NE(message.find("record 102 of 10000"), std::string::npos) << message;
+}
+
 TEST_F(ImuBinary, FailedWritesLeaveNothingBehind) {
   ImuSeries s = make_series(100, 0.01, ImuQuantity::kRates, 5);
   s.samples[99].t_s = INFINITY;

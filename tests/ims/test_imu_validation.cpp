@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -66,6 +67,7 @@ const char* const kBadCases[] = {
     "acc_in_mg",
     "increments_holding_rates",
     "gyro_in_deg_s",
+    "byte_order_mark_bad_quantity",
 };
 
 struct Expected {
@@ -163,6 +165,52 @@ ImuSeries rest_series(std::size_t n, double dt, double gravity_m_s2) {
                                   Eigen::Vector3d(0, 1e-3 * std::cos(k), gravity_m_s2)});
   }
   return s;
+}
+
+// A UTF-8 byte-order mark (some editors write one) is skipped with a warning: the record reads as
+// the same file without it, sample for sample.
+// A file that is not an imscal CSV is refused from its first byte, before the reader maps and
+// pages in the rest: a sparse file of 8 GiB is refused at once (paging it in would take minutes).
+TEST(ImuValidation, HugeForeignFileIsRefusedFromItsFirstLine) {
+  const fs::path file =
+      fs::temp_directory_path() / fmt::format("imscal-test-imu-sparse-{}.csv", ::getpid());
+  { std::ofstream(file, std::ios::binary) << ""; }
+  fs::resize_file(file, std::uintmax_t{8} << 30);  // zeros, no disk blocks
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    imscal::ims::read_imu_csv(file);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 1u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not an imscal IMU CSV file"), std::string::npos)
+        << e.what();
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  fs::remove(file);
+  EXPECT_LT(seconds, 1.0);
+}
+
+TEST(ImuValidation, ByteOrderMarkIsSkippedWithAWarning) {
+  const ImuSeries series = rest_series(200, 0.01, 9.80665);
+  const fs::path folder =
+      fs::temp_directory_path() / fmt::format("imscal-test-imu-bom-{}", ::getpid());
+  fs::create_directories(folder);
+  const std::string text = imscal::ims::format_imu_csv(series);
+  std::ofstream(folder / "plain.csv", std::ios::binary) << text;
+  std::ofstream(folder / "marked.csv", std::ios::binary) << "\xEF\xBB\xBF" << text;
+  ImuReadReport report;
+  const ImuSeries plain = imscal::ims::read_imu_csv(folder / "plain.csv");
+  const ImuSeries marked = imscal::ims::read_imu_csv(folder / "marked.csv", {}, &report);
+  fs::remove_all(folder);
+  ASSERT_EQ(marked.samples.size(), plain.samples.size());
+  for (std::size_t i = 0; i < plain.samples.size(); ++i) {
+    EXPECT_EQ(marked.samples[i].t_s, plain.samples[i].t_s);
+    EXPECT_EQ(marked.samples[i].gyro, plain.samples[i].gyro);
+    EXPECT_EQ(marked.samples[i].acc, plain.samples[i].acc);
+  }
+  ASSERT_FALSE(report.warnings.empty());
+  EXPECT_NE(report.warnings.front().find("byte-order mark"), std::string::npos);
 }
 
 TEST(ImuValidation, StatisticsOfAJitteredRecord) {

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "tests/support/scratch_dir.hpp"
 #include "tests/tools/run_campaign.hpp"
@@ -136,6 +138,29 @@ TEST_F(RunCli, ExitCodesNameTheReason) {
   EXPECT_EQ(run(config.parent_path() / "run.yaml", dir_ / "apart", "--force"), 2) << log();
   EXPECT_NE(log().find("do not overlap in time"), std::string::npos) << log();
   EXPECT_FALSE(fs::exists(dir_ / "apart" / "validate"));
+}
+
+// A log in which no joint moved: the identify stage's table would correct nothing, so the run
+// ends with a failed check (exit 1) that says why, instead of "identify: ok".
+TEST_F(RunCli, IdentificationThatCorrectsNothingIsAFailedCheck) {
+  const fs::path config = imscal::test_support::write_campaign(dir_);
+  imscal::ident::JointErrorLog errors =
+      imscal::ident::read_joint_errors_csv(dir_ / "joint_errors.csv");
+  for (std::size_t j = 0; j < errors.joint_count(); ++j) {
+    std::fill(errors.q_desired_rad[j].begin(), errors.q_desired_rad[j].end(), 0.25);
+    std::fill(errors.q_internal_rad[j].begin(), errors.q_internal_rad[j].end(), 0.25);
+    std::fill(errors.q_measured_rad[j].begin(), errors.q_measured_rad[j].end(), 0.2501);
+  }
+  fs::remove(dir_ / "joint_errors.csv");
+  imscal::ident::write_joint_errors_csv(dir_ / "joint_errors.csv", errors);
+  EXPECT_EQ(run(config, dir_ / "out"), 1) << log();
+  EXPECT_NE(log().find("no joint could be identified"), std::string::npos) << log();
+  // The refusal names files the user can find, not the stage's hidden staging folder.
+  const std::string text = log();
+  const auto at = text.find("no joint could be identified");
+  const std::string refusal = text.substr(text.rfind('\n', at) + 1, text.find('\n', at) - at);
+  EXPECT_EQ(refusal.find(".staging-"), std::string::npos) << refusal;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "identify" / "parameters.json"));
 }
 
 TEST_F(RunCli, KilledDuringIdentificationResumesToTheSameOutputs) {

@@ -47,12 +47,16 @@ case("empty", [], 0, "", "the file is empty", "an empty file")
 case("no_header_row", header(), 3, "", "no header line", "only comment lines, no column names")
 case("missing_version", header(version=None) + [",".join(COLS)] + rows(), 0, "imscal-robot-log",
      "missing header line", "no '# imscal-robot-log' line")
-case("unknown_version", header(version="7") + [",".join(COLS)] + rows(), 0, "imscal-robot-log",
+case("unknown_version", header(version="7") + [",".join(COLS)] + rows(), 1, "imscal-robot-log",
      "unknown version '7'", "a future version")
-case("other_robot", header(robot="kr6") + [",".join(COLS)] + rows(), 0, "robot",
+case("other_robot", header(robot="kr6") + [",".join(COLS)] + rows(), 2, "robot",
      "the log is of robot 'kr6'", "a log of another robot")
-case("bad_cycle", header(cycle="2ms") + [",".join(COLS)] + rows(), 0, "cycle_s",
+case("bad_cycle", header(cycle="2ms") + [",".join(COLS)] + rows(), 3, "cycle_s",
      "is not a cycle time", "cycle with a unit in the value")
+with_mark = header(cycle="-0.002")
+with_mark[0] = "\ufeff" + with_mark[0]
+case("byte_order_mark_negative_cycle", with_mark + [",".join(COLS)] + rows(), 3, "cycle_s",
+     "is not a cycle time", "a UTF-8 byte-order mark (skipped), then a negative cycle time")
 missing = [c for c in COLS if c != "q_internal_A4_rad"]
 case("missing_column", header() + [",".join(missing)] +
      [",".join(r[:11] + r[12:]) for r in (row(k) for k in range(6))], 4, "q_internal_A4_rad",

@@ -1,0 +1,15 @@
+#pragma once
+// JSON read from a user's file. nlohmann keeps the last of two equal keys in one object without a
+// word; a hand-edited table with a joint's key given twice would then use one of them silently,
+// so the reader refuses it, naming the line of the second one.
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace imscal {
+
+// The parsed document. nlohmann::json::parse_error on a syntax error (the caller words it);
+// InputError (origin, line, key) when a key appears twice in one object.
+nlohmann::json parse_json_refusing_duplicate_keys(const std::string& text,
+                                                  const std::string& origin);
+
+}  // namespace imscal
