@@ -21,13 +21,7 @@ ParameterTable parameter_table_header(const JointErrorLog& log, const Identifica
   table.model_form =
       config.options.form == ArxModelForm::kInverse ? TableForm::kInverse : TableForm::kForward;
   table.preview_cycles = config.options.preview_cycles;
-  if (config.options.model_torque_input) table.extra_inputs.push_back(TableInput::kModelTorque);
-  if (config.options.direction_input) table.extra_inputs.push_back(TableInput::kDirection);
-  if (config.options.torque_sign_input) table.extra_inputs.push_back(TableInput::kTorqueSign);
-  if (config.options.transmission_error_input) {
-    table.extra_inputs.push_back(TableInput::kTransmissionErrorSin);
-    table.extra_inputs.push_back(TableInput::kTransmissionErrorCos);
-  }
+  table.extra_inputs = extra_inputs_of(config.options);
   table.direction_speed_scale_rad_s = config.options.direction_speed_scale_rad_s;
   table.source = std::move(source);
   return table;

@@ -167,6 +167,28 @@ struct FitSignals {
   }
 };
 
+// The further inputs' values at every sample of the segments, input after input, along the
+// path `driver` (its speed over one cycle, 0 at a segment's first sample) with the model torque
+// (0 when not given).
+std::vector<std::vector<double>> exogenous_signals(
+    std::span<const TableInput> inputs, const ExogenousParameters& parameters,
+    std::span<const double> driver, std::span<const double> model_torque_nm,
+    std::span<const std::pair<std::size_t, std::size_t>> segments, double cycle_s) {
+  const std::size_t n = driver.size();
+  std::vector<std::vector<double>> values(inputs.size(), std::vector<double>(n, 0.0));
+  std::array<double, kMaxExtraInputs> sample_values{};
+  for (const auto& [begin, end] : segments)
+    for (std::size_t k = begin; k < end; ++k) {
+      ExogenousSample sample;
+      sample.angle_rad = driver[k];
+      sample.speed_rad_s = k > begin ? (driver[k] - driver[k - 1]) / cycle_s : 0.0;
+      sample.model_torque_nm = model_torque_nm.empty() ? 0.0 : model_torque_nm[k];
+      exogenous_values(inputs, parameters, sample, sample_values.data());
+      for (std::size_t e = 0; e < inputs.size(); ++e) values[e][k] = sample_values[e];
+    }
+  return values;
+}
+
 bool is_error_form(const JointIdentificationOptions& options) {
   return options.form == ArxModelForm::kJointError || options.form == ArxModelForm::kInverse;
 }
@@ -191,37 +213,16 @@ FitSignals make_fit_signals(std::span<const double> q_desired, std::span<const d
       for (std::size_t k = begin; k + preview < end; ++k)
         if (k + preview > begin) s.input[k] = driver[k + preview] - driver[k + preview - 1];
   }
-  auto ahead = [&](std::span<const double> signal, std::vector<double>& out) {
-    out.resize(n);
+  const std::vector<TableInput> inputs = extra_inputs_of(options);
+  const std::vector<std::vector<double>> values =
+      exogenous_signals(inputs, exogenous_parameters(options, torque_sign_scale_nm), driver,
+                        model_torque_nm, segments, cycle_s);
+  s.extra_count = int(inputs.size());
+  for (std::size_t e = 0; e < inputs.size(); ++e) {
+    s.extra[e].resize(n);
     for (const auto& [begin, end] : segments)
-      for (std::size_t k = begin; k < end; ++k) out[k] = signal[std::min(k + preview, end - 1)];
-  };
-  if (options.model_torque_input) ahead(model_torque_nm, s.extra[std::size_t(s.extra_count++)]);
-  if (options.direction_input) {
-    std::vector<double> direction(n, 0.0);
-    for (const auto& [begin, end] : segments)
-      for (std::size_t k = begin + 1; k < end; ++k)
-        direction[k] =
-            std::tanh((driver[k] - driver[k - 1]) / cycle_s / options.direction_speed_scale_rad_s);
-    ahead(direction, s.extra[std::size_t(s.extra_count++)]);
-  }
-  if (options.torque_sign_input) {
-    std::vector<double> side(n);
-    for (std::size_t k = 0; k < n; ++k)
-      side[k] = std::tanh(model_torque_nm[k] / torque_sign_scale_nm);
-    ahead(side, s.extra[std::size_t(s.extra_count++)]);
-  }
-  if (options.transmission_error_input) {
-    const double f = options.transmission_error_rad_per_rad;
-    const double compliance = options.transmission_error_compliance_rad_per_nm;
-    std::vector<double> sine(n), cosine(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      const double motor = driver[k] + (compliance != 0.0 ? compliance * model_torque_nm[k] : 0.0);
-      sine[k] = std::sin(f * motor);
-      cosine[k] = std::cos(f * motor);
-    }
-    ahead(sine, s.extra[std::size_t(s.extra_count++)]);
-    ahead(cosine, s.extra[std::size_t(s.extra_count++)]);
+      for (std::size_t k = begin; k < end; ++k)
+        s.extra[e][k] = values[e][std::min(k + preview, end - 1)];
   }
   return s;
 }
@@ -288,9 +289,44 @@ ArxModel angle_form_of_error_model(const ArxModel& error_model) {
   return ArxModel(angle, error_model.a(), b, c, error_model.sample_time_s());
 }
 
+std::vector<TableInput> extra_inputs_of(const JointIdentificationOptions& options) {
+  std::vector<TableInput> inputs;
+  if (options.model_torque_input) inputs.push_back(TableInput::kModelTorque);
+  if (options.direction_input) inputs.push_back(TableInput::kDirection);
+  if (options.torque_sign_input) inputs.push_back(TableInput::kTorqueSign);
+  if (options.transmission_error_input) {
+    inputs.push_back(TableInput::kTransmissionErrorSin);
+    inputs.push_back(TableInput::kTransmissionErrorCos);
+  }
+  return inputs;
+}
+
 int extra_input_count(const JointIdentificationOptions& options) {
-  return int(options.model_torque_input) + int(options.direction_input) +
-         int(options.torque_sign_input) + 2 * int(options.transmission_error_input);
+  return int(extra_inputs_of(options).size());
+}
+
+int extra_input_taps(TableInput input, const JointIdentificationOptions& options) {
+  switch (input) {
+    case TableInput::kModelTorque:
+    case TableInput::kDirection:
+      return options.input_taps;
+    case TableInput::kTorqueSign:
+      return options.torque_sign_taps;
+    case TableInput::kTransmissionErrorSin:
+    case TableInput::kTransmissionErrorCos:
+      return options.transmission_error_taps;
+  }
+  return options.input_taps;
+}
+
+ExogenousParameters exogenous_parameters(const JointIdentificationOptions& options,
+                                         double torque_sign_scale_nm) {
+  ExogenousParameters p;
+  p.direction_speed_scale_rad_s = options.direction_speed_scale_rad_s;
+  p.torque_sign_scale_nm = torque_sign_scale_nm;
+  p.transmission_error_rad_per_rad = options.transmission_error_rad_per_rad;
+  p.transmission_error_compliance_rad_per_nm = options.transmission_error_compliance_rad_per_nm;
+  return p;
 }
 
 JointParameters neutral_joint_parameters(const std::string& name, double max_speed_rad_s,
@@ -433,18 +469,9 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
 
   OrderSelectionOptions sweep_options;
   sweep_options.grid = options.grid;
-  {  // the further inputs' taps, in the order they were added above
-    int e = 0;
-    if (options.model_torque_input)
-      sweep_options.grid.extra_taps[std::size_t(e++)] = options.input_taps;
-    if (options.direction_input)
-      sweep_options.grid.extra_taps[std::size_t(e++)] = options.input_taps;
-    if (options.torque_sign_input)
-      sweep_options.grid.extra_taps[std::size_t(e++)] = options.torque_sign_taps;
-    if (options.transmission_error_input)
-      for (int pair = 0; pair < 2; ++pair)
-        sweep_options.grid.extra_taps[std::size_t(e++)] = options.transmission_error_taps;
-  }
+  const std::vector<TableInput> inputs = extra_inputs_of(options);
+  for (std::size_t e = 0; e < inputs.size(); ++e)
+    sweep_options.grid.extra_taps[e] = extra_input_taps(inputs[e], options);
   sweep_options.criterion = options.criterion;
   sweep_options.min_relative_pivot = options.min_relative_pivot;
   sweep_options.final_fit = options.fit;

@@ -166,8 +166,16 @@ JointParameters neutral_joint_parameters(const std::string& name, double max_spe
 JointIdentification neutral_joint_identification(const std::string& name, double max_speed_rad_s,
                                                  const std::string& reason, int extra_inputs = 0);
 
-// The number of further inputs the options switch on (the transmission error counts twice).
+// The further inputs the options switch on (ident/exogenous_inputs.hpp), in the order of the
+// table and of the fit: model torque, direction, torque sign, transmission-error sin and cos.
+std::vector<TableInput> extra_inputs_of(const JointIdentificationOptions& options);
+// The number of them (the transmission error counts twice).
 int extra_input_count(const JointIdentificationOptions& options);
+// The taps the options give one of them (OrderGrid::extra_taps).
+int extra_input_taps(TableInput input, const JointIdentificationOptions& options);
+// The constants of the inputs for one joint, with the torque-sign scale found from its data.
+ExogenousParameters exogenous_parameters(const JointIdentificationOptions& options,
+                                         double torque_sign_scale_nm);
 
 // segments: [begin, end) ranges of separate runs. model_torque_nm: the joint's model torque per
 // sample (needed with options.model_torque_input), along q_desired in the forward forms and

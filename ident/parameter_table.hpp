@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "ident/arx_model.hpp"
+#include "ident/exogenous_inputs.hpp"
 #include "ident/operating_point.hpp"
 
 namespace imscal::ident {
@@ -27,25 +28,8 @@ inline constexpr int kParameterTableSchemaVersion = 3;
 enum class TableForm { kForward, kInverse };
 const char* to_string(TableForm form);
 
-// The further inputs of the cells' models (ident/joint_identification.hpp), in the order the
-// table lists them: the model torque of the joint [N m] from the caller, the direction of motion
-// tanh(q̇_x / direction_speed_scale) from the precontrol's own input x, and the side of the gear
-// the model torque presses on, tanh(torque / torque_sign_scale of the joint), and the gear's
-// angle-transmission error as the pair sin(f x), cos(f x) of the precontrol's input x with the
-// joint's transmission_error_rad_per_rad f (harmonic x gear ratio: the phase of the error advances
-// f rad per rad of joint angle).
-enum class TableInput {
-  kModelTorque,
-  kDirection,
-  kTorqueSign,
-  kTransmissionErrorSin,
-  kTransmissionErrorCos
-};
-inline constexpr TableInput kTableInputs[] = {
-    TableInput::kModelTorque, TableInput::kDirection, TableInput::kTorqueSign,
-    TableInput::kTransmissionErrorSin, TableInput::kTransmissionErrorCos};
-// "model_torque", "direction", "torque_sign", "transmission_error_sin", "transmission_error_cos"
-const char* to_string(TableInput input);
+// The further inputs of the cells' models (TableInput, their names and values):
+// ident/exogenous_inputs.hpp.
 
 enum class CellStatus {
   kIdentified,  // fitted from this cell's own rows

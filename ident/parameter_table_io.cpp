@@ -37,22 +37,6 @@ const char* to_string(TableForm form) {
   return form == TableForm::kInverse ? "inverse" : "forward";
 }
 
-const char* to_string(TableInput input) {
-  switch (input) {
-    case TableInput::kModelTorque:
-      return "model_torque";
-    case TableInput::kDirection:
-      return "direction";
-    case TableInput::kTorqueSign:
-      return "torque_sign";
-    case TableInput::kTransmissionErrorSin:
-      return "transmission_error_sin";
-    case TableInput::kTransmissionErrorCos:
-      return "transmission_error_cos";
-  }
-  return "?";
-}
-
 ArxModel CellParameters::model(double sample_time_s) const {
   return ArxModel(structure, Eigen::Map<const Eigen::VectorXd>(a.data(), Eigen::Index(a.size())),
                   Eigen::Map<const Eigen::VectorXd>(b.data(), Eigen::Index(b.size())),
@@ -288,6 +272,19 @@ CellParameters read_cell(const Node& n, const CellGrid& grid, double sample_time
   return c;
 }
 
+// A further input by its name (ident/exogenous_inputs.hpp).
+TableInput read_input(const Node& n) {
+  const std::string name = n.string();
+  std::string expected;
+  for (int k = 0; k < kExogenousInputKindCount; ++k) {
+    const ExogenousInputKind& kind = kExogenousInputKinds[k];
+    if (name == kind.name) return kind.input;
+    expected += k == 0 ? "" : k + 1 < kExogenousInputKindCount ? ", " : " or ";
+    expected += fmt::format("'{}'", kind.name);
+  }
+  n.fail("expected " + expected + ", got '" + name + "'");
+}
+
 // extra_inputs: the table's further inputs (-1: schema version 1); torque_sign: whether one of
 // them is the torque's sign (the joint then needs its scale); transmission_error: whether the
 // transmission-error pair is (the joint then needs its phase rate; the key from version 3 on).
@@ -505,21 +502,11 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
       r.child("preview_cycles").fail("only an inverse-form table has a preview");
     t.preview_cycles = int(preview);
     const Node inputs = r.child("extra_inputs");
-    for (const Node& i : inputs.items()) {
-      const std::string name = i.string();
-      const auto* kind = std::find_if(std::begin(kTableInputs), std::end(kTableInputs),
-                                      [&](TableInput k) { return name == to_string(k); });
-      if (kind == std::end(kTableInputs))
-        i.fail(
-            "expected 'model_torque', 'direction', 'torque_sign', 'transmission_error_sin' or "
-            "'transmission_error_cos', got '" +
-            name + "'");
-      t.extra_inputs.push_back(*kind);
-    }
-    for (std::size_t e = 0; e < t.extra_inputs.size(); ++e)
-      if (t.schema_version < 3 && (t.extra_inputs[e] == TableInput::kTransmissionErrorSin ||
-                                   t.extra_inputs[e] == TableInput::kTransmissionErrorCos))
-        inputs.fail("the transmission-error inputs need schema version 3");
+    for (const Node& i : inputs.items()) t.extra_inputs.push_back(read_input(i));
+    for (const TableInput input : t.extra_inputs)
+      if (t.schema_version < kind_of(input).since_schema_version)
+        inputs.fail(fmt::format("the {} inputs need schema version {}", kind_of(input).family,
+                                kind_of(input).since_schema_version));
     if (t.extra_inputs.size() > std::size_t(kMaxExtraInputs))
       inputs.fail(fmt::format("at most {} further inputs", kMaxExtraInputs));
     for (std::size_t a = 0; a < t.extra_inputs.size(); ++a)

@@ -68,29 +68,11 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
   if (table.extra_inputs.size() > std::size_t(kArxStepMaxExtras))
     return refuse("at most " + std::to_string(kArxStepMaxExtras) + " further inputs supported");
   p.extra_count_ = static_cast<int>(table.extra_inputs.size());
-  for (int e = 0; e < p.extra_count_; ++e) {
-    switch (table.extra_inputs[std::size_t(e)]) {
-      case TableInput::kModelTorque:
-        p.torque_input_ = e;
-        break;
-      case TableInput::kDirection:
-        p.direction_input_ = e;
-        break;
-      case TableInput::kTorqueSign:
-        p.torque_sign_input_ = e;
-        break;
-      case TableInput::kTransmissionErrorSin:
-        p.te_sin_input_ = e;
-        break;
-      case TableInput::kTransmissionErrorCos:
-        p.te_cos_input_ = e;
-        break;
-    }
-  }
-  if (p.torque_sign_input_ >= 0 && p.torque_input_ < 0)
-    return refuse("the torque-sign input needs the model torque input");
+  std::copy(table.extra_inputs.begin(), table.extra_inputs.end(), p.inputs_.begin());
+  p.needs_torque_ = has_input(table.extra_inputs, TableInput::kModelTorque);
+  if (const std::string problem = exogenous_inputs_problem(table.extra_inputs); !problem.empty())
+    return refuse(problem);
   if (!(table.direction_speed_scale_rad_s > 0.0)) return refuse("direction scale must be > 0");
-  p.direction_scale_ = table.direction_speed_scale_rad_s;
   const double up = c / T, down = T / c;
   if (std::abs(up - std::round(up)) < 1e-9 * up && std::round(up) >= 1 && std::round(up) <= 8) {
     p.steps_per_call_ = static_cast<int>(std::round(up));
@@ -143,20 +125,11 @@ bool Precontrol::create(const ParameterTable& table, const std::string& robot,
                     " samples exceeds the supported " + std::to_string(kSpeedRing - 1));
     }
     joint.backlash_lag = static_cast<int>(source.backlash_lag_samples);
-    joint.torque_sign_scale_nm = source.torque_sign_scale_nm;
-    if (p.torque_sign_input_ >= 0 && !(joint.torque_sign_scale_nm > 0.0))
-      return refuse(name + "the torque-sign input needs a scale > 0");
-    joint.transmission_error_rad_per_rad = source.transmission_error_rad_per_rad;
-    joint.transmission_error_compliance = source.transmission_error_compliance_rad_per_nm;
-    if (!(joint.transmission_error_compliance >= 0.0 &&
-          std::isfinite(joint.transmission_error_compliance)))
-      return refuse(name + "the transmission error's compliance must be finite and >= 0");
-    if (joint.transmission_error_compliance > 0.0 && p.torque_input_ < 0)
-      return refuse(name + "the transmission error's compliance needs the model torque input");
-    if ((p.te_sin_input_ >= 0 || p.te_cos_input_ >= 0) &&
-        !(joint.transmission_error_rad_per_rad > 0.0 &&
-          std::isfinite(joint.transmission_error_rad_per_rad)))
-      return refuse(name + "the transmission-error inputs need a phase rate > 0");
+    joint.exogenous = exogenous_parameters(table, source);
+    if (const std::string problem =
+            exogenous_parameters_problem(table.extra_inputs, joint.exogenous);
+        !problem.empty())
+      return refuse(name + problem);
     for (int k = 0; k < joint.cells; ++k) {
       const CellParameters& cell = source.cells[k];
       ArxCellCoefficients& model = joint.model[k];
@@ -227,16 +200,8 @@ std::array<double, kArxStepMaxExtras> Precontrol::extra_values(const JointModel&
                                                                double speed,
                                                                double torque) const noexcept {
   std::array<double, kArxStepMaxExtras> value{};
-  if (torque_input_ >= 0) value[torque_input_] = torque;
-  if (direction_input_ >= 0) value[direction_input_] = std::tanh(speed / direction_scale_);
-  if (torque_sign_input_ >= 0)
-    value[torque_sign_input_] = std::tanh(torque / joint.torque_sign_scale_nm);
-  if (te_sin_input_ >= 0 || te_cos_input_ >= 0) {
-    const double phase =
-        joint.transmission_error_rad_per_rad * (x + joint.transmission_error_compliance * torque);
-    if (te_sin_input_ >= 0) value[te_sin_input_] = std::sin(phase);
-    if (te_cos_input_ >= 0) value[te_cos_input_] = std::cos(phase);
-  }
+  exogenous_values(std::span(inputs_.data(), std::size_t(extra_count_)), joint.exogenous,
+                   ExogenousSample{x, speed, torque}, value.data());
   return value;
 }
 

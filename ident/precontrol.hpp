@@ -124,7 +124,7 @@ class Precontrol {
                          double payload_kg,
                          const std::array<double, kPrecontrolJoints>& model_torque_nm,
                          std::uint64_t cycle_counter) noexcept;
-  bool needs_model_torque() const noexcept { return torque_input_ >= 0; }
+  bool needs_model_torque() const noexcept { return needs_torque_; }
 
   // Explicit re-activation after a deactivation: the models restart from the current desired
   // values (at rest: zero error) and the offsets rise smoothly from zero.
@@ -166,9 +166,7 @@ class Precontrol {
     std::array<int, 4> centre_count{};
     std::array<double, 4> lower{}, upper{};  // grid bounds (outside: event)
     double backlash_l_rad = 0.0;
-    double torque_sign_scale_nm = 0.0;            // of the torque-sign input [N m]
-    double transmission_error_rad_per_rad = 0.0;  // phase rate of the transmission-error pair
-    double transmission_error_compliance = 0.0;   // 1 / k [rad/(N m)]
+    ExogenousParameters exogenous;  // the constants of the further inputs
     // The identification's direction of motion is the desired velocity `backlash_lag` cycles
     // earlier (ident/backlash_identification.hpp): a ring of past speeds [rad/s].
     int backlash_lag = 0;
@@ -186,8 +184,8 @@ class Precontrol {
 
   void model_step(JointModel& joint, double q_desired, double speed, double acceleration,
                   double payload, double torque, bool& outside) noexcept;
-  // The further inputs' values of a model step at input x [rad] (model torque, direction,
-  // torque sign, transmission-error pair), table order.
+  // The further inputs' values of a model step at input x [rad] (ident/exogenous_inputs.hpp),
+  // table order.
   std::array<double, kArxStepMaxExtras> extra_values(const JointModel& joint, double x,
                                                      double speed, double torque) const noexcept;
   void restart_models(const std::array<double, kPrecontrolJoints>& q_desired,
@@ -209,13 +207,9 @@ class Precontrol {
   std::array<double, kPrecontrolJoints> last_q_{};
   std::array<double, kPrecontrolJoints> last_torque_{};
   std::array<double, kPrecontrolJoints> last_speed_{};
-  int extra_count_ = 0;         // further inputs of every cell's model
-  int torque_input_ = -1;       // index of the model torque among them, -1: none
-  int direction_input_ = -1;    // index of the direction, -1: none
-  int torque_sign_input_ = -1;  // index of the torque's sign, -1: none
-  int te_sin_input_ = -1;       // indices of the transmission-error pair, -1: none
-  int te_cos_input_ = -1;
-  double direction_scale_ = 0.01;  // [rad/s]
+  int extra_count_ = 0;                                 // further inputs of every cell's model
+  std::array<TableInput, kArxStepMaxExtras> inputs_{};  // the first extra_count_: table order
+  bool needs_torque_ = false;                           // one of them is the model torque
   double last_payload_ = 0.0;
   bool started_ = false;
   std::uint64_t last_cycle_ = 0;

@@ -5,12 +5,11 @@
 // that the faster runtime is compared with: by tests/ident/test_precontrol*.cpp (same offsets
 // within a stated tolerance) and by bench/bench_precontrol.cpp (before/after cycle times in the
 // same run). Not for production use.
-// Extended since by the further inputs of the multi-input models as ident/precontrol.hpp defines
-// them (commit 29523ed: model torque from the caller, direction tanh(q̇ / scale), torque sign
-// tanh(torque / joint scale); started at the steady state of the pose's torque; lost cycles
-// bridged with the last torque), written here again from that definition: Σ_j c_e,j x_e(k-d-j)
-// over the nx_e coefficients of input e, in the runtime's table order. And since the twelfth
-// round by the transmission-error pair sin(f (x + τ / k)), cos(f (x + τ / k)) of the input x.
+// Extended by the further inputs of the multi-input models: their values from the one definition
+// of ident/exogenous_inputs.hpp (exogenous_values, as the runtime and the identification), their
+// sums written here again: Σ_j c_e,j x_e(k-d-j) over the nx_e coefficients of input e, in the
+// table order; started at the steady state of the pose's torque; lost cycles bridged with the
+// last torque.
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
@@ -69,7 +68,7 @@ class AllCellsPrecontrol {
                          std::uint64_t cycle_counter) noexcept {
     return run_cycle(q_desired_rad, payload_kg, &model_torque_nm, cycle_counter);
   }
-  bool needs_model_torque() const noexcept { return torque_input_ >= 0; }
+  bool needs_model_torque() const noexcept { return needs_torque_; }
 
   // Explicit re-activation after a deactivation: the models restart from the current desired
   // values (at rest: zero error) and the offsets rise smoothly from zero.
@@ -108,8 +107,7 @@ class AllCellsPrecontrol {
     std::array<int, 4> centre_count{};
     std::array<double, 4> lower{}, upper{};  // grid bounds (outside: event)
     double backlash_l_rad = 0.0;
-    double torque_sign_scale_nm = 0.0;
-    double te_rad_per_rad = 0.0, te_compliance = 0.0;
+    ExogenousParameters exogenous;  // the constants of the further inputs
     // The identification's direction of motion is the desired velocity `backlash_lag` cycles
     // earlier (ident/backlash_identification.hpp): a ring of past speeds [rad/s].
     int backlash_lag = 0;
@@ -148,9 +146,8 @@ class AllCellsPrecontrol {
   std::array<double, kPrecontrolJoints> last_speed_{};
   std::array<double, kPrecontrolJoints> last_torque_{};
   int extra_count_ = 0;
-  int torque_input_ = -1, direction_input_ = -1, torque_sign_input_ = -1;  // -1: none
-  int te_sin_input_ = -1, te_cos_input_ = -1;
-  double direction_scale_ = 0.01;  // [rad/s]
+  std::array<TableInput, kMaxExtras> inputs_{};  // the first extra_count_: table order
+  bool needs_torque_ = false;
   double last_payload_ = 0.0;
   bool started_ = false;
   std::uint64_t last_cycle_ = 0;
@@ -181,16 +178,9 @@ inline bool AllCellsPrecontrol::create(const ParameterTable& table, const std::s
   p.model_sample_s_ = T;
   if (table.extra_inputs.size() > std::size_t(kMaxExtras)) return refuse("too many inputs");
   p.extra_count_ = static_cast<int>(table.extra_inputs.size());
-  for (int e = 0; e < p.extra_count_; ++e) {
-    const TableInput input = table.extra_inputs[std::size_t(e)];
-    if (input == TableInput::kModelTorque) p.torque_input_ = e;
-    if (input == TableInput::kDirection) p.direction_input_ = e;
-    if (input == TableInput::kTorqueSign) p.torque_sign_input_ = e;
-    if (input == TableInput::kTransmissionErrorSin) p.te_sin_input_ = e;
-    if (input == TableInput::kTransmissionErrorCos) p.te_cos_input_ = e;
-  }
-  if (p.torque_sign_input_ >= 0 && p.torque_input_ < 0) return refuse("sign without torque");
-  p.direction_scale_ = table.direction_speed_scale_rad_s;
+  std::copy(table.extra_inputs.begin(), table.extra_inputs.end(), p.inputs_.begin());
+  p.needs_torque_ = has_input(table.extra_inputs, TableInput::kModelTorque);
+  if (!exogenous_inputs_problem(table.extra_inputs).empty()) return refuse("sign without torque");
   const double up = c / T, down = T / c;
   if (std::abs(up - std::round(up)) < 1e-9 * up && std::round(up) >= 1 && std::round(up) <= 8) {
     p.steps_per_call_ = static_cast<int>(std::round(up));
@@ -237,9 +227,7 @@ inline bool AllCellsPrecontrol::create(const ParameterTable& table, const std::s
                     " samples exceeds the supported " + std::to_string(kSpeedRing - 1));
     }
     joint.backlash_lag = static_cast<int>(source.backlash_lag_samples);
-    joint.torque_sign_scale_nm = source.torque_sign_scale_nm;
-    joint.te_rad_per_rad = source.transmission_error_rad_per_rad;
-    joint.te_compliance = source.transmission_error_compliance_rad_per_nm;
+    joint.exogenous = exogenous_parameters(table, source);
     for (int k = 0; k < joint.cells; ++k) {
       const CellParameters& cell = source.cells[k];
       CellModel& model = joint.cell[k];
@@ -298,13 +286,8 @@ inline int AllCellsPrecontrol::read_events(PrecontrolEvent* out, int capacity) n
 inline std::array<double, AllCellsPrecontrol::kMaxExtras> AllCellsPrecontrol::extra_values(
     const JointModel& joint, double x, double speed, double torque) const noexcept {
   std::array<double, kMaxExtras> value{};
-  if (torque_input_ >= 0) value[torque_input_] = torque;
-  if (direction_input_ >= 0) value[direction_input_] = std::tanh(speed / direction_scale_);
-  if (torque_sign_input_ >= 0)
-    value[torque_sign_input_] = std::tanh(torque / joint.torque_sign_scale_nm);
-  const double motor_angle = x + joint.te_compliance * torque;
-  if (te_sin_input_ >= 0) value[te_sin_input_] = std::sin(joint.te_rad_per_rad * motor_angle);
-  if (te_cos_input_ >= 0) value[te_cos_input_] = std::cos(joint.te_rad_per_rad * motor_angle);
+  exogenous_values(std::span(inputs_.data(), std::size_t(extra_count_)), joint.exogenous,
+                   ExogenousSample{x, speed, torque}, value.data());
   return value;
 }
 

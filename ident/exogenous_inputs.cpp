@@ -1,0 +1,62 @@
+#include "ident/exogenous_inputs.hpp"
+
+#include <algorithm>
+
+#include "ident/parameter_table.hpp"
+
+namespace imscal::ident {
+
+// kind_of indexes the descriptors by the enum's value.
+static_assert([] {
+  for (int i = 0; i < kExogenousInputKindCount; ++i)
+    if (int(kExogenousInputKinds[i].input) != i) return false;
+  return true;
+}());
+
+const ExogenousInputKind& kind_of(TableInput input) {
+  return kExogenousInputKinds[std::size_t(input)];
+}
+
+const char* to_string(TableInput input) {
+  return kind_of(input).name;
+}
+
+ExogenousParameters exogenous_parameters(const ParameterTable& table,
+                                         const JointParameters& joint) {
+  ExogenousParameters p;
+  p.direction_speed_scale_rad_s = table.direction_speed_scale_rad_s;
+  p.torque_sign_scale_nm = joint.torque_sign_scale_nm;
+  p.transmission_error_rad_per_rad = joint.transmission_error_rad_per_rad;
+  p.transmission_error_compliance_rad_per_nm = joint.transmission_error_compliance_rad_per_nm;
+  return p;
+}
+
+bool has_input(std::span<const TableInput> inputs, TableInput input) {
+  return std::find(inputs.begin(), inputs.end(), input) != inputs.end();
+}
+
+std::string exogenous_inputs_problem(std::span<const TableInput> inputs) {
+  for (const TableInput input : inputs)
+    if (kind_of(input).needs_model_torque_input && !has_input(inputs, TableInput::kModelTorque))
+      return std::string("the ") + kind_of(input).family + " input needs the model torque input";
+  return {};
+}
+
+std::string exogenous_parameters_problem(std::span<const TableInput> inputs,
+                                         const ExogenousParameters& p) {
+  if (has_input(inputs, TableInput::kTorqueSign) && !(p.torque_sign_scale_nm > 0.0))
+    return "the torque-sign input needs a scale > 0";
+  const double compliance = p.transmission_error_compliance_rad_per_nm;
+  if (!(compliance >= 0.0 && std::isfinite(compliance)))
+    return "the transmission error's compliance must be finite and >= 0";
+  if (compliance > 0.0 && !has_input(inputs, TableInput::kModelTorque))
+    return "the transmission error's compliance needs the model torque input";
+  const bool transmission_error = has_input(inputs, TableInput::kTransmissionErrorSin) ||
+                                  has_input(inputs, TableInput::kTransmissionErrorCos);
+  const double f = p.transmission_error_rad_per_rad;
+  if (transmission_error && !(f > 0.0 && std::isfinite(f)))
+    return "the transmission-error inputs need a phase rate > 0";
+  return {};
+}
+
+}  // namespace imscal::ident

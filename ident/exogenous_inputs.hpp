@@ -1,0 +1,112 @@
+#pragma once
+// The further (exogenous) inputs x_e of the ARX models (imscal's multi-input extension of the
+// paper's eq. 2), defined once: their kinds and names, the constants they depend on, and the one
+// function that computes their values from a sample's joint state. The identification
+// (ident/joint_identification.cpp), the real-time precontrol (ident/precontrol.cpp, inside its
+// cycle: no allocation, no exception) and the test reference (tests/support/
+// reference_precontrol.hpp) all call exogenous_values, so the three cannot disagree.
+//
+// The kinds (the maths and why: ident/joint_identification.hpp, JointIdentificationOptions):
+//  * model_torque: the joint torque τ of the robot's rigid-body model [N m], from the caller;
+//  * direction: the direction of motion tanh(ẋ / direction_speed_scale);
+//  * torque_sign: the side of the gear the model torque presses on, tanh(τ / torque_sign_scale);
+//  * transmission_error_sin / _cos: the gear's angle-transmission error as the pair
+//    sin(f (x + τ / k)), cos(f (x + τ / k)), f = harmonic per motor revolution x gear ratio,
+//    1 / k the gear's compliance (the motor angle the deflected gear sits at).
+#include <array>
+#include <cmath>
+#include <span>
+#include <string>
+
+namespace imscal::ident {
+
+struct ParameterTable;
+struct JointParameters;
+
+enum class TableInput {
+  kModelTorque,
+  kDirection,
+  kTorqueSign,
+  kTransmissionErrorSin,
+  kTransmissionErrorCos
+};
+
+// One input kind: how parameters.json names it, the words errors use for it, the first table
+// schema version that has it, and whether its value needs the model torque input beside it.
+struct ExogenousInputKind {
+  TableInput input;
+  const char* name;
+  const char* family;  // "the <family> input(s) ..." in messages
+  int since_schema_version;
+  bool needs_model_torque_input;
+};
+inline constexpr ExogenousInputKind kExogenousInputKinds[] = {
+    {TableInput::kModelTorque, "model_torque", "model-torque", 2, false},
+    {TableInput::kDirection, "direction", "direction", 2, false},
+    {TableInput::kTorqueSign, "torque_sign", "torque-sign", 2, true},
+    {TableInput::kTransmissionErrorSin, "transmission_error_sin", "transmission-error", 3, false},
+    {TableInput::kTransmissionErrorCos, "transmission_error_cos", "transmission-error", 3, false},
+};
+inline constexpr int kExogenousInputKindCount = int(std::size(kExogenousInputKinds));
+const ExogenousInputKind& kind_of(TableInput input);
+// "model_torque", "direction", "torque_sign", "transmission_error_sin", "transmission_error_cos"
+const char* to_string(TableInput input);
+
+// The joint state of one sample the inputs are computed from: the model's input path x (the
+// desired angle, or the link's path in the inverse form), its rate, and the model torque along
+// it (0 when the caller has none: no input that reads it is then switched on).
+struct ExogenousSample {
+  double angle_rad = 0.0;
+  double speed_rad_s = 0.0;
+  double model_torque_nm = 0.0;
+};
+
+// The constants the inputs' values depend on, of one joint (0 where the input is not used).
+struct ExogenousParameters {
+  double direction_speed_scale_rad_s = 0.01;
+  double torque_sign_scale_nm = 0.0;
+  double transmission_error_rad_per_rad = 0.0;
+  double transmission_error_compliance_rad_per_nm = 0.0;
+};
+// A table's constants for one of its joints.
+ExogenousParameters exogenous_parameters(const ParameterTable& table, const JointParameters& joint);
+bool has_input(std::span<const TableInput> inputs, TableInput input);
+// Why the list `inputs` cannot be computed (an input needs another that is missing); empty when
+// it can.
+std::string exogenous_inputs_problem(std::span<const TableInput> inputs);
+// Why a joint's constants cannot feed `inputs`; empty when they can.
+std::string exogenous_parameters_problem(std::span<const TableInput> inputs,
+                                         const ExogenousParameters& p);
+
+// The motor-side phase f (x + τ / k) of the transmission error [rad].
+inline double transmission_error_phase(const ExogenousParameters& p,
+                                       const ExogenousSample& s) noexcept {
+  const double compliance = p.transmission_error_compliance_rad_per_nm;
+  const double motor = s.angle_rad + (compliance != 0.0 ? compliance * s.model_torque_nm : 0.0);
+  return p.transmission_error_rad_per_rad * motor;
+}
+
+inline double exogenous_value(TableInput input, const ExogenousParameters& p,
+                              const ExogenousSample& s) noexcept {
+  switch (input) {
+    case TableInput::kModelTorque:
+      return s.model_torque_nm;
+    case TableInput::kDirection:
+      return std::tanh(s.speed_rad_s / p.direction_speed_scale_rad_s);
+    case TableInput::kTorqueSign:
+      return std::tanh(s.model_torque_nm / p.torque_sign_scale_nm);
+    case TableInput::kTransmissionErrorSin:
+      return std::sin(transmission_error_phase(p, s));
+    case TableInput::kTransmissionErrorCos:
+      return std::cos(transmission_error_phase(p, s));
+  }
+  return 0.0;
+}
+
+// The values of `inputs` (in their order) of one sample, into values[0 .. inputs.size()).
+inline void exogenous_values(std::span<const TableInput> inputs, const ExogenousParameters& p,
+                             const ExogenousSample& s, double* values) noexcept {
+  for (std::size_t e = 0; e < inputs.size(); ++e) values[e] = exogenous_value(inputs[e], p, s);
+}
+
+}  // namespace imscal::ident
