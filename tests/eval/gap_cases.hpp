@@ -33,6 +33,9 @@ struct WithheldEffect {
                      // `joint`), mounting, ims_scale, ims_bias (`joint` unused: they spread over
                      // the joints; Case::spread_joint says where they show most)
   int joint = 0;
+  // > 0: the effect resized rather than switched: "real" runs the joint's parameter times this
+  // factor, "sim" the robot file's value (coulomb: the Coulomb friction torque).
+  double scale = 0.0;
 };
 
 inline EffectKind expected_kind(const std::string& name) {
@@ -88,10 +91,14 @@ inline Eigen::Matrix3d rotation_exp(const Eigen::Vector3d& phi) {
 }
 
 struct GapWorld {
+  GapWorld() = default;
+  // Another motion program (a motion program file, datasets/FORMAT.md).
+  explicit GapWorld(std::string program) : program_file(std::move(program)) {}
+
   calib::RobotDescription robot =
       calib::load_robot_description(IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml");
-  sim::DesiredJointPath path = sim::plan_motion(
-      robot, sim::load_motion_program(IMSCAL_TEST_DATA_DIR "/scenarios/gap-program.yaml"));
+  std::string program_file = IMSCAL_TEST_DATA_DIR "/scenarios/gap-program.yaml";
+  sim::DesiredJointPath path = sim::plan_motion(robot, sim::load_motion_program(program_file));
   sim::PlantConfig base = [this] {
     sim::PlantConfig c = sim::make_plant_config(robot, nullptr);
     for (auto& e : c.effects) e.backlash = false;
@@ -250,7 +257,12 @@ struct GapWorld {
         re.transmission_error = real_changed = true;
         re.transmission_error_shape.amplitude_rad *= 2.0 * size(rng);  // 28..52 arcsec
       }
-      if (e.name == "coulomb") se.coulomb_friction = false, sim_changed = true;
+      if (e.name == "coulomb" && e.scale > 0.0) {
+        real_config.robot.joints[std::size_t(e.joint)].drive.coulomb_nm *= e.scale;
+        real_changed = true;
+      } else if (e.name == "coulomb") {
+        se.coulomb_friction = false, sim_changed = true;
+      }
       if (e.name == "elastic") se.elastic_gear = se.gear_damping = false, sim_changed = true;
       if (e.name == "payload") {
         for (auto& p : real_path.payloads) p.body.mass_kg += 4.0 * size(rng);
