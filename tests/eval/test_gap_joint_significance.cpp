@@ -83,6 +83,8 @@ TEST(GapJointSignificance, ControlsRaiseNothing) {
     const Diagnosis d = diagnose_case(control);
     EXPECT_FALSE(d.significant_gap) << d.verdict;
     for (const JointSignificance& js : d.joint_significance) {
+      fmt::print("  {} joint {}: {:.2f} times its noise reference\n", control.program, js.joint,
+                 js.excess);
       EXPECT_LT(js.excess, 3.0) << control.program << " joint " << js.joint;
       EXPECT_FALSE(js.by_candidate) << control.program << " joint " << js.joint;
     }
