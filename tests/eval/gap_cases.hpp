@@ -27,7 +27,8 @@
 namespace imscal::eval::test {
 
 struct WithheldEffect {
-  std::string name;  // backlash, coulomb, elastic, transmission, time_offset, zero_offset,
+  std::string name;  // backlash, coulomb, elastic, transmission, time_offset, clock_offset (every
+                     // joint's measurement delayed alike; `joint` unused), zero_offset,
                      // drift, resonance, operating_point; payload (`joint` unused: the mass loads
                      // every joint); errors of the IMS chain: kinematic (DH error of link
                      // `joint`), mounting, ims_scale, ims_bias (`joint` unused: they spread over
@@ -44,6 +45,7 @@ inline EffectKind expected_kind(const std::string& name) {
   if (name == "elastic") return EffectKind::kGearCompliance;
   if (name == "transmission") return EffectKind::kTransmissionError;
   if (name == "time_offset") return EffectKind::kTimeOffset;
+  if (name == "clock_offset") return EffectKind::kClockOffset;
   if (name == "zero_offset") return EffectKind::kZeroOffset;
   if (name == "payload") return EffectKind::kPayloadMismatch;
   if (name == "kinematic") return EffectKind::kKinematicParameters;
@@ -61,7 +63,7 @@ inline bool is_chain_effect(const std::string& name) {
 
 // Effects that act on several joints at once (no source joint): located where they show most.
 inline bool spreads_over_joints(const std::string& name) {
-  return is_chain_effect(name) || name == "payload";
+  return is_chain_effect(name) || name == "payload" || name == "clock_offset";
 }
 
 // The joint angles the nominal model's inverse kinematics returns for the flange pose `target`,
@@ -283,17 +285,22 @@ struct GapWorld {
     const std::size_t n = log.sample_count();
     for (const auto& e : effects)
       if (is_chain_effect(e.name)) inject_chain_error(e, rng, log);
+    // The measurement stream lags by dt: q_m(t) = q_link(t - dt), linear interpolation.
+    const auto delay = [&](std::vector<double>& qm, double dt) {
+      const std::vector<double> q = qm;
+      for (std::size_t k = 0; k < n; ++k) {
+        const double x = std::clamp((log.time_s[k] - dt) / log.cycle_s, 0.0, double(n - 1));
+        const std::size_t i = std::min(std::size_t(x), n - 2);
+        qm[k] = q[i] + (x - double(i)) * (q[i + 1] - q[i]);
+      }
+    };
     for (const auto& e : effects) {
       auto& qm = log.q_measured_rad[std::size_t(e.joint)];
-      if (e.name == "time_offset") {
-        // The measurement stream lags by dt: q_m(t) = q_link(t - dt), linear interpolation.
-        const double dt = 0.004 * size(rng);
-        const std::vector<double> q = qm;
-        for (std::size_t k = 0; k < n; ++k) {
-          const double x = std::clamp((log.time_s[k] - dt) / log.cycle_s, 0.0, double(n - 1));
-          const std::size_t i = std::min(std::size_t(x), n - 2);
-          qm[k] = q[i] + (x - double(i)) * (q[i + 1] - q[i]);
-        }
+      if (e.name == "time_offset") delay(qm, 0.004 * size(rng));
+      if (e.name == "clock_offset") {  // the measuring clock's offset: every joint at once
+        // 0.5 ms: a gap of ~100 arcsec on the main axes, of the order of the other effects.
+        const double dt = 0.0005 * size(rng);
+        for (auto& q : log.q_measured_rad) delay(q, dt);
       }
       if (e.name == "zero_offset") {
         const double offset = 1.5e-4 * size(rng);
