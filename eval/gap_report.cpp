@@ -20,6 +20,21 @@ nlohmann::json shares_json(const std::vector<GapShare>& shares) {
 
 constexpr double kArcsec = 180.0 / M_PI * 3600.0;
 
+// Each joint's own test (eval/gap_joint_significance.hpp), one line per joint.
+std::string significance_text(const GapSignals& s, const Diagnosis& d) {
+  std::string t;
+  t += "\nSignificance per joint (gap RMS against its noise reference; its leading candidate at "
+       "the Sidak level over the joints)\n";
+  for (const auto& js : d.joint_significance)
+    t += fmt::format(
+        "  {:<4} RMS {:.3g} rad, {:.3g} times its noise reference {:.3g} rad (floor "
+        "{:.3g} rad); leader p {:.4f} at level {:.4f}  {}\n",
+        s.joint_names[js.joint], js.rms_rad, js.excess, js.noise_reference_rad, js.noise_floor_rad,
+        js.leader_p_value, js.corrected_alpha,
+        js.significant() ? "significant" : "not significant");
+  return t;
+}
+
 }  // namespace
 
 nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
@@ -223,15 +238,7 @@ std::string diagnosis_text(const GapSignals& s, const Diagnosis& d) {
                      fmt::format("{}", fmt::join(l, " / ")), leader.joint_shrinkage_percent,
                      leader.joint_p_value, f.supported ? "supported" : "not supported");
   }
-  t += "\nSignificance per joint (gap RMS against its noise reference; its leading candidate at "
-       "the Sidak level over the joints)\n";
-  for (const auto& js : d.joint_significance)
-    t += fmt::format(
-        "  {:<4} RMS {:.3g} rad, {:.3g} times its noise reference {:.3g} rad (floor "
-        "{:.3g} rad); leader p {:.4f} at level {:.4f}  {}\n",
-        s.joint_names[js.joint], js.rms_rad, js.excess, js.noise_reference_rad, js.noise_floor_rad,
-        js.leader_p_value, js.corrected_alpha,
-        js.significant() ? "significant" : "not significant");
+  t += significance_text(s, d);
   t += "\nGreedy combination\n";
   for (const auto& c : d.combination)
     t += fmt::format("  + {:<34} cumulative {:6.1f} %  p {:.3f}\n", c.label, c.shrinkage_percent,
