@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <random>
 
 #include "eval/gap_diagnosis.hpp"
@@ -74,11 +75,12 @@ TEST(GapJointSignificance, MixedProgramNamesTheJoint) {
 // Controls: every joint's gap is noise of a like level: each stands within 3 times its noise
 // reference (measured <= 1.3) and no joint's leading candidate passes its corrected level.
 TEST(GapJointSignificance, ControlsRaiseNothing) {
-  const std::vector<JointCase> controls = {{"gap-mixed-program.yaml", {}, 75},
-                                           {"gap-mixed-program.yaml", {}, 76},
-                                           {"gap-mixed-program.yaml", {}, 77},
-                                           {"short-program.yaml", {}, 78},
-                                           {"short-program.yaml", {}, 79}};
+  std::vector<JointCase> controls = {{"gap-mixed-program.yaml", {}, 75},
+                                     {"short-program.yaml", {}, 78},
+                                     {"gap-mixed-program.yaml", {}, 76},
+                                     {"gap-mixed-program.yaml", {}, 77},
+                                     {"short-program.yaml", {}, 79}};
+  if (std::getenv("IMSCAL_SANITIZED")) controls.resize(2);  // one of each program
   for (const auto& control : controls) {
     const Diagnosis d = diagnose_case(control);
     EXPECT_FALSE(d.significant_gap) << d.verdict;
