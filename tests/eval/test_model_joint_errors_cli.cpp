@@ -101,6 +101,18 @@ TEST_F(ModelJointErrorsCli, TheNominalModelReproducesANominalPlantOnTheSameSampl
       << read(dir_ / "d.log");
   const auto report = nlohmann::json::parse(read(dir_ / "out" / "report.json"));
   EXPECT_FALSE(report["significant_gap"].get<bool>()) << report["verdict"];
+  // With --robot instead of the scenario: the simulator's defaults (every effect but the
+  // transmission error, the play of every joint, upright gravity, the logged mass as a point
+  // mass), on the same samples. Not the scenario's plant, so only the samples are compared.
+  ASSERT_EQ(run("model-joint-errors --joint-errors " + (dir_ / "measured.csv").string() +
+                    " --robot " + IMSCAL_SOURCE_DIR + "/datasets/robots/kr16.yaml --out " +
+                    (dir_ / "model-robot.csv").string(),
+                dir_ / "r.log"),
+            0)
+      << read(dir_ / "r.log");
+  const ident::JointErrorLog by_robot = ident::read_joint_errors_csv(dir_ / "model-robot.csv");
+  EXPECT_EQ(by_robot.time_s, truth.time_s);
+  EXPECT_EQ(by_robot.q_desired_rad, truth.q_desired_rad);
   // An existing output is refused without --force (exit 2, unchanged), replaced with it.
   const std::string before = read(dir_ / "model.csv");
   EXPECT_EQ(run(args, dir_ / "b.log"), 2) << read(dir_ / "b.log");
