@@ -56,6 +56,9 @@ const char* what_to_measure(EffectKind kind) {
     case EffectKind::kImsScaleFactor:
       return "turn tests of the IMS about each axis by a known angle (rotary table or joint 6) "
              "and a known linear displacement";
+    case EffectKind::kClockOffset:
+      return "sharp starts and stops of several joints with both streams stamped by one clock (a "
+             "common offset shifts every joint's error by the same time)";
     case EffectKind::kImsBias:
       return "a longer rest of the IMS before and after the path, and rests during it (the "
              "rests bound the attitude drift)";

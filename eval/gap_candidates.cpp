@@ -76,6 +76,8 @@ const char* to_string(EffectKind kind) {
       return "ims_scale_factor";
     case EffectKind::kImsBias:
       return "ims_bias";
+    case EffectKind::kClockOffset:
+      return "clock_offset";
   }
   return "?";
 }
@@ -304,6 +306,18 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
     case EffectKind::kTimeOffset:
       out.push_back(local("qd_d * dt", {qd}, {"dt_s"}));
       break;
+    case EffectKind::kClockOffset: {
+      if (joint != 0 || nj < 2) break;  // one candidate for all joints
+      // The measured motion's velocity: the drive's actual one where known (the link lags q_d by
+      // the tracking error, ~80 ms on the main axes), else q̇_d.
+      const auto velocity = [&](std::size_t j) {
+        const bool known =
+            j < s.qd_internal_rad_s.size() && rms_of(to_column(s.qd_internal_rad_s[j])) > 0.0;
+        return Eigen::MatrixXd(to_column(known ? s.qd_internal_rad_s[j] : s.qd_desired_rad_s[j]));
+      };
+      out.push_back(shared("q̇_j * dt on every joint", velocity, {0}, {"dt_s"}));
+      break;
+    }
     case EffectKind::kPayloadMismatch: {
       if (joint != 0) break;  // one candidate for all joints, as the IMS chain's errors below
       // Every joint the payload loads (d tau / d m above 1e-6 N m/kg), each with its own
@@ -658,6 +672,7 @@ std::string size_in_words(const CandidateFit& c, const CandidateShape& sh, doubl
       break;
     }
     case EffectKind::kTimeOffset:
+    case EffectKind::kClockOffset:
       first += " s";
       break;
     case EffectKind::kSensorMounting:

@@ -34,6 +34,9 @@
 //   resonance       q̈_d through ω²/(s² + 2ζωs + ω²), f 2..40 Hz in 10 % steps x ζ {0.02, 0.04,
 //                   0.07, 0.12, 0.3}; [y, ẏ/ω] (gain and phase)
 //   time_offset     [q̇_d]: the parameter is the offset dt [s] between the streams
+//   clock_offset    all joints at once, one parameter: [q̇_d,j] on every joint j, the offset dt [s]
+//                   of the measuring clock against the robot's (a parameter of the nominal model:
+//                   q_m(t) = q(t - dt), linearised -dt q̇ of the joint error's measured side)
 //   payload         all joints at once (one mass acts on every joint it loads): per joint
 //                   u_j = d tau_j / d m_payload, [u_j], [L_30ms,0..3 u_j], [L_100ms,0..5 u_j] or
 //                   [L_30ms,0..3 u_j, L_100ms,0..5 u_j] with its own parameters per joint (Δm / k_j
@@ -78,8 +81,9 @@ enum class EffectKind {
   kSensorMounting,
   kImsScaleFactor,
   kImsBias,
+  kClockOffset,
 };
-inline constexpr int kEffectKindCount = 14;
+inline constexpr int kEffectKindCount = 15;
 const char* to_string(EffectKind kind);
 EffectKind effect_kind_from_index(int index);
 

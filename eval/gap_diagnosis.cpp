@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "eval/gap_verdict.hpp"
@@ -92,6 +93,68 @@ void find_per_joint(const GapSignals& s, const DiagnosisOptions& o,
       f.separate_by = groups.front().separate_by;
     }
     d.joint_findings.push_back(std::move(f));
+  }
+}
+
+// Per held-out row the reduction of the squared gap of a candidate's own joint.
+std::vector<double> own_joint_gains(const GapSignals& s, const CandidateFit& f,
+                                    const std::vector<std::size_t>& heldout) {
+  std::vector<double> d(heldout.size(), 0.0);
+  const auto& p = f.prediction[f.joint];
+  const auto& g = s.gap_rad[f.joint];
+  if (p.empty()) return d;
+  for (std::size_t i = 0; i < heldout.size(); ++i) {
+    const std::size_t k = heldout[i];
+    d[i] = g[k] * g[k] - (g[k] - p[k]) * (g[k] - p[k]);
+  }
+  return d;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  if (v.size() % 2 == 1) return *mid;
+  return 0.5 * (*mid + *std::max_element(v.begin(), mid));
+}
+
+// How far a joint's gap stands above its noise reference (eval/gap_joint_significance.hpp).
+void place_above_noise(const GapSignals& s, const DiagnosisOptions& o, std::size_t j,
+                       JointSignificance& js, const Diagnosis& d) {
+  std::vector<double> others;
+  for (std::size_t i = 0; i < d.where.joints.size(); ++i)
+    if (i != j) others.push_back(d.where.joints[i].rms_rad);
+  js.rms_rad = d.where.joints[j].rms_rad;
+  js.noise_floor_rad = high_frequency_noise_floor(s.gap_rad[j], s.runs);
+  js.noise_reference_rad = std::max(js.noise_floor_rad, median(others));
+  js.excess = js.noise_reference_rad > 0.0 ? js.rms_rad / js.noise_reference_rad
+              : js.rms_rad > 0.0           ? std::numeric_limits<double>::infinity()
+                                           : 0.0;
+  js.far_above_noise = js.excess >= o.far_above_noise_factor;
+}
+
+// Each joint's own test (eval/gap_joint_significance.hpp): its leading candidate at the Šidák
+// level over the joints, with enough resamples that the bootstrap's floor lies below it.
+void test_joints(const GapSignals& s, const DiagnosisOptions& o,
+                 const std::vector<std::size_t>& heldout, std::size_t block, std::uint64_t seed,
+                 Diagnosis& d) {
+  const double alpha_j = sidak_alpha(o.alpha, s.joint_count());
+  const int resamples = std::max(o.bootstrap_resamples, int(std::ceil(4.0 / alpha_j)));
+  for (std::size_t j = 0; j < s.joint_count(); ++j) {
+    JointSignificance js;
+    js.joint = j;
+    js.corrected_alpha = alpha_j;
+    place_above_noise(s, o, j, js, d);
+    for (const JointFinding& f : d.joint_findings) {
+      if (f.joint != j) continue;
+      const CandidateResult& leader = d.candidates[f.leading.front()];
+      js.leader_shrinkage_percent = leader.joint_shrinkage_percent;
+      if (leader.joint_shrinkage_percent < o.min_shrinkage_percent) continue;
+      js.leader_p_value = block_bootstrap_p_value(own_joint_gains(s, leader.fit, heldout), block,
+                                                  resamples, seed + j);
+      js.by_candidate = js.leader_p_value < alpha_j;
+    }
+    d.joint_significance.push_back(js);
   }
 }
 
@@ -267,14 +330,26 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
   }
 
   find_per_joint(s, o, rows.heldout, out);
+  test_joints(s, o, rows.heldout, block, seed, out);
+  for (const JointSignificance& js : out.joint_significance)
+    out.significant_gap = out.significant_gap || js.significant();
   write_verdict(s, o, out);
   return out;
 }
 
 std::vector<std::size_t> leading_group(const Diagnosis& d) {
   if (!d.significant_gap || d.candidates.empty()) return {};
-  const int g = d.candidates.front().ambiguity_group;
-  return g >= 0 ? d.ambiguity_groups[std::size_t(g)].members : std::vector<std::size_t>{0};
+  if (d.candidates.front().supported) {
+    const int g = d.candidates.front().ambiguity_group;
+    return g >= 0 ? d.ambiguity_groups[std::size_t(g)].members : std::vector<std::size_t>{0};
+  }
+  const JointSignificance* best = nullptr;
+  for (const JointSignificance& js : d.joint_significance)
+    if (js.by_candidate && (!best || js.excess > best->excess)) best = &js;
+  if (best)
+    for (const JointFinding& f : d.joint_findings)
+      if (f.joint == best->joint) return f.leading;
+  return {};
 }
 
 }  // namespace imscal::eval

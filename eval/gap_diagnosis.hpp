@@ -13,7 +13,9 @@
 // then combined greedily (a joint fit of the chosen columns per joint), a step kept only when it
 // shrinks the held-out gap significantly further. Candidates the data cannot tell apart form
 // ambiguity groups (eval/gap_ambiguity.hpp), reported together with what would separate them,
-// overall and per joint (its candidates ranked on its own gap); the plain words are
+// overall and per joint (its candidates ranked on its own gap). A gap concentrated in one joint
+// is significant on its own, with a level corrected for the number of joints, or when it stands
+// far above that joint's noise (eval/gap_joint_significance.hpp). The plain words are
 // eval/gap_verdict.hpp's.
 //
 // References (docs/references.md): [Kunsch1989] (moving-block bootstrap).
@@ -24,6 +26,7 @@
 #include "eval/gap_ambiguity.hpp"
 #include "eval/gap_analysis.hpp"
 #include "eval/gap_candidates.hpp"
+#include "eval/gap_joint_significance.hpp"
 #include "eval/gap_model_error.hpp"
 
 namespace imscal::eval {
@@ -36,8 +39,11 @@ struct DiagnosisOptions {
   double min_shrinkage_percent = 5.0;         // below this an effect is not worth modelling
   double min_combination_gain_percent = 2.0;  // further shrinkage a combination step must add
   int max_combination = 3;
-  int combination_pool = 8;       // best supported candidates the greedy combination tries
-  std::uint64_t seed = 1;         // of the bootstrap (deterministic reports)
+  int combination_pool = 8;  // best supported candidates the greedy combination tries
+  std::uint64_t seed = 1;    // of the bootstrap (deterministic reports)
+  // A joint's gap this many times its noise reference is significant on its own
+  // (eval/gap_joint_significance.hpp).
+  double far_above_noise_factor = 10.0;
   ModelErrorOptions model_error;  // of the per-joint model-error model
 };
 
@@ -83,10 +89,13 @@ struct Diagnosis {
   // Candidates the data cannot tell apart (members index `candidates`; groups in ranking order,
   // the group of the first candidate first when it has one).
   std::vector<AmbiguityGroup> ambiguity_groups;
-  std::vector<JointFinding> joint_findings;  // every joint with candidates, in joint order
-  bool significant_gap = false;              // some candidate supported
-  std::string verdict;                       // plain words
-  std::vector<std::string> measure_next;     // when the evidence is weak
+  std::vector<JointFinding> joint_findings;           // every joint with candidates, in joint order
+  std::vector<JointSignificance> joint_significance;  // every joint, in joint order
+  // The first candidate is supported (on all joints), or some joint's gap is significant on its
+  // own (joint_significance).
+  bool significant_gap = false;
+  std::string verdict;                    // plain words
+  std::vector<std::string> measure_next;  // when the evidence is weak
 };
 
 // Training rows: blocks 0, 2, 4, ... of `block_s` (counted from each run's start).
@@ -101,7 +110,9 @@ Diagnosis diagnose_gap(const GapSignals& signals, const DiagnosisOptions& option
 std::string candidate_label(const GapSignals& signals, const CandidateFit& fit);
 
 // The members of the leading ambiguity group (the first candidate and those the data cannot tell
-// apart from it), indices into `candidates`; empty without a significant gap.
+// apart from it), indices into `candidates`; empty without a significant gap. When the gap is
+// significant per joint only: the leading explanation of the joint whose gap stands highest above
+// its noise among those significant by candidate (empty when none is).
 std::vector<std::size_t> leading_group(const Diagnosis& diagnosis);
 
 }  // namespace imscal::eval

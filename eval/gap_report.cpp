@@ -20,6 +20,21 @@ nlohmann::json shares_json(const std::vector<GapShare>& shares) {
 
 constexpr double kArcsec = 180.0 / M_PI * 3600.0;
 
+// Each joint's own test (eval/gap_joint_significance.hpp), one line per joint.
+std::string significance_text(const GapSignals& s, const Diagnosis& d) {
+  std::string t;
+  t += "\nSignificance per joint (gap RMS against its noise reference; its leading candidate at "
+       "the Sidak level over the joints)\n";
+  for (const auto& js : d.joint_significance)
+    t += fmt::format(
+        "  {:<4} RMS {:.3g} rad, {:.3g} times its noise reference {:.3g} rad (floor "
+        "{:.3g} rad); leader p {:.4f} at level {:.4f}  {}\n",
+        s.joint_names[js.joint], js.rms_rad, js.excess, js.noise_reference_rad, js.noise_floor_rad,
+        js.leader_p_value, js.corrected_alpha,
+        js.significant() ? "significant" : "not significant");
+  return t;
+}
+
 }  // namespace
 
 nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
@@ -110,6 +125,21 @@ nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
     combination.push_back({{"added", c.label},
                            {"heldout_shrinkage_percent", c.shrinkage_percent},
                            {"p_value", c.p_value}});
+  json significance = json::array();
+  for (const auto& js : d.joint_significance)
+    significance.push_back({{"joint", s.joint_names[js.joint]},
+                            {"rms_rad", js.rms_rad},
+                            {"noise_floor_rad", js.noise_floor_rad},
+                            {"noise_reference_rad", js.noise_reference_rad},
+                            {"excess", js.excess},
+                            {"corrected_alpha", js.corrected_alpha},
+                            {"leader_p_value", js.leader_p_value},
+                            {"leader_shrinkage_percent", js.leader_shrinkage_percent},
+                            {"by_candidate", js.by_candidate},
+                            {"far_above_noise", js.far_above_noise},
+                            {"significant", js.significant()}});
+  json per_joint = json::object();
+  for (const auto& j : d.where.joints) per_joint[j.joint] = j.rms_rad;
   json not_supported = json::array();
   for (const auto& c : d.candidates)
     if (!c.supported) not_supported.push_back(candidate_label(s, c.fit));
@@ -118,6 +148,7 @@ nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
           {"samples", s.sample_count()},
           {"cycle_s", s.cycle_s},
           {"gap_rms_rad", d.where.rms_rad},
+          {"gap_rms_per_joint_rad", per_joint},
           {"heldout_gap_rms_rad", d.heldout_rms_rad},
           {"heldout_gap_rms_modelled_rad", d.heldout_rms_modelled_rad},
           {"significant_gap", d.significant_gap},
@@ -131,11 +162,15 @@ nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
           {"leading_group", labels(leading_group(d))},
           {"ambiguity_groups", groups},
           {"joint_findings", findings},
+          {"joint_significance", significance},
           {"not_supported", not_supported}};
 }
 
 std::string diagnosis_text(const GapSignals& s, const Diagnosis& d) {
-  std::string t = "imscal gap diagnosis\n====================\n\n" + d.verdict + "\n";
+  std::string t = "imscal gap diagnosis\n====================\n\nGap RMS per joint:";
+  for (const auto& j : d.where.joints)
+    t += fmt::format(" {} {:.3g} rad ({:.1f} arcsec);", j.joint, j.rms_rad, j.rms_rad * kArcsec);
+  t += "\n\n" + d.verdict + "\n";
   for (const auto& m : d.measure_next) t += "  - measure next: " + m + "\n";
   t += fmt::format("\nWhere (gap RMS {:.3g} rad = {:.2f} arcsec, {} samples)\n", d.where.rms_rad,
                    d.where.rms_rad * kArcsec, s.sample_count());
@@ -203,6 +238,7 @@ std::string diagnosis_text(const GapSignals& s, const Diagnosis& d) {
                      fmt::format("{}", fmt::join(l, " / ")), leader.joint_shrinkage_percent,
                      leader.joint_p_value, f.supported ? "supported" : "not supported");
   }
+  t += significance_text(s, d);
   t += "\nGreedy combination\n";
   for (const auto& c : d.combination)
     t += fmt::format("  + {:<34} cumulative {:6.1f} %  p {:.3f}\n", c.label, c.shrinkage_percent,

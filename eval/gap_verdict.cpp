@@ -23,12 +23,16 @@ std::string where_in_words(const Diagnosis& d) {
     });
   };
   const GapShare ph = top_of(ja.by_phase), band = top_of(ja.by_band);
+  std::vector<std::string> per_joint;
+  for (const auto& jo : d.where.joints)
+    per_joint.push_back(fmt::format("{} {:.1f}", jo.joint, jo.rms_rad * kArcsecPerRad));
   std::string where = fmt::format(
-      "The gap (RMS {:.3g} rad = {:.1f} arcsec over all joints) lies mostly in joint {} ({:.0f} % "
-      "of its energy), there mostly during {} ({:.0f} % of the joint's gap energy in {:.0f} % of "
-      "the time) and in the {} band ({:.0f} %).",
-      d.where.rms_rad, d.where.rms_rad * kArcsecPerRad, ja.joint, 100.0 * ja.energy_share, ph.label,
-      100.0 * ph.energy_share, 100.0 * ph.time_share, band.label, 100.0 * band.energy_share);
+      "The gap (RMS {:.3g} rad = {:.1f} arcsec over all joints; per joint {} arcsec) lies mostly "
+      "in joint {} ({:.0f} % of its energy), there mostly during {} ({:.0f} % of the joint's gap "
+      "energy in {:.0f} % of the time) and in the {} band ({:.0f} %).",
+      d.where.rms_rad, d.where.rms_rad * kArcsecPerRad, fmt::join(per_joint, ", "), ja.joint,
+      100.0 * ja.energy_share, ph.label, 100.0 * ph.energy_share, 100.0 * ph.time_share, band.label,
+      100.0 * band.energy_share);
   std::vector<std::string> outside;
   for (const auto& jo : d.where.joints) {
     double time = 0.0, energy = 0.0;
@@ -66,6 +70,61 @@ std::string labels_of(const GapSignals& s, const Diagnosis& d,
   return fmt::format("{}", fmt::join(l, " / "));
 }
 
+const JointFinding* finding_of(const Diagnosis& d, std::size_t joint) {
+  for (const JointFinding& f : d.joint_findings)
+    if (f.joint == joint) return &f;
+  return nullptr;
+}
+
+// One joint significant on its own: its most likely cause when its leading candidate is
+// significant at the joints' corrected level, else that nothing carries over and what to record.
+void joint_in_words(const GapSignals& s, const JointSignificance& js, Diagnosis& out) {
+  const JointFinding* f = finding_of(out, js.joint);
+  const std::string& name = s.joint_names[js.joint];
+  if (js.by_candidate && f) {
+    out.verdict += fmt::format(
+        " On joint {} the most likely cause: {}, which shrinks that joint's held-out gap by "
+        "{:.0f} % (p = {:.4f}, below the level {:.4f} of each of the {} joints' tests).",
+        name, members_in_words(s, out, f->leading), js.leader_shrinkage_percent, js.leader_p_value,
+        js.corrected_alpha, s.joint_count());
+    return;
+  }
+  const CandidateResult* leader = f ? &out.candidates[f->leading.front()] : nullptr;
+  out.verdict += fmt::format(
+      " On joint {} no candidate effect fitted on the training blocks carries over to the "
+      "held-out ones{}: an effect outside the library, or a record too short for the candidates "
+      "to be judged.",
+      name,
+      leader ? fmt::format(" (the best, {}, shrinks its held-out gap by {:.0f} %)",
+                           candidate_label(s, leader->fit), js.leader_shrinkage_percent)
+             : std::string());
+  out.measure_next.push_back(fmt::format(
+      "on joint {}: a longer record that repeats each kind of motion (so that the training and "
+      "the held-out blocks both see it){}",
+      name, leader ? std::string(", and ") + what_to_measure(leader->fit.kind) : std::string()));
+}
+
+// The gap is significant per joint only (eval/gap_joint_significance.hpp): which joints, how far
+// above their noise, and per joint its cause or what to record.
+void write_joint_verdict(const GapSignals& s, const DiagnosisOptions& o, const std::string& where,
+                         Diagnosis& out) {
+  std::vector<std::string> joints;
+  for (const JointSignificance& js : out.joint_significance)
+    if (js.significant())
+      joints.push_back(
+          fmt::format("{} (RMS {:.1f} arcsec, {:.0f} times its noise reference of "
+                      "{:.2g} arcsec)",
+                      s.joint_names[js.joint], js.rms_rad * kArcsecPerRad, js.excess,
+                      js.noise_reference_rad * kArcsecPerRad));
+  out.verdict = fmt::format(
+      "{} A significant structured gap on joint{} {}, though no candidate effect shrinks the gap "
+      "of all joints by at least {:.0f} % with p < {:g}.",
+      where, joints.size() > 1 ? "s" : "", fmt::join(joints, "; "), o.min_shrinkage_percent,
+      o.alpha);
+  for (const JointSignificance& js : out.joint_significance)
+    if (js.significant()) joint_in_words(s, js, out);
+}
+
 }  // namespace
 
 std::string candidate_in_words(const GapSignals& s, const CandidateFit& f) {
@@ -85,6 +144,10 @@ void write_verdict(const GapSignals& s, const DiagnosisOptions& o, Diagnosis& ou
       out.measure_next.push_back(
           fmt::format("if a gap of {:.3g} rad matters: longer records of the path, and {}",
                       out.heldout_rms_rad, what_to_measure(out.candidates.front().fit.kind)));
+    return;
+  }
+  if (out.candidates.empty() || !out.candidates.front().supported) {
+    write_joint_verdict(s, o, where, out);
     return;
   }
   const CandidateResult& top = out.candidates.front();

@@ -27,12 +27,16 @@
 namespace imscal::eval::test {
 
 struct WithheldEffect {
-  std::string name;  // backlash, coulomb, elastic, transmission, time_offset, zero_offset,
+  std::string name;  // backlash, coulomb, elastic, transmission, time_offset, clock_offset (every
+                     // joint's measurement delayed alike; `joint` unused), zero_offset,
                      // drift, resonance, operating_point; payload (`joint` unused: the mass loads
                      // every joint); errors of the IMS chain: kinematic (DH error of link
                      // `joint`), mounting, ims_scale, ims_bias (`joint` unused: they spread over
                      // the joints; Case::spread_joint says where they show most)
   int joint = 0;
+  // > 0: the effect resized rather than switched: "real" runs the joint's parameter times this
+  // factor, "sim" the robot file's value (coulomb: the Coulomb friction torque).
+  double scale = 0.0;
 };
 
 inline EffectKind expected_kind(const std::string& name) {
@@ -41,6 +45,7 @@ inline EffectKind expected_kind(const std::string& name) {
   if (name == "elastic") return EffectKind::kGearCompliance;
   if (name == "transmission") return EffectKind::kTransmissionError;
   if (name == "time_offset") return EffectKind::kTimeOffset;
+  if (name == "clock_offset") return EffectKind::kClockOffset;
   if (name == "zero_offset") return EffectKind::kZeroOffset;
   if (name == "payload") return EffectKind::kPayloadMismatch;
   if (name == "kinematic") return EffectKind::kKinematicParameters;
@@ -58,7 +63,7 @@ inline bool is_chain_effect(const std::string& name) {
 
 // Effects that act on several joints at once (no source joint): located where they show most.
 inline bool spreads_over_joints(const std::string& name) {
-  return is_chain_effect(name) || name == "payload";
+  return is_chain_effect(name) || name == "payload" || name == "clock_offset";
 }
 
 // The joint angles the nominal model's inverse kinematics returns for the flange pose `target`,
@@ -88,10 +93,14 @@ inline Eigen::Matrix3d rotation_exp(const Eigen::Vector3d& phi) {
 }
 
 struct GapWorld {
+  GapWorld() = default;
+  // Another motion program (a motion program file, datasets/FORMAT.md).
+  explicit GapWorld(std::string program) : program_file(std::move(program)) {}
+
   calib::RobotDescription robot =
       calib::load_robot_description(IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml");
-  sim::DesiredJointPath path = sim::plan_motion(
-      robot, sim::load_motion_program(IMSCAL_TEST_DATA_DIR "/scenarios/gap-program.yaml"));
+  std::string program_file = IMSCAL_TEST_DATA_DIR "/scenarios/gap-program.yaml";
+  sim::DesiredJointPath path = sim::plan_motion(robot, sim::load_motion_program(program_file));
   sim::PlantConfig base = [this] {
     sim::PlantConfig c = sim::make_plant_config(robot, nullptr);
     for (auto& e : c.effects) e.backlash = false;
@@ -250,7 +259,12 @@ struct GapWorld {
         re.transmission_error = real_changed = true;
         re.transmission_error_shape.amplitude_rad *= 2.0 * size(rng);  // 28..52 arcsec
       }
-      if (e.name == "coulomb") se.coulomb_friction = false, sim_changed = true;
+      if (e.name == "coulomb" && e.scale > 0.0) {
+        real_config.robot.joints[std::size_t(e.joint)].drive.coulomb_nm *= e.scale;
+        real_changed = true;
+      } else if (e.name == "coulomb") {
+        se.coulomb_friction = false, sim_changed = true;
+      }
       if (e.name == "elastic") se.elastic_gear = se.gear_damping = false, sim_changed = true;
       if (e.name == "payload") {
         for (auto& p : real_path.payloads) p.body.mass_kg += 4.0 * size(rng);
@@ -271,17 +285,22 @@ struct GapWorld {
     const std::size_t n = log.sample_count();
     for (const auto& e : effects)
       if (is_chain_effect(e.name)) inject_chain_error(e, rng, log);
+    // The measurement stream lags by dt: q_m(t) = q_link(t - dt), linear interpolation.
+    const auto delay = [&](std::vector<double>& qm, double dt) {
+      const std::vector<double> q = qm;
+      for (std::size_t k = 0; k < n; ++k) {
+        const double x = std::clamp((log.time_s[k] - dt) / log.cycle_s, 0.0, double(n - 1));
+        const std::size_t i = std::min(std::size_t(x), n - 2);
+        qm[k] = q[i] + (x - double(i)) * (q[i + 1] - q[i]);
+      }
+    };
     for (const auto& e : effects) {
       auto& qm = log.q_measured_rad[std::size_t(e.joint)];
-      if (e.name == "time_offset") {
-        // The measurement stream lags by dt: q_m(t) = q_link(t - dt), linear interpolation.
-        const double dt = 0.004 * size(rng);
-        const std::vector<double> q = qm;
-        for (std::size_t k = 0; k < n; ++k) {
-          const double x = std::clamp((log.time_s[k] - dt) / log.cycle_s, 0.0, double(n - 1));
-          const std::size_t i = std::min(std::size_t(x), n - 2);
-          qm[k] = q[i] + (x - double(i)) * (q[i + 1] - q[i]);
-        }
+      if (e.name == "time_offset") delay(qm, 0.004 * size(rng));
+      if (e.name == "clock_offset") {  // the measuring clock's offset: every joint at once
+        // 0.5 ms: a gap of ~100 arcsec on the main axes, of the order of the other effects.
+        const double dt = 0.0005 * size(rng);
+        for (auto& q : log.q_measured_rad) delay(q, dt);
       }
       if (e.name == "zero_offset") {
         const double offset = 1.5e-4 * size(rng);
