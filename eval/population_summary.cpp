@@ -77,8 +77,9 @@ std::string summarize_figure(const PopulationTable& table, const std::string& fi
       values.size(), percentile(values, 50.0), percentile(values, 10.0), values[worst],
       table.rows[static_cast<std::size_t>(worst)].front());
   if (values.size() < 3) return text;
-  text += "  draws correlated with it (Pearson r over the plants; a low figure goes with the\n"
-          "  draw when r > 0 and the draw is low, or r < 0 and the draw is high):";
+  text +=
+      "  draws correlated with it (Pearson r over the plants; a low figure goes with the\n"
+      "  draw when r > 0 and the draw is low, or r < 0 and the draw is high):";
   for (const DrawCorrelation& c : strongest_correlations(table, figure, figures, 5))
     text += fmt::format(" {} {:+.2f};", c.column, c.r);
   return text + "\n";

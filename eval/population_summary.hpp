@@ -9,8 +9,8 @@
 namespace imscal::eval {
 
 struct PopulationTable {
-  std::vector<std::string> columns;          // the first is the seed
-  std::vector<std::vector<double>> rows;     // one per plant, columns.size() values each
+  std::vector<std::string> columns;       // the first is the seed
+  std::vector<std::vector<double>> rows;  // one per plant, columns.size() values each
 };
 
 // Percentile p in [0, 100] of `values` by linear interpolation between the sorted values

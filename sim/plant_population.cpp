@@ -40,8 +40,8 @@ std::vector<TransmissionErrorOrder> draw_transmission_error(PlantRandom& random,
     TransmissionErrorOrder order;
     order.harmonic_per_motor_rev = choices[static_cast<std::size_t>(pick)];
     choices.erase(choices.begin() + pick);
-    order.amplitude_arcsec = random.uniform(ranges.transmission_error_low_arcsec,
-                                            ranges.transmission_error_high_arcsec);
+    order.amplitude_arcsec =
+        random.uniform(ranges.transmission_error_low_arcsec, ranges.transmission_error_high_arcsec);
     order.phase_deg = random.uniform(0.0, 360.0);
     orders.push_back(order);
   }
@@ -73,14 +73,13 @@ std::string number(double value) {
 }
 
 std::string joint_deviations(const JointDraw& j, const calib::JointDescription& nominal) {
-  std::string text = "{link_mass: " + number(j.link_mass) + ", centre_of_mass_offset_mm: [" +
-                     number(j.centre_of_mass_offset_mm[0]) + ", " +
-                     number(j.centre_of_mass_offset_mm[1]) + ", " +
-                     number(j.centre_of_mass_offset_mm[2]) + "], gear_stiffness: " +
-                     number(j.gear_stiffness) + ", coulomb_friction: " + number(j.coulomb_friction) +
-                     ", viscous_friction: " + number(j.viscous_friction) +
-                     ", position_gain: " + number(j.position_gain) +
-                     ", velocity_gain: " + number(j.velocity_gain);
+  std::string text =
+      "{link_mass: " + number(j.link_mass) + ", centre_of_mass_offset_mm: [" +
+      number(j.centre_of_mass_offset_mm[0]) + ", " + number(j.centre_of_mass_offset_mm[1]) + ", " +
+      number(j.centre_of_mass_offset_mm[2]) + "], gear_stiffness: " + number(j.gear_stiffness) +
+      ", coulomb_friction: " + number(j.coulomb_friction) +
+      ", viscous_friction: " + number(j.viscous_friction) +
+      ", position_gain: " + number(j.position_gain) + ", velocity_gain: " + number(j.velocity_gain);
   if (j.play_arcmin > 0.0)
     text += ", backlash: " + number(j.play_arcmin / (nominal.drive.backlash_rad * kArcminPerRad));
   return text + "}";
@@ -144,8 +143,9 @@ std::string plant_scenario_yaml(const PlantDraw& plant, const calib::RobotDescri
   const std::string sigma_mm = session.random_frames ? "2.0" : "0";
   const std::string sigma_deg = session.random_frames ? "1.5" : "0";
   return "# Plant " + std::to_string(plant.seed) + " of a population around " +
-         nominal_file.string() + " (sim/plant_population.hpp)\nimscal-scenario: 1\nname: " +
-         session.name + "\ndescription: \"plant " + std::to_string(plant.seed) +
+         nominal_file.string() +
+         " (sim/plant_population.hpp)\nimscal-scenario: 1\nname: " + session.name +
+         "\ndescription: \"plant " + std::to_string(plant.seed) +
          "\"\nrobot: " + std::filesystem::absolute(nominal_file).string() +
          "\nnominal_robot: " + std::filesystem::absolute(nominal_file).string() +
          "\nprogram: " + std::filesystem::absolute(session.program_file).string() +

@@ -21,19 +21,19 @@ namespace imscal::sim {
 
 // The ranges of the draws (uniform unless said).
 struct PlantPopulationRanges {
-  double link_mass = 0.20;             // factor 1 +- this
-  double centre_of_mass_m = 0.03;      // per axis, +- this, added in the link's frame
-  double gear_stiffness = 0.30;        // factor 1 +- this
-  double friction_low = 0.5;           // Coulomb and viscous: factor in [low, high], log-uniform
-  double friction_high = 2.0;          //
-  double play_low_arcmin = 0.5;        // full width of the play on the joints that have one
-  double play_high_arcmin = 5.0;       //
+  double link_mass = 0.20;                // factor 1 +- this
+  double centre_of_mass_m = 0.03;         // per axis, +- this, added in the link's frame
+  double gear_stiffness = 0.30;           // factor 1 +- this
+  double friction_low = 0.5;              // Coulomb and viscous: factor in [low, high], log-uniform
+  double friction_high = 2.0;             //
+  double play_low_arcmin = 0.5;           // full width of the play on the joints that have one
+  double play_high_arcmin = 5.0;          //
   int transmission_error_orders_max = 3;  // 1..max orders per joint
-  double transmission_error_low_arcsec = 3.0;   // amplitude of each order
+  double transmission_error_low_arcsec = 3.0;    // amplitude of each order
   double transmission_error_high_arcsec = 20.0;  //
-  double controller_gain = 0.20;       // position and velocity gains: factor 1 +- this
-  int dead_time_cycles_max = 3;        // 0..max controller cycles, the same on every joint
-  double payload_mass = 0.10;          // carried payload's mass: factor 1 +- this
+  double controller_gain = 0.20;                 // position and velocity gains: factor 1 +- this
+  int dead_time_cycles_max = 3;  // 0..max controller cycles, the same on every joint
+  double payload_mass = 0.10;    // carried payload's mass: factor 1 +- this
 };
 
 // The orders per motor revolution a transmission error is drawn from (distinct per joint): the

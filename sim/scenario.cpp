@@ -61,10 +61,10 @@ DeviationFactors read_factors(const ConfigNode& node, const DeviationFactors& fa
   f.viscous_friction = factor(node, "viscous_friction", fallback.viscous_friction);
   f.position_gain = factor(node, "position_gain", fallback.position_gain);
   f.velocity_gain = factor(node, "velocity_gain", fallback.velocity_gain);
-  f.centre_of_mass_offset_m = node.has("centre_of_mass_offset_mm")
-                                  ? Eigen::Vector3d(
-                                        node.child("centre_of_mass_offset_mm").as_vector3() * 1e-3)
-                                  : fallback.centre_of_mass_offset_m;
+  f.centre_of_mass_offset_m =
+      node.has("centre_of_mass_offset_mm")
+          ? Eigen::Vector3d(node.child("centre_of_mass_offset_mm").as_vector3() * 1e-3)
+          : fallback.centre_of_mass_offset_m;
   return f;
 }
 
@@ -183,7 +183,8 @@ Scenario load_scenario(const fs::path& file) {
     if (seed < 0) root.child("seed").fail("must not be negative");
     s.seed = static_cast<std::uint64_t>(seed);
   }
-  load_plant_robot(s);  // the deviations' keys and factors checked here, with the file's lines
+  // The deviations' and the effects' keys and values checked here, with the file's lines.
+  make_plant_config(load_plant_robot(s), s);
   if (s.plant_deviations && s.plant_deviations->is_map())
     s.plant_payload_mass_factor = factor(*s.plant_deviations, "payload_mass", 1.0);
   if (!s.nominal_robot_given) {

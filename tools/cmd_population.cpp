@@ -76,7 +76,9 @@ void run_step(const std::string& step, const std::vector<std::string>& arguments
   options.timeout_s = args.timeout_s;
   const imscal::SubprocessResult r = imscal::run_subprocess(argv, options);
   const fs::path log = dir / (step + ".log");
-  std::ofstream(log) << r.output;
+  std::string command = "$ imscal";  // the command line first: what the step was handed
+  for (const std::string& argument : arguments) command += " " + argument;
+  std::ofstream(log) << command << "\n" << r.output;
   if (r.exit_code == 0 || (verdict_may_fail && r.exit_code == 1 && !r.timed_out)) return;
   throw std::runtime_error(fmt::format("{} ended with {}{}; see {}", step, r.exit_code,
                                        r.timed_out ? " (timed out)" : "", log.string()));
@@ -123,9 +125,20 @@ fs::path write_unit_calibration(const fs::path& sim_dir, const fs::path& dir) {
 
 std::vector<std::string> calibrate_arguments(const fs::path& sim_dir, const fs::path& unit,
                                              const PopulationArgs& args, const fs::path& out) {
-  return {"calibrate", "--imu", (sim_dir / "imu.csv").string(), "--robot-log",
-          (sim_dir / "robot.csv").string(), "--robot", args.nominal, "--sensor", args.sensor,
-          "--config", args.calibrate_config, "--unit-calibration", unit.string(), "--out",
+  return {"calibrate",
+          "--imu",
+          (sim_dir / "imu.csv").string(),
+          "--robot-log",
+          (sim_dir / "robot.csv").string(),
+          "--robot",
+          args.nominal,
+          "--sensor",
+          args.sensor,
+          "--config",
+          args.calibrate_config,
+          "--unit-calibration",
+          unit.string(),
+          "--out",
           out.string()};
 }
 
@@ -146,8 +159,8 @@ fs::path identify_plant(const PlantFiles& files, const PopulationArgs& args, con
            {"simulate", "--scenario", files.mounting.string(), "--out", sim_cal.string()}, dir,
            args);
   run_step("simulate-identification",
-           {"simulate", "--scenario", files.identification.string(), "--out", sim_id.string()},
-           dir, args);
+           {"simulate", "--scenario", files.identification.string(), "--out", sim_id.string()}, dir,
+           args);
   const fs::path unit = write_unit_calibration(sim_cal, dir);
   run_step("calibrate", calibrate_arguments(sim_cal, unit, args, dir / "calibrate"), dir, args,
            true);
@@ -185,16 +198,24 @@ VerifiedFigures read_verification(const fs::path& file) {
 VerifiedFigures verify_plant(const fs::path& table, const fs::path& scenario,
                              const std::string& segments, const std::string& step,
                              const PopulationArgs& args, const fs::path& dir) {
-  std::vector<std::string> arguments{"verify",        "--table",     table.string(),
-                                     "--scenario",    scenario.string(),
-                                     "--cycles",      std::to_string(args.cycles),
-                                     "--no-ablation", "--out",       (dir / step).string()};
+  std::vector<std::string> arguments{"verify",
+                                     "--table",
+                                     table.string(),
+                                     "--scenario",
+                                     scenario.string(),
+                                     "--cycles",
+                                     std::to_string(args.cycles),
+                                     "--no-ablation",
+                                     "--out",
+                                     (dir / step).string()};
   if (!segments.empty()) arguments.insert(arguments.end(), {"--segments", segments});
   run_step(step, arguments, dir, args);
   return read_verification(dir / step / sim::load_scenario(scenario).name / "verification.json");
 }
 
-std::string number(double value) { return fmt::format("{:.6g}", value); }
+std::string number(double value) {
+  return fmt::format("{:.6g}", value);
+}
 
 // The plant's row: its draws (per joint, then the whole robot's) and its figures.
 std::pair<std::string, std::string> plant_row(const sim::PlantDraw& plant,
@@ -215,9 +236,9 @@ std::pair<std::string, std::string> plant_row(const sim::PlantDraw& plant,
         main_amplitude = o.amplitude_arcsec, main_order = o.harmonic_per_motor_rev;
     }
     add("link_mass_" + a, j.link_mass);
-    add("com_offset_mm_" + a, std::hypot(j.centre_of_mass_offset_mm[0],
-                                         j.centre_of_mass_offset_mm[1],
-                                         j.centre_of_mass_offset_mm[2]));
+    add("com_offset_mm_" + a,
+        std::hypot(j.centre_of_mass_offset_mm[0], j.centre_of_mass_offset_mm[1],
+                   j.centre_of_mass_offset_mm[2]));
     add("gear_stiffness_" + a, j.gear_stiffness);
     add("coulomb_" + a, j.coulomb_friction);
     add("viscous_" + a, j.viscous_friction);
@@ -241,11 +262,14 @@ std::pair<std::string, std::string> plant_row(const sim::PlantDraw& plant,
   return {header, row};
 }
 
-const std::vector<std::string> kFigures{
-    "seed_line_before_mm",        "seed_line_after_mm",
-    "seed_line_reduction_percent", "seed_line_true_reduction_percent",
-    "iso100_before_mm",           "iso100_after_mm",
-    "iso100_reduction_percent",    "iso100_true_reduction_percent"};
+const std::vector<std::string> kFigures{"seed_line_before_mm",
+                                        "seed_line_after_mm",
+                                        "seed_line_reduction_percent",
+                                        "seed_line_true_reduction_percent",
+                                        "iso100_before_mm",
+                                        "iso100_after_mm",
+                                        "iso100_reduction_percent",
+                                        "iso100_true_reduction_percent"};
 
 // One plant, all or nothing: built in a hidden folder, renamed when its row is written.
 void run_plant(std::uint64_t seed, const imscal::calib::RobotDescription& nominal,
@@ -265,15 +289,15 @@ void run_plant(std::uint64_t seed, const imscal::calib::RobotDescription& nomina
   imscal::write_file_atomically(dir / "row.csv", header + "\n" + row + "\n",
                                 imscal::Overwrite::kAllow);
   fs::rename(dir, done);
-  spdlog::info("population: plant {}: seed-line {:.3f} -> {:.3f} mm ({:.1f} %), ISO 100 % {:.3f} "
-               "-> {:.3f} mm ({:.1f} %)",
-               seed, line.before_mm, line.after_mm, line.reduction_percent, iso.before_mm,
-               iso.after_mm, iso.reduction_percent);
+  spdlog::info(
+      "population: plant {}: seed-line {:.3f} -> {:.3f} mm ({:.1f} %), ISO 100 % {:.3f} "
+      "-> {:.3f} mm ({:.1f} %)",
+      seed, line.before_mm, line.after_mm, line.reduction_percent, iso.before_mm, iso.after_mm,
+      iso.reduction_percent);
 }
 
 // Reads the finished plants' rows of the range into one table.
-eval::PopulationTable collect_rows(const SeedRange& seeds, const fs::path& out,
-                                   std::string& csv) {
+eval::PopulationTable collect_rows(const SeedRange& seeds, const fs::path& out, std::string& csv) {
   eval::PopulationTable table;
   for (std::uint64_t seed = seeds.first; seed <= seeds.last; ++seed) {
     std::ifstream in(out / fmt::format("plant-{}", seed) / "row.csv");
@@ -322,7 +346,8 @@ void run(PopulationArgs args) {
     args.calibrate_config = (datasets / "calibration" / "calibrate-default.yaml").string();
   if (args.sensor.empty()) args.sensor = (datasets / "sensors" / "navigation-grade.yaml").string();
   if (args.cycles < 1) throw imscal::InputError("", 0, "--cycles", "must be >= 1");
-  const imscal::calib::RobotDescription nominal = imscal::calib::load_robot_description(args.nominal);
+  const imscal::calib::RobotDescription nominal =
+      imscal::calib::load_robot_description(args.nominal);
   fs::create_directories(args.out);
   int failed = 0;
   const std::uint64_t count = seeds.last - seeds.first + 1;
