@@ -179,6 +179,8 @@ fs::path identify_plant(const PlantFiles& files, const PopulationArgs& args, con
 
 struct VerifiedFigures {
   double before_mm = 0.0, after_mm = 0.0, reduction_percent = 0.0, true_reduction_percent = 0.0;
+  double scatter_floor_mm = 0.0;  // the cycles' own scatter with the precontrol, as measured
+  double systematic_mm = 0.0;     // the largest deviation of the cycles' mean path with it
 };
 
 VerifiedFigures read_verification(const fs::path& file) {
@@ -190,7 +192,9 @@ VerifiedFigures read_verification(const fs::path& file) {
     return {cases.front().at("max_path_deviation_mm").get<double>(),
             c.at("max_path_deviation_mm").get<double>(),
             c.at("reduction_of_max_path_deviation_percent").get<double>(),
-            c.at("true_path").at("reduction_of_max_path_deviation_percent").get<double>()};
+            c.at("true_path").at("reduction_of_max_path_deviation_percent").get<double>(),
+            c.at("scatter_floor_mm").get<double>(),
+            c.at("systematic_max_mm").get<double>()};
   }
   throw std::runtime_error(file.string() + ": no compensated case");
 }
@@ -217,8 +221,19 @@ std::string number(double value) {
   return fmt::format("{:.6g}", value);
 }
 
+// The transmission error's order per motor revolution identify chose per joint (its report).
+std::vector<double> found_orders(const fs::path& identify_dir) {
+  std::ifstream in(identify_dir / "identification_report.json");
+  const json report = json::parse(in);
+  std::vector<double> orders;
+  for (const json& joint : report.at("transmission_error_order_search").at("joints"))
+    orders.push_back(joint.at("chosen_harmonic_per_motor_rev").get<double>());
+  return orders;
+}
+
 // The plant's row: its draws (per joint, then the whole robot's) and its figures.
 std::pair<std::string, std::string> plant_row(const sim::PlantDraw& plant,
+                                              const std::vector<double>& orders,
                                               const VerifiedFigures& line,
                                               const VerifiedFigures& iso) {
   std::string header = "seed", row = std::to_string(plant.seed);
@@ -251,25 +266,42 @@ std::pair<std::string, std::string> plant_row(const sim::PlantDraw& plant,
   }
   add("dead_time_cycles", plant.dead_time_cycles);
   add("payload_mass", plant.payload_mass);
+  for (std::size_t j = 0; j < orders.size(); ++j)
+    add(fmt::format("te_found_order_A{}", j + 1), orders[j]);
   add("seed_line_before_mm", line.before_mm);
   add("seed_line_after_mm", line.after_mm);
   add("seed_line_reduction_percent", line.reduction_percent);
   add("seed_line_true_reduction_percent", line.true_reduction_percent);
+  add("seed_line_scatter_floor_mm", line.scatter_floor_mm);
+  add("seed_line_systematic_mm", line.systematic_mm);
   add("iso100_before_mm", iso.before_mm);
   add("iso100_after_mm", iso.after_mm);
   add("iso100_reduction_percent", iso.reduction_percent);
   add("iso100_true_reduction_percent", iso.true_reduction_percent);
+  add("iso100_scatter_floor_mm", iso.scatter_floor_mm);
+  add("iso100_systematic_mm", iso.systematic_mm);
   return {header, row};
 }
 
-const std::vector<std::string> kFigures{"seed_line_before_mm",
+// The row's outcomes (not draws): left out of the correlations.
+const std::vector<std::string> kFigures{"te_found_order_A1",
+                                        "te_found_order_A2",
+                                        "te_found_order_A3",
+                                        "te_found_order_A4",
+                                        "te_found_order_A5",
+                                        "te_found_order_A6",
+                                        "seed_line_before_mm",
                                         "seed_line_after_mm",
                                         "seed_line_reduction_percent",
                                         "seed_line_true_reduction_percent",
+                                        "seed_line_scatter_floor_mm",
+                                        "seed_line_systematic_mm",
+                                        "iso100_systematic_mm",
                                         "iso100_before_mm",
                                         "iso100_after_mm",
                                         "iso100_reduction_percent",
-                                        "iso100_true_reduction_percent"};
+                                        "iso100_true_reduction_percent",
+                                        "iso100_scatter_floor_mm"};
 
 // One plant, all or nothing: built in a hidden folder, renamed when its row is written.
 void run_plant(std::uint64_t seed, const imscal::calib::RobotDescription& nominal,
@@ -285,7 +317,7 @@ void run_plant(std::uint64_t seed, const imscal::calib::RobotDescription& nomina
       verify_plant(table, files.seed_line, "", "verify-seed-line", args, dir);
   const VerifiedFigures iso =
       verify_plant(table, files.iso9283, "100%", "verify-iso9283", args, dir);
-  const auto [header, row] = plant_row(plant, line, iso);
+  const auto [header, row] = plant_row(plant, found_orders(dir / "identify"), line, iso);
   imscal::write_file_atomically(dir / "row.csv", header + "\n" + row + "\n",
                                 imscal::Overwrite::kAllow);
   fs::rename(dir, done);
@@ -303,6 +335,11 @@ eval::PopulationTable collect_rows(const SeedRange& seeds, const fs::path& out, 
     std::ifstream in(out / fmt::format("plant-{}", seed) / "row.csv");
     std::string header, row;
     if (!std::getline(in, header) || !std::getline(in, row)) continue;
+    if (!csv.empty() && header + "\n" != csv.substr(0, csv.find('\n') + 1)) {
+      spdlog::warn("population: plant {}'s row has other columns (an older imscal); left out",
+                   seed);
+      continue;
+    }
     if (table.columns.empty()) {
       std::stringstream names(header);
       for (std::string name; std::getline(names, name, ',');) table.columns.push_back(name);
