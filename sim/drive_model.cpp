@@ -21,26 +21,33 @@ DriveModel::DriveModel(const calib::DriveParameters& drive, const JointEffects& 
   coulomb_scale_ = effects.coulomb_velocity_scale_rad_s;
   viscous_ = effects.viscous_friction ? drive.viscous_nm_s_per_rad : 0.0;
   if (effects.transmission_error) {
-    te_amplitude_ = effects.transmission_error_shape.amplitude_rad;
-    te_frequency_ = effects.transmission_error_shape.harmonic_per_motor_rev * n;
-    te_phase_ = effects.transmission_error_shape.phase_rad;
+    const auto add = [&](const TransmissionErrorShape& shape) {
+      if (shape.amplitude_rad != 0.0)
+        te_.push_back({shape.amplitude_rad, shape.harmonic_per_motor_rev * n, shape.phase_rad});
+    };
+    add(effects.transmission_error_shape);
+    for (const auto& shape : effects.further_transmission_error_shapes) add(shape);
   }
 }
 
 double DriveModel::te(double theta) const {
-  if (te_amplitude_ == 0.0) return 0.0;
-  return te_amplitude_ * std::sin(te_frequency_ * theta + te_phase_);
+  double sum = 0.0;
+  for (const auto& h : te_) sum += h.amplitude * std::sin(h.frequency * theta + h.phase);
+  return sum;
 }
 
 double DriveModel::te_slope(double theta) const {
-  if (te_amplitude_ == 0.0) return 0.0;
-  return te_amplitude_ * te_frequency_ * std::cos(te_frequency_ * theta + te_phase_);
+  double sum = 0.0;
+  for (const auto& h : te_)
+    sum += h.amplitude * h.frequency * std::cos(h.frequency * theta + h.phase);
+  return sum;
 }
 
 double DriveModel::te_curvature(double theta) const {
-  if (te_amplitude_ == 0.0) return 0.0;
-  return -te_amplitude_ * te_frequency_ * te_frequency_ *
-         std::sin(te_frequency_ * theta + te_phase_);
+  double sum = 0.0;
+  for (const auto& h : te_)
+    sum -= h.amplitude * h.frequency * h.frequency * std::sin(h.frequency * theta + h.phase);
+  return sum;
 }
 
 double DriveModel::dead_zone(double x) const {
@@ -80,7 +87,7 @@ double DriveModel::motor_angle_for(double q_link, double gear_torque) const {
       kind_ == DriveKind::kRigid ? 0.0 : inverse_dead_zone(gear_torque / stiffness_);
   double theta = q_link + deflection;
   // Fixed point theta = q + deflection + te(theta): contraction with factor |te'| (~0.02).
-  for (int iteration = 0; iteration < 8 && te_amplitude_ != 0.0; ++iteration) {
+  for (int iteration = 0; iteration < 8 && !te_.empty(); ++iteration) {
     theta = q_link + deflection + te(theta);
   }
   return theta;

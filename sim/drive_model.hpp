@@ -24,6 +24,8 @@
 // with the spring, so the gear passes the drive torque to the link unchanged (friction then acts
 // at the link velocity) and the encoder reads the static position theta = q + te(theta) +
 // dz^-1(tau_g / k) (backlash taken up on the side of the torque; centred at zero torque).
+#include <vector>
+
 #include "calib/robot_description.hpp"
 #include "sim/plant_config.hpp"
 
@@ -85,9 +87,12 @@ class DriveModel {
   double coulomb_ = 0.0;
   double coulomb_scale_ = 0.01;
   double viscous_ = 0.0;
-  double te_amplitude_ = 0.0;
-  double te_frequency_ = 0.0;  // harmonic * N [1/rad of theta]
-  double te_phase_ = 0.0;
+  struct TeHarmonic {
+    double amplitude = 0.0;  // [rad at the link]
+    double frequency = 0.0;  // harmonic * N [1/rad of theta]
+    double phase = 0.0;      // [rad]
+  };
+  std::vector<TeHarmonic> te_;  // empty: no transmission error
   double link_share_ = 0.0;
 };
 

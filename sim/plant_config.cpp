@@ -26,15 +26,35 @@ void read_shape(const ConfigNode& node, TransmissionErrorShape& shape) {
   if (node.has("phase_deg")) shape.phase_rad = node.child("phase_deg").as_double() * M_PI / 180.0;
 }
 
+// `transmission_error_shapes: [{...}, ...]`: the first replaces the joint's shape, the others are
+// its further orders (summed).
+void read_shapes(const ConfigNode& node, JointEffects& effects) {
+  const std::vector<ConfigNode> items = node.as_sequence();
+  if (items.empty()) node.fail("expected at least one shape");
+  effects.further_transmission_error_shapes.clear();
+  for (std::size_t k = 0; k < items.size(); ++k) {
+    TransmissionErrorShape shape;
+    read_shape(items[k], shape);
+    if (k == 0)
+      effects.transmission_error_shape = shape;
+    else
+      effects.further_transmission_error_shapes.push_back(shape);
+  }
+}
+
 // Applies the keys present in `node` on top of `effects` (for `all` and per joint).
 void read_effects(const ConfigNode& node, bool per_joint, JointEffects& effects) {
   if (per_joint) {
     node.require_only_keys({"motor_inertia", "elastic_gear", "gear_damping", "backlash",
                             "coulomb_friction", "viscous_friction", "transmission_error",
                             "dead_time_s", "coulomb_velocity_scale_rad_s", "friction_at_link",
-                            "link_friction_fraction", "transmission_error_shape"});
+                            "link_friction_fraction", "transmission_error_shape",
+                            "transmission_error_shapes"});
     if (const auto shape = node.optional_child("transmission_error_shape")) {
       read_shape(*shape, effects.transmission_error_shape);
+    }
+    if (const auto shapes = node.optional_child("transmission_error_shapes")) {
+      read_shapes(*shapes, effects);
     }
   } else {
     node.require_only_keys({"motor_inertia", "elastic_gear", "gear_damping", "backlash",

@@ -11,11 +11,13 @@
 //           link_friction_fraction: 0.1}
 //     transmission_error: {amplitude_arcsec: 20, harmonic_per_motor_rev: 1, phase_deg: 0}
 //     A2: {backlash: true, ...}          # per-joint overrides by joint name (same keys as `all`,
-//                                        # plus `transmission_error_shape: {...}` as above)
+//                                        # plus `transmission_error_shape: {...}` as above, or
+//                                        # `transmission_error_shapes: [{...}, ...]`, summed)
 //   integration_step_s: 0.0005           # scenario level, beside `effects:`
 // Backlash and gear damping live in the elastic gear: a joint with elastic_gear false and
 // backlash or gear_damping true is refused (the play of a rigid gear has no model here).
 #include <array>
+#include <vector>
 
 #include "calib/robot_description.hpp"
 
@@ -58,6 +60,9 @@ struct JointEffects {
   // within RK4's stability limit on the motor inertia at a 0.5 ms step (see drive_model.hpp).
   double coulomb_velocity_scale_rad_s = 0.01;
   TransmissionErrorShape transmission_error_shape;
+  // Further orders of the same gear's transmission error, added to transmission_error_shape
+  // (a real gear's error has several: eccentricity, tooth meshing, ...).
+  std::vector<TransmissionErrorShape> further_transmission_error_shapes;
 };
 
 struct PlantConfig {
@@ -65,6 +70,9 @@ struct PlantConfig {
   std::array<JointEffects, calib::kJointCount> effects{};
   double integration_step_s = 0.0005;  // RK4 step; must divide robot.controller_cycle_s
   bool gravity = true;
+  // The payload the plant carries against the one the program names (and the robot log logs):
+  // its mass and inertia tensor times this factor (scenario `plant_deviations: payload_mass`).
+  double payload_mass_factor = 1.0;
   bool controller = true;  // false: drive torque 0 (free motion, e.g. for the energy check)
   // Gravity in the robot base R [m/s^2]: the base stands upright (z_R up) unless told otherwise;
   // the coordinator may set the site's local gravity here.

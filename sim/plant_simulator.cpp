@@ -10,9 +10,24 @@ namespace {
 
 constexpr int kN = calib::kJointCount;
 
-std::optional<calib::RigidBodyParameters> payload_body(const DesiredJointPath& path, int index) {
+// The body the plant carries: the program's payload, its mass and inertia times the plant's
+// factor (the logged payload stays the program's).
+std::optional<calib::RigidBodyParameters> payload_body(const DesiredJointPath& path, int index,
+                                                       double mass_factor) {
   if (path.payloads.empty()) return std::nullopt;
-  return path.payloads[index].body;
+  calib::RigidBodyParameters body = path.payloads[index].body;
+  body.mass_kg *= mass_factor;
+  body.inertia_kg_m2 *= mass_factor;
+  return body;
+}
+
+// Largest slope of a joint's transmission error, sum of amplitude * harmonic * N over its orders.
+double largest_te_slope(const JointEffects& effects, double gear_ratio) {
+  double slope = effects.transmission_error_shape.amplitude_rad *
+                 effects.transmission_error_shape.harmonic_per_motor_rev;
+  for (const auto& shape : effects.further_transmission_error_shapes)
+    slope += shape.amplitude_rad * shape.harmonic_per_motor_rev;
+  return slope * gear_ratio;
 }
 
 }  // namespace
@@ -41,11 +56,11 @@ PlantSimulator::PlantSimulator(const PlantConfig& config, const DesiredJointPath
     const calib::JointDescription& joint = config_.robot.joints[i];
     drives_[i] = DriveModel(joint.drive, config_.effects[i]);
     // |te'| must stay well below 1 or the transmission is not monotonic.
-    const TransmissionErrorShape& te = config_.effects[i].transmission_error_shape;
     if (config_.effects[i].transmission_error &&
-        te.amplitude_rad * te.harmonic_per_motor_rev * joint.drive.gear_ratio > 0.2) {
-      throw std::invalid_argument("plant: joint " + joint.name +
-                                  ": transmission error slope amplitude * harmonic * N > 0.2");
+        largest_te_slope(config_.effects[i], joint.drive.gear_ratio) > 0.2) {
+      throw std::invalid_argument(
+          "plant: joint " + joint.name +
+          ": transmission error slope, sum of amplitude * harmonic * N, > 0.2");
     }
     controllers_[i] = JointController(joint.controller, cycle);
     delay_cycles_[i] = static_cast<int>(std::lround(config_.effects[i].dead_time_s / cycle));
@@ -57,7 +72,7 @@ PlantSimulator::PlantSimulator(const PlantConfig& config, const DesiredJointPath
 
 void PlantSimulator::apply_payload(int index) {
   payload_index_ = index;
-  dynamics_.set_payload(payload_body(path_, index));
+  dynamics_.set_payload(payload_body(path_, index, config_.payload_mass_factor));
 }
 
 void PlantSimulator::start_at_rest() {

@@ -44,37 +44,53 @@ struct DeviationFactors {
   double backlash = 1.0;
   double coulomb_friction = 1.0;
   double viscous_friction = 1.0;
+  double position_gain = 1.0;  // the controller's kp_position
+  double velocity_gain = 1.0;  // the velocity PI's kp and ki (its corner kept)
+  // Not a factor: added to the link's centre of mass, in the link's DH frame [m].
+  Eigen::Vector3d centre_of_mass_offset_m = Eigen::Vector3d::Zero();
 };
 
 DeviationFactors read_factors(const ConfigNode& node, const DeviationFactors& fallback) {
-  node.require_only_keys(
-      {"link_mass", "gear_stiffness", "backlash", "coulomb_friction", "viscous_friction"});
+  node.require_only_keys({"link_mass", "gear_stiffness", "backlash", "coulomb_friction",
+                          "viscous_friction", "position_gain", "velocity_gain",
+                          "centre_of_mass_offset_mm"});
   DeviationFactors f;
   f.link_mass = factor(node, "link_mass", fallback.link_mass);
   f.gear_stiffness = factor(node, "gear_stiffness", fallback.gear_stiffness);
   f.backlash = factor(node, "backlash", fallback.backlash);
   f.coulomb_friction = factor(node, "coulomb_friction", fallback.coulomb_friction);
   f.viscous_friction = factor(node, "viscous_friction", fallback.viscous_friction);
+  f.position_gain = factor(node, "position_gain", fallback.position_gain);
+  f.velocity_gain = factor(node, "velocity_gain", fallback.velocity_gain);
+  f.centre_of_mass_offset_m =
+      node.has("centre_of_mass_offset_mm")
+          ? Eigen::Vector3d(node.child("centre_of_mass_offset_mm").as_vector3() * 1e-3)
+          : fallback.centre_of_mass_offset_m;
   return f;
 }
 
 void apply(const DeviationFactors& f, calib::JointDescription& joint) {
   joint.link.mass_kg *= f.link_mass;
   joint.link.inertia_kg_m2 *= f.link_mass;
+  joint.link.com_m += f.centre_of_mass_offset_m;
   joint.drive.stiffness_nm_per_rad *= f.gear_stiffness;
   joint.drive.backlash_rad *= f.backlash;
   joint.drive.coulomb_nm *= f.coulomb_friction;
   joint.drive.viscous_nm_s_per_rad *= f.viscous_friction;
+  joint.controller.kp_position_1_s *= f.position_gain;
+  joint.controller.kp_velocity_nm_s_per_rad *= f.velocity_gain;
+  joint.controller.ki_velocity_nm_per_rad *= f.velocity_gain;
 }
 
 // `plant_deviations:` on the robot file's description: `all` first, then each joint's own keys
-// (a joint's key replaces the `all` value).
+// (a joint's key replaces the `all` value). `payload_mass` is read by payload_mass_factor.
 void apply_deviations(const ConfigNode& node, calib::RobotDescription& robot) {
-  if (!node.is_map()) node.fail("expected a map: all, <joint name>");
+  if (!node.is_map()) node.fail("expected a map: all, payload_mass, <joint name>");
   for (const std::string& key : node.keys()) {
-    bool known = key == "all";
+    bool known = key == "all" || key == "payload_mass";
     for (const auto& joint : robot.joints) known = known || key == joint.name;
-    if (!known) node.child(key).fail("unknown key: expected all or a joint name of the robot");
+    if (!known)
+      node.child(key).fail("unknown key: expected all, payload_mass or a joint name of the robot");
   }
   DeviationFactors common;
   if (const auto all = node.optional_child("all")) common = read_factors(*all, common);
@@ -168,7 +184,10 @@ Scenario load_scenario(const fs::path& file) {
     if (seed < 0) root.child("seed").fail("must not be negative");
     s.seed = static_cast<std::uint64_t>(seed);
   }
-  load_plant_robot(s);  // the deviations' keys and factors checked here, with the file's lines
+  // The deviations' and the effects' keys and values checked here, with the file's lines.
+  make_plant_config(load_plant_robot(s), s);
+  if (s.plant_deviations && s.plant_deviations->is_map())
+    s.plant_payload_mass_factor = factor(*s.plant_deviations, "payload_mass", 1.0);
   if (!s.nominal_robot_given) {
     spdlog::info(
         "scenario {}: no nominal_robot given; the chain believes the plant's robot file "
@@ -234,8 +253,11 @@ fs::path resolve_scenario(const std::string& name_or_file) {
 
 PlantConfig make_plant_config(const calib::RobotDescription& plant_robot,
                               const Scenario& scenario) {
-  return make_plant_config(plant_robot, scenario.effects ? &*scenario.effects : nullptr,
-                           scenario.integration_step ? &*scenario.integration_step : nullptr);
+  PlantConfig config =
+      make_plant_config(plant_robot, scenario.effects ? &*scenario.effects : nullptr,
+                        scenario.integration_step ? &*scenario.integration_step : nullptr);
+  config.payload_mass_factor = scenario.plant_payload_mass_factor;
+  return config;
 }
 
 }  // namespace imscal::sim

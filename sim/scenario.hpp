@@ -53,6 +53,9 @@ struct Scenario {
   // How the plant differs from its robot file: factors per joint (`plant_deviations:`, checked
   // by load_scenario; applied by load_plant_robot).
   std::optional<ConfigNode> plant_deviations;
+  // `plant_deviations: payload_mass`: the payload the plant carries against the program's (and
+  // the robot log's) as a factor on its mass and inertia (applied by make_plant_config).
+  double plant_payload_mass_factor = 1.0;
   std::optional<ConfigNode> effects;           // the plant's effects section (sim/plant_config.hpp)
   std::optional<ConfigNode> integration_step;  // the plant's step (sim/plant_config.hpp)
   double plant_output_interval_s = 0.001;      // link-side truth and the IMS's pose samples

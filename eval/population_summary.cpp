@@ -1,0 +1,88 @@
+#include "eval/population_summary.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace imscal::eval {
+namespace {
+
+std::size_t column_index(const PopulationTable& table, const std::string& name) {
+  const auto it = std::find(table.columns.begin(), table.columns.end(), name);
+  if (it == table.columns.end()) throw std::invalid_argument("population: no column " + name);
+  return static_cast<std::size_t>(it - table.columns.begin());
+}
+
+std::vector<double> column_values(const PopulationTable& table, std::size_t index) {
+  std::vector<double> values;
+  for (const auto& row : table.rows) values.push_back(row.at(index));
+  return values;
+}
+
+}  // namespace
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) throw std::invalid_argument("percentile of no values");
+  std::sort(values.begin(), values.end());
+  const double position = p / 100.0 * static_cast<double>(values.size() - 1);
+  const auto below = static_cast<std::size_t>(std::floor(position));
+  const std::size_t above = std::min(below + 1, values.size() - 1);
+  const double weight = position - static_cast<double>(below);
+  return values[below] * (1.0 - weight) + values[above] * weight;
+}
+
+double correlation(const std::vector<double>& a, const std::vector<double>& b) {
+  const double n = static_cast<double>(a.size());
+  double mean_a = 0.0, mean_b = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    mean_a += a[k] / n;
+    mean_b += b[k] / n;
+  }
+  double ab = 0.0, aa = 0.0, bb = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    ab += (a[k] - mean_a) * (b[k] - mean_b);
+    aa += (a[k] - mean_a) * (a[k] - mean_a);
+    bb += (b[k] - mean_b) * (b[k] - mean_b);
+  }
+  return aa > 0.0 && bb > 0.0 ? ab / std::sqrt(aa * bb) : 0.0;
+}
+
+std::vector<DrawCorrelation> strongest_correlations(const PopulationTable& table,
+                                                    const std::string& figure,
+                                                    const std::vector<std::string>& figures,
+                                                    std::size_t count) {
+  const std::vector<double> target = column_values(table, column_index(table, figure));
+  std::vector<DrawCorrelation> out;
+  for (std::size_t c = 1; c < table.columns.size(); ++c) {
+    if (std::find(figures.begin(), figures.end(), table.columns[c]) != figures.end()) continue;
+    out.push_back({table.columns[c], correlation(column_values(table, c), target)});
+  }
+  std::stable_sort(out.begin(), out.end(), [](const DrawCorrelation& x, const DrawCorrelation& y) {
+    return std::abs(x.r) > std::abs(y.r);
+  });
+  if (out.size() > count) out.resize(count);
+  return out;
+}
+
+std::string summarize_figure(const PopulationTable& table, const std::string& figure,
+                             const std::vector<std::string>& figures) {
+  const std::size_t index = column_index(table, figure);
+  const std::vector<double> values = column_values(table, index);
+  if (values.empty()) return figure + ": no plants\n";
+  const auto worst = std::min_element(values.begin(), values.end()) - values.begin();
+  std::string text = fmt::format(
+      "{}: {} plants, median {:.1f}, 10th percentile {:.1f}, worst {:.1f} (seed {:.0f})\n", figure,
+      values.size(), percentile(values, 50.0), percentile(values, 10.0), values[worst],
+      table.rows[static_cast<std::size_t>(worst)].front());
+  if (values.size() < 3) return text;
+  text +=
+      "  draws correlated with it (Pearson r over the plants; a low figure goes with the\n"
+      "  draw when r > 0 and the draw is low, or r < 0 and the draw is high):";
+  for (const DrawCorrelation& c : strongest_correlations(table, figure, figures, 5))
+    text += fmt::format(" {} {:+.2f};", c.column, c.r);
+  return text + "\n";
+}
+
+}  // namespace imscal::eval
