@@ -15,7 +15,7 @@ if(IMSCAL_SANITIZE)
   endif()
   target_compile_options(imscal_build_options INTERFACE
     -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
-    -fsanitize-ignorelist=${ubsan_ignorelist})
+    $<BUILD_INTERFACE:-fsanitize-ignorelist=${ubsan_ignorelist}>)
   target_link_options(imscal_build_options INTERFACE -fsanitize=address,undefined)
 endif()
 

@@ -421,10 +421,11 @@ TEST_F(CalibrateCampaignScratch, MountingWithoutBacklash) {
   const fs::path datasets = fs::path(IMSCAL_SOURCE_DIR) / "datasets";
   std::ifstream in(datasets / "scenarios" / "mounting.yaml");
   std::string text((std::istreambuf_iterator<char>(in)), {});
+  // Every occurrence: the scenario names the robot twice (the plant and the nominal robot).
   auto replace = [&](const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    text.replace(at, from.size(), to);
+    ASSERT_NE(text.find(from), std::string::npos) << from;
+    for (auto at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+      text.replace(at, from.size(), to);
   };
   replace("../robots/", (datasets / "robots").string() + "/");
   replace("../programs/", (datasets / "programs").string() + "/");
