@@ -66,6 +66,18 @@ struct Unknowns {
   double offset[1];
 };
 
+// The calibration's problems have 11 unknowns: dense QR on one thread, as the whole record and
+// each bootstrap replicate solve it.
+ceres::Solver::Summary solve_small_problem(ceres::Problem& problem, int max_iterations) {
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = max_iterations;
+  solver_options.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  return summary;
+}
+
 // Solves the window residuals from `x` (updated in place); the problem as calibrate_rotation
 // builds it.
 bool solve_windows(const ToolImuRecord& record, const std::vector<Window>& windows,
@@ -79,13 +91,7 @@ bool solve_windows(const ToolImuRecord& record, const std::vector<Window>& windo
   }
   problem.SetManifold(x.q, new ceres::EigenQuaternionManifold);
   if (!options.estimate_scale) problem.SetParameterBlockConstant(x.scale);
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.num_threads = 1;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
-  return summary.IsSolutionUsable();
+  return solve_small_problem(problem, options.max_iterations).IsSolutionUsable();
 }
 
 Eigen::Quaterniond rotation_of(const Unknowns& x) {
@@ -273,12 +279,7 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
   }
   result.initial_rms_residual_rad = std::sqrt(initial_sum / (3.0 * windows.size()));
 
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.num_threads = 1;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
+  const ceres::Solver::Summary summary = solve_small_problem(problem, options.max_iterations);
   result.summary = summary.BriefReport();
   result.iterations = static_cast<int>(summary.iterations.size());
   // A failed solve has no estimate and no covariance (ceres::Covariance on it aborts).
