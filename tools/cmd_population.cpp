@@ -268,18 +268,15 @@ std::pair<std::string, std::string> plant_row(const sim::PlantDraw& plant,
   add("payload_mass", plant.payload_mass);
   for (std::size_t j = 0; j < orders.size(); ++j)
     add(fmt::format("te_found_order_A{}", j + 1), orders[j]);
-  add("seed_line_before_mm", line.before_mm);
-  add("seed_line_after_mm", line.after_mm);
-  add("seed_line_reduction_percent", line.reduction_percent);
-  add("seed_line_true_reduction_percent", line.true_reduction_percent);
-  add("seed_line_scatter_floor_mm", line.scatter_floor_mm);
-  add("seed_line_systematic_mm", line.systematic_mm);
-  add("iso100_before_mm", iso.before_mm);
-  add("iso100_after_mm", iso.after_mm);
-  add("iso100_reduction_percent", iso.reduction_percent);
-  add("iso100_true_reduction_percent", iso.true_reduction_percent);
-  add("iso100_scatter_floor_mm", iso.scatter_floor_mm);
-  add("iso100_systematic_mm", iso.systematic_mm);
+  for (const auto& [prefix, f] : {std::pair<const char*, const VerifiedFigures&>{"seed_line", line},
+                                  std::pair<const char*, const VerifiedFigures&>{"iso100", iso}}) {
+    add(fmt::format("{}_before_mm", prefix), f.before_mm);
+    add(fmt::format("{}_after_mm", prefix), f.after_mm);
+    add(fmt::format("{}_reduction_percent", prefix), f.reduction_percent);
+    add(fmt::format("{}_true_reduction_percent", prefix), f.true_reduction_percent);
+    add(fmt::format("{}_scatter_floor_mm", prefix), f.scatter_floor_mm);
+    add(fmt::format("{}_systematic_mm", prefix), f.systematic_mm);
+  }
   return {header, row};
 }
 
