@@ -74,11 +74,7 @@ class FramesJson {
 
 FramesJson parse(const std::filesystem::path& file) {
   const std::string text = read_input_file(file);
-  try {
-    return FramesJson(file.string(), parse_json_refusing_duplicate_keys(text, file.string()));
-  } catch (const json::parse_error& e) {
-    throw InputError(file.string(), 0, "", fmt::format("not a JSON file: {}", e.what()));
-  }
+  return FramesJson(file.string(), parse_json_refusing_duplicate_keys(text, file.string()));
 }
 
 // The version key and the robot, before anything else: a file of another kind or robot is

@@ -36,6 +36,12 @@ std::size_t line_of_key(const std::string& text, const RepeatedKey& repeated) {
   return 0;
 }
 
+// The 1-based line holding the 1-based byte position nlohmann reports for a syntax error.
+std::size_t line_of_byte(const std::string& text, std::size_t byte) {
+  const auto end = text.begin() + long(std::min(byte, text.size()));
+  return 1 + static_cast<std::size_t>(std::count(text.begin(), end, '\n'));
+}
+
 }  // namespace
 
 json parse_json_refusing_duplicate_keys(const std::string& text, const std::string& origin) {
@@ -53,7 +59,15 @@ json parse_json_refusing_duplicate_keys(const std::string& text, const std::stri
     }
     return true;
   };
-  json root = json::parse(text, watch);
+  json root;
+  try {
+    root = json::parse(text, watch);
+  } catch (const json::parse_error& e) {
+    throw InputError(origin, line_of_byte(text, e.byte), "",
+                     fmt::format("not valid JSON: {}", e.what()));
+  } catch (const json::exception& e) {  // numbers beyond double (1e710) are out_of_range
+    throw InputError(origin, 0, "", fmt::format("not valid JSON: {}", e.what()));
+  }
   if (repeated) {
     throw InputError(
         origin, line_of_key(text, *repeated), repeated->key,

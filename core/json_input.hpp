@@ -7,7 +7,7 @@
 
 namespace imscal {
 
-// The parsed document. nlohmann::json::parse_error on a syntax error (the caller words it);
+// The parsed document. InputError (origin, line) on a syntax error or a number beyond double;
 // InputError (origin, line, key) when a key appears twice in one object.
 nlohmann::json parse_json_refusing_duplicate_keys(const std::string& text,
                                                   const std::string& origin);
