@@ -25,6 +25,7 @@
 #include "core/input_error.hpp"
 #include "core/subprocess.hpp"
 #include "eval/population_summary.hpp"
+#include "ident/identification_report.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "sim/plant_population.hpp"
@@ -223,11 +224,15 @@ std::string number(double value) {
 
 // The transmission error's order per motor revolution identify chose per joint (its report).
 std::vector<double> found_orders(const fs::path& identify_dir) {
-  std::ifstream in(identify_dir / "identification_report.json");
-  const json report = json::parse(in);
+  const fs::path file = identify_dir / "identification_report.json";
+  const imscal::ident::IdentificationReport report =
+      imscal::ident::read_identification_report(file);
+  if (!report.header.order_search)
+    throw imscal::InputError(file.string(), 0, "transmission_error_order_search",
+                             "missing: identify ran without --search-transmission-error-order");
   std::vector<double> orders;
-  for (const json& joint : report.at("transmission_error_order_search").at("joints"))
-    orders.push_back(joint.at("chosen_harmonic_per_motor_rev").get<double>());
+  for (const imscal::ident::OrderSearchJoint& joint : report.header.order_search->joints)
+    orders.push_back(joint.chosen_harmonic_per_motor_rev);
   return orders;
 }
 
