@@ -109,6 +109,8 @@ json joint_json(const JointIdentification& r, double seconds) {
     cells.push_back(cell_json(c, r.parameters.cells.at(std::size_t(c.cell)).figures));
   return {{"joint", r.parameters.name},
           {"seconds", seconds},
+          {"table_joint_error_fit_percent", number_or_null(r.table_fit.joint_error_fit_percent)},
+          {"table_validation_rows", r.table_fit.rows},
           {"backlash",
            {{"identified", r.parameters.backlash_identified},
             {"l_rad", b.l_rad},
@@ -192,6 +194,8 @@ ReportedJoint joint_of(const JsonField& f) {
   ReportedJoint j;
   j.name = f["joint"].text();
   j.seconds = f["seconds"].number();
+  j.table_joint_error_fit_percent = f["table_joint_error_fit_percent"].number_or_nan();
+  j.table_validation_rows = f["table_validation_rows"].count();
   j.backlash = backlash_of(f["backlash"]);
   const JsonField cells = f["cells"];
   for (std::size_t k = 0; k < cells.size(); ++k) j.cells.push_back(cell_of(cells[k]));

@@ -74,6 +74,10 @@ struct ReportedBacklash {
 struct ReportedJoint {
   std::string name;
   double seconds = 0.0;
+  // The whole table's held-out joint-error fit, cells blended as the precontrol does
+  // (ident/table_fit.hpp; NaN: not judged), and the rows it is over.
+  double table_joint_error_fit_percent = 0.0;
+  std::size_t table_validation_rows = 0;
   ReportedBacklash backlash;
   std::vector<ReportedCell> cells;
 };

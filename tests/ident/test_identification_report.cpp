@@ -26,6 +26,7 @@ JointOutcome sample_joint() {
   outcome.seconds = 1.25;
   JointIdentification& r = outcome.result;
   r.parameters.name = "A2";
+  r.table_fit = {9.75, 3300};
   r.parameters.backlash_identified = true;
   r.parameters.backlash_l_rad = 2.5e-4;
   r.parameters.cells.resize(2);
@@ -93,6 +94,8 @@ TEST_F(IdentificationReportTest, WhatIsWrittenIsReadBack) {
   const ReportedJoint& j = read.joints[0];
   EXPECT_EQ(j.name, "A2");
   EXPECT_EQ(j.seconds, 1.25);
+  EXPECT_EQ(j.table_joint_error_fit_percent, 9.75);
+  EXPECT_EQ(j.table_validation_rows, 3300u);
   EXPECT_TRUE(j.backlash.identified);
   EXPECT_EQ(j.backlash.l_rad, 2.5e-4);
   EXPECT_EQ(j.backlash.full_play_rad, 5e-4);
@@ -143,6 +146,7 @@ TEST_F(IdentificationReportTest, RefusalsNameTheFileAndTheField) {
   with("/transmission_error_order_search/joints/0/held_out_joint_error_fit_percent"_json_pointer,
        {1.0}, "transmission_error_order_search.joints[0].held_out_joint_error_fit_percent");
   with("/joints"_json_pointer, json::object(), "joints");
+  with("/joints/0/table_validation_rows"_json_pointer, removed, "joints[0].table_validation_rows");
   for (const Case& c : cases) {
     SCOPED_TRACE(c.field);
     std::ofstream(file, std::ios::trunc) << c.document.dump();
