@@ -40,6 +40,7 @@
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
+#include "core/payload_plausibility.hpp"
 #include "core/progress.hpp"
 #include "core/sha256.hpp"
 #include "core/version.hpp"
@@ -116,6 +117,10 @@ Inputs read_inputs(const CalibrateArgs& args) {
   in.sensor_file = pick(args.sensor, in.config.sensor_file, "--sensor");
   in.robot = calib::load_robot_description(in.robot_file);
   warn_if_rigid(in.robot);
+  const std::string rating_of = fmt::format("robot {} ({})", in.robot.name, in.robot.source);
+  check_payload_plausible(in.config.payload.mass_kg, in.robot.nominal_payload_kg,
+                          {args.config.empty() ? "the calibration defaults" : args.config, 0,
+                           "payload.mass_kg", rating_of});
   in.spec = ims::load_sensor_spec(in.sensor_file);
   // The earlier session's frames before the (long) records: a wrong file fails fast.
   if (!args.frames.empty()) in.previous = calib::read_frames_json(args.frames, in.robot.name);
@@ -137,6 +142,13 @@ Inputs read_inputs(const CalibrateArgs& args) {
                      "the IMS file does not state its site (site_latitude_deg, "
                      "site_longitude_deg, site_height_m): gravity and Earth rate need it");
   in.log = calib::read_robot_log_csv(args.robot_log, in.robot.name);
+  std::vector<double> payload_kg, t_s;
+  for (const calib::RobotLogSample& sample : in.log.samples) {
+    payload_kg.push_back(sample.payload_kg);
+    t_s.push_back(sample.t_s);
+  }
+  check_payload_series(payload_kg, t_s, in.robot.nominal_payload_kg,
+                       {args.robot_log, 0, "payload_kg", rating_of});
   // The two records must overlap in time (up to the time-offset search range).
   const double imu_begin = in.imu.samples.front().t_s, imu_end = in.imu.samples.back().t_s;
   const double log_begin = in.log.samples.front().t_s, log_end = in.log.samples.back().t_s;

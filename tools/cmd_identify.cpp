@@ -18,6 +18,7 @@
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
+#include "core/payload_plausibility.hpp"
 #include "core/version.hpp"
 #include "eval/model_torque.hpp"
 #include "eval/transmission_error_order.hpp"
@@ -114,23 +115,13 @@ void check_orders_fit_record(const ident::JointErrorLog& log,
                   log_file, longest_segment));
 }
 
-// A payload far above the robot's rating is a wrong column or unit, not a load the robot can
-// carry: the payload cells (fractions of the rating) would hold nothing the precontrol meets.
-constexpr double kMaxPayloadOfRating = 1.5;
-
+// The log's payload against the rating of the config (the payload cells are fractions of it).
 void check_payload_plausible(const ident::JointErrorLog& log,
-                             const ident::IdentificationConfig& config,
-                             const std::string& log_file) {
-  const double limit_kg = kMaxPayloadOfRating * config.nominal_payload_kg;
-  for (std::size_t k = 0; k < log.sample_count(); ++k) {
-    if (log.payload_kg[k] <= limit_kg) continue;
-    throw imscal::InputError(
-        log_file, 0, "payload_kg",
-        fmt::format("payload {} kg at t = {} s exceeds {} x the robot's rated {} kg "
-                    "(joints.nominal_payload_kg); is the column in another unit?",
-                    log.payload_kg[k], log.time_s[k], kMaxPayloadOfRating,
-                    config.nominal_payload_kg));
-  }
+                             const ident::IdentificationConfig& config, const IdentifyArgs& args) {
+  imscal::check_payload_series(
+      log.payload_kg, log.time_s, config.nominal_payload_kg,
+      {args.joint_errors, 0, "payload_kg",
+       fmt::format("robot {} ({}: joints.nominal_payload_kg)", log.robot, args.config)});
 }
 
 // A table in which no joint was identified corrects nothing: a failed check, not a result.
@@ -204,7 +195,7 @@ void run(const IdentifyArgs& args) {
         fmt::format("{} maximum speeds, but {} has {} joints ({})", config.max_speed_rad_s.size(),
                     args.joint_errors, log.joint_count(), fmt::join(log.joint_names, ", ")));
   check_orders_fit_record(log, config, config_node, args.config, args.joint_errors);
-  check_payload_plausible(log, config, args.joint_errors);
+  check_payload_plausible(log, config, args);
   imscal::OutputFolder folder(args.out, output_names(config),
                               args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
   std::optional<ident::OrderSearchReport> order_search;
