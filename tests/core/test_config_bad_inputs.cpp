@@ -259,6 +259,10 @@ TEST_F(PayloadPlausibility, RefusedFarAboveTheRatingInEveryCommandThatTakesAPayl
        "calibrate --imu none.csv --robot-log " + log.string() + " --robot " + robot + " --sensor " +
            sensor + " --config " + (dir_ / "calibrate.yaml").string(),
        "calibrate.yaml", "payload.mass_kg"},
+      {"calibrate log",
+       "calibrate --imu " + (source / "fuzz/corpus/imu_csv/increments.csv").string() +
+           " --robot-log " + log.string() + " --robot " + robot + " --sensor " + sensor,
+       "robot.csv", "payload_kg"},
       {"compensate log",
        "compensate --table " + (source / "fuzz/corpus/parameter_table/table.json").string() +
            " --robot-log " + log.string(),
