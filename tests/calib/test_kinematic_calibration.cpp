@@ -159,7 +159,10 @@ TEST(KinematicCalibration, RealUr10PredictsHeldOutPosesBetter) {
     const KinematicParameter& b = other.parameters[k];
     if (!a.estimated || !b.estimated) continue;
     const double z = std::abs(a.value - b.value) / std::hypot(a.sigma, b.sigma);
-    if (z > worst_z) worst_z = z, worst = a.name;
+    if (z > worst_z) {
+      worst_z = z;
+      worst = a.name;
+    }
   }
   std::printf(
       "real UR10, held-out RMS: nominal %.3f mm, calibrated %.3f mm (%d parameters); halves "
