@@ -54,8 +54,8 @@ Eigen::Vector3d rotation_vector(const Eigen::Quaterniond& q) {
 // Measured (gyro scale estimated, block-bootstrap 1σ): (-3.99, -1.27, -17.51) ± (0.55, 4.56,
 // 1.04) arcmin against mu0 = (-5.30, 2.47, -17.57): 2.4σ, 0.8σ, 0.1σ. Tolerance 3σ per axis: the
 // bootstrap σ carries the MEMS noise and the residuals' time correlation over the 100 s; the
-// reference is itself an estimate (a Kalman filter on the same 100 s, its σ not published), so
-// nothing tighter is justified. The y axis (forward) is weakly seen: the vehicle rolls about it,
+// reference is itself an estimate whose origin and σ PSINS does not state, so nothing tighter is
+// justified. The y axis (forward) is weakly seen: the vehicle rolls about it,
 // pitch and yaw rates are small. The gyro bias against eb0 (-213.6, 158.9, 84.5 deg/h):
 // measured (-215.2, 171.9, 84.4); tolerance 20 deg/h, 4 % of the demo's 500 deg/h bias model.
 TEST(RealPsinsMounting, MisalignmentAndBiasMatchThePsinsReference) {
