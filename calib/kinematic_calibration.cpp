@@ -225,6 +225,14 @@ KinematicCalibration calibrate_kinematics(const KinematicModel& nominal,
   for (int c = 0; c < kKinematicParameterCount; ++c) {
     if (!result.parameters[c].estimated) fixed.push_back(c);
   }
+  for (int c = 0; c < kDhIndex; ++c) {
+    if (!result.parameters[c].estimated) {
+      throw std::invalid_argument(
+          "kinematic calibration: the poses do not determine the tracker "
+          "frame and the target (" +
+          result.parameters[c].name + " has no effect of its own): too little motion");
+    }
+  }
   result.estimated_count = kKinematicParameterCount - static_cast<int>(fixed.size());
   if (3 * poses.size() < 2 * static_cast<std::size_t>(result.estimated_count)) {
     throw std::invalid_argument("kinematic calibration: too few poses for the parameters");

@@ -65,8 +65,9 @@ struct KinematicCalibration {
 
 std::vector<std::string> kinematic_parameter_names();
 
-// Throws std::invalid_argument with fewer poses than 2 × the parameters estimated would need
-// and std::runtime_error when the solver fails (no covariance is then computed).
+// Throws std::invalid_argument with fewer than 10 poses, fewer residuals than 2 × the parameters
+// estimated, or poses that leave a base or target parameter without an effect of its own, and
+// std::runtime_error when the solver fails (no covariance is then computed).
 KinematicCalibration calibrate_kinematics(const KinematicModel& nominal,
                                           const std::vector<TrackerPose>& poses,
                                           const KinematicCalibrationOptions& options = {});

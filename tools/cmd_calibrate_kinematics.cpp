@@ -15,6 +15,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 
 #include "calib/kinematic_calibration.hpp"
@@ -101,6 +102,18 @@ void split_poses(const Args& args, std::vector<TrackerPose>& fit,
     throw imscal::InputError(args.poses, 0, "", "one pose: nothing to hold out");
 }
 
+// Poses that cannot give a calibration (too few, or not determining the tracker frame) are bad
+// input: an InputError naming the pose file.
+KinematicCalibration fit_or_refuse(const KinematicModel& nominal,
+                                   const std::vector<TrackerPose>& fit,
+                                   const KinematicCalibrationOptions& options, const Args& args) {
+  try {
+    return calibrate_kinematics(nominal, fit, options);
+  } catch (const std::invalid_argument& e) {
+    throw imscal::InputError(args.poses, 0, "", e.what());
+  }
+}
+
 void print_errors(const char* name, const ErrorStats& fit, const ErrorStats& held_out) {
   std::cout << fmt::format(
       "{:<10} fitted poses RMS {:.3f} mm, max {:.3f} mm | held-out RMS {:.3f} mm, median {:.3f} "
@@ -132,9 +145,9 @@ void run(const Args& args) {
   KinematicCalibrationOptions options;
   options.min_independence = args.min_independence;
   options.estimate_geometry = false;
-  const KinematicCalibration nominal = calibrate_kinematics(robot.kinematics, fit, options);
+  const KinematicCalibration nominal = fit_or_refuse(robot.kinematics, fit, options, args);
   options.estimate_geometry = true;
-  const KinematicCalibration calibrated = calibrate_kinematics(robot.kinematics, fit, options);
+  const KinematicCalibration calibrated = fit_or_refuse(robot.kinematics, fit, options, args);
   const ErrorStats nominal_fit = error_stats(nominal, fit);
   const ErrorStats nominal_held = error_stats(nominal, held_out);
   const ErrorStats calibrated_fit = error_stats(calibrated, fit);

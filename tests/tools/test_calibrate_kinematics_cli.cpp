@@ -65,4 +65,23 @@ TEST_F(CalibrateKinematicsCli, AJointInDegreesIsBadInput) {
   EXPECT_FALSE(fs::exists(dir_ / "k.json"));
 }
 
+// One pose measured 30 times cannot place the tracker frame: bad input (exit 2), no report.
+TEST_F(CalibrateKinematicsCli, OnePoseRepeatedIsBadInput) {
+  std::ifstream in(kPoses);
+  std::string header, row;
+  std::getline(in, header);
+  std::getline(in, row);
+  const fs::path poses = dir_ / "same.csv";
+  std::ofstream file(poses);
+  file << header << '\n';
+  for (int k = 0; k < 30; ++k) file << row << '\n';
+  file.close();
+  const int code = run_imscal("calibrate-kinematics --robot " + kRobot.string() + " --poses " +
+                                  poses.string() + " --out " + (dir_ / "k.json").string(),
+                              dir_ / "same.log");
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(read_file_text(dir_ / "same.log").find("too little motion"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ / "k.json"));
+}
+
 }  // namespace
