@@ -19,6 +19,7 @@
 #include "calib/tracker_poses.hpp"
 #include "calib/urdf_robot.hpp"
 #include "core/input_error.hpp"
+#include "tests/support/record_figure.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal::calib {
@@ -168,6 +169,8 @@ TEST(KinematicCalibration, RealUr10PredictsHeldOutPosesBetter) {
       "real UR10, held-out RMS: nominal %.3f mm, calibrated %.3f mm (%d parameters); halves "
       "differ by up to %.1f sigma (%s)\n",
       nominal_mm, calibrated_mm, c.estimated_count, worst_z, worst.c_str());
+  test_support::record_figure("ur10_held_out_rms_nominal_mm", nominal_mm);
+  test_support::record_figure("ur10_held_out_rms_calibrated_mm", calibrated_mm);
   EXPECT_GT(nominal_mm, 0.8);
   EXPECT_LT(calibrated_mm, 0.6);
   EXPECT_LT(calibrated_mm, 0.6 * nominal_mm);

@@ -3,6 +3,7 @@
 // 10 Hz attitude) of the PSINS transfer-alignment data set (tests/data/real/psins-fog-mems/
 // SOURCE.md), through the tool-IMU rotation calibration (calib/master_slave_record.hpp), against
 // PSINS's reference installation angles mu0 and gyro bias eb0.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "calib/rotation_calibration.hpp"
 #include "calib/tool_imu_record.hpp"
 #include "core/numeric_table.hpp"
+#include "tests/support/record_figure.hpp"
 
 namespace imscal::calib {
 namespace {
@@ -82,6 +84,12 @@ TEST(RealPsinsMounting, MisalignmentAndBiasMatchThePsinsReference) {
       rotation_vector(Eigen::Quaterniond(pair.analysis.R_T_S)) * kArcmin;
   std::printf("rate-vector fit alone (the initial value): (%.2f, %.2f, %.2f) arcmin\n",
               kabsch_arcmin.x(), kabsch_arcmin.y(), kabsch_arcmin.z());
+  for (int k = 0; k < 3; ++k) {
+    test_support::record_figure(fmt::format("mems_in_fog_{}_arcmin", "xyz"[k]), mu_arcmin(k));
+    test_support::record_figure(fmt::format("mems_in_fog_{}_sigma_arcmin", "xyz"[k]),
+                                sigma_arcmin(k));
+  }
+  test_support::record_figure("mems_fog_clock_offset_ms", c.time_offset_s * 1e3);
   EXPECT_TRUE(c.sigma_from_bootstrap);
   for (int k = 0; k < 3; ++k) {
     EXPECT_LT(std::abs(mu_arcmin(k) - mu0_arcmin(k)), 3.0 * sigma_arcmin(k)) << "axis " << k;

@@ -1,6 +1,7 @@
 // ISO 9283 pose accuracy and repeatability: the formulas against closed forms on constructed
 // poses, and the figures of a real UR10 measured by a laser tracker (ISO cubes of series D of the
 // IPA data set, tests/data/real/ipa-ur10/SOURCE.md).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 
 #include "calib/tracker_poses.hpp"
 #include "eval/iso9283_pose.hpp"
+#include "tests/support/record_figure.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -162,6 +164,8 @@ TEST(Iso9283Pose, RealUr10OnTheIsoCubes) {
   // nominal model's RMS error against the same tracker (0.8-1.0 mm, calibrate-kinematics).
   EXPECT_EQ(repeated_poses, 50);
   for (const auto& [edge, f] : by_size) {
+    test_support::record_figure(fmt::format("ur10_cube{}_AP_p_median_mm", edge), median(f.AP_p_mm));
+    test_support::record_figure(fmt::format("ur10_cube{}_RP_l_median_mm", edge), median(f.RP_l_mm));
     EXPECT_LT(median(f.RP_l_mm), 0.1) << edge;
     EXPECT_GT(median(f.AP_p_mm), 0.3) << edge;
     EXPECT_LT(median(f.AP_p_mm), 2.0) << edge;
