@@ -81,7 +81,7 @@ struct SimulatedCell {
 };
 
 // 300 simulated poses with 20 µm tracker noise (a laser tracker's order). Every estimated
-// deviation lies within 4σ of the truth (4σ: 34 parameters, a 1-in-16000 miss each); the
+// deviation lies within 4σ of the truth (4σ: 14 DH deviations checked, a 1-in-16000 miss each); the
 // dropped set is the one the geometry predicts: joint 1's Δθ and Δd (the base frame takes them),
 // Δd of joints 3 and 4 (axes 2, 3, 4 parallel: only the sum of their d is seen, kept in Δd2),
 // all of joint 6 (the target position on the flange takes them) and joint 5's Δa and Δα (0.1 % of
