@@ -11,10 +11,12 @@
 
 #include "calib/calibration_config.hpp"
 #include "calib/frames_json.hpp"
+#include "calib/master_slave_record.hpp"
 #include "calib/mounting_report_json.hpp"
 #include "calib/robot_description.hpp"
 #include "calib/robot_log.hpp"
 #include "calib/tool_imu_record.hpp"
+#include "calib/tracker_poses.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "core/numeric_table.hpp"
@@ -79,6 +81,12 @@ inline void read_with(std::string_view target, const std::filesystem::path& file
       read_numeric_table(file);
     } else if (target == "tool_imu_record") {
       calib::read_tool_imu_record(file);
+    } else if (target == "tracker_poses") {
+      calib::read_tracker_poses(file);
+    } else if (target == "increment_imu") {
+      calib::read_increment_imu_csv(file);
+    } else if (target == "psins_attitude") {
+      calib::read_psins_attitude_csv(file);
     } else if (target == "nav_trajectory") {
       ims::read_trajectory_csv(file);
     } else if (target == "joint_errors") {
