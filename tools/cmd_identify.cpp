@@ -194,8 +194,8 @@ void run(const IdentifyArgs& args) {
         "joints.max_speed_deg_s",
         fmt::format("{} maximum speeds, but {} has {} joints ({})", config.max_speed_rad_s.size(),
                     args.joint_errors, log.joint_count(), fmt::join(log.joint_names, ", ")));
-  check_orders_fit_record(log, config, config_node, args.config, args.joint_errors);
   check_payload_plausible(log, config, args);
+  check_orders_fit_record(log, config, config_node, args.config, args.joint_errors);
   imscal::OutputFolder folder(args.out, output_names(config),
                               args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
   std::optional<ident::OrderSearchReport> order_search;

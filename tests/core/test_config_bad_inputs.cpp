@@ -267,6 +267,10 @@ TEST_F(PayloadPlausibility, RefusedFarAboveTheRatingInEveryCommandThatTakesAPayl
        "compensate --table " + (source / "fuzz/corpus/parameter_table/table.json").string() +
            " --robot-log " + log.string(),
        "robot.csv", "payload_kg"},
+      {"identify",
+       "identify --joint-errors " + errors.string() + " --config " +
+           (source / "datasets/identification/ident-paper.yaml").string(),
+       "joint_errors.csv", "payload_kg"},
       {"model-joint-errors",
        "model-joint-errors --joint-errors " + errors.string() + " --robot " + robot,
        "joint_errors.csv", "payload_kg"},
