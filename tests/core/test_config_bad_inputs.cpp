@@ -296,6 +296,26 @@ TEST_F(PayloadPlausibility, RefusedFarAboveTheRatingInEveryCommandThatTakesAPayl
   }
 }
 
+// Above the rating but a load the robot can lift (20 kg on the 16 kg KR 16): the command runs and
+// warns with the file, the field, both masses and what follows.
+TEST_F(PayloadPlausibility, AboveTheRatingIsAWarningWithTheReason) {
+  const fs::path source(IMSCAL_SOURCE_DIR), errors = dir_ / "joint_errors.csv";
+  std::ofstream(errors) << with_payload(source / "fuzz/corpus/joint_errors/small.csv", "20");
+  const fs::path log = dir_ / "message.log";
+  EXPECT_EQ(run_imscal("model-joint-errors --joint-errors " + errors.string() + " --robot " +
+                           (source / "datasets/robots/kr16.yaml").string() + " --out " +
+                           (dir_ / "model.csv").string(),
+                       log),
+            0)
+      << read_file_text(log);
+  const std::string message = read_file_text(log);
+  EXPECT_NE(message.find("[warning] " + errors.string() + ": field 'payload_kg': payload 20 kg"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("above the rated payload of 16 kg"), std::string::npos) << message;
+  EXPECT_NE(message.find("outside their rating"), std::string::npos) << message;
+}
+
 // The scenario's program (simulate, verify, population and `imscal run` load it): refused naming
 // the program file and the line of the mass; 20 kg (above the rating, a load) loads with a warning.
 TEST_F(PayloadPlausibility, AScenariosProgramPayloadIsCheckedAgainstThePlantRobot) {
