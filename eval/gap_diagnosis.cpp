@@ -296,7 +296,8 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
       std::vector<std::vector<double>> best_residual;
       std::vector<Eigen::MatrixXd> best_columns;
       for (std::size_t c : pool) {
-        if (used[c]) continue;
+        // The model starts from the cause ranked first: the verdict names it and models with it.
+        if (used[c] || (step == 0 && c != 0)) continue;
         const CandidateFit& f = out.candidates[c].fit;
         std::vector<Eigen::MatrixXd> cols =
             join_columns(chosen_columns, f.columns, s.sample_count());

@@ -10,6 +10,7 @@
 
 #include "eval/gap_bounds.hpp"
 #include "eval/gap_diagnosis.hpp"
+#include "eval/gap_verdict.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -240,6 +241,35 @@ TEST(GapDiagnosis, ComplianceIsSizedWithinItsPhysicalBound) {
     EXPECT_FALSE(r.supported) << flipped.verdict;    // at its bound it explains nothing
   }
   EXPECT_EQ(flipped.verdict.find("cause: gear_compliance"), std::string::npos) << flipped.verdict;
+}
+
+// The verdict names the causes it models: the model starts from the cause ranked first, and every
+// further candidate of the model is named as a cause before "Modelled with".
+TEST(GapDiagnosis, VerdictModelsTheCausesItNames) {
+  GapSignals s = synthetic();
+  for (std::size_t k = 0; k < s.sample_count(); ++k) {
+    s.gap_rad[2][k] = 3e-7 * s.torque_nm[2][k];          // a compliance of A3, ~1e-4 rad
+    s.gap_rad[4][k] = 0.004 * s.qd_desired_rad_s[4][k];  // a time offset of A5, ~1e-3 rad
+  }
+  add_white_noise(s, 1e-5, 12);
+  const Diagnosis d = diagnose_gap(s);
+  ASSERT_TRUE(d.significant_gap);
+  ASSERT_FALSE(d.combination.empty());
+  EXPECT_EQ(d.combination.front().candidate, 0u);
+  const std::size_t modelled = d.verdict.find("Modelled with");
+  ASSERT_NE(modelled, std::string::npos) << d.verdict;
+  std::vector<EffectKind> kinds;
+  for (const CombinationStep& step : d.combination) {
+    const CandidateFit& f = d.candidates[step.candidate].fit;
+    kinds.push_back(f.kind);
+    EXPECT_LT(d.verdict.find(candidate_in_words(s, f)), modelled) << d.verdict;
+    if (d.combination.size() > 1) {
+      EXPECT_NE(d.verdict.find(step.label, modelled), std::string::npos) << d.verdict;
+    }
+  }
+  // Both effects are in the model.
+  EXPECT_NE(std::find(kinds.begin(), kinds.end(), EffectKind::kTimeOffset), kinds.end());
+  EXPECT_NE(std::find(kinds.begin(), kinds.end(), EffectKind::kGearCompliance), kinds.end());
 }
 
 }  // namespace
