@@ -130,11 +130,10 @@ void write_joint_verdict(const GapSignals& s, const DiagnosisOptions& o, const s
 std::string further_causes_in_words(const GapSignals& s, const Diagnosis& d) {
   std::vector<std::string> further;
   for (std::size_t i = 1; i < d.combination.size(); ++i)
-    further.push_back(
-        fmt::format("{}, a further {:.0f} % (p = {:.3f})",
-                    candidate_in_words(s, d.candidates[d.combination[i].candidate].fit),
-                    d.combination[i].shrinkage_percent - d.combination[i - 1].shrinkage_percent,
-                    d.combination[i].p_value));
+    further.push_back(fmt::format(
+        "{}, a further {:.0f} % (p = {:.3f})", candidate_in_words(s, d.combination[i].fit),
+        d.combination[i].shrinkage_percent - d.combination[i - 1].shrinkage_percent,
+        d.combination[i].p_value));
   if (further.empty()) return {};
   return fmt::format(" Together with it, also causes: {}.", fmt::join(further, "; "));
 }
