@@ -8,6 +8,14 @@
 namespace imscal::eval {
 namespace {
 
+// Of the joint refits of a forward step, the best held-out shrinkage less this charge per own
+// parameter, its coupling's left aside [pp] (the per-joint ranking's, eval/gap_diagnosis.cpp): a
+// drift does not displace the offset it nests for a sliver of noise.
+constexpr double kParsimonyPercentPerParameter = 0.5;
+// A member kept by its own joint's gain must still add this much to the whole gap [pp]: not the
+// remaining coloured noise of a joint already explained.
+constexpr double kJointRouteMinWholePercent = 0.5;
+
 // A joint refit of a set of candidates: the residual of every joint and its held-out energy.
 struct Refit {
   std::vector<std::vector<double>> residual;
@@ -92,7 +100,8 @@ struct Context {
   bool significant(const Gain& g) const {
     const double alpha_j = sidak_alpha(o.alpha, s.joint_count());
     return (g.p < o.alpha && g.whole_pp >= o.min_combination_gain_percent) ||
-           (g.joint_p < alpha_j && g.joint_percent >= o.min_shrinkage_percent && g.whole_pp > 0.0);
+           (g.joint_p < alpha_j && g.joint_percent >= o.min_shrinkage_percent &&
+            g.whole_pp >= kJointRouteMinWholePercent);
   }
 };
 
@@ -173,14 +182,18 @@ JointModel select_joint_model(const GapSignals& s, const DiagnosisOptions& o,
     if (scored.size() > kJointRefitsPerStep) scored.resize(kJointRefitsPerStep);
     on_residual.gap_rad = model.residual;
     int best = -1;
+    double best_score = 0.0;
     Refit best_refit;
     std::vector<CandidateFit> best_set;
-    for (const auto& [score, c] : scored) {
+    for (const auto& [residual_energy, c] : scored) {
       std::vector<CandidateFit> grown = set;
       grown.push_back(refined(x, c, on_residual));
       Refit r = refit(s, grown, training, heldout);
-      if (best < 0 || r.energy < best_refit.energy)
-        best = int(c), best_refit = std::move(r), best_set = std::move(grown);
+      const CandidateFit& added = grown.back();
+      const double own = double(added.parameters.size() - added.coupling_parameter_count);
+      const double score = x.shrink(r.energy) - kParsimonyPercentPerParameter * own;
+      if (best < 0 || score > best_score)
+        best = int(c), best_score = score, best_refit = std::move(r), best_set = std::move(grown);
     }
     if (best < 0) break;
     tried[std::size_t(best)] = true;

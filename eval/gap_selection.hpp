@@ -5,16 +5,19 @@
 // physical bound, eval/gap_bounds.hpp):
 //
 //   start     the candidate ranked first (the verdict names it, so the model holds it)
-//   forward   add the pool member whose joint refit leaves the least held-out gap energy; kept when
-//             its further held-out gain is significant (block bootstrap, p < alpha) and adds at
+//   forward   add the pool member whose joint refit shrinks the held-out gap most, less 0.5 pp per
+//             own parameter (the per-joint ranking's parsimony charge); kept when its further
+//             held-out gain is significant (block bootstrap, p < alpha) and adds at
 //             least min_combination_gain_percent of the whole gap or min_shrinkage_percent of its
-//             own joint's remaining gap (an effect on a joint with a small share of the whole gap
-//             is still a cause of its own)
+//             own joint's remaining gap with at least 0.5 pp of the whole (an effect on a joint
+//             with a small share of the whole gap is still a cause of its own)
 //   backward  after each addition, drop a member (not the first) whose loss, with the others
 //             refitted without it, is no longer significant by the same rule
 //
-// The pool: the best `combination_pool` candidates supported on all joints, and every candidate
-// supported on its own joint. The predicted shrinkage is the final joint refit's held-out one.
+// The pool: every candidate that shrinks the held-out gap of all joints or of its own joint; per
+// forward step the three whose own columns best explain the model's residual are fitted again to
+// that residual (shape and size: an effect hidden behind a larger one) and refitted jointly. The
+// predicted shrinkage is the final joint refit's held-out one.
 #include <cstdint>
 #include <vector>
 
