@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "eval/gap_bounds.hpp"
 
@@ -157,6 +158,51 @@ CandidateFit refined(const Context& x, std::size_t c, const GapSignals& on_resid
   return fit ? std::move(*fit) : f;
 }
 
+// A forward step's trial: the model grown by one candidate (fitted again to the model's
+// residual), its joint refit, and the p-value of its further gain once tested.
+struct Trial {
+  double score = 0.0;
+  std::size_t candidate = 0;
+  std::vector<CandidateFit> set;
+  Refit refit;
+  double p_value = 1.0;
+};
+
+// The three candidates whose own columns best explain the model's residual, fitted again to it and
+// refitted jointly with the model, tried in the order of their held-out shrinkage less the
+// parsimony charge: the first whose gain is significant, or none.
+std::optional<Trial> forward_step(const Context& x, const std::vector<std::size_t>& pool,
+                                  const std::vector<CandidateFit>& set, const Refit& model,
+                                  const GapSignals& on_residual, std::vector<bool>& tried) {
+  std::vector<std::pair<double, std::size_t>> scored;
+  for (std::size_t c : pool)
+    if (!tried[c]) scored.emplace_back(residual_score(x, c, model), c);
+  std::sort(scored.begin(), scored.end());
+  if (scored.size() > kJointRefitsPerStep) scored.resize(kJointRefitsPerStep);
+  std::vector<Trial> trials;
+  for (const auto& [residual_energy, c] : scored) {
+    Trial t;
+    t.candidate = c;
+    t.set = set;
+    t.set.push_back(refined(x, c, on_residual));
+    t.refit = refit(x.s, t.set, x.training, x.heldout);
+    const CandidateFit& added = t.set.back();
+    const double own = double(added.parameters.size() - added.coupling_parameter_count);
+    t.score = x.shrink(t.refit.energy) - kParsimonyPercentPerParameter * own;
+    trials.push_back(std::move(t));
+  }
+  std::stable_sort(trials.begin(), trials.end(),
+                   [](const Trial& a, const Trial& b) { return a.score > b.score; });
+  for (Trial& t : trials) {
+    tried[t.candidate] = true;
+    const Gain g = x.gain(model, t.refit, x.candidates[t.candidate].fit.joint);
+    if (!x.significant(g)) continue;
+    t.p_value = std::min(g.p, g.joint_p);
+    return std::move(t);
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 JointModel select_joint_model(const GapSignals& s, const DiagnosisOptions& o,
@@ -175,34 +221,13 @@ JointModel select_joint_model(const GapSignals& s, const DiagnosisOptions& o,
   std::vector<bool> tried(candidates.size(), false);
   GapSignals on_residual = s;
   while (int(set.size()) < o.max_combination) {
-    std::vector<std::pair<double, std::size_t>> scored;
-    for (std::size_t c : pool)
-      if (!tried[c]) scored.emplace_back(residual_score(x, c, model), c);
-    std::sort(scored.begin(), scored.end());
-    if (scored.size() > kJointRefitsPerStep) scored.resize(kJointRefitsPerStep);
     on_residual.gap_rad = model.residual;
-    int best = -1;
-    double best_score = 0.0;
-    Refit best_refit;
-    std::vector<CandidateFit> best_set;
-    for (const auto& [residual_energy, c] : scored) {
-      std::vector<CandidateFit> grown = set;
-      grown.push_back(refined(x, c, on_residual));
-      Refit r = refit(s, grown, training, heldout);
-      const CandidateFit& added = grown.back();
-      const double own = double(added.parameters.size() - added.coupling_parameter_count);
-      const double score = x.shrink(r.energy) - kParsimonyPercentPerParameter * own;
-      if (best < 0 || score > best_score)
-        best = int(c), best_score = score, best_refit = std::move(r), best_set = std::move(grown);
-    }
-    if (best < 0) break;
-    tried[std::size_t(best)] = true;
-    const Gain g = x.gain(model, best_refit, candidates[std::size_t(best)].fit.joint);
-    if (!x.significant(g)) break;
-    set = std::move(best_set);
-    index.push_back(std::size_t(best));
-    p_of.push_back(std::min(g.p, g.joint_p));
-    model = std::move(best_refit);
+    std::optional<Trial> added = forward_step(x, pool, set, model, on_residual, tried);
+    if (!added) break;
+    set = std::move(added->set);
+    index.push_back(added->candidate);
+    p_of.push_back(added->p_value);
+    model = std::move(added->refit);
     const int weakest = weakest_member(x, set, model);
     if (weakest > 0) {
       set.erase(set.begin() + weakest);

@@ -212,7 +212,7 @@ TEST(GapBounds, ActiveBoundGivesTheClosedFormConstrainedFit) {
 // A compliance of either sign on A3 (nominal model rigid): the physical sign is named with its
 // size; the sign-flipped one, a negative compliance, is never reported with that size.
 Diagnosis compliance_case(double compliance_rad_per_nm) {
-  GapSignals s = synthetic();
+  GapSignals s = synthetic(5000);  // 10 s: short for the sanitizer build
   for (std::size_t k = 0; k < s.sample_count(); ++k)
     s.gap_rad[2][k] = compliance_rad_per_nm * s.torque_nm[2][k];
   add_white_noise(s, 1e-5, 11);
@@ -226,7 +226,7 @@ TEST(GapDiagnosis, ComplianceIsSizedWithinItsPhysicalBound) {
   const CandidateFit& top = positive.candidates.front().fit;
   EXPECT_EQ(top.kind, EffectKind::kGearCompliance) << positive.verdict;
   EXPECT_FALSE(top.at_bound);
-  // The level against the truth: white noise of 1e-5 rad on 5000 training rows, far below 1 %.
+  // The level against the truth: white noise of 1e-5 rad on 2500 training rows, far below 1 %.
   EXPECT_NEAR(top.level, c, 0.01 * c);
 
   const Diagnosis flipped = compliance_case(-c);
@@ -246,7 +246,7 @@ TEST(GapDiagnosis, ComplianceIsSizedWithinItsPhysicalBound) {
 // The verdict names the causes it models: the model starts from the cause ranked first, and every
 // further candidate of the model is named as a cause before "Modelled with".
 TEST(GapDiagnosis, VerdictModelsTheCausesItNames) {
-  GapSignals s = synthetic();
+  GapSignals s = synthetic(5000);  // 10 s: short for the sanitizer build
   for (std::size_t k = 0; k < s.sample_count(); ++k) {
     s.gap_rad[2][k] = 3e-7 * s.torque_nm[2][k];          // a compliance of A3, ~1e-4 rad
     s.gap_rad[4][k] = 0.004 * s.qd_desired_rad_s[4][k];  // a time offset of A5, ~1e-3 rad
