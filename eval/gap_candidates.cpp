@@ -9,6 +9,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "eval/gap_bounds.hpp"
 #include "eval/gap_coupling.hpp"
 #include "eval/gap_filters.hpp"
 #include "eval/gap_validation.hpp"
@@ -42,6 +43,11 @@ double identified_speed_limit(const GapSignals& s, std::size_t joint) {
       top_band = std::max(top_band, grid.bands_of(c)[std::size_t(speed_dim)]);
   if (top_band < 0) return std::numeric_limits<double>::quiet_NaN();
   return dims[std::size_t(speed_dim)].bounds[std::size_t(top_band) + 1];
+}
+
+// A nominal drive parameter of a joint, 0 when not known.
+double nominal_of(const std::vector<double>& values, std::size_t joint) {
+  return joint < values.size() ? values[joint] : 0.0;
 }
 
 }  // namespace
@@ -189,9 +195,16 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
           out.push_back(local(fmt::format("{} + Laguerre {} ms x4", label, ms), cols, names));
         }
       }
+      for (auto& sh : out)  // the flank: the first column
+        sh.level_signal = sh.columns[joint].col(0),
+        sh.level_lower = -nominal_of(s.nominal_half_play_rad, joint);
       break;
     }
     case EffectKind::kCoulombFriction: {
+      // A lower friction than the nominal one is physical when the nominal model has some.
+      const double lower = nominal_of(s.nominal_coulomb_nm, joint) > 0.0
+                               ? -std::numeric_limits<double>::infinity()
+                               : 0.0;
       for (double scale : {0.005, 0.01, 0.02}) {
         const Column sv = (qd_actual / scale).array().tanh().matrix();
         const int mrad = int(std::lround(1000.0 * scale));
@@ -205,6 +218,8 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
               local(fmt::format("sign(qd / {} mrad/s) through Laguerre {} ms x{}", mrad, ms, order),
                     laguerre(sv, tl, order, s), numbered(fmt::format("laguerre{}ms_", ms), order)));
         }
+        for (std::size_t i = out.size() - 4; i < out.size(); ++i)
+          out[i].level_signal = sv, out[i].level_lower = lower;
       }
       break;
     }
@@ -223,6 +238,8 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
         names.insert(names.begin(), "compliance_rad_per_nm");
         out.push_back(local(fmt::format("tau_d / k + Laguerre 30 ms x{}", order), cols, names));
       }
+      for (auto& sh : out)
+        sh.level_signal = tau, sh.level_lower = -nominal_of(s.nominal_compliance_rad_per_nm, joint);
       break;
     }
     case EffectKind::kTransmissionError: {
@@ -648,10 +665,18 @@ std::string size_in_words(const CandidateFit& c, const CandidateShape& sh, doubl
   std::string first =
       fmt::format("{} = {:.4g} ± {:.2g}", c.parameter_names[0], c.parameters[0], c.sigma[0]);
   switch (c.kind) {
-    case EffectKind::kGearCompliance:
-      if (c.parameters[0] != 0.0)
-        first += fmt::format(" (stiffness {:.3g} N m/rad)", 1.0 / c.parameters[0]);
+    case EffectKind::kGearCompliance: {
+      // The static compliance: the modelled deflection's coefficient on tau_d (the Laguerre
+      // columns' static gain included), added to the nominal model's.
+      const double nominal = -c.bound.lower, combined = nominal + c.level;
+      first = fmt::format("static compliance change {:.3g} rad/N m", c.level);
+      if (c.level > 0.0) first += fmt::format(" (a stiffness of {:.3g} N m/rad)", 1.0 / c.level);
+      if (nominal > 0.0)
+        first += fmt::format(
+            "; with the robot's {:.3g} N m/rad, a gear stiffness of {}", 1.0 / nominal,
+            combined > 0.0 ? fmt::format("{:.3g} N m/rad", 1.0 / combined) : std::string("rigid"));
       break;
+    }
     case EffectKind::kBacklash: {
       const double l = half_play(c, sh);
       if (sh.label == kOneFlankShape)
@@ -690,6 +715,17 @@ std::string size_in_words(const CandidateFit& c, const CandidateShape& sh, doubl
       break;
   }
   return first;
+}
+
+// The LS fit of a candidate's columns within its physical bound (eval/gap_bounds.hpp): sets its
+// level, the unconstrained one and whether the bound is active.
+LinearFit fit_bounded(CandidateFit& c, const GapSignals& s, const std::vector<bool>& training) {
+  LinearFit f = fit_joint_columns(c.columns, s.gap_rad, training);
+  if (c.bound.count == 0) return f;
+  c.unconstrained_level = bound_level(c.columns, c.bound, f.parameters, training);
+  c.at_bound = apply_level_bounds(c.columns, s.gap_rad, training, {c.bound}, f);
+  c.level = bound_level(c.columns, c.bound, f.parameters, training);
+  return f;
 }
 
 }  // namespace
@@ -745,7 +781,9 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
   c.shape = sh.label;
   c.parameter_names = sh.parameter_names;
   c.columns = sh.columns;
-  LinearFit f = fit_joint_columns(c.columns, s.gap_rad, training);
+  if (sh.level_signal.size() > 0)
+    c.bound = {joint, 0, Eigen::Index(sh.parameter_names.size()), sh.level_signal, sh.level_lower};
+  LinearFit f = fit_bounded(c, s, training);
   c.prediction = predict_joint_columns(c.columns, f.parameters);
   // Acting on several joints by its own columns: located where its modelled gap has the most
   // energy; acting on one: that joint, wherever its coupling carries it.
@@ -778,7 +816,7 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
         reach.push_back(
             fmt::format("{} ({})", s.joint_names[coupling.joints[i]], coupling.shapes[i]));
       c.coupling = fmt::format("through the inertia M_ij q̈_j into {}", fmt::join(reach, ", "));
-      f = fit_joint_columns(c.columns, s.gap_rad, training);
+      f = fit_bounded(c, s, training);
       c.prediction = predict_joint_columns(c.columns, f.parameters);
     }
   }
@@ -796,6 +834,11 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
                              c.spans_joints             ? " over all joints"
                              : c.coupled_joints.empty() ? ""
                                                         : " with its coupling");
+  if (c.at_bound)
+    c.size_text += fmt::format(
+        "; held at its physical bound (level {:.3g}: the unconstrained fit's level {:.3g} would "
+        "leave the combined model unphysical)",
+        c.level, c.unconstrained_level);
   return c;
 }
 

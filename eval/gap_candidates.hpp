@@ -93,6 +93,21 @@ struct CandidateShape {
   std::string label;                         // e.g. "sign(qd), lag 30 ms"
   std::vector<Eigen::MatrixXd> columns;      // [joint]: samples x parameters, or empty
   std::vector<std::string> parameter_names;  // with units, e.g. "l_rad"
+  // The effect's static signal on its own joint, whose coefficient in the modelled gap is the
+  // effect's level, and the level's physical lower bound (eval/gap_bounds.hpp): tau_d for a
+  // compliance (>= -1 / nominal stiffness), the flank for a play (>= -nominal half play), the sign
+  // of the velocity for friction (>= 0 when the nominal model has none). Empty: unbounded.
+  Eigen::VectorXd level_signal;
+  double level_lower = 0.0;
+};
+
+// A physical bound of a fit (eval/gap_bounds.hpp): the level of the parameters
+// [first, first + count), on joint `joint`, is at least `lower`.
+struct LevelBound {
+  std::size_t joint = 0;
+  Eigen::Index first = 0, count = 0;  // count 0: no bound
+  Eigen::VectorXd signal;             // the static signal u over all samples
+  double lower = 0.0;                 // in the level's units (u's coefficient)
 };
 
 // The shapes of a candidate on a joint (empty when the candidate does not apply, e.g. the
@@ -131,6 +146,11 @@ struct CandidateFit {
   double training_rms_rad = 0.0;                // residual RMS on the training rows
   // The size of the effect in words, e.g. "l = 0.000437 ± 0.000002 rad (1.50 arcmin)".
   std::string size_text;
+  // Its physical bound (count 0: none), the level fitted, and whether the bound is active (the
+  // unconstrained fit was unphysical; its level is `unconstrained_level`).
+  LevelBound bound;
+  double level = 0.0, unconstrained_level = 0.0;
+  bool at_bound = false;
 };
 
 // LS fit of columns to y on the rows flagged `use`; returns the parameters, their sigma

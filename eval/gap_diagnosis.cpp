@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 
+#include "eval/gap_selection.hpp"
 #include "eval/gap_verdict.hpp"
 
 namespace imscal::eval {
@@ -21,19 +22,6 @@ double heldout_energy(const std::vector<std::vector<double>>& residual, const Ro
   for (const auto& r : residual)
     for (std::size_t k : rows.heldout) e += r[k] * r[k];
   return e;
-}
-
-// Residual of every joint after a joint LS fit of the given columns (training rows); joints
-// without columns keep their gap.
-std::vector<std::vector<double>> residual_after(const std::vector<Eigen::MatrixXd>& columns,
-                                                const std::vector<std::vector<double>>& gap,
-                                                const std::vector<bool>& training) {
-  const LinearFit f = fit_joint_columns(columns, gap, training);
-  const auto pred = predict_joint_columns(columns, f.parameters);
-  std::vector<std::vector<double>> r = gap;
-  for (std::size_t j = 0; j < r.size(); ++j)
-    for (std::size_t k = 0; k < pred[j].size(); ++k) r[j][k] -= pred[j][k];
-  return r;
 }
 
 // Ranking charge per parameter [percentage points of shrinkage]: of two candidates that explain
@@ -265,68 +253,13 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
   out.significant_gap = !out.candidates.empty() && out.candidates.front().supported;
   group_ambiguous(s, rows.heldout, out);
 
-  // Greedy combination of the supported candidates: each step adds the candidate whose columns,
-  // fitted jointly with those already chosen (one stacked LS over the joints they act on), shrink
-  // the held-out gap most. Only the best `combination_pool` supported candidates are tried.
+  // The joint model: candidates fitted together, chosen by forward-backward selection on the
+  // held-out rows (eval/gap_selection.hpp), starting from the cause ranked first.
   if (out.significant_gap) {
-    std::vector<std::vector<double>> residual = s.gap_rad;
-    std::vector<Eigen::MatrixXd> chosen_columns(s.joint_count());
-    // The pool: the best supported candidates, and on every other joint its best candidate with a
-    // significant held-out gain (an effect on a joint with a small share of the gap shrinks the
-    // whole gap by less than min_shrinkage_percent, yet is a cause of its own).
-    std::vector<std::size_t> pool;
-    std::vector<bool> joint_in_pool(s.joint_count(), false);
-    for (std::size_t c = 0; c < out.candidates.size() && int(pool.size()) < o.combination_pool; ++c)
-      if (out.candidates[c].supported) {
-        pool.push_back(c);
-        joint_in_pool[out.candidates[c].fit.joint] = true;
-      }
-    for (std::size_t c = 0; c < out.candidates.size(); ++c) {
-      const CandidateResult& r = out.candidates[c];
-      if (joint_in_pool[r.fit.joint] || r.p_value >= o.alpha || r.shrinkage_percent <= 0.0)
-        continue;
-      pool.push_back(c);
-      joint_in_pool[r.fit.joint] = true;
-    }
-    std::vector<bool> used(out.candidates.size(), false);
-    double energy = e0;
-    for (int step = 0; step < o.max_combination; ++step) {
-      int best = -1;
-      double best_energy = energy;
-      std::vector<std::vector<double>> best_residual;
-      std::vector<Eigen::MatrixXd> best_columns;
-      for (std::size_t c : pool) {
-        if (used[c]) continue;
-        const CandidateFit& f = out.candidates[c].fit;
-        std::vector<Eigen::MatrixXd> cols =
-            join_columns(chosen_columns, f.columns, s.sample_count());
-        std::vector<std::vector<double>> r = residual_after(cols, s.gap_rad, training);
-        const double e = heldout_energy(r, rows);
-        if (e < best_energy) {
-          best_energy = e;
-          best = int(c);
-          best_residual = std::move(r);
-          best_columns = std::move(cols);
-        }
-      }
-      if (best < 0) break;
-      const CandidateFit& f = out.candidates[std::size_t(best)].fit;
-      std::vector<double> d(rows.heldout.size(), 0.0);
-      for (std::size_t j = 0; j < s.joint_count(); ++j)
-        for (std::size_t i = 0; i < rows.heldout.size(); ++i) {
-          const std::size_t k = rows.heldout[i];
-          d[i] += residual[j][k] * residual[j][k] - best_residual[j][k] * best_residual[j][k];
-        }
-      const double p = block_bootstrap_p_value(d, block, o.bootstrap_resamples, seed++);
-      const double gain_pp = shrink(best_energy) - shrink(energy);
-      if (step > 0 && (p >= o.alpha || gain_pp < o.min_combination_gain_percent)) break;
-      used[std::size_t(best)] = true;
-      chosen_columns = std::move(best_columns);
-      residual = std::move(best_residual);
-      energy = best_energy;
-      out.combination.push_back({candidate_label(s, f), shrink(energy), p, std::size_t(best)});
-    }
-    out.heldout_rms_modelled_rad = std::sqrt(std::max(energy, 0.0) / m);
+    const JointModel model =
+        select_joint_model(s, o, out.candidates, training, rows.heldout, block, seed);
+    out.combination = model.steps;
+    out.heldout_rms_modelled_rad = std::sqrt(std::max(model.heldout_energy, 0.0) / m);
   }
 
   find_per_joint(s, o, rows.heldout, out);

@@ -9,9 +9,9 @@
 // Significance: a moving-block bootstrap of the held-out per-sample reduction of the squared gap
 // (summed over joints); blocks because the residuals are coloured. A candidate is supported when
 // the bootstrap p-value is below `alpha` and the shrinkage at least `min_shrinkage_percent`.
-// Supported candidates (and on every other joint its best candidate with a significant gain) are
-// then combined greedily (a joint fit of the chosen columns per joint), a step kept only when it
-// shrinks the held-out gap significantly further. Candidates the data cannot tell apart form
+// The candidates are then fitted together: forward-backward selection of a joint model starting
+// from the candidate ranked first (eval/gap_selection.hpp), a member kept only while it shrinks the
+// held-out gap significantly further. Candidates the data cannot tell apart form
 // ambiguity groups (eval/gap_ambiguity.hpp), reported together with what would separate them,
 // overall and per joint (its candidates ranked on its own gap). A gap concentrated in one joint
 // is significant on its own, with a level corrected for the number of joints, or when it stands
@@ -38,9 +38,8 @@ struct DiagnosisOptions {
   double alpha = 0.01;                        // significance level (one-sided)
   double min_shrinkage_percent = 5.0;         // below this an effect is not worth modelling
   double min_combination_gain_percent = 2.0;  // further shrinkage a combination step must add
-  int max_combination = 3;
-  int combination_pool = 8;  // best supported candidates the greedy combination tries
-  std::uint64_t seed = 1;    // of the bootstrap (deterministic reports)
+  int max_combination = 4;  // candidates in the joint model (eval/gap_selection.hpp)
+  std::uint64_t seed = 1;   // of the bootstrap (deterministic reports)
   // A joint's gap this many times its noise reference is significant on its own
   // (eval/gap_joint_significance.hpp).
   double far_above_noise_factor = 10.0;
@@ -75,6 +74,9 @@ struct CombinationStep {
   double shrinkage_percent = 0.0;  // held-out, all joints, cumulative
   double p_value = 1.0;            // of this step's further shrinkage
   std::size_t candidate = 0;       // index into Diagnosis::candidates
+  // The candidate as it stands in the joint model: after the first, its shape and size fitted
+  // again to the gap the model's earlier members leave (an effect behind a larger one).
+  CandidateFit fit;
 };
 
 struct Diagnosis {
@@ -83,9 +85,9 @@ struct Diagnosis {
   // band (eval/gap_model_error.hpp), same training / held-out rows as the candidates.
   std::vector<ModelErrorModel> model_error;
   double heldout_rms_rad = 0.0;              // held-out gap before any candidate
-  double heldout_rms_modelled_rad = 0.0;     // after the kept combination
+  double heldout_rms_modelled_rad = 0.0;     // after the joint model
   std::vector<CandidateResult> candidates;   // sorted by held-out shrinkage, best first
-  std::vector<CombinationStep> combination;  // kept greedy steps
+  std::vector<CombinationStep> combination;  // the joint model's members
   // Candidates the data cannot tell apart (members index `candidates`; groups in ranking order,
   // the group of the first candidate first when it has one).
   std::vector<AmbiguityGroup> ambiguity_groups;

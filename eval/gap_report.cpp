@@ -239,7 +239,7 @@ std::string diagnosis_text(const GapSignals& s, const Diagnosis& d) {
                      leader.joint_p_value, f.supported ? "supported" : "not supported");
   }
   t += significance_text(s, d);
-  t += "\nGreedy combination\n";
+  t += "\nJoint model (forward-backward selection)\n";
   for (const auto& c : d.combination)
     t += fmt::format("  + {:<34} cumulative {:6.1f} %  p {:.3f}\n", c.label, c.shrinkage_percent,
                      c.p_value);

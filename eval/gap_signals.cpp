@@ -297,6 +297,11 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
     g.qd_internal_rad_s.push_back(derivative(real.q_internal_rad[j], g.runs, g.cycle_s));
     g.gear_ratio.push_back(robot.joints[j].drive.gear_ratio);
     g.max_speed_rad_s.push_back(robot.joints[j].max_velocity_rad_s);
+    const auto& drive = robot.joints[j].drive;
+    g.nominal_compliance_rad_per_nm.push_back(
+        drive.stiffness_nm_per_rad > 0.0 ? 1.0 / drive.stiffness_nm_per_rad : 0.0);
+    g.nominal_half_play_rad.push_back(0.5 * drive.backlash_rad);
+    g.nominal_coulomb_nm.push_back(drive.coulomb_nm);
   }
   // Torques of the desired motion: the logged payload as a point mass at the tool origin (the
   // log has no centre of mass); the unit-payload torque is the change for 1 kg more.

@@ -51,6 +51,12 @@ struct GapSignals {
   std::vector<std::vector<double>> mass_matrix_kg_m2;
   std::vector<double> gear_ratio;       // motor angle = N * joint angle
   std::vector<double> max_speed_rad_s;  // the robot's joint speed limits
+  // The nominal model's drive parameters (the robot description; empty: not known, taken as
+  // none): how far a candidate may lower them before the combined model turns unphysical
+  // (eval/gap_candidates.hpp, physical bounds).
+  std::vector<double> nominal_compliance_rad_per_nm;  // 1 / gear stiffness, 0: rigid
+  std::vector<double> nominal_half_play_rad;          // half the backlash's full width
+  std::vector<double> nominal_coulomb_nm;             // Coulomb friction torque
   // The operating-point grids of the identified model (empty without a table), per joint, and
   // whether each of its cells was identified from data (false: filled from a neighbour).
   std::vector<std::vector<ident::CellDimension>> table_dimensions;

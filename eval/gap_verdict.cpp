@@ -125,6 +125,27 @@ void write_joint_verdict(const GapSignals& s, const DiagnosisOptions& o, const s
     if (js.significant()) joint_in_words(s, js, out);
 }
 
+// The causes the model holds beside the first (the combination's further steps), each with the
+// further shrinkage it adds.
+std::string further_causes_in_words(const GapSignals& s, const Diagnosis& d) {
+  std::vector<std::string> further;
+  for (std::size_t i = 1; i < d.combination.size(); ++i)
+    further.push_back(fmt::format(
+        "{}, a further {:.0f} % (p = {:.3f})", candidate_in_words(s, d.combination[i].fit),
+        d.combination[i].shrinkage_percent - d.combination[i - 1].shrinkage_percent,
+        d.combination[i].p_value));
+  if (further.empty()) return {};
+  return fmt::format(" Together with it, also causes: {}.", fmt::join(further, "; "));
+}
+
+// The model whose shrinkage is predicted: the cause named first, and the further ones.
+std::string model_in_words(const Diagnosis& d) {
+  if (d.combination.size() < 2) return "it";
+  std::vector<std::string> labels;
+  for (const auto& c : d.combination) labels.push_back(c.label);
+  return fmt::format("these ({})", fmt::join(labels, " + "));
+}
+
 }  // namespace
 
 std::string candidate_in_words(const GapSignals& s, const CandidateFit& f) {
@@ -152,16 +173,13 @@ void write_verdict(const GapSignals& s, const DiagnosisOptions& o, Diagnosis& ou
   }
   const CandidateResult& top = out.candidates.front();
   const std::vector<std::size_t> lead = leading_group(out);
-  std::vector<std::string> steps;
-  for (const auto& c : out.combination) steps.push_back(c.label);
   out.verdict = fmt::format(
-      "{} Most likely cause: {}, which shrinks the held-out gap by {:.0f} % (p = {:.3f}). "
+      "{} Most likely cause: {}, which shrinks the held-out gap by {:.0f} % (p = {:.3f}).{} "
       "Modelled with {}, the held-out gap is expected to fall from {:.3g} rad to {:.3g} rad "
-      "({:.0f} "
-      "% smaller).",
+      "({:.0f} % smaller).",
       where, members_in_words(s, out, lead), top.shrinkage_percent, top.p_value,
-      steps.empty() ? std::string("it") : fmt::format("{}", fmt::join(steps, " + ")),
-      out.heldout_rms_rad, out.heldout_rms_modelled_rad,
+      further_causes_in_words(s, out), model_in_words(out), out.heldout_rms_rad,
+      out.heldout_rms_modelled_rad,
       100.0 * (1.0 - out.heldout_rms_modelled_rad / std::max(out.heldout_rms_rad, 1e-300)));
   if (lead.size() > 1) {
     const AmbiguityGroup& g = out.ambiguity_groups[std::size_t(top.ambiguity_group)];

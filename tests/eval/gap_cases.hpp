@@ -35,7 +35,8 @@ struct WithheldEffect {
                      // the joints; Case::spread_joint says where they show most)
   int joint = 0;
   // > 0: the effect resized rather than switched: "real" runs the joint's parameter times this
-  // factor, "sim" the robot file's value (coulomb: the Coulomb friction torque).
+  // factor, "sim" the robot file's value (coulomb: the Coulomb friction torque); transmission: the
+  // error's harmonic per motor revolution (another order than the first).
   double scale = 0.0;
 };
 
@@ -258,6 +259,7 @@ struct GapWorld {
       if (e.name == "transmission") {
         re.transmission_error = real_changed = true;
         re.transmission_error_shape.amplitude_rad *= 2.0 * size(rng);  // 28..52 arcsec
+        if (e.scale > 0.0) re.transmission_error_shape.harmonic_per_motor_rev = e.scale;
       }
       if (e.name == "coulomb" && e.scale > 0.0) {
         real_config.robot.joints[std::size_t(e.joint)].drive.coulomb_nm *= e.scale;

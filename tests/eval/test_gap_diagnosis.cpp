@@ -4,10 +4,13 @@
 // the block bootstrap on clear and on null cases.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
+#include "eval/gap_bounds.hpp"
 #include "eval/gap_diagnosis.hpp"
+#include "eval/gap_verdict.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -176,6 +179,97 @@ TEST(GapDiagnosis, BlockBootstrapSeparatesClearGainsFromNoise) {
   for (double& v : null) v = n(rng);
   // A zero-mean null gives p around 0.5; 0.05 is far in the tail for any reasonable draw.
   EXPECT_GT(block_bootstrap_p_value(null, 100, 199, 1), 0.05);
+}
+
+TEST(GapBounds, ActiveBoundGivesTheClosedFormConstrainedFit) {
+  // y = -0.5 u + 2 v with u, v orthogonal (sin and cos over whole periods): the level of u is
+  // the first parameter; with level >= 0 the constrained optimum is (0, 2) exactly, its residual
+  // 0.5 u (RMS 0.5 / sqrt 2). Tolerances: rounding of the normal equations.
+  const Eigen::Index n = 1000;
+  Eigen::MatrixXd x(n, 2);
+  std::vector<double> y(std::size_t(n), 0.0);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double a = 2.0 * M_PI * 5.0 * double(k) / double(n);
+    x(k, 0) = std::sin(a), x(k, 1) = std::cos(a);
+    y[std::size_t(k)] = -0.5 * x(k, 0) + 2.0 * x(k, 1);
+  }
+  const std::vector<Eigen::MatrixXd> columns = {x};
+  const std::vector<bool> use(std::size_t(n), true);
+  LinearFit f = fit_joint_columns(columns, {y}, use);
+  EXPECT_NEAR(f.parameters[0], -0.5, 1e-12);
+  const LevelBound bound{0, 0, 2, x.col(0), 0.0};
+  EXPECT_NEAR(bound_level(columns, bound, f.parameters, use), -0.5, 1e-12);
+  EXPECT_TRUE(apply_level_bounds(columns, {y}, use, {bound}, f));
+  EXPECT_NEAR(f.parameters[0], 0.0, 1e-12);
+  EXPECT_NEAR(f.parameters[1], 2.0, 1e-12);
+  EXPECT_NEAR(f.rms, 0.5 / std::sqrt(2.0), 1e-12);
+  // A bound that holds leaves the fit alone.
+  LinearFit g = fit_joint_columns(columns, {y}, use);
+  EXPECT_FALSE(apply_level_bounds(columns, {y}, use, {{0, 0, 2, x.col(0), -1.0}}, g));
+  EXPECT_NEAR(g.parameters[0], -0.5, 1e-12);
+}
+
+// A compliance of either sign on A3 (nominal model rigid): the physical sign is named with its
+// size; the sign-flipped one, a negative compliance, is never reported with that size.
+Diagnosis compliance_case(double compliance_rad_per_nm) {
+  GapSignals s = synthetic(5000);  // 10 s: short for the sanitizer build
+  for (std::size_t k = 0; k < s.sample_count(); ++k)
+    s.gap_rad[2][k] = compliance_rad_per_nm * s.torque_nm[2][k];
+  add_white_noise(s, 1e-5, 11);
+  return diagnose_gap(s);
+}
+
+TEST(GapDiagnosis, ComplianceIsSizedWithinItsPhysicalBound) {
+  const double c = 3e-7;  // rad/N m: ~1e-4 rad of deflection at the synthetic torques
+  const Diagnosis positive = compliance_case(c);
+  ASSERT_TRUE(positive.significant_gap);
+  const CandidateFit& top = positive.candidates.front().fit;
+  EXPECT_EQ(top.kind, EffectKind::kGearCompliance) << positive.verdict;
+  EXPECT_FALSE(top.at_bound);
+  // The level against the truth: white noise of 1e-5 rad on 2500 training rows, far below 1 %.
+  EXPECT_NEAR(top.level, c, 0.01 * c);
+
+  const Diagnosis flipped = compliance_case(-c);
+  for (const CandidateResult& r : flipped.candidates) {
+    if (r.fit.kind != EffectKind::kGearCompliance) continue;
+    EXPECT_GE(r.fit.level, -1e-12 * c) << r.fit.size_text;  // rounding of the active bound
+    EXPECT_EQ(r.fit.size_text.find("stiffness of -"), std::string::npos) << r.fit.size_text;
+    EXPECT_EQ(r.fit.size_text.find("stiffness -"), std::string::npos) << r.fit.size_text;
+    if (r.fit.joint != 2) continue;
+    EXPECT_TRUE(r.fit.at_bound) << r.fit.size_text;
+    EXPECT_LT(r.fit.unconstrained_level, -0.9 * c);  // the unconstrained fit: the negative truth
+    EXPECT_FALSE(r.supported) << flipped.verdict;    // at its bound it explains nothing
+  }
+  EXPECT_EQ(flipped.verdict.find("cause: gear_compliance"), std::string::npos) << flipped.verdict;
+}
+
+// The verdict names the causes it models: the model starts from the cause ranked first, and every
+// further candidate of the model is named as a cause before "Modelled with".
+TEST(GapDiagnosis, VerdictModelsTheCausesItNames) {
+  GapSignals s = synthetic(5000);  // 10 s: short for the sanitizer build
+  for (std::size_t k = 0; k < s.sample_count(); ++k) {
+    s.gap_rad[2][k] = 3e-7 * s.torque_nm[2][k];          // a compliance of A3, ~1e-4 rad
+    s.gap_rad[4][k] = 0.004 * s.qd_desired_rad_s[4][k];  // a time offset of A5, ~1e-3 rad
+  }
+  add_white_noise(s, 1e-5, 12);
+  const Diagnosis d = diagnose_gap(s);
+  ASSERT_TRUE(d.significant_gap);
+  ASSERT_FALSE(d.combination.empty());
+  EXPECT_EQ(d.combination.front().candidate, 0u);
+  const std::size_t modelled = d.verdict.find("Modelled with");
+  ASSERT_NE(modelled, std::string::npos) << d.verdict;
+  std::vector<EffectKind> kinds;
+  for (const CombinationStep& step : d.combination) {
+    const CandidateFit& f = d.candidates[step.candidate].fit;
+    kinds.push_back(f.kind);
+    EXPECT_LT(d.verdict.find(candidate_in_words(s, f)), modelled) << d.verdict;
+    if (d.combination.size() > 1) {
+      EXPECT_NE(d.verdict.find(step.label, modelled), std::string::npos) << d.verdict;
+    }
+  }
+  // Both effects are in the model.
+  EXPECT_NE(std::find(kinds.begin(), kinds.end(), EffectKind::kTimeOffset), kinds.end());
+  EXPECT_NE(std::find(kinds.begin(), kinds.end(), EffectKind::kGearCompliance), kinds.end());
 }
 
 }  // namespace

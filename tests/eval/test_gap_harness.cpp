@@ -41,9 +41,93 @@ struct Score {
   std::string name;
   std::string top;  // "A2 backlash" or "none"; with its ambiguity group "A3 backlash / A3 ..."
   bool ranked_first = false, joint_located = false, alarm = false;
+  bool all_found = false;  // every withheld effect in the model whose shrinkage is predicted
+  std::size_t effects = 0;
   std::size_t group_size = 0;  // members of the leading ambiguity group
   double predicted = 0.0, truth = 0.0;
 };
+
+// One case run blind and scored (see the file's head); its row of the confusion matrix counted.
+Score score_case(const test::GapWorld& world, const HarnessCase& hc,
+                 std::map<std::string, std::map<std::string, int>>& confusion) {
+  const auto c = world.make_case(hc.effects, hc.seed);
+  const GapSignals signals =
+      make_gap_signals(c.real, c.sim_joint_error_rad, world.robot, c.table ? &*c.table : nullptr);
+  const Diagnosis d = diagnose_gap(signals);
+  Score s;
+  for (const auto& e : hc.effects)
+    s.name +=
+        (s.name.empty() ? "" : " + ") +
+        (test::spreads_over_joints(e.name)
+             ? (e.name == "kinematic" ? fmt::format("link {} kinematic", e.joint + 1) : e.name)
+             : fmt::format("{} {}", world.robot.joints[std::size_t(e.joint)].name, e.name)) +
+        (e.scale > 0.0 ? fmt::format(" x{:g}", e.scale) : std::string());
+  if (s.name.empty()) s.name = "control";
+  s.alarm = d.significant_gap;
+  s.top = "none";
+  if (d.significant_gap) {
+    // Ranked first: the withheld effect is the top candidate or one of those the data cannot
+    // tell apart from it (the leading ambiguity group: modelled gaps within 10 % of the
+    // residual, no more parameters; eval/gap_ambiguity.hpp). Its size is printed and bounded
+    // below, so that a large group cannot buy a hit.
+    const std::vector<std::size_t> lead = leading_group(d);
+    s.group_size = lead.size();
+    s.top.clear();
+    for (std::size_t m : lead)
+      s.top += (s.top.empty() ? "" : " / ") + candidate_label(signals, d.candidates[m].fit);
+    const auto& top = d.candidates.front().fit;
+    for (const auto& e : hc.effects) {
+      // An effect that spreads over the joints (the IMS chain's errors, the payload): its kind
+      // ranked first counts on any joint, located is the joint where the gap has the most
+      // energy. The others: kind and source joint.
+      const bool spread = test::spreads_over_joints(e.name);
+      const int joint = spread ? c.spread_joint : e.joint;
+      for (std::size_t m : lead) {
+        const auto& f = d.candidates[m].fit;
+        s.ranked_first |=
+            f.kind == test::expected_kind(e.name) && (spread || int(f.joint) == joint);
+      }
+      s.joint_located |= int(top.joint) == joint;
+    }
+    s.predicted = d.combination.empty() ? d.candidates.front().shrinkage_percent
+                                        : d.combination.back().shrinkage_percent;
+    // Found: each withheld effect's kind (and joint, unless it spreads over the joints) in the
+    // model whose shrinkage is predicted or in the leading ambiguity group.
+    std::vector<const CandidateFit*> model;
+    for (std::size_t m : lead) model.push_back(&d.candidates[m].fit);
+    for (const CombinationStep& step : d.combination) model.push_back(&step.fit);
+    s.all_found = true;
+    for (const auto& e : hc.effects) {
+      const bool spread = test::spreads_over_joints(e.name);
+      bool found = false;
+      for (const CandidateFit* f : model)
+        found |= f->kind == test::expected_kind(e.name) && (spread || int(f->joint) == e.joint);
+      s.all_found = s.all_found && found;
+    }
+  }
+  s.effects = hc.effects.size();
+  // Truth: the sim re-run with the true effects on leaves only the noise of the real data.
+  const std::vector<bool> training = training_rows(signals, DiagnosisOptions{}.block_s);
+  double e_gap = 0.0, e_noise = 0.0;
+  for (std::size_t j = 0; j < signals.joint_count(); ++j)
+    for (std::size_t k = 0; k < signals.sample_count(); ++k) {
+      if (training[k]) continue;
+      const double noise = c.real.q_measured_rad[j][k] - c.real_noise_free.q_measured_rad[j][k];
+      e_gap += signals.gap_rad[j][k] * signals.gap_rad[j][k];
+      e_noise += noise * noise;
+    }
+  s.truth = 100.0 * (1.0 - std::sqrt(e_noise / e_gap));
+  const std::string row = hc.effects.empty() ? "control" : hc.effects.front().name;
+  // The confusion matrix counts the top candidate (the first of its group).
+  const std::string col = d.significant_gap ? to_string(d.candidates.front().fit.kind) : "none";
+  ++confusion[row][col];
+  fmt::print(
+      "{:<32} top {:<34} first {:d} joint {:d}  shrinkage predicted {:6.1f} % true {:6.1f} %"
+      "  gap {:.3g} rad  all found {:d}\n  {}\n",
+      s.name, s.top, s.ranked_first, s.joint_located, s.predicted, s.truth, d.heldout_rms_rad,
+      s.all_found, d.verdict);
+  return s;
+}
 
 TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
   const test::GapWorld world;
@@ -116,70 +200,7 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
 
   std::vector<Score> scores;
   std::map<std::string, std::map<std::string, int>> confusion;
-  for (const auto& hc : cases) {
-    const auto c = world.make_case(hc.effects, hc.seed);
-    const GapSignals signals =
-        make_gap_signals(c.real, c.sim_joint_error_rad, world.robot, c.table ? &*c.table : nullptr);
-    const Diagnosis d = diagnose_gap(signals);
-    Score s;
-    for (const auto& e : hc.effects)
-      s.name +=
-          (s.name.empty() ? "" : " + ") +
-          (test::spreads_over_joints(e.name)
-               ? (e.name == "kinematic" ? fmt::format("link {} kinematic", e.joint + 1) : e.name)
-               : fmt::format("{} {}", world.robot.joints[std::size_t(e.joint)].name, e.name));
-    if (s.name.empty()) s.name = "control";
-    s.alarm = d.significant_gap;
-    s.top = "none";
-    if (d.significant_gap) {
-      // Ranked first: the withheld effect is the top candidate or one of those the data cannot
-      // tell apart from it (the leading ambiguity group: modelled gaps within 10 % of the
-      // residual, no more parameters; eval/gap_ambiguity.hpp). Its size is printed and bounded
-      // below, so that a large group cannot buy a hit.
-      const std::vector<std::size_t> lead = leading_group(d);
-      s.group_size = lead.size();
-      s.top.clear();
-      for (std::size_t m : lead)
-        s.top += (s.top.empty() ? "" : " / ") + candidate_label(signals, d.candidates[m].fit);
-      const auto& top = d.candidates.front().fit;
-      for (const auto& e : hc.effects) {
-        // An effect that spreads over the joints (the IMS chain's errors, the payload): its kind
-        // ranked first counts on any joint, located is the joint where the gap has the most
-        // energy. The others: kind and source joint.
-        const bool spread = test::spreads_over_joints(e.name);
-        const int joint = spread ? c.spread_joint : e.joint;
-        for (std::size_t m : lead) {
-          const auto& f = d.candidates[m].fit;
-          s.ranked_first |=
-              f.kind == test::expected_kind(e.name) && (spread || int(f.joint) == joint);
-        }
-        s.joint_located |= int(top.joint) == joint;
-      }
-      s.predicted = d.combination.empty() ? d.candidates.front().shrinkage_percent
-                                          : d.combination.back().shrinkage_percent;
-    }
-    // Truth: the sim re-run with the true effects on leaves only the noise of the real data.
-    const std::vector<bool> training = training_rows(signals, DiagnosisOptions{}.block_s);
-    double e_gap = 0.0, e_noise = 0.0;
-    for (std::size_t j = 0; j < signals.joint_count(); ++j)
-      for (std::size_t k = 0; k < signals.sample_count(); ++k) {
-        if (training[k]) continue;
-        const double noise = c.real.q_measured_rad[j][k] - c.real_noise_free.q_measured_rad[j][k];
-        e_gap += signals.gap_rad[j][k] * signals.gap_rad[j][k];
-        e_noise += noise * noise;
-      }
-    s.truth = 100.0 * (1.0 - std::sqrt(e_noise / e_gap));
-    const std::string row = hc.effects.empty() ? "control" : hc.effects.front().name;
-    // The confusion matrix counts the top candidate (the first of its group).
-    const std::string col = d.significant_gap ? to_string(d.candidates.front().fit.kind) : "none";
-    ++confusion[row][col];
-    fmt::print(
-        "{:<32} top {:<34} first {:d} joint {:d}  shrinkage predicted {:6.1f} % true {:6.1f} %"
-        "  gap {:.3g} rad\n  {}\n",
-        s.name, s.top, s.ranked_first, s.joint_located, s.predicted, s.truth, d.heldout_rms_rad,
-        d.verdict);
-    scores.push_back(s);
-  }
+  for (const auto& hc : cases) scores.push_back(score_case(world, hc, confusion));
 
   // Confusion matrix: withheld effect (first of a pair) x top-ranked candidate kind.
   std::vector<std::string> cols;
@@ -234,6 +255,60 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
   if (!sanitized()) {  // a figure of the whole set: the subset's few cases say little
     EXPECT_GE(pct(within, effect_cases), 90.0);
   }
+}
+
+// Cases apart from the figures above (Release only: ~0.6 s each): effects resized rather than
+// switched (Coulomb friction x1.5 and x0.5, a transmission error of the 2nd or 3rd harmonic) and
+// two and three effects at once. Scored: the predicted shrinkage of the resized effects, and in
+// every case with several effects (these and the two-effect cases above) whether every withheld
+// effect is in the model whose shrinkage is predicted.
+TEST(GapHarness, ResizedAndSimultaneousEffectsAreAllFound) {
+  if (sanitized()) GTEST_SKIP() << "Release-only figures";
+  const test::GapWorld world;
+  const std::vector<HarnessCase> cases = {
+      {{{"coulomb", 0, 1.5}}, 70},
+      {{{"coulomb", 2, 0.5}}, 71},
+      {{{"coulomb", 1, 0.5}}, 72},
+      {{{"coulomb", 4, 1.5}}, 80},
+      {{{"transmission", 0, 2.0}}, 73},
+      {{{"transmission", 2, 3.0}}, 74},
+      {{{"backlash", 0}, {"transmission", 3}}, 24},
+      {{{"zero_offset", 1}, {"time_offset", 3}}, 25},
+      {{{"coulomb", 2}, {"backlash", 1}}, 60},
+      {{{"mounting", 0}, {"drift", 1}}, 61},
+      {{{"payload", 0}, {"time_offset", 4}}, 62},
+      {{{"coulomb", 2, 0.5}, {"backlash", 1}}, 75},
+      {{{"clock_offset", 0}, {"backlash", 3}}, 76},
+      {{{"backlash", 0}, {"transmission", 3}, {"zero_offset", 2}}, 77},
+      {{{"coulomb", 1}, {"elastic", 4}, {"time_offset", 5}}, 78},
+      {{{"payload", 0}, {"backlash", 5}, {"drift", 2}}, 79},
+  };
+  std::map<std::string, std::map<std::string, int>> confusion;
+  int resized = 0, resized_within = 0, multi = 0, multi_found = 0;
+  for (const auto& hc : cases) {
+    const Score s = score_case(world, hc, confusion);
+    if (s.effects > 1) {
+      ++multi;
+      multi_found += s.all_found;
+    } else {
+      ++resized;
+      resized_within += std::abs(s.predicted - s.truth) <= 20.0;
+    }
+  }
+  const auto pct = [](int a, int b) { return b ? 100.0 * a / b : 0.0; };
+  fmt::print(
+      "\nresized effects: predicted shrinkage within ±20 pp of the true one {}/{} ({:.0f} %)\n"
+      "several effects at once: every withheld effect found {}/{} ({:.0f} %)\n",
+      resized_within, resized, pct(resized_within, resized), multi_found, multi,
+      pct(multi_found, multi));
+  test_support::record_figure("resized_within_20pp_percent", pct(resized_within, resized));
+  test_support::record_figure("multi_effect_all_found_percent", pct(multi_found, multi));
+  // At the measured level (8/10 and 2/6 with the joint model; the greedy combination: 5/10 and
+  // 3/6): a fall shows here. The goal of every effect found in >= 80 % is met; shrinkage within
+  // ±20 pp in >= 85 % is not: the resized effects are found but under-predicted by the
+  // candidates' shapes.
+  EXPECT_GE(pct(multi_found, multi), 80.0);
+  EXPECT_GE(pct(resized_within, resized), 100.0 / 3.0 - 1e-9);
 }
 
 }  // namespace
