@@ -55,6 +55,8 @@ const char* state_name(ident::PrecontrolState s) {
       return "fading_out";
     case ident::PrecontrolState::kInactive:
       return "inactive";
+    case ident::PrecontrolState::kEngaging:
+      return "engaging";
   }
   return "?";
 }
@@ -68,6 +70,9 @@ void run(const CompensateArgs& args) {
       args.robot_log, table.robot, "the parameter table " + args.table);
   ident::PrecontrolOptions options;
   options.caller_cycle_s = log.cycle_s;
+  // A log may start in the middle of a motion, and a fault need not end the run: the precontrol
+  // engages smoothly and re-engages (ident/precontrol.hpp, auto_engage).
+  options.auto_engage = true;
   if (args.offset_tolerance_rad > 0.0) options.offset_tolerance_rad.fill(args.offset_tolerance_rad);
   auto precontrol = std::make_unique<ident::Precontrol>();
   std::string why;
