@@ -24,6 +24,8 @@ const char* to_string(RsiFault fault) {
       return "reordered IPOC";
     case RsiFault::kUnknownRobot:
       return "unknown robot type";
+    case RsiFault::kOffPath:
+      return "set-point off the loaded path";
   }
   return "?";
 }
@@ -31,7 +33,8 @@ const char* to_string(RsiFault fault) {
 std::unique_ptr<RsiSession> RsiSession::create(const ident::ParameterTable& table,
                                                const std::string& robot_name,
                                                ident::PrecontrolOptions precontrol,
-                                               const RsiSessionOptions& options, std::string* why) {
+                                               const RsiSessionOptions& options, std::string* why,
+                                               std::unique_ptr<PathFollower> path) {
   auto refuse = [&](const std::string& reason) {
     if (why) *why = reason;
     return std::unique_ptr<RsiSession>();
@@ -47,7 +50,12 @@ std::unique_ptr<RsiSession> RsiSession::create(const ident::ParameterTable& tabl
   std::string reason;
   if (!ident::Precontrol::create(table, robot_name, precontrol, &session->precontrol_, &reason))
     return refuse(reason);
+  if (!path && (table.preview_cycles > 0 || session->precontrol_.needs_model_torque()))
+    return refuse(
+        "the table takes the desired path ahead or the model torque: load the program's "
+        "path");
   session->options_ = options;
+  session->path_ = std::move(path);
   return session;
 }
 
@@ -96,6 +104,7 @@ bool RsiSession::judge(const RsiRobotDatagram& d, double receive_time_s) noexcep
     if (cycle > last_cycle_ + 1)
       record(d.ipoc, RsiFault::kLost, 0, double(cycle - last_cycle_ - 1));
   }
+  advanced_ = started_ ? cycle - last_cycle_ : 1;
   started_ = true;
   last_cycle_ = cycle;
   last_receive_s_ = receive_time_s;
@@ -123,6 +132,17 @@ void RsiSession::answer_values(const std::array<double, kRsiAxes>& offset_rad,
   }
 }
 
+bool RsiSession::precontrol_input(const std::array<double, kRsiAxes>& setpoint_rad,
+                                  PathSample* input) noexcept {
+  input->q_rad = setpoint_rad;
+  input->payload_kg = options_.payload_kg;
+  if (!path_) return true;
+  const bool on_path = path_->step(setpoint_rad, advanced_, input);
+  // A path without payloads: the session's.
+  if (on_path && input->payload_kg == 0.0) input->payload_kg = options_.payload_kg;
+  return on_path;
+}
+
 int RsiSession::handle(std::string_view datagram, double receive_time_s, char* answer,
                        int capacity) noexcept {
   const RsiParseError error = parse_rsi_robot_datagram(datagram, &datagram_);
@@ -133,14 +153,22 @@ int RsiSession::handle(std::string_view datagram, double receive_time_s, char* a
     return 0;
   }
   const std::uint64_t cycle = datagram_.ipoc / options_.ipoc_per_cycle;
-  const bool fade = judge(datagram_, receive_time_s);
+  bool fade = judge(datagram_, receive_time_s);
   std::array<double, kRsiAxes> values_deg{};
   if (in_order_) {
-    if (fade) precontrol_.fault(cycle, 0.0);
     std::array<double, ident::kPrecontrolJoints> q_rad{};
     for (int a = 0; a < kRsiAxes; ++a)
       q_rad[std::size_t(a)] = datagram_.setpoint_deg[std::size_t(a)] / kDegPerRad;
-    const ident::PrecontrolOutput out = precontrol_.cycle(q_rad, options_.payload_kg, cycle);
+    PathSample input;
+    if (!precontrol_input(q_rad, &input)) {
+      record(datagram_.ipoc, RsiFault::kOffPath, 0, 0.0);
+      fade = true;
+    }
+    if (fade) precontrol_.fault(cycle, 0.0);
+    const ident::PrecontrolOutput out =
+        precontrol_.needs_model_torque()
+            ? precontrol_.cycle(input.q_rad, input.payload_kg, input.torque_nm, cycle)
+            : precontrol_.cycle(input.q_rad, input.payload_kg, cycle);
     state_ = out.state;
     answer_values(out.offset_rad, &values_deg);
   } else if (options_.mode == RsiCorrectionMode::kAbsolute) {

@@ -35,6 +35,7 @@
 
 #include "ident/parameter_table.hpp"
 #include "ident/precontrol.hpp"
+#include "online/path_follower.hpp"
 #include "online/rsi_datagram.hpp"
 
 namespace imscal::online {
@@ -58,6 +59,7 @@ enum class RsiFault : std::uint8_t {
   kDuplicated,    // the IPOC of the previous datagram again
   kReordered,     // an IPOC older than the previous one
   kUnknownRobot,  // Rob's Type is not the expected one
+  kOffPath,       // the set-point is not on the loaded path at its time (online/path_follower)
 };
 const char* to_string(RsiFault fault);
 
@@ -72,11 +74,14 @@ inline constexpr int kRsiFaultCapacity = 256;
 class RsiSession {
  public:
   // nullptr with the reason in *why when the precontrol refuses the table or the options are
-  // inconsistent (cycle, IPOC step, sensor type).
+  // inconsistent (cycle, IPOC step, sensor type). `path`: the program's desired path, which a
+  // table with a preview or the model torque needs (refused without); the precontrol is then fed
+  // the path ahead of the set-point, with its torque and payload.
   static std::unique_ptr<RsiSession> create(const ident::ParameterTable& table,
                                             const std::string& robot_name,
                                             ident::PrecontrolOptions precontrol,
-                                            const RsiSessionOptions& options, std::string* why);
+                                            const RsiSessionOptions& options, std::string* why,
+                                            std::unique_ptr<PathFollower> path = nullptr);
 
   // One received datagram at receive_time_s (any monotonic clock): the answer's length written
   // to `answer`, or 0 when the datagram is not answered (malformed).
@@ -99,8 +104,15 @@ class RsiSession {
   void answer_values(const std::array<double, kRsiAxes>& offset_rad,
                      std::array<double, kRsiAxes>* values_deg) noexcept;
 
+  // The precontrol's input of an in-order datagram (the set-point, or the loaded path ahead);
+  // false when it is off the loaded path.
+  bool precontrol_input(const std::array<double, kRsiAxes>& setpoint_rad,
+                        PathSample* input) noexcept;
+
   ident::Precontrol precontrol_;
   RsiSessionOptions options_;
+  std::unique_ptr<PathFollower> path_;
+  std::uint64_t advanced_ = 1;  // cycles since the previous in-order datagram
   RsiRobotDatagram datagram_;
   bool started_ = false;
   bool pending_fault_ = false;  // a malformed datagram since the last answer

@@ -6,18 +6,23 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
 #include <memory>
 #include <stdexcept>
 
+#include "calib/robot_log.hpp"
 #include "core/input_error.hpp"
+#include "eval/model_torque.hpp"
 #include "ident/parameter_table_io.hpp"
+#include "online/path_follower.hpp"
 #include "online/rsi_server.hpp"
 #include "online/rsi_session.hpp"
 #include "online/udp_socket.hpp"
 #include "tools/command_registry.hpp"
+#include "tools/model_torque_option.hpp"
 
 namespace {
 namespace ident = imscal::ident;
@@ -30,7 +35,8 @@ extern "C" void request_stop(int) {
 }
 
 struct ServeArgs {
-  std::string table, robot, bind = "0.0.0.0", mode = "absolute";
+  std::string table, bind = "0.0.0.0", mode = "absolute", path;
+  imscal::tools::ModelTorqueOption model_torque;  // for tables with the model-torque input
   int port = 0;
   online::RsiSessionOptions session;
   double cycle_ms = 4.0, late_ms = 0.0, idle_timeout_s = 0.0;
@@ -38,25 +44,63 @@ struct ServeArgs {
   double max_setpoint_speed_deg_s = 1000.0;
 };
 
-// The table, refused when the interface cannot feed its models: RSI sends the current set-point
-// only, neither the preview an inverse-form table needs nor the model torque (decision 0024).
-ident::ParameterTable servable_table(const std::string& file) {
-  ident::ParameterTable table = ident::read_parameters_json(file);
+// The robot program's desired path (a robot log: q_desired and payload per sample), with the
+// model torque along it when the table's models take it (eval/model_torque.hpp, as `imscal
+// compensate`), for a table with a preview or the model torque (decision 0024).
+std::unique_ptr<online::PathFollower> load_path(const ServeArgs& args,
+                                                const ident::ParameterTable& table) {
+  const imscal::calib::RobotLog log = imscal::calib::read_robot_log_csv(
+      args.path, table.robot, "the parameter table " + args.table);
+  online::LoadedPath path;
+  path.cycle_s = log.cycle_s;
+  const std::size_t n = log.samples.size();
+  std::vector<std::vector<double>> q(imscal::calib::kJointCount, std::vector<double>(n));
+  for (std::size_t k = 0; k < n; ++k) {
+    std::array<double, online::kPathJoints> sample{};
+    for (int j = 0; j < online::kPathJoints; ++j) {
+      sample[std::size_t(j)] = log.samples[k].q_desired_rad[j];
+      q[std::size_t(j)][k] = sample[std::size_t(j)];
+    }
+    path.q_rad.push_back(sample);
+    path.payload_kg.push_back(log.samples[k].payload_kg);
+  }
+  const bool needs_torque = std::find(table.extra_inputs.begin(), table.extra_inputs.end(),
+                                      ident::TableInput::kModelTorque) != table.extra_inputs.end();
+  if (needs_torque) {
+    const imscal::eval::ModelTorqueSource model =
+        args.model_torque.source(log.robot_name, args.path, args.table, "extra_inputs");
+    const std::vector<std::pair<std::size_t, std::size_t>> whole{{0, n}};
+    const auto torque =
+        imscal::eval::model_torques_along(model, log.cycle_s, q, path.payload_kg, whole);
+    path.torque_nm.resize(n);
+    for (std::size_t k = 0; k < n; ++k)
+      for (int j = 0; j < online::kPathJoints; ++j)
+        path.torque_nm[k][std::size_t(j)] = torque[std::size_t(j)][k];
+  }
+  try {
+    return std::make_unique<online::PathFollower>(std::move(path), args.cycle_ms * 1e-3,
+                                                  table.preview_cycles * table.sample_time_s);
+  } catch (const std::invalid_argument& e) {
+    throw imscal::InputError(args.path, 0, "cycle_s", e.what());
+  }
+}
+
+// Without a loaded path the table must not need one: RSI sends the current set-point only.
+void check_servable_without_path(const std::string& file, const ident::ParameterTable& table) {
   if (table.preview_cycles > 0) {
     throw imscal::InputError(
         file, 0, "preview_cycles",
         "the table needs the desired path " + std::to_string(table.preview_cycles) +
-            " cycles ahead, which RSI does not send; identify a table without preview for "
-            "serving (model.form: joint-error, see docs/decisions/0024)");
+            " cycles ahead, which RSI does not send: give the program's path (--path robot.csv) "
+            "or serve a table without preview (docs/decisions/0024)");
   }
   for (ident::TableInput input : table.extra_inputs) {
     if (input == ident::TableInput::kModelTorque) {
       throw imscal::InputError(file, 0, "extra_inputs",
-                               "the table's models take the model torque, which `serve` does not "
-                               "compute; identify without model.model_torque for serving");
+                               "the table's models take the model torque along the desired path: "
+                               "give the program's path (--path robot.csv) and --robot");
     }
   }
-  return table;
 }
 
 void log_events(online::RsiSession& session) {
@@ -84,7 +128,13 @@ void log_events(online::RsiSession& session) {
 }
 
 void run(ServeArgs args) {
-  const ident::ParameterTable table = servable_table(args.table);
+  const ident::ParameterTable table = ident::read_parameters_json(args.table);
+  std::unique_ptr<online::PathFollower> path;
+  if (args.path.empty()) {
+    check_servable_without_path(args.table, table);
+  } else {
+    path = load_path(args, table);
+  }
   args.session.mode = args.mode == "increment" ? online::RsiCorrectionMode::kIncrement
                                                : online::RsiCorrectionMode::kAbsolute;
   args.session.cycle_s = args.cycle_ms * 1e-3;
@@ -94,9 +144,9 @@ void run(ServeArgs args) {
     precontrol.offset_tolerance_rad.fill(args.offset_tolerance_rad);
   precontrol.max_input_speed_rad_s = args.max_setpoint_speed_deg_s * M_PI / 180.0;
   std::string why;
-  const std::string robot = args.robot.empty() ? table.robot : args.robot;
+  const std::string& robot = table.robot;
   std::unique_ptr<online::RsiSession> session =
-      online::RsiSession::create(table, robot, precontrol, args.session, &why);
+      online::RsiSession::create(table, robot, precontrol, args.session, &why, std::move(path));
   if (!session) throw imscal::InputError(args.table, 0, "", "cannot serve this table: " + why);
   try {
     (void)online::udp_peer(args.bind, 0);
@@ -121,15 +171,17 @@ imscal::tools::CommandRegistration registration{
     "serve", "Serve the precontrol online to a KUKA controller over RSI (UDP, XML)",
     [](CLI::App& sub) {
       auto args = std::make_shared<ServeArgs>();
-      sub.add_option("--table", args->table, "parameters.json (imscal identify; no preview)")
-          ->required();
+      sub.add_option("--table", args->table, "parameters.json (imscal identify)")->required();
       sub.add_option("--port", args->port, "UDP port the controller sends to")
           ->required()
           ->check(CLI::Range(0, 65535));
       sub.add_option("--bind", args->bind, "local IPv4 address to bind (default all)");
       sub.add_option("--mode", args->mode, "AKorr as the RSI configuration sums it")
           ->check(CLI::IsMember({"absolute", "increment"}));
-      sub.add_option("--robot", args->robot, "robot the table must be for (default: the table's)");
+      sub.add_option("--path", args->path,
+                     "the program's desired path (robot.csv), followed by IPOC: needed by tables "
+                     "with a preview or the model torque");
+      args->model_torque.add_to(sub);
       sub.add_option("--robot-type", args->session.robot_type,
                      "Type attribute of <Rob> expected (default: any)");
       sub.add_option("--sensor-type", args->session.sensor_type,

@@ -19,10 +19,12 @@ namespace imscal::test_support {
 class RsiLoopbackServer {
  public:
   RsiLoopbackServer(const ident::ParameterTable& table, const ident::PrecontrolOptions& precontrol,
-                    const online::RsiSessionOptions& options)
+                    const online::RsiSessionOptions& options,
+                    std::unique_ptr<online::PathFollower> path = nullptr)
       : socket_("127.0.0.1", 0) {
     std::string why;
-    session_ = online::RsiSession::create(table, table.robot, precontrol, options, &why);
+    session_ =
+        online::RsiSession::create(table, table.robot, precontrol, options, &why, std::move(path));
     if (!session_) throw std::invalid_argument("RSI session refused: " + why);
     thread_ = std::thread([this] {
       stats_ = online::serve_rsi(socket_, *session_, stop_, online::RsiServerOptions{},

@@ -2,12 +2,14 @@
 // controller emulator (online/rsi_controller_emulator.hpp) drives it, with a malformed datagram
 // and a lost one among 1000; every datagram sent in order is answered, the command logs the
 // faults and stops after its idle timeout with exit code 0. A table the interface cannot feed
-// (with preview) is refused with exit code 2, naming the field.
+// (with preview) without the program's path is refused with exit code 2, naming the field; with
+// the path (--path robot.csv) it is served, following the path by the IPOC.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <thread>
 
+#include "calib/robot_log.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "online/rsi_controller_emulator.hpp"
 #include "tests/support/run_imscal.hpp"
@@ -86,6 +88,62 @@ TEST_F(ServeCli, ServesTheControllerAndLogsItsFaults) {
   EXPECT_NE(log.find("engaged"), std::string::npos) << log;
   // 1 probe + 999 sent + 1 malformed.
   EXPECT_NE(log.find("1001 datagrams, 1000 answered, 1 not answered"), std::string::npos) << log;
+}
+
+TEST_F(ServeCli, FollowsALoadedPathForATableWithPreview) {
+  // The program: rest for 1 s at 0, then every joint swings 0.1 (1 - cos) rad over 3 s; a robot
+  // log at 2 ms, served at the RSI cycle of 4 ms.
+  calib::RobotLog path;
+  path.robot_name = "kr16";
+  path.cycle_s = 0.002;
+  for (int k = 0; k < 2500; ++k) {
+    const double t = k * 0.002, s_t = std::max(0.0, t - 1.0);
+    const Eigen::VectorXd q = Eigen::VectorXd::Constant(6, 0.1 * (1.0 - std::cos(2.0 * s_t)));
+    path.samples.push_back({t, 0.0, q, q});
+  }
+  calib::write_robot_log_csv(dir_ / "robot.csv", path, Overwrite::kAllow);
+  ident::ParameterTable table = lag_table();
+  table.model_form = ident::TableForm::kInverse;
+  table.preview_cycles = 20;
+  ident::write_parameters_json(dir_ / "preview.json", table);
+  const std::uint16_t port = free_port();
+  int exit_code = -1;
+  std::thread server([&] {
+    exit_code =
+        run_imscal("serve --table " + (dir_ / "preview.json").string() + " --path " +
+                       (dir_ / "robot.csv").string() + " --bind 127.0.0.1 --port " +
+                       std::to_string(port) + " --offset-tolerance-rad 0.05 --idle-timeout-s 0.5",
+                   dir_ / "serve.log");
+  });
+  UdpSocket controller("127.0.0.1", 0);
+  const UdpPeer peer = udp_peer("127.0.0.1", port);
+  std::array<char, 1024> buffer{};
+  bool up = false;
+  for (int attempt = 0; attempt < 100 && !up; ++attempt) {
+    const int n = write_rsi_robot_datagram("KUKA", {}, 1000, buffer.data(), int(buffer.size()));
+    ASSERT_TRUE(controller.send(buffer.data(), n, peer));
+    UdpPeer from;
+    up = controller.receive(buffer.data(), int(buffer.size()), 0.1, &from) > 0;
+  }
+  ASSERT_TRUE(up) << read_file_text(dir_ / "serve.log");
+  std::vector<std::array<double, kRsiAxes>> setpoint;
+  for (std::size_t k = 0; k < path.samples.size(); k += 2) {
+    std::array<double, kRsiAxes> q{};
+    for (int a = 0; a < kRsiAxes; ++a) q[std::size_t(a)] = path.samples[k].q_desired_rad[a];
+    setpoint.push_back(q);
+  }
+  RsiEmulatorOptions options;
+  options.first_ipoc = 1004;
+  const RsiEmulatorRun run = emulate_rsi_controller(controller, peer, setpoint, options);
+  server.join();
+  const std::string log = read_file_text(dir_ / "serve.log");
+  EXPECT_EQ(exit_code, 0) << log;
+  EXPECT_EQ(run.missed, 0u);
+  EXPECT_EQ(log.find("off the loaded path"), std::string::npos) << log;
+  EXPECT_NE(log.find("engaged"), std::string::npos) << log;
+  double largest = 0.0;
+  for (const auto& c : run.correction_rad) largest = std::max(largest, std::abs(c[0]));
+  EXPECT_GT(largest, 1e-4) << log;  // the preview table corrects the swing
 }
 
 TEST_F(ServeCli, RefusesATableWithPreview) {
