@@ -42,6 +42,9 @@ struct ServeArgs {
   double cycle_ms = 4.0, late_ms = 0.0, idle_timeout_s = 0.0;
   double offset_tolerance_rad = 0.0;
   double max_setpoint_speed_deg_s = 1000.0;
+  // With a loaded path the precontrol is fed this many table cycles beyond the table's preview:
+  // the delay of its smoother (2 tau = 8 ms), as `imscal verify` does (eval/verification.hpp).
+  int look_ahead_cycles = 4;
 };
 
 // The robot program's desired path (a robot log: q_desired and payload per sample), with the
@@ -78,8 +81,9 @@ std::unique_ptr<online::PathFollower> load_path(const ServeArgs& args,
         path.torque_nm[k][std::size_t(j)] = torque[std::size_t(j)][k];
   }
   try {
-    return std::make_unique<online::PathFollower>(std::move(path), args.cycle_ms * 1e-3,
-                                                  table.preview_cycles * table.sample_time_s);
+    return std::make_unique<online::PathFollower>(
+        std::move(path), args.cycle_ms * 1e-3,
+        (table.preview_cycles + args.look_ahead_cycles) * table.sample_time_s);
   } catch (const std::invalid_argument& e) {
     throw imscal::InputError(args.path, 0, "cycle_s", e.what());
   }
@@ -182,6 +186,10 @@ imscal::tools::CommandRegistration registration{
                      "the program's desired path (robot.csv), followed by IPOC: needed by tables "
                      "with a preview or the model torque");
       args->model_torque.add_to(sub);
+      sub.add_option(
+             "--look-ahead-cycles", args->look_ahead_cycles,
+             "with --path: table cycles fed ahead beyond the preview (default 4, as verify)")
+          ->check(CLI::Range(0, 32));
       sub.add_option("--robot-type", args->session.robot_type,
                      "Type attribute of <Rob> expected (default: any)");
       sub.add_option("--sensor-type", args->session.sensor_type,
