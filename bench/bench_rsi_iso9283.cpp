@@ -6,8 +6,9 @@
 // in lock-step, and eval::verify_scenario runs the plant on the corrections received
 // (VerificationOptions::compensation_runner). Reported: the maximum path deviation's reduction
 // in process and through the sockets, on the true path over 3 friction cycles, and their
-// difference in percentage points (goal: within 0.5). The sockets' run differs where the
-// server cannot know the path ahead: at the start of the first motion.
+// difference in percentage points (goal: within 0.5), with the path's clock started at the
+// motion (the server cannot know the path ahead at the start of the first motion) and with the
+// stream (the path recorded from the stream's first datagram).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -40,10 +41,12 @@ const eval::IdentifiedTable& default_table() {
   return table;
 }
 
-// The offsets of `table` along `path` as the RSI server answers them (the path loaded).
-eval::CompensationRun through_sockets(const ident::ParameterTable& table, const std::string&,
+// The offsets of `table` along `path` as the RSI server answers them (the path loaded, its clock
+// started at the motion or, with the path recorded from the stream's start, with the stream).
+eval::CompensationRun through_sockets(const ident::ParameterTable& table,
                                       const sim::DesiredJointPath& path,
-                                      const eval::CompensationOptions& options) {
+                                      const eval::CompensationOptions& options,
+                                      bool clock_from_stream) {
   online::LoadedPath loaded;
   loaded.cycle_s = path.cycle_s;
   std::vector<calib::JointVector> torque;
@@ -62,15 +65,23 @@ eval::CompensationRun through_sockets(const ident::ParameterTable& table, const 
             : path.payloads[std::size_t(path.samples[k].payload_index)].body.mass_kg);
   }
   const double ahead_s = (table.preview_cycles + options.look_ahead_cycles) * table.sample_time_s;
-  auto follower = std::make_unique<online::PathFollower>(loaded, path.cycle_s, ahead_s);
-  online::RsiSessionOptions session;
-  session.cycle_s = path.cycle_s;
-  session.ipoc_per_cycle = 2;
-  test_support::RsiLoopbackServer server(table, options.precontrol, session, std::move(follower));
   // The warm-up as in process: the start pose for warm_up_cycles, then the path.
   const std::size_t warm_up = std::size_t(std::max(0, options.warm_up_cycles));
   std::vector<std::array<double, online::kRsiAxes>> setpoint(warm_up, loaded.q_rad.front());
   setpoint.insert(setpoint.end(), loaded.q_rad.begin(), loaded.q_rad.end());
+  online::PathFollowerOptions follow;
+  follow.clock_from_first_datagram = clock_from_stream;
+  if (clock_from_stream) {  // the recording starts with the stream: the warm-up's rest first
+    loaded.q_rad = setpoint;
+    if (!loaded.torque_nm.empty())
+      loaded.torque_nm.insert(loaded.torque_nm.begin(), warm_up, loaded.torque_nm.front());
+    loaded.payload_kg.insert(loaded.payload_kg.begin(), warm_up, loaded.payload_kg.front());
+  }
+  auto follower = std::make_unique<online::PathFollower>(loaded, path.cycle_s, ahead_s, follow);
+  online::RsiSessionOptions session;
+  session.cycle_s = path.cycle_s;
+  session.ipoc_per_cycle = 2;
+  test_support::RsiLoopbackServer server(table, options.precontrol, session, std::move(follower));
   online::UdpSocket controller("127.0.0.1", 0);
   online::RsiEmulatorOptions emulator;
   emulator.cycle_s = path.cycle_s;
@@ -95,19 +106,29 @@ void compare(benchmark::State& state, const char* scenario_name) {
   options.cycles = 3;
   options.measure_with_ims = false;
   const std::vector<eval::NamedTable> tables{{"default", default_table().table}};
-  double in_process = 0.0, sockets = 0.0;
+  auto reduction = [](const eval::VerificationResult& r) {
+    return eval::reduction_percent(r.before.true_figures.max_path_deviation_m,
+                                   r.after[0].true_figures.max_path_deviation_m);
+  };
+  double in_process = 0.0, at_motion = 0.0, with_stream = 0.0;
   for (auto _ : state) {
-    const eval::VerificationResult a = eval::verify_scenario(scenario, tables, options);
-    options.compensation_runner = through_sockets;
-    const eval::VerificationResult b = eval::verify_scenario(scenario, tables, options);
-    in_process = eval::reduction_percent(a.before.true_figures.max_path_deviation_m,
-                                         a.after[0].true_figures.max_path_deviation_m);
-    sockets = eval::reduction_percent(b.before.true_figures.max_path_deviation_m,
-                                      b.after[0].true_figures.max_path_deviation_m);
+    in_process = reduction(eval::verify_scenario(scenario, tables, options));
+    for (const bool from_stream : {false, true}) {
+      options.compensation_runner = [from_stream](const ident::ParameterTable& table,
+                                                  const std::string&,
+                                                  const sim::DesiredJointPath& path,
+                                                  const eval::CompensationOptions& compensation) {
+        return through_sockets(table, path, compensation, from_stream);
+      };
+      (from_stream ? with_stream : at_motion) =
+          reduction(eval::verify_scenario(scenario, tables, options));
+    }
   }
   state.counters["in_process_reduction_percent"] = in_process;
-  state.counters["sockets_reduction_percent"] = sockets;
-  state.counters["difference_pp"] = sockets - in_process;
+  state.counters["sockets_clock_at_motion_reduction_percent"] = at_motion;
+  state.counters["sockets_clock_with_stream_reduction_percent"] = with_stream;
+  state.counters["at_motion_difference_pp"] = at_motion - in_process;
+  state.counters["with_stream_difference_pp"] = with_stream - in_process;
 }
 
 void BM_RsiSeedLineInProcessVsSockets(benchmark::State& state) {

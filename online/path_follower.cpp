@@ -58,6 +58,14 @@ bool PathFollower::step(const std::array<double, kPathJoints>& setpoint_rad,
                         std::uint64_t cycles_advanced, PathSample* ahead) noexcept {
   const bool at_start = near(setpoint_rad, 0, options_.rest_tolerance_rad);
   const bool finished = index_ + 1 >= path_.q_rad.size();
+  const bool first_datagram = !stream_started_;
+  stream_started_ = true;
+  if (first_datagram && options_.clock_from_first_datagram && at_start) {
+    state_ = PathFollowerState::kFollowing;  // the path's clock starts with the stream
+    index_ = 0;
+    fill(preview_samples_, ahead);
+    return true;
+  }
   if (at_start && (state_ != PathFollowerState::kFollowing || finished)) {
     state_ = PathFollowerState::kWaiting;
     index_ = 0;

@@ -45,6 +45,7 @@ struct ServeArgs {
   // With a loaded path the precontrol is fed this many table cycles beyond the table's preview:
   // the delay of its smoother (2 tau = 8 ms), as `imscal verify` does (eval/verification.hpp).
   int look_ahead_cycles = 4;
+  std::string path_clock = "motion";  // online/path_follower.hpp: "motion" or "stream"
 };
 
 // The robot program's desired path (a robot log: q_desired and payload per sample), with the
@@ -81,9 +82,11 @@ std::unique_ptr<online::PathFollower> load_path(const ServeArgs& args,
         path.torque_nm[k][std::size_t(j)] = torque[std::size_t(j)][k];
   }
   try {
+    online::PathFollowerOptions follow;
+    follow.clock_from_first_datagram = args.path_clock == "stream";
     return std::make_unique<online::PathFollower>(
         std::move(path), args.cycle_ms * 1e-3,
-        (table.preview_cycles + args.look_ahead_cycles) * table.sample_time_s);
+        (table.preview_cycles + args.look_ahead_cycles) * table.sample_time_s, follow);
   } catch (const std::invalid_argument& e) {
     throw imscal::InputError(args.path, 0, "cycle_s", e.what());
   }
@@ -190,6 +193,10 @@ imscal::tools::CommandRegistration registration{
              "--look-ahead-cycles", args->look_ahead_cycles,
              "with --path: table cycles fed ahead beyond the preview (default 4, as verify)")
           ->check(CLI::Range(0, 32));
+      sub.add_option("--path-clock", args->path_clock,
+                     "with --path: start its clock at the motion from its start pose, or with the "
+                     "stream's first datagram (a path recorded from RSI_ON)")
+          ->check(CLI::IsMember({"motion", "stream"}));
       sub.add_option("--robot-type", args->session.robot_type,
                      "Type attribute of <Rob> expected (default: any)");
       sub.add_option("--sensor-type", args->session.sensor_type,

@@ -65,6 +65,23 @@ TEST(PathFollower, WaitsFollowsNoticesADepartureAndReArms) {
   EXPECT_EQ(f.state(), PathFollowerState::kWaiting);
 }
 
+TEST(PathFollower, WithTheStreamsClockThePreviewSeesTheFirstMotionComing) {
+  PathFollowerOptions options;
+  options.clock_from_first_datagram = true;
+  PathFollower f(ramp_path(200), 0.004, 0.020, options);
+  PathSample s;
+  std::array<double, kPathJoints> q{};
+  ASSERT_TRUE(f.step(q, 1, &s));  // the first datagram: the path's sample 0
+  EXPECT_EQ(f.state(), PathFollowerState::kFollowing);
+  EXPECT_EQ(f.index(), 0u);
+  EXPECT_DOUBLE_EQ(s.q_rad[0], 0.001);  // sample 10: the motion 20 ms ahead, still at rest now
+  ASSERT_TRUE(f.step(q, 1, &s));
+  EXPECT_EQ(f.index(), 2u);
+  EXPECT_DOUBLE_EQ(s.q_rad[0], 0.003);
+  q[0] = 0.5;  // off the path: lost as with the motion's clock
+  EXPECT_FALSE(f.step(q, 1, &s));
+}
+
 TEST(PathFollower, RefusesCyclesThatAreNotWholeSamples) {
   EXPECT_THROW(PathFollower(ramp_path(10), 0.003, 0.0), std::invalid_argument);
   EXPECT_THROW(PathFollower(ramp_path(10), 0.004, 0.001), std::invalid_argument);
