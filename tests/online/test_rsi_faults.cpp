@@ -72,13 +72,17 @@ FaultRun run_with(const std::map<std::size_t, InjectedFault>& faults, RsiCorrect
   session.mode = mode;
   session.cycle_s = kCycle;
   session.robot_type = "KUKA";
-  session.late_after_s = 0.02;  // lock-step datagrams come every ~0.1 ms; the late one 50 ms late
+  // Lock-step datagrams come every ~0.1 ms; the late one 0.6 s late. A threshold far above any
+  // scheduling stall of a loaded (sanitizer) machine: no false late datagram in the clean run.
+  session.late_after_s = 0.3;
   test_support::RsiLoopbackServer server(lag_table(), precontrol_options(), session);
   UdpSocket controller("127.0.0.1", 0);
   RsiEmulatorOptions emulator;
   emulator.mode = mode;
   emulator.cycle_s = kCycle;
   emulator.faults = faults;
+  emulator.late_delay_s = 0.6;
+  emulator.answer_timeout_s = 5.0;  // a stalled server thread is not a missed answer here
   FaultRun out;
   out.run = emulate_rsi_controller(controller, server.peer(), swinging_path(cycles), emulator);
   server.finish();

@@ -54,11 +54,10 @@ TEST_F(ServeCli, ServesTheControllerAndLogsItsFaults) {
   const std::uint16_t port = free_port();
   int exit_code = -1;
   std::thread server([&] {
-    exit_code =
-        run_imscal("serve --table " + (dir_ / "table.json").string() + " --bind 127.0.0.1 --port " +
-                       std::to_string(port) +
-                       " --robot-type KUKA --offset-tolerance-rad 0.05 --idle-timeout-s 0.5",
-                   dir_ / "serve.log");
+    exit_code = run_imscal("serve --table " + (dir_ / "table.json").string() +
+                               " --bind 127.0.0.1 --port " + std::to_string(port) +
+                               " --robot-type KUKA --offset-tolerance-rad 0.05 --idle-timeout-s 3",
+                           dir_ / "serve.log");
   });
   UdpSocket controller("127.0.0.1", 0);
   const UdpPeer peer = udp_peer("127.0.0.1", port);
@@ -76,7 +75,9 @@ TEST_F(ServeCli, ServesTheControllerAndLogsItsFaults) {
   for (std::size_t k = 0; k < setpoint.size(); ++k)
     for (int a = 0; a < kRsiAxes; ++a) setpoint[k][std::size_t(a)] = 0.1 * std::sin(0.004 * k);
   RsiEmulatorOptions options;
-  options.first_ipoc = 1004;  // after the probe's
+  options.first_ipoc = 1004;
+  options.answer_timeout_s =
+      2.0;  // a stalled server (loaded machine) is not a missed answer  // after the probe's
   options.faults = {{300, InjectedFault::kMalformed}, {600, InjectedFault::kDrop}};
   const RsiEmulatorRun run = emulate_rsi_controller(controller, peer, setpoint, options);
   server.join();
@@ -112,7 +113,7 @@ TEST_F(ServeCli, FollowsALoadedPathForATableWithPreview) {
     exit_code =
         run_imscal("serve --table " + (dir_ / "preview.json").string() + " --path " +
                        (dir_ / "robot.csv").string() + " --bind 127.0.0.1 --port " +
-                       std::to_string(port) + " --offset-tolerance-rad 0.05 --idle-timeout-s 0.5",
+                       std::to_string(port) + " --offset-tolerance-rad 0.05 --idle-timeout-s 3",
                    dir_ / "serve.log");
   });
   UdpSocket controller("127.0.0.1", 0);
@@ -134,6 +135,7 @@ TEST_F(ServeCli, FollowsALoadedPathForATableWithPreview) {
   }
   RsiEmulatorOptions options;
   options.first_ipoc = 1004;
+  options.answer_timeout_s = 2.0;  // a stalled server (loaded machine) is not a missed answer
   const RsiEmulatorRun run = emulate_rsi_controller(controller, peer, setpoint, options);
   server.join();
   const std::string log = read_file_text(dir_ / "serve.log");
