@@ -6,11 +6,14 @@
 #include <array>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
+#include "calib/calibration_json.hpp"
 #include "core/input_error.hpp"
 #include "core/input_file.hpp"
 #include "core/json_input.hpp"
 #include "core/sha256.hpp"
+#include "ims/sensor_error_model.hpp"
 
 namespace imscal::calib {
 namespace {
@@ -139,7 +142,73 @@ void read_link_share(const FramesJson& f, SessionFrames& out) {
   }
 }
 
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+json solver_json(const FrameCalibrationResult& result) {
+  return {{"converged", result.converged},
+          {"iterations", result.iterations},
+          {"final_cost", result.final_cost},
+          {"brief_report", result.solver_brief_report}};
+}
+
+json initial_values_json(const FrameCalibrationResult& result, const FramesJsonContext& context) {
+  return {{"T_R_W", pose_json(result.initial_T_R_W)},
+          {"T_S_H", pose_json(result.initial_T_S_H)},
+          {"time_offset_ms", result.initial_time_offset_s * 1e3},
+          {"time_offset_peak_correlation", context.time_offset_peak_correlation}};
+}
+
+const json& conventions_and_units() {
+  static const json kept = {
+      {"conventions",
+       {{"transforms", "T_A_B maps coordinates in B into A (p_A = T_A_B p_B)"},
+        {"W", "Earth-fixed ENU at the site; origin at the sensor's position at rest 1"},
+        {"rpy", "R = Rz(yaw) Ry(pitch) Rx(roll)"},
+        {"time_offset", "t_ims = t_robot + time_offset"}}},
+      {"units",
+       {{"xyz", "mm"},
+        {"angles", "deg"},
+        {"gyro_bias", "deg/h"},
+        {"acc_bias", "ug"},
+        {"time_offset", "ms"},
+        {"covariance_si", "rad, m, rad/s, m/s^2, s (order of parameter_names)"}}}};
+  return kept;
+}
+
 }  // namespace
+
+json frames_json(const FrameCalibrationResult& result, const FramesJsonContext& context) {
+  json estimates = json::array();
+  for (const auto& e : result.estimates) estimates.push_back(estimate_json(e));
+  json weak = json::array();
+  for (const auto& w : result.weak_directions) weak.push_back(weak_json(w));
+  return {{"imscal-frames", 1},
+          {"created_by", context.created_by},
+          {"robot", context.robot},
+          {"frames_from", context.frames_from},
+          {"conventions", conventions_and_units()["conventions"]},
+          {"units", conventions_and_units()["units"]},
+          {"T_R_W", pose_json(result.T_R_W)},
+          {"T_S_H", pose_json(result.T_S_H)},
+          {"gyro_bias_deg_per_h", vector_json(result.biases.gyro_rad_s, 3600.0 / kDeg)},
+          {"acc_bias_ug", vector_json(result.biases.acc_m_s2, 1e6 / ims::sensor_units::kStandardGravity)},
+          {"time_offset_ms", result.time_offset_s * 1e3},
+          {"gyro_scale_factor_ppm", vector_json(result.gyro_scale_factor, 1e6)},
+          {"acc_scale_factor_ppm", vector_json(result.acc_scale_factor, 1e6)},
+          {"estimates", estimates},
+          {"parameter_names", result.parameter_names},
+          {"covariance_si", matrix_json(result.covariance)},
+          {"correlation", matrix_json(result.correlation)},
+          {"covariance_rank_deficient", result.covariance_rank_deficient},
+          {"weak_directions", weak},
+          {"solver", solver_json(result)},
+          {"initial_values", initial_values_json(result, context)},
+          {"rests",
+           {{"used", context.rests_used},
+            {"rejected", context.rests_rejected},
+            {"trimmed", context.rests_trimmed}}},
+          {"inputs", context.inputs}};
+}
 
 SessionFrames read_frames_json(const std::filesystem::path& file, const std::string& robot_name) {
   const FramesJson f = parse(file);

@@ -18,6 +18,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/run_record.hpp"
 #include "core/sha256.hpp"
 
 namespace imscal {
@@ -211,9 +212,16 @@ bool run_record_needed(const RunOptions& options) {
   if (fs::exists(folder) && !fs::is_directory(folder))
     throw InputError(folder.string(), 0, "--out", "exists and is not a folder");
   if (fs::exists(record)) {
-    const std::optional<json> run = read_json_file(record);
-    const std::string made_by =
-        run && run->contains("config") && (*run)["config"].is_string() ? (*run)["config"] : "";
+    std::string made_by;
+    try {
+      made_by = read_run_record(record).config;
+    } catch (const InputError& e) {
+      if (!options.force)
+        throw InputError(e.file(), e.line(), e.field(),
+                         e.problem() + "; use another --out, or --force to replace the record");
+      spdlog::warn("{}: replaced (--force): {}", record.string(), e.what());
+      return true;
+    }
     if (made_by != config && !options.force)
       throw InputError(record.string(), 0, "config",
                        "this run folder was made by '" + made_by + "', not by '" + config +
@@ -228,13 +236,9 @@ bool run_record_needed(const RunOptions& options) {
   return true;
 }
 
-void write_run_record(const RunOptions& options) {
-  const fs::path record = options.folder / kRunRecordName;
-  const json run = {{"schema", "imscal-run-folder"},
-                    {"schema_version", 1},
-                    {"config", config_identity(options)},
-                    {"created_by", options.tool_version}};
-  write_file_atomically(record, json_text(run, 1, record.string()));
+void record_run_folder(const RunOptions& options) {
+  write_run_record(options.folder / kRunRecordName,
+                   {config_identity(options), options.tool_version});
 }
 
 void remove_leftovers(const fs::path& folder) {
@@ -277,7 +281,7 @@ RunSummary run_stages(const std::vector<std::unique_ptr<Stage>>& stages,
   const fs::path& run_dir = options.folder;
   fs::create_directories(run_dir);
   FolderLock lock(run_dir);
-  if (run_record_needed(options)) write_run_record(options);
+  if (run_record_needed(options)) record_run_folder(options);
   RunLog log(run_dir / "run.log");
   spdlog::info("run in {} ({}, config {}){}", run_dir.string(), options.tool_version,
                options.config_file.string(), options.force ? ", --force: every stage reruns" : "");

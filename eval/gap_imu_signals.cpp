@@ -212,27 +212,30 @@ double imu_gap_rms(const calib::ToolImuRecord& record, const calib::RobotRateSer
   return gap_rms(GyroSamples{record.t_s, record.gyro_rad_s}, rate, model);
 }
 
-ImuGapDiagnosis diagnose_imu_gap(const calib::ToolImuRecord& training,
-                                 const calib::ToolImuRecord& heldout, const ImuGapOptions& o) {
-  const calib::RobotRateSeries rate_train = calib::robot_tool_rate(training);
-  const calib::RobotRateSeries rate_held = calib::robot_tool_rate(heldout);
-  // The rails the record's own check confirms as clipping (training record only).
-  Eigen::Vector3d rails = Eigen::Vector3d::Constant(1e300);
-  const calib::ToolImuAnalysis check = calib::check_tool_imu_record(training, o.check);
-  const calib::ToolImuAnalysis check_heldout = calib::check_tool_imu_record(heldout, o.check);
-  double excluded_train = 0.0, excluded_held = 0.0;
-  const GyroSamples train = usable(training, check, excluded_train);
-  const GyroSamples held = usable(heldout, check_heldout, excluded_held);
-  for (std::size_t i = 0; i < check.clipped_axes.size(); ++i)
-    rails[check.clipped_axes[i]] = check.clipped_axis_rail_rad_s[i];
+namespace {
 
-  ImuGapDiagnosis d;
-  const ImuGapModel naive;
-  d.excluded_training_s = excluded_train;
-  d.excluded_heldout_s = excluded_held;
-  d.training_rms_rad_s = gap_rms(train, rate_train, naive);
-  d.heldout_rms_rad_s = gap_rms(held, rate_held, naive);
-  std::set<ImuGapEffect> chosen;
+// The unit check's ratio |gyro as labelled| / |robot rate| when it calls the labelled unit wrong
+// (further from 1 than the check's scale tolerance), else 1.
+double unit_scale_of(const calib::ToolImuAnalysis& check, const ImuGapOptions& o) {
+  const double ratio = check.gyro_scale_ratio;
+  return ratio > 0.0 && std::abs(ratio - 1.0) > o.check.scale_tolerance ? ratio : 1.0;
+}
+
+GyroSamples divided(GyroSamples g, double unit_scale) {
+  for (Eigen::Vector3d& w : g.w) w /= unit_scale;
+  return g;
+}
+
+struct GapInputs {
+  GyroSamples train, held;
+  calib::RobotRateSeries rate_train, rate_held;
+  Eigen::Vector3d rails;  // in the units the gap is measured in
+};
+
+// Effects added greedily while each shrinks the held-out gap by min_gain_percent; returns the
+// held-out RMS after the last one kept.
+double add_effects(const GapInputs& in, const ImuGapOptions& o, std::set<ImuGapEffect>& chosen,
+                   ImuGapDiagnosis& d) {
   double current = d.heldout_rms_rad_s;
   const auto shrink = [&](double rms) { return 100.0 * (1.0 - rms / d.heldout_rms_rad_s); };
   for (;;) {
@@ -244,38 +247,95 @@ ImuGapDiagnosis diagnose_imu_gap(const calib::ToolImuRecord& training,
       if (chosen.count(effect)) continue;
       std::set<ImuGapEffect> trial = chosen;
       trial.insert(effect);
-      const ImuGapModel m = fit_model(train, rate_train, trial, rails, o);
-      const double rms = gap_rms(held, rate_held, m);
+      const ImuGapModel m = fit_model(in.train, in.rate_train, trial, in.rails, o);
+      const double rms = gap_rms(in.held, in.rate_held, m);
       if (rms < best_rms) best_rms = rms, best = e, best_model = m;
     }
     if (best < 0 || shrink(best_rms) - shrink(current) < o.min_gain_percent) break;
     chosen.insert(ImuGapEffect(best));
     current = best_rms;
     d.model = best_model;
-    d.steps.push_back({ImuGapEffect(best), best_rms, shrink(best_rms), ""});
+    d.steps.push_back({ImuGapEffect(best), best_rms, shrink(best_rms), "", false});
   }
-  for (auto& step : d.steps) step.size = size_of(step.effect, d.model);
-  for (int e = 0; e < kImuGapEffectCount; ++e)
-    if (!chosen.count(ImuGapEffect(e))) d.not_supported.push_back(ImuGapEffect(e));
-  d.heldout_rms_modelled_rad_s = current;
-  d.heldout_noise_rad_s = noise_floor(held, rate_held, d.model);
+  for (auto& step : d.steps) {
+    if (!step.from_unit_check) step.size = size_of(step.effect, d.model);
+  }
+  return current;
+}
 
+// The model for the gyro as labelled: the fit was made on the gyro divided by the unit scale.
+void to_labelled_units(double unit_scale, ImuGapModel& m) {
+  m.scale *= unit_scale;
+  m.bias_rad_s *= unit_scale;
+  for (int i = 0; i < 3; ++i) {
+    if (m.rail_rad_s[i] < 1e299) m.rail_rad_s[i] *= unit_scale;
+  }
+}
+
+std::string verdict_of(const ImuGapDiagnosis& d, double excluded_train, double excluded_held) {
   std::vector<std::string> found, absent;
-  for (const auto& s : d.steps)
-    found.push_back(fmt::format("{} ({}; held-out gap {:.0f} % smaller)", to_string(s.effect),
-                                s.size, s.heldout_shrinkage_percent));
+  for (const auto& s : d.steps) {
+    found.push_back(s.from_unit_check
+                        ? fmt::format("{} ({})", to_string(s.effect), s.size)
+                        : fmt::format("{} ({}; held-out gap {:.0f} % smaller)", to_string(s.effect),
+                                      s.size, s.heldout_shrinkage_percent));
+  }
   for (auto e : d.not_supported) absent.push_back(to_string(e));
-  d.verdict = fmt::format(
-      "Gyro gap (measured minus the rate of the robot's reported tool motion) on the held-out "
+  const double shrunk = 100.0 * (1.0 - d.heldout_rms_modelled_rad_s / d.heldout_rms_rad_s);
+  return fmt::format(
+      "Gyro gap (measured minus the rate of the robot's reported tool motion{}) on the held-out "
       "record: RMS {:.2f} deg/s before, {:.2f} deg/s once modelled ({:.0f} % smaller). Found, "
       "in order: {}. Not supported: {}. Left: sensor noise ~{:.2f} deg/s per axis (white part "
       "of the residual) and what the 15 Hz robot poses do not resolve. Left out as data "
       "defects (motion the sensor did not record, calib::check_tool_imu_record): {:.2f} s of "
       "the training and {:.2f} s of the held-out record.",
-      d.heldout_rms_rad_s * kDeg, current * kDeg, shrink(current),
+      d.unit_scale != 1.0 ? ", the gyro divided by the unit check's scale" : "",
+      d.heldout_rms_rad_s * kDeg, d.heldout_rms_modelled_rad_s * kDeg, shrunk,
       found.empty() ? std::string("nothing") : fmt::format("{}", fmt::join(found, "; ")),
       absent.empty() ? std::string("none") : fmt::format("{}", fmt::join(absent, ", ")),
       d.heldout_noise_rad_s * kDeg, excluded_train, excluded_held);
+}
+
+}  // namespace
+
+ImuGapDiagnosis diagnose_imu_gap(const calib::ToolImuRecord& training,
+                                 const calib::ToolImuRecord& heldout, const ImuGapOptions& o) {
+  // The rails the record's own check confirms as clipping (training record only).
+  const calib::ToolImuAnalysis check = calib::check_tool_imu_record(training, o.check);
+  const calib::ToolImuAnalysis check_heldout = calib::check_tool_imu_record(heldout, o.check);
+  ImuGapDiagnosis d;
+  d.unit_scale = unit_scale_of(check, o);
+  GapInputs in{{},
+               {},
+               calib::robot_tool_rate(training),
+               calib::robot_tool_rate(heldout),
+               Eigen::Vector3d::Constant(1e300)};
+  const GyroSamples held_as_labelled = usable(heldout, check_heldout, d.excluded_heldout_s);
+  in.train = divided(usable(training, check, d.excluded_training_s), d.unit_scale);
+  in.held = divided(held_as_labelled, d.unit_scale);
+  for (std::size_t i = 0; i < check.clipped_axes.size(); ++i)
+    in.rails[check.clipped_axes[i]] = check.clipped_axis_rail_rad_s[i] / d.unit_scale;
+
+  const ImuGapModel naive;
+  d.heldout_rms_as_labelled_rad_s = gap_rms(held_as_labelled, in.rate_held, naive);
+  d.training_rms_rad_s = gap_rms(in.train, in.rate_train, naive);
+  d.heldout_rms_rad_s = gap_rms(in.held, in.rate_held, naive);
+  if (d.unit_scale != 1.0) {
+    d.steps.push_back(
+        {ImuGapEffect::kScaleFactors, d.heldout_rms_rad_s, 0.0,
+         fmt::format("unit check: the gyro reads {:.4f} x the robot's rate, 1/{:.1f} of the "
+                     "labelled unit; the gap is measured after dividing by it",
+                     d.unit_scale, 1.0 / d.unit_scale),
+         true});
+  }
+  std::set<ImuGapEffect> chosen;
+  d.heldout_rms_modelled_rad_s = add_effects(in, o, chosen, d);
+  if (d.unit_scale != 1.0) chosen.insert(ImuGapEffect::kScaleFactors);
+  for (int e = 0; e < kImuGapEffectCount; ++e)
+    if (!chosen.count(ImuGapEffect(e))) d.not_supported.push_back(ImuGapEffect(e));
+  d.heldout_noise_rad_s = noise_floor(in.held, in.rate_held, d.model);
+  to_labelled_units(d.unit_scale, d.model);
+  d.verdict = verdict_of(d, d.excluded_training_s, d.excluded_heldout_s);
   return d;
 }
 

@@ -7,7 +7,13 @@
 //   g(t) = w_meas(t) - w_model(t),   w_model(t) = K R^T w_T(t - dt) + b, each axis clipped at the
 //                                                  rail where the sensor saturates   [rad/s]
 //
-// starting from the naive model (R = I, K = I, dt = 0, b = 0, no clipping). The candidate effects
+// starting from the naive model (R = I, K = I, dt = 0, b = 0, no clipping). First the unit check
+// (calib::check_tool_imu_record: |gyro as labelled| / |robot rate|): a ratio further from 1 than
+// the check's scale tolerance is a unit or scale error (the LSM9DS0 reads 1/64 of the labelled
+// deg/s); it is reported as the first step, a scale error, and both records' gyros are divided by
+// it before any gap is measured, so that the gap is in the robot's rate units and the other
+// effects are weighed against what the sensor sees, not against a signal 64 times too small
+// (where predicting almost nothing looks like a 98 % fit). The candidate effects
 // are the terms of that model: time offset dt between the streams, axis misalignment R (sensor
 // axes in the tool), scale factors K (per axis), bias b, saturation (the rails of
 // calib::check_tool_imu_record), and the sensor noise (a floor: the white part of the residual,
@@ -41,15 +47,22 @@ struct ImuGapModel {
 struct ImuGapStep {
   ImuGapEffect effect;
   double heldout_rms_rad_s = 0.0;          // after this step
-  double heldout_shrinkage_percent = 0.0;  // of the naive gap, cumulative
+  double heldout_shrinkage_percent = 0.0;  // of the naive gap (after the unit check), cumulative
   std::string size;                        // the fitted effect in words
+  bool from_unit_check = false;            // the unit check's scale error (the gap's baseline: 0 %)
 };
 
 struct ImuGapDiagnosis {
-  double training_rms_rad_s = 0.0, heldout_rms_rad_s = 0.0;  // naive gap (all three axes)
-  std::vector<ImuGapStep> steps;                             // kept greedy steps, in order
-  std::vector<ImuGapEffect> not_supported;                   // tried, never kept
-  ImuGapModel model;                                         // after the kept steps
+  // |gyro as labelled| / |robot rate| of the training record when the unit check calls it a unit
+  // or scale error, else 1; the gyros are divided by it before the gap is measured.
+  double unit_scale = 1.0;
+  double heldout_rms_as_labelled_rad_s = 0.0;  // naive gap of the gyro as read, for the record
+  // Naive gap (all three axes) after the unit check, in the robot's rate units; the gaps, the
+  // steps' RMS and the noise floor below are all in these units.
+  double training_rms_rad_s = 0.0, heldout_rms_rad_s = 0.0;
+  std::vector<ImuGapStep> steps;            // kept greedy steps, in order
+  std::vector<ImuGapEffect> not_supported;  // tried, never kept
+  ImuGapModel model;  // after the kept steps, for the gyro as labelled (unit scale included)
   double heldout_noise_rad_s = 0.0;  // white noise floor of the held-out residual, per axis RMS
   double heldout_rms_modelled_rad_s = 0.0;
   // Seconds left out of each record: motion the sensor did not record (data defects found by

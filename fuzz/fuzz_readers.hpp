@@ -12,13 +12,18 @@
 
 #include "calib/calibration_config.hpp"
 #include "calib/frames_json.hpp"
+#include "calib/master_slave_record.hpp"
+#include "calib/mounting_report_json.hpp"
 #include "calib/robot_description.hpp"
 #include "calib/robot_log.hpp"
 #include "calib/tool_imu_record.hpp"
+#include "calib/tracker_poses.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "core/numeric_table.hpp"
+#include "core/run_record.hpp"
 #include "ident/identification_config.hpp"
+#include "ident/identification_report.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "ims/imu_binary.hpp"
@@ -88,12 +93,24 @@ inline void read_with(std::string_view target, const std::filesystem::path& file
       read_numeric_table(file);
     } else if (target == "tool_imu_record") {
       calib::read_tool_imu_record(file);
+    } else if (target == "tracker_poses") {
+      calib::read_tracker_poses(file);
+    } else if (target == "increment_imu") {
+      calib::read_increment_imu_csv(file);
+    } else if (target == "psins_attitude") {
+      calib::read_psins_attitude_csv(file);
     } else if (target == "nav_trajectory") {
       ims::read_trajectory_csv(file);
     } else if (target == "joint_errors") {
       ident::read_joint_errors_csv(file);
     } else if (target == "frames_json") {
       calib::read_frames_json(file, "kr16");
+    } else if (target == "mounting_report") {
+      calib::read_mounting_report(file);
+    } else if (target == "identification_report") {
+      ident::read_identification_report(file);
+    } else if (target == "run_record") {
+      read_run_record(file);
     } else if (target == "parameter_table") {
       ident::read_parameters_json(file);
     } else if (target == "rsi_datagram") {

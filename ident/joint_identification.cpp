@@ -360,6 +360,30 @@ JointIdentification neutral_joint_identification(const std::string& name, double
   return out;
 }
 
+namespace {
+
+// The whole table's held-out fit (ident/table_fit.hpp): each cell predicts with the model the
+// precontrol holds there (a filled cell with its source's); in the joint-error form that is the
+// angle form of the fitted error model, as the cell's own figure uses it.
+TableFit table_fit_of(const JointIdentification& joint, const CellGrid& grid, TableFitInput input,
+                      bool angle_form_of_fit) {
+  std::vector<std::optional<ArxModel>> models(joint.cells.size());
+  for (std::size_t c = 0; c < joint.cells.size(); ++c) {
+    const CellIdentification& cell = joint.cells[c];
+    if (cell.status != CellStatus::kIdentified || !cell.fit) continue;
+    models[c] = angle_form_of_fit ? angle_form_of_error_model(cell.fit->model) : cell.fit->model;
+  }
+  input.grid = &grid;
+  for (const CellIdentification& cell : joint.cells) {
+    const int source = cell.status == CellStatus::kFilled ? cell.filled_from : cell.cell;
+    const bool known = source >= 0 && models[std::size_t(source)].has_value();
+    input.models.push_back(known ? &*models[std::size_t(source)] : nullptr);
+  }
+  return table_held_out_fit(input);
+}
+
+}  // namespace
+
 JointIdentification identify_joint(const std::string& name, std::span<const double> q_desired,
                                    std::span<const double> q_measured,
                                    std::span<const double> payload,
@@ -599,6 +623,16 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
     spdlog::warn("joint {} cell {} ({}) filled from cell {}: {}", name, cell, r.label,
                  r.filled_from, r.reason);
   }
+  out.table_fit = table_fit_of(out, grid,
+                               {.error_models = inverse,
+                                .model_signals = inverse ? fit_signals : angle_signals,
+                                .q_desired = q_desired,
+                                .q_measured = q_measured,
+                                .payload_kg = payload,
+                                .operating = &signals,
+                                .segments = segments,
+                                .held_out = held_out},
+                               error_form && !inverse);
   return out;
 }
 

@@ -63,6 +63,7 @@
 #include "ident/operating_point.hpp"
 #include "ident/order_selection.hpp"
 #include "ident/parameter_table.hpp"
+#include "ident/table_fit.hpp"
 
 namespace imscal::ident {
 
@@ -149,6 +150,10 @@ struct JointIdentification {
   JointParameters parameters;
   BacklashEstimate backlash;
   std::vector<CellIdentification> cells;  // flat order of the grid
+  // The whole table's held-out joint-error fit, its cells blended as the precontrol blends them
+  // (ident/table_fit.hpp): what the joint's correction achieves, where a cell's own figure
+  // judges its model only on its own held-out runs.
+  TableFit table_fit;
 };
 
 // The eq. 2 model (input q_d, output q̂, dead time 0) equivalent to an error model of the form

@@ -8,6 +8,7 @@ packages=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev libopencv-calib3d-dev libtinyxml2-dev
   gnuplot-nox python3 python3-numpy clang-format clang-tidy clang lld chromium
+  snakemake slurm-wlm munge
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -11,6 +11,7 @@
 #include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
 #include "core/path_checks.hpp"
+#include "core/payload_plausibility.hpp"
 
 #ifndef IMSCAL_DATASETS_DIR
 #define IMSCAL_DATASETS_DIR ""
@@ -100,6 +101,31 @@ void apply_deviations(const ConfigNode& node, calib::RobotDescription& robot) {
   }
 }
 
+// The program's payloads (the one carried at the start and every change), times the plant's
+// payload factor, against the plant robot's rating (core/payload_plausibility.hpp), naming the
+// program file and the line of each mass.
+void check_program_payloads(const Scenario& s, const calib::RobotDescription& robot) {
+  const ConfigNode program = ConfigNode::load_file(s.program_file);
+  std::vector<ConfigNode> masses;
+  if (const auto initial = program.optional_child("payload"); initial && initial->is_map())
+    if (const auto mass = initial->optional_child("mass_kg")) masses.push_back(*mass);
+  if (const auto segments = program.optional_child("segments"))
+    for (const ConfigNode& item : segments->as_sequence())
+      if (item.is_map() && item.has("payload") && item.child("payload").is_map())
+        if (const auto mass = item.child("payload").optional_child("mass_kg"))
+          masses.push_back(*mass);
+  const std::string rating_of = fmt::format("robot {} ({})", robot.name, robot.source);
+  const std::string factor =
+      s.plant_payload_mass_factor == 1.0
+          ? std::string()
+          : fmt::format("(x {} from {}'s plant_deviations.payload_mass)",
+                        s.plant_payload_mass_factor, s.file.filename().string());
+  for (const ConfigNode& mass : masses)
+    check_payload_plausible(mass.as_double() * s.plant_payload_mass_factor,
+                            robot.nominal_payload_kg,
+                            {mass.file(), mass.line(), mass.path(), rating_of}, factor);
+}
+
 }  // namespace
 
 Scenario load_scenario(const fs::path& file) {
@@ -185,9 +211,11 @@ Scenario load_scenario(const fs::path& file) {
     s.seed = static_cast<std::uint64_t>(seed);
   }
   // The deviations' and the effects' keys and values checked here, with the file's lines.
-  make_plant_config(load_plant_robot(s), s);
+  const calib::RobotDescription plant = load_plant_robot(s);
+  make_plant_config(plant, s);
   if (s.plant_deviations && s.plant_deviations->is_map())
     s.plant_payload_mass_factor = factor(*s.plant_deviations, "payload_mass", 1.0);
+  check_program_payloads(s, plant);
   if (!s.nominal_robot_given) {
     spdlog::info(
         "scenario {}: no nominal_robot given; the chain believes the plant's robot file "

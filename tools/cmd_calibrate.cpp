@@ -27,9 +27,11 @@
 #include <string>
 
 #include "calib/calibration_config.hpp"
+#include "calib/calibration_json.hpp"
 #include "calib/frame_calibration.hpp"
 #include "calib/frames_json.hpp"
 #include "calib/joint_space_errors.hpp"
+#include "calib/mounting_report_json.hpp"
 #include "calib/mounting_validation.hpp"
 #include "calib/rest_poses.hpp"
 #include "calib/robot_description.hpp"
@@ -38,6 +40,7 @@
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
+#include "core/payload_plausibility.hpp"
 #include "core/progress.hpp"
 #include "core/sha256.hpp"
 #include "core/version.hpp"
@@ -46,7 +49,6 @@
 #include "ims/imu_file.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
-#include "ims/so3.hpp"
 #include "ims/zupt_options.hpp"
 #include "tools/command_registry.hpp"
 
@@ -69,88 +71,6 @@ struct CalibrateArgs {
   std::string out;
   bool force = false;
 };
-
-json vector_json(const Eigen::VectorXd& v, double scale = 1.0) {
-  json a = json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i)
-    a.push_back(std::isfinite(v[i]) ? json(v[i] * scale) : json(nullptr));
-  return a;
-}
-
-json matrix_json(const Eigen::MatrixXd& m) {
-  json rows = json::array();
-  for (Eigen::Index r = 0; r < m.rows(); ++r) rows.push_back(vector_json(m.row(r).transpose()));
-  return rows;
-}
-
-// R = Rz(yaw) Ry(pitch) Rx(roll) (as pose_from_xyz_rpy) [rad].
-Eigen::Vector3d roll_pitch_yaw(const Eigen::Matrix3d& R) {
-  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-  return {std::atan2(R(2, 1), R(2, 2)), pitch, std::atan2(R(1, 0), R(0, 0))};
-}
-
-json pose_json(const Eigen::Isometry3d& T) {
-  const Eigen::Quaterniond q(T.linear());
-  return {{"xyz_mm", vector_json(T.translation(), 1e3)},
-          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
-          {"rpy_deg", vector_json(roll_pitch_yaw(T.linear()), 1.0 / kDeg)},
-          {"rotation_vector_deg", vector_json(imscal::ims::quat_log<double>(q), 1.0 / kDeg)}};
-}
-
-json estimate_json(const calib::EstimatedVector& e) {
-  return {{"name", e.name},
-          {"unit", e.unit},
-          {"components", e.components},
-          {"value", vector_json(e.value)},
-          {"sigma", vector_json(e.sigma)}};
-}
-
-json residual_json(const calib::PoseResidual& r) {
-  return {{"label", r.label},
-          {"normalised", r.normalised},
-          {"rotation_deg", r.rotation_rad / kDeg},
-          {"position_mm", r.position_m * 1e3},
-          {"outlier", r.outlier}};
-}
-
-json weak_json(const calib::WeakDirection& w) {
-  return {{"description", w.description},
-          {"sigma", w.sigma},
-          {"unit", w.unit},
-          {"suggestion", w.suggestion}};
-}
-
-json mounting_json(const calib::MountingEstimate& e) {
-  const Eigen::Matrix<double, 6, 1> s = e.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  json j = {{"T_S_H", pose_json(e.T_S_H)}};
-  if (e.has_covariance) {
-    j["sigma_rotation_deg"] = vector_json(s.head<3>(), 1.0 / kDeg);
-    j["sigma_translation_mm"] = vector_json(s.tail<3>(), 1e3);
-  }
-  return j;
-}
-
-json difference_json(const calib::MountingDifference& d) {
-  return {{"rotation_deg", d.rotation_rad / kDeg},
-          {"translation_mm", d.translation_m * 1e3},
-          {"difference_rotation_deg", vector_json(d.difference.head<3>(), 1.0 / kDeg)},
-          {"difference_translation_mm", vector_json(d.difference.tail<3>(), 1e3)},
-          {"combined_sigma_rotation_deg", vector_json(d.combined_sigma.head<3>(), 1.0 / kDeg)},
-          {"combined_sigma_translation_mm", vector_json(d.combined_sigma.tail<3>(), 1e3)},
-          {"normalised_sigma", std::isfinite(d.normalised) ? json(d.normalised) : json(nullptr)}};
-}
-
-json part_json(const calib::SessionPart& p) {
-  json j = {{"label", p.label},
-            {"first_rest", p.first_rest + 1},
-            {"last_rest", p.last_rest + 1},
-            {"calibrated", p.calibrated}};
-  if (p.calibrated)
-    j["estimate"] = mounting_json(p.estimate);
-  else
-    j["failure"] = p.failure;
-  return j;
-}
 
 json input_json(const std::string& file) {
   if (file.empty()) return nullptr;
@@ -197,6 +117,10 @@ Inputs read_inputs(const CalibrateArgs& args) {
   in.sensor_file = pick(args.sensor, in.config.sensor_file, "--sensor");
   in.robot = calib::load_robot_description(in.robot_file);
   warn_if_rigid(in.robot);
+  const std::string rating_of = fmt::format("robot {} ({})", in.robot.name, in.robot.source);
+  check_payload_plausible(in.config.payload.mass_kg, in.robot.nominal_payload_kg,
+                          {args.config.empty() ? "the calibration defaults" : args.config, 0,
+                           "payload.mass_kg", rating_of});
   in.spec = ims::load_sensor_spec(in.sensor_file);
   // The earlier session's frames before the (long) records: a wrong file fails fast.
   if (!args.frames.empty()) in.previous = calib::read_frames_json(args.frames, in.robot.name);
@@ -218,6 +142,13 @@ Inputs read_inputs(const CalibrateArgs& args) {
                      "the IMS file does not state its site (site_latitude_deg, "
                      "site_longitude_deg, site_height_m): gravity and Earth rate need it");
   in.log = calib::read_robot_log_csv(args.robot_log, in.robot.name);
+  std::vector<double> payload_kg, t_s;
+  for (const calib::RobotLogSample& sample : in.log.samples) {
+    payload_kg.push_back(sample.payload_kg);
+    t_s.push_back(sample.t_s);
+  }
+  check_payload_series(payload_kg, t_s, in.robot.nominal_payload_kg,
+                       {args.robot_log, 0, "payload_kg", rating_of});
   // The two records must overlap in time (up to the time-offset search range).
   const double imu_begin = in.imu.samples.front().t_s, imu_end = in.imu.samples.back().t_s;
   const double log_begin = in.log.samples.front().t_s, log_end = in.log.samples.back().t_s;
@@ -264,11 +195,11 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
           e.value[k], k < e.sigma.size() ? e.sigma[k] : 0.0);
     line(fmt::format("  {} [{}]:{}", e.name, e.unit, values));
   }
-  const Eigen::Vector3d rpy_S_H = roll_pitch_yaw(r.T_S_H.linear()) / kDeg;
+  const Eigen::Vector3d rpy_S_H = calib::roll_pitch_yaw(r.T_S_H.linear()) / kDeg;
   line(fmt::format("  T_S_H: xyz {:.4f} {:.4f} {:.4f} mm, rpy {:.5f} {:.5f} {:.5f} deg",
                    r.T_S_H.translation().x() * 1e3, r.T_S_H.translation().y() * 1e3,
                    r.T_S_H.translation().z() * 1e3, rpy_S_H.x(), rpy_S_H.y(), rpy_S_H.z()));
-  const Eigen::Vector3d rpy_R_W = roll_pitch_yaw(r.T_R_W.linear()) / kDeg;
+  const Eigen::Vector3d rpy_R_W = calib::roll_pitch_yaw(r.T_R_W.linear()) / kDeg;
   line(
       fmt::format("  T_R_W: xyz {:.4f} {:.4f} {:.4f} mm, rpy {:.5f} {:.5f} {:.5f} deg "
                   "(W origin: the sensor at rest 1)",
@@ -527,100 +458,22 @@ void run(const CalibrateArgs& args) {
                           "record's rest 1 (W convention); the other estimates are conditional "
                           "on these frames"}}
                   : json(nullptr);
-  json estimates = json::array();
-  for (const auto& e : result.estimates) estimates.push_back(estimate_json(e));
-  json weak = json::array();
-  for (const auto& w : result.weak_directions) weak.push_back(weak_json(w));
-  const json frames = {
-      {"imscal-frames", 1},
-      {"created_by", created_by},
-      {"robot", in.robot.name},
-      {"frames_from", frames_from},
-      {"conventions",
-       {{"transforms", "T_A_B maps coordinates in B into A (p_A = T_A_B p_B)"},
-        {"W", "Earth-fixed ENU at the site; origin at the sensor's position at rest 1"},
-        {"rpy", "R = Rz(yaw) Ry(pitch) Rx(roll)"},
-        {"time_offset", "t_ims = t_robot + time_offset"}}},
-      {"units",
-       {{"xyz", "mm"},
-        {"angles", "deg"},
-        {"gyro_bias", "deg/h"},
-        {"acc_bias", "ug"},
-        {"time_offset", "ms"},
-        {"covariance_si", "rad, m, rad/s, m/s^2, s (order of parameter_names)"}}},
-      {"T_R_W", pose_json(result.T_R_W)},
-      {"T_S_H", pose_json(result.T_S_H)},
-      {"gyro_bias_deg_per_h", vector_json(result.biases.gyro_rad_s, 3600.0 / kDeg)},
-      {"acc_bias_ug", vector_json(result.biases.acc_m_s2, 1e6 / 9.80665)},
-      {"time_offset_ms", result.time_offset_s * 1e3},
-      {"gyro_scale_factor_ppm", vector_json(result.gyro_scale_factor, 1e6)},
-      {"acc_scale_factor_ppm", vector_json(result.acc_scale_factor, 1e6)},
-      {"estimates", estimates},
-      {"parameter_names", result.parameter_names},
-      {"covariance_si", matrix_json(result.covariance)},
-      {"correlation", matrix_json(result.correlation)},
-      {"covariance_rank_deficient", result.covariance_rank_deficient},
-      {"weak_directions", weak},
-      {"solver",
-       {{"converged", result.converged},
-        {"iterations", result.iterations},
-        {"final_cost", result.final_cost},
-        {"brief_report", result.solver_brief_report}}},
-      {"initial_values",
-       {{"T_R_W", pose_json(result.initial_T_R_W)},
-        {"T_S_H", pose_json(result.initial_T_S_H)},
-        {"time_offset_ms", result.initial_time_offset_s * 1e3},
-        {"time_offset_peak_correlation", dt0.peak_correlation}}},
-      {"rests",
-       {{"used", rests.rests.size()}, {"rejected", rests.rejected}, {"trimmed", rests.trimmed}}},
-      {"inputs", inputs}};
-
-  json rest_res = json::array(), motion_res = json::array();
-  for (const auto& p : result.rest_residuals) rest_res.push_back(residual_json(p));
-  for (const auto& p : result.motion_residuals) motion_res.push_back(residual_json(p));
-  json checks = json::array();
-  for (const auto& c : validation.checks)
-    checks.push_back(
-        {{"name", c.name}, {"level", calib::to_string(c.level)}, {"message", c.message}});
-  json halves = json::array(), segments = json::array(), comparisons = json::array();
-  for (const auto& p : validation.halves) halves.push_back(part_json(p));
-  for (const auto& p : validation.segments) segments.push_back(part_json(p));
-  for (const auto& c : validation.segment_comparisons)
-    comparisons.push_back({{"earlier", validation.segments[c.earlier].label},
-                           {"later", validation.segments[c.later].label},
-                           {"slipped", c.slipped},
-                           {"difference", difference_json(c.difference)}});
-  const auto& t = config.validation.thresholds;
-  const json report = {{"imscal-mounting-report", 1},
-                       {"created_by", created_by},
-                       {"frames_from", frames_from},
-                       {"verdict", calib::to_string(validation.verdict)},
-                       {"reasons", validation.reasons},
-                       {"checks", checks},
-                       {"combined", mounting_json(validation.combined)},
-                       {"rest_residuals", rest_res},
-                       {"motion_residuals", motion_res},
-                       {"outliers", result.outliers},
-                       {"outlier_count", validation.outlier_count},
-                       {"halves", halves},
-                       {"halves_difference", validation.halves_difference
-                                                 ? difference_json(*validation.halves_difference)
-                                                 : json(nullptr)},
-                       {"segments", segments},
-                       {"segment_comparisons", comparisons},
-                       {"weak_directions", weak},
-                       {"thresholds",
-                        {{"max_outliers_pass", t.max_outliers_pass},
-                         {"max_outlier_fraction_warn", t.max_outlier_fraction_warn},
-                         {"repeat_warn_sigma", t.repeat_warn_sigma},
-                         {"repeat_fail_sigma", t.repeat_fail_sigma},
-                         {"repeat_rotation_floor_deg", t.repeat_rotation_floor_rad / kDeg},
-                         {"repeat_translation_floor_mm", t.repeat_translation_floor_m * 1e3},
-                         {"slip_sigma", t.slip_sigma},
-                         {"max_rotation_sigma_deg", t.max_rotation_sigma_rad / kDeg},
-                         {"max_translation_sigma_mm", t.max_translation_sigma_m * 1e3},
-                         {"segment_rests", config.validation.segment_rests}}},
-                       {"inputs", inputs}};
+  calib::FramesJsonContext frames_context;
+  frames_context.created_by = created_by;
+  frames_context.robot = in.robot.name;
+  frames_context.frames_from = frames_from;
+  frames_context.inputs = inputs;
+  frames_context.time_offset_peak_correlation = dt0.peak_correlation;
+  frames_context.rests_used = rests.rests.size();
+  frames_context.rests_rejected = rests.rejected;
+  frames_context.rests_trimmed = rests.trimmed;
+  const json frames = calib::frames_json(result, frames_context);
+  calib::MountingReport mounting;
+  mounting.created_by = created_by;
+  mounting.validation = validation;
+  mounting.thresholds = config.validation.thresholds;
+  mounting.segment_rests = config.validation.segment_rests;
+  const json report = calib::mounting_report_json(mounting, frames_from, inputs);
 
   OutputFolder folder(args.out, outputs, overwrite);
   write_file_atomically(folder.staged("frames.json"),

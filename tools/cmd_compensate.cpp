@@ -9,10 +9,12 @@
 #include <sstream>
 #include <vector>
 
+#include "calib/robot_description.hpp"
 #include "calib/robot_log.hpp"
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/output_folder.hpp"
+#include "core/payload_plausibility.hpp"
 #include "eval/model_torque.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "ident/precontrol.hpp"
@@ -47,6 +49,32 @@ std::vector<std::vector<double>> model_torques(const CompensateArgs& args,
   return imscal::eval::model_torques_along(model, log.cycle_s, q, payload, whole);
 }
 
+// The log's payload against the rating the table was identified for: the upper bound of its
+// payload cells, or, for a table without payload cells, the rating in --robot's file.
+void check_log_payload(const CompensateArgs& args, const ident::ParameterTable& table,
+                       const imscal::calib::RobotLog& log) {
+  double rated_kg = 0.0;
+  std::string rating_of;
+  for (const ident::CellDimension& d :
+       table.joints.empty() ? std::vector<ident::CellDimension>{} : table.joints.front().dimensions)
+    if (d.quantity == ident::OperatingQuantity::kPayload) {
+      rated_kg = d.bounds.back();
+      rating_of =
+          fmt::format("the parameter table {} (its payload cells' upper bound)", args.table);
+    }
+  if (rated_kg <= 0.0 && !args.model_torque.robot.empty()) {
+    const auto robot = imscal::calib::load_robot_description(args.model_torque.robot);
+    rated_kg = robot.nominal_payload_kg;
+    rating_of = fmt::format("robot {} ({})", robot.name, robot.source);
+  }
+  std::vector<double> payload, t;
+  for (const auto& sample : log.samples) {
+    payload.push_back(sample.payload_kg);
+    t.push_back(sample.t_s);
+  }
+  imscal::check_payload_series(payload, t, rated_kg, {args.robot_log, 0, "payload_kg", rating_of});
+}
+
 const char* state_name(ident::PrecontrolState s) {
   switch (s) {
     case ident::PrecontrolState::kActive:
@@ -68,6 +96,7 @@ void run(const CompensateArgs& args) {
   const ident::ParameterTable table = ident::read_parameters_json(args.table);
   const imscal::calib::RobotLog log = imscal::calib::read_robot_log_csv(
       args.robot_log, table.robot, "the parameter table " + args.table);
+  check_log_payload(args, table, log);
   ident::PrecontrolOptions options;
   options.caller_cycle_s = log.cycle_s;
   // A log may start in the middle of a motion, and a fault need not end the run: the precontrol

@@ -16,6 +16,7 @@
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
+#include "core/payload_plausibility.hpp"
 #include "eval/gap_analysis.hpp"
 #include "eval/gap_report.hpp"
 #include "ident/joint_error_io.hpp"
@@ -128,6 +129,9 @@ void run(const DiagnoseArgs& args) {
     throw imscal::InputError(args.joint_errors, 2, "robot",
                              fmt::format("'{}', but the robot file {} describes '{}'", real.robot,
                                          args.robot, robot.name));
+  imscal::check_payload_series(
+      real.payload_kg, real.time_s, robot.nominal_payload_kg,
+      {args.joint_errors, 0, "payload_kg", fmt::format("robot {} ({})", robot.name, robot.source)});
   std::vector<std::vector<double>> sim_errors;
   std::optional<ident::ParameterTable> table;
   if (!args.table.empty()) {

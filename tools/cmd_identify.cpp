@@ -18,11 +18,13 @@
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
+#include "core/payload_plausibility.hpp"
 #include "core/version.hpp"
 #include "eval/model_torque.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
+#include "ident/identification_report.hpp"
 #include "ident/identify_joints.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/joint_identification.hpp"
@@ -56,14 +58,10 @@ void attach_model_torques(ident::JointErrorLog& log, const ident::Identification
   imscal::eval::attach_model_torques(log, model, config.options);
 }
 
-json number_or_null(double v) {
-  return std::isfinite(v) ? json(v) : json(nullptr);
-}
-
 // `--search-transmission-error-order`: each joint's harmonic found from the data replaces the
 // config's (eval/transmission_error_order.hpp); the search for the report.
-json search_orders(const ident::JointErrorLog& log, const IdentifyArgs& args,
-                   ident::IdentificationConfig& config) {
+ident::OrderSearchReport search_orders(const ident::JointErrorLog& log, const IdentifyArgs& args,
+                                       ident::IdentificationConfig& config) {
   if (!config.options.transmission_error_input)
     throw imscal::InputError(args.config, 0, "model.transmission_error",
                              "--search-transmission-error-order needs the transmission-error "
@@ -72,123 +70,18 @@ json search_orders(const ident::JointErrorLog& log, const IdentifyArgs& args,
   const imscal::eval::TransmissionErrorOrderSearch search =
       imscal::eval::search_transmission_error_orders(log, config,
                                                      imscal::eval::default_order_candidates());
-  json joints = json::array();
+  ident::OrderSearchReport report;
+  report.candidates_per_motor_rev = search.candidates;
   for (std::size_t j = 0; j < search.chosen_harmonic.size(); ++j) {
     spdlog::info("identify: {}: {}", log.joint_names[j],
                  imscal::eval::describe_order_search(search, j));
-    json fits = json::array();
-    for (const auto& per_candidate : search.fit_percent)
-      fits.push_back(number_or_null(per_candidate[j]));
-    joints.push_back({{"name", log.joint_names[j]},
-                      {"config_harmonic_per_motor_rev", search.prior_harmonic[j]},
-                      {"best_harmonic_per_motor_rev", search.best_harmonic[j]},
-                      {"gain_points", number_or_null(search.gain_points[j])},
-                      {"chosen_harmonic_per_motor_rev", search.chosen_harmonic[j]},
-                      {"held_out_joint_error_fit_percent", fits}});
+    std::vector<double> fits;
+    for (const auto& per_candidate : search.fit_percent) fits.push_back(per_candidate[j]);
+    report.joints.push_back({log.joint_names[j], search.prior_harmonic[j], search.best_harmonic[j],
+                             search.gain_points[j], search.chosen_harmonic[j], fits});
   }
   config = imscal::eval::with_searched_orders(std::move(config), search);
-  return {{"candidates_per_motor_rev", search.candidates}, {"joints", joints}};
-}
-
-json correlation_json(const ident::CorrelationTest& t) {
-  json c = json::array();
-  for (double v : t.correlation) c.push_back(v);
-  return {{"lags", t.lags},
-          {"correlation", c},
-          {"band", t.band},
-          {"family_band", t.family_band},
-          {"max_abs_correlation", t.max_abs_correlation},
-          {"outside_count", t.outside_count},
-          {"allowed_outside", t.allowed_outside},
-          {"passed", t.passed}};
-}
-
-// Criterion curves through the chosen structure: over na (chosen nb, d), over nb (chosen na, d)
-// and over d (chosen na, nb) — the whole grid would be thousands of points per cell.
-json curves_json(const ident::OrderSweepResult& sweep) {
-  json curves = {{"over_na", json::array()}, {"over_nb", json::array()}, {"over_d", json::array()}};
-  const auto& c = sweep.chosen;
-  for (const auto& cand : sweep.candidates) {
-    const auto& s = cand.structure;
-    const json point = {{"na", s.na},
-                        {"nb", s.nb},
-                        {"dead_time", s.dead_time},
-                        {"valid", cand.valid},
-                        {"loss", number_or_null(cand.loss)},
-                        {"aic", number_or_null(cand.aic)},
-                        {"bic", number_or_null(cand.bic)},
-                        {"validation_loss", number_or_null(cand.validation_loss)}};
-    if (s.nb == c.nb && s.dead_time == c.dead_time) curves["over_na"].push_back(point);
-    if (s.na == c.na && s.dead_time == c.dead_time) curves["over_nb"].push_back(point);
-    if (s.na == c.na && s.nb == c.nb) curves["over_d"].push_back(point);
-  }
-  return curves;
-}
-
-json joint_report(const ident::JointIdentification& r, double seconds) {
-  const auto& b = r.backlash;
-  json cells = json::array();
-  for (const auto& c : r.cells) {
-    json cell = {{"cell", c.cell},
-                 {"label", c.label},
-                 {"status", ident::to_string(c.status)},
-                 {"estimation_rows", c.estimation_rows},
-                 {"validation_rows", c.validation_rows},
-                 {"rms_desired_speed_rad_s", c.rms_speed_rad_s}};
-    if (c.status == ident::CellStatus::kFilled) {
-      cell["filled_from"] = c.filled_from;
-      cell["reason"] = c.reason;
-    }
-    if (c.sweep) {
-      cell["criterion"] = ident::to_string(c.sweep->criterion);
-      cell["chosen"] = {{"na", c.sweep->chosen.na},
-                        {"nb", c.sweep->chosen.nb},
-                        {"dead_time", c.sweep->chosen.dead_time}};
-      cell["criterion_curves"] = curves_json(*c.sweep);
-    }
-    if (c.fit) {
-      cell["fit"] = {{"rows", c.fit->row_count},
-                     {"residual_variance_rad2", c.fit->residual_variance},
-                     {"scaled_condition", c.fit->scaled_condition},
-                     {"method", ident::to_string(c.fit->method_used)},
-                     {"refinement_steps", c.fit->refinement_steps},
-                     {"parameter_std", std::vector<double>(c.fit->parameter_std.data(),
-                                                           c.fit->parameter_std.data() +
-                                                               c.fit->parameter_std.size())}};
-    }
-    if (c.stability) {
-      cell["stability"] = {{"stable", c.stability->stable},
-                           {"spectral_radius", c.stability->spectral_radius},
-                           {"margin", c.stability->margin},
-                           {"reason", c.stability->reason}};
-    }
-    if (c.validation) {
-      const auto& v = *c.validation;
-      cell["validation"] = {
-          {"samples", v.sample_count},
-          {"one_step_fit_percent", v.one_step_fit_percent},
-          {"simulation_fit_percent", v.simulation_fit_percent},
-          {"joint_error_fit_percent",
-           number_or_null(r.parameters.cells[std::size_t(c.cell)].figures.joint_error_fit_percent)},
-          {"residual_rms_rad", v.residual_rms},
-          {"residual_whiteness", correlation_json(v.residual_whiteness)},
-          {"input_residual", correlation_json(v.input_residual)}};
-    }
-    cells.push_back(cell);
-  }
-  return {{"joint", r.parameters.name},
-          {"seconds", seconds},
-          {"backlash",
-           {{"identified", r.parameters.backlash_identified},
-            {"l_rad", b.l_rad},
-            {"l_sigma_rad", b.l_sigma_rad},
-            {"full_play_rad", 2.0 * r.parameters.backlash_l_rad},
-            {"reversals_found", b.reversals_found},
-            {"reversals_used", b.reversals_used},
-            {"lag_samples", b.lag_samples},
-            {"per_reversal_l_rad", b.per_reversal_rad},
-            {"reason", b.reason}}},
-          {"cells", cells}};
+  return report;
 }
 
 // The outputs of this config, relative to --out; written all or nothing.
@@ -222,23 +115,13 @@ void check_orders_fit_record(const ident::JointErrorLog& log,
                   log_file, longest_segment));
 }
 
-// A payload far above the robot's rating is a wrong column or unit, not a load the robot can
-// carry: the payload cells (fractions of the rating) would hold nothing the precontrol meets.
-constexpr double kMaxPayloadOfRating = 1.5;
-
+// The log's payload against the rating of the config (the payload cells are fractions of it).
 void check_payload_plausible(const ident::JointErrorLog& log,
-                             const ident::IdentificationConfig& config,
-                             const std::string& log_file) {
-  const double limit_kg = kMaxPayloadOfRating * config.nominal_payload_kg;
-  for (std::size_t k = 0; k < log.sample_count(); ++k) {
-    if (log.payload_kg[k] <= limit_kg) continue;
-    throw imscal::InputError(
-        log_file, 0, "payload_kg",
-        fmt::format("payload {} kg at t = {} s exceeds {} x the robot's rated {} kg "
-                    "(joints.nominal_payload_kg); is the column in another unit?",
-                    log.payload_kg[k], log.time_s[k], kMaxPayloadOfRating,
-                    config.nominal_payload_kg));
-  }
+                             const ident::IdentificationConfig& config, const IdentifyArgs& args) {
+  imscal::check_payload_series(
+      log.payload_kg, log.time_s, config.nominal_payload_kg,
+      {args.joint_errors, 0, "payload_kg",
+       fmt::format("robot {} ({}: joints.nominal_payload_kg)", log.robot, args.config)});
 }
 
 // A table in which no joint was identified corrects nothing: a failed check, not a result.
@@ -268,13 +151,21 @@ void print_joint(const ident::JointOutcome& outcome, const std::string& name) {
   spdlog::info("joint {}: {}/{} cells identified, backlash l = {:.3g} ± {:.2g} rad, {:.2f} s", name,
                identified, r.cells.size(), r.parameters.backlash_l_rad,
                r.parameters.backlash_l_sigma_rad, outcome.seconds);
-  for (const auto& c : r.cells)
+  // A cell's figures judge its own model on its own held-out runs (each restarted from the
+  // measured output); the table line judges what the precontrol applies: every cell blended.
+  for (const auto& c : r.cells) {
+    const ident::CellFitFigures& f = r.parameters.cells[std::size_t(c.cell)].figures;
     std::cout << fmt::format(
-        "{:>4} cell {:>2} {:<40} {:<10} {:>14} sim fit {:>7.2f} %  joint error fit {:>7.2f} %\n",
+        "{:>4} cell {:>2} {:<40} {:<10} {:>14} cell's own held-out fit: angle {:>7.2f} %, "
+        "joint error {:>7.2f} %\n",
         name, c.cell, c.label, ident::to_string(c.status),
-        c.sweep ? ident::to_string(c.sweep->chosen) : "-",
-        r.parameters.cells[std::size_t(c.cell)].figures.simulation_fit_percent,
-        r.parameters.cells[std::size_t(c.cell)].figures.joint_error_fit_percent);
+        c.sweep ? ident::to_string(c.sweep->chosen) : "-", f.simulation_fit_percent,
+        f.joint_error_fit_percent);
+  }
+  std::cout << fmt::format(
+      "{:>4} table: held-out joint-error fit {:>7.2f} % over {} rows (all {} cells blended as "
+      "the precontrol applies them)\n",
+      name, r.table_fit.joint_error_fit_percent, r.table_fit.rows, r.cells.size());
 }
 
 // An inverse-form table does not predict the joint error from q_d (the gap diagnosis's "sim"):
@@ -303,18 +194,18 @@ void run(const IdentifyArgs& args) {
         "joints.max_speed_deg_s",
         fmt::format("{} maximum speeds, but {} has {} joints ({})", config.max_speed_rad_s.size(),
                     args.joint_errors, log.joint_count(), fmt::join(log.joint_names, ", ")));
+  check_payload_plausible(log, config, args);
   check_orders_fit_record(log, config, config_node, args.config, args.joint_errors);
-  check_payload_plausible(log, config, args.joint_errors);
   imscal::OutputFolder folder(args.out, output_names(config),
                               args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
-  const json order_search = args.search_order ? search_orders(log, args, config) : json(nullptr);
+  std::optional<ident::OrderSearchReport> order_search;
+  if (args.search_order) order_search = search_orders(log, args, config);
 
   const auto segments = log.segments();
   ident::ParameterTable table =
       ident::parameter_table_header(log, config,
                                     {args.joint_errors, ident::file_sha256_hex(args.joint_errors),
                                      log.sample_count(), log.source});
-  json joints_report = json::array();
   spdlog::info("identify: {} joints, {} samples in {} segments, cycle {} s", log.joint_count(),
                log.sample_count(), segments.size(), log.cycle_s);
   spdlog::info("identify: per joint {} cells, order sweep na {}..{} nb {}..{} d {}..{}",
@@ -328,21 +219,20 @@ void run(const IdentifyArgs& args) {
       });
   for (std::size_t j = 0; j < log.joint_count(); ++j) {
     print_joint(outcomes[j], log.joint_names[j]);
-    joints_report.push_back(joint_report(outcomes[j].result, outcomes[j].seconds));
     table.joints.push_back(outcomes[j].result.parameters);
   }
   check_some_joint_identified(outcomes, log, args.joint_errors);
-  const json report = {
-      {"created_by", table.created_by},
-      {"joint_errors", args.joint_errors},
-      {"joint_errors_sha256", table.source.sha256},
-      {"config", args.config},
-      {"samples", log.sample_count()},
-      {"segments", segments.size()},
-      {"sample_time_s", log.cycle_s},
-      {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
-      {"transmission_error_order_search", order_search},
-      {"joints", joints_report}};
+  const ident::IdentificationReportHeader header{
+      table.created_by,
+      args.joint_errors,
+      table.source.sha256,
+      args.config,
+      log.sample_count(),
+      segments.size(),
+      log.cycle_s,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+      order_search};
+  const json report = ident::identification_report_json(header, outcomes);
   const std::optional<ident::ParameterTable> forward_table = forward_table_of(log, config, table);
   const fs::path report_path = folder.folder() / "identification_report.json";
   imscal::write_file_atomically(folder.staged("identification_report.json"),

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/input_error.hpp"
+#include "core/payload_plausibility.hpp"
 #include "eval/model_joint_errors.hpp"
 #include "ident/joint_error_io.hpp"
 #include "sim/scenario.hpp"
@@ -35,6 +36,10 @@ void run(const ModelJointErrorsArgs& args) {
   const sim::NominalRobot nominal =
       scenario ? sim::load_nominal_robot(*scenario)
                : sim::NominalRobot{calib::load_robot_description(args.robot)};
+  imscal::check_payload_series(
+      measured.payload_kg, measured.time_s, nominal.description.nominal_payload_kg,
+      {args.joint_errors, 0, "payload_kg",
+       "robot " + nominal.description.name + " (" + nominal.description.source + ")"});
   ident::JointErrorLog model;
   try {
     model = eval::nominal_model_joint_errors(measured, nominal, scenario ? &*scenario : nullptr);

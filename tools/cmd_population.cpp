@@ -25,6 +25,7 @@
 #include "core/input_error.hpp"
 #include "core/subprocess.hpp"
 #include "eval/population_summary.hpp"
+#include "ident/identification_report.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "sim/plant_population.hpp"
@@ -39,7 +40,7 @@ namespace eval = imscal::eval;
 using nlohmann::json;
 
 struct PopulationArgs {
-  std::string nominal, seeds, out, ident_config, calibrate_config, sensor;
+  std::string nominal, seeds, out, ident_config, calibrate_config, sensor, step;
   int cycles = 10;
   double timeout_s = 3600;
 };
@@ -91,13 +92,18 @@ struct PlantFiles {
 // The plant's four scenarios: the two lab sessions (same scenario seed: same base heading,
 // mount and unit; a clock of their own each) and the two verification paths (fixed frames, as
 // the shipped seed-line.yaml and iso9283.yaml).
-PlantFiles write_plant_scenarios(const sim::PlantDraw& plant,
-                                 const imscal::calib::RobotDescription& nominal,
-                                 const PopulationArgs& args, const fs::path& dir) {
+PlantFiles plant_files(const fs::path& plant_dir) {
+  const fs::path dir = plant_dir / "plant";
+  return {dir / "mounting.yaml", dir / "identification.yaml", dir / "seed-line.yaml",
+          dir / "iso9283.yaml"};
+}
+
+void write_plant_scenarios(const sim::PlantDraw& plant,
+                           const imscal::calib::RobotDescription& nominal,
+                           const PopulationArgs& args, const fs::path& plant_dir) {
   const fs::path programs = datasets_dir() / "programs";
-  fs::create_directories(dir);
-  PlantFiles files{dir / "mounting.yaml", dir / "identification.yaml", dir / "seed-line.yaml",
-                   dir / "iso9283.yaml"};
+  const PlantFiles files = plant_files(plant_dir);
+  fs::create_directories(files.mounting.parent_path());
   const auto write = [&](const fs::path& file, const sim::PlantSession& session) {
     imscal::write_file_atomically(
         file, sim::plant_scenario_yaml(plant, nominal, args.nominal, args.sensor, session),
@@ -108,7 +114,6 @@ PlantFiles write_plant_scenarios(const sim::PlantDraw& plant,
         {"identification", programs / "identification.yaml", 0.0371, true, plant.seed});
   write(files.seed_line, {"seed-line", programs / "seed-line.yaml", 0.0123, false, 1});
   write(files.iso9283, {"iso9283", programs / "iso9283.yaml", 0.0123, false, 1});
-  return files;
 }
 
 // The unit's lab calibration: the simulated unit's scale factors and misalignments (a lab
@@ -151,32 +156,6 @@ std::string gravity_down(const fs::path& scenario) {
   return text.str();
 }
 
-// simulate -> unit calibration -> calibrate -> calibrate --frames -> identify: the lab's
-// chain from the raw IMS records and robot logs, with the nominal robot file only.
-fs::path identify_plant(const PlantFiles& files, const PopulationArgs& args, const fs::path& dir) {
-  const fs::path sim_cal = dir / "sim-mounting", sim_id = dir / "sim-identification";
-  run_step("simulate-mounting",
-           {"simulate", "--scenario", files.mounting.string(), "--out", sim_cal.string()}, dir,
-           args);
-  run_step("simulate-identification",
-           {"simulate", "--scenario", files.identification.string(), "--out", sim_id.string()}, dir,
-           args);
-  const fs::path unit = write_unit_calibration(sim_cal, dir);
-  run_step("calibrate", calibrate_arguments(sim_cal, unit, args, dir / "calibrate"), dir, args,
-           true);
-  std::vector<std::string> frames =
-      calibrate_arguments(sim_id, unit, args, dir / "calibrate-frames");
-  frames.insert(frames.end(), {"--frames", (dir / "calibrate" / "frames.json").string()});
-  run_step("calibrate-frames", frames, dir, args, true);
-  run_step("identify",
-           {"identify", "--joint-errors", (dir / "calibrate-frames" / "joint_errors.csv").string(),
-            "--config", args.ident_config, "--robot", args.nominal, "--gravity-m-s2", "0", "0",
-            gravity_down(files.identification), "--search-transmission-error-order", "--out",
-            (dir / "identify").string()},
-           dir, args);
-  return dir / "identify" / "parameters.json";
-}
-
 struct VerifiedFigures {
   double before_mm = 0.0, after_mm = 0.0, reduction_percent = 0.0, true_reduction_percent = 0.0;
   double scatter_floor_mm = 0.0;  // the cycles' own scatter with the precontrol, as measured
@@ -199,9 +178,8 @@ VerifiedFigures read_verification(const fs::path& file) {
   throw std::runtime_error(file.string() + ": no compensated case");
 }
 
-VerifiedFigures verify_plant(const fs::path& table, const fs::path& scenario,
-                             const std::string& segments, const std::string& step,
-                             const PopulationArgs& args, const fs::path& dir) {
+void verify_plant(const fs::path& table, const fs::path& scenario, const std::string& segments,
+                  const std::string& step, const PopulationArgs& args, const fs::path& dir) {
   std::vector<std::string> arguments{"verify",
                                      "--table",
                                      table.string(),
@@ -214,6 +192,10 @@ VerifiedFigures verify_plant(const fs::path& table, const fs::path& scenario,
                                      (dir / step).string()};
   if (!segments.empty()) arguments.insert(arguments.end(), {"--segments", segments});
   run_step(step, arguments, dir, args);
+}
+
+VerifiedFigures verified_figures(const fs::path& scenario, const std::string& step,
+                                 const fs::path& dir) {
   return read_verification(dir / step / sim::load_scenario(scenario).name / "verification.json");
 }
 
@@ -223,11 +205,15 @@ std::string number(double value) {
 
 // The transmission error's order per motor revolution identify chose per joint (its report).
 std::vector<double> found_orders(const fs::path& identify_dir) {
-  std::ifstream in(identify_dir / "identification_report.json");
-  const json report = json::parse(in);
+  const fs::path file = identify_dir / "identification_report.json";
+  const imscal::ident::IdentificationReport report =
+      imscal::ident::read_identification_report(file);
+  if (!report.header.order_search)
+    throw imscal::InputError(file.string(), 0, "transmission_error_order_search",
+                             "missing: identify ran without --search-transmission-error-order");
   std::vector<double> orders;
-  for (const json& joint : report.at("transmission_error_order_search").at("joints"))
-    orders.push_back(joint.at("chosen_harmonic_per_motor_rev").get<double>());
+  for (const imscal::ident::OrderSearchJoint& joint : report.header.order_search->joints)
+    orders.push_back(joint.chosen_harmonic_per_motor_rev);
   return orders;
 }
 
@@ -300,29 +286,118 @@ const std::vector<std::string> kFigures{"te_found_order_A1",
                                         "iso100_true_reduction_percent",
                                         "iso100_scatter_floor_mm"};
 
-// One plant, all or nothing: built in a hidden folder, renamed when its row is written.
+// One step of a plant's chain, run in the plant's folder DIR (OUT/plant-SEED when a workflow
+// engine runs the steps one by one, a hidden folder when `population` runs them all).
+struct PlantStepContext {
+  std::uint64_t seed = 0;
+  const imscal::calib::RobotDescription& nominal;
+  const PopulationArgs& args;
+  fs::path dir;
+};
+
+struct PlantStep {
+  const char* name;
+  void (*run)(const PlantStepContext&);
+};
+
+void step_scenarios(const PlantStepContext& c) {
+  write_plant_scenarios(sim::draw_plant(c.nominal, c.seed), c.nominal, c.args, c.dir);
+}
+
+void step_simulate(const PlantStepContext& c, const fs::path& scenario, const char* session) {
+  run_step(fmt::format("simulate-{}", session),
+           {"simulate", "--scenario", scenario.string(), "--out",
+            (c.dir / fmt::format("sim-{}", session)).string()},
+           c.dir, c.args);
+}
+
+// The unit's lab calibration, then calibrate on the mounting session: frames and verdict.
+void step_calibrate(const PlantStepContext& c) {
+  const fs::path unit = write_unit_calibration(c.dir / "sim-mounting", c.dir);
+  run_step("calibrate",
+           calibrate_arguments(c.dir / "sim-mounting", unit, c.args, c.dir / "calibrate"), c.dir,
+           c.args, true);
+}
+
+// calibrate --frames on the identification session: its joint errors, with the mounting's frames.
+void step_calibrate_frames(const PlantStepContext& c) {
+  std::vector<std::string> frames =
+      calibrate_arguments(c.dir / "sim-identification", c.dir / "unit-calibration.yaml", c.args,
+                          c.dir / "calibrate-frames");
+  frames.insert(frames.end(), {"--frames", (c.dir / "calibrate" / "frames.json").string()});
+  run_step("calibrate-frames", frames, c.dir, c.args, true);
+}
+
+void step_identify(const PlantStepContext& c) {
+  run_step(
+      "identify",
+      {"identify", "--joint-errors", (c.dir / "calibrate-frames" / "joint_errors.csv").string(),
+       "--config", c.args.ident_config, "--robot", c.args.nominal, "--gravity-m-s2", "0", "0",
+       gravity_down(plant_files(c.dir).identification), "--search-transmission-error-order",
+       "--out", (c.dir / "identify").string()},
+      c.dir, c.args);
+}
+
+fs::path identified_table(const PlantStepContext& c) {
+  return c.dir / "identify" / "parameters.json";
+}
+
+// The plant's row: its draws, the orders identify found and both paths' figures.
+void step_row(const PlantStepContext& c) {
+  const PlantFiles files = plant_files(c.dir);
+  const VerifiedFigures line = verified_figures(files.seed_line, "verify-seed-line", c.dir);
+  const VerifiedFigures iso = verified_figures(files.iso9283, "verify-iso9283", c.dir);
+  const auto [header, row] =
+      plant_row(sim::draw_plant(c.nominal, c.seed), found_orders(c.dir / "identify"), line, iso);
+  imscal::write_file_atomically(c.dir / "row.csv", header + "\n" + row + "\n",
+                                imscal::Overwrite::kAllow);
+  spdlog::info(
+      "population: plant {}: seed-line {:.3f} -> {:.3f} mm ({:.1f} %), ISO 100 % {:.3f} "
+      "-> {:.3f} mm ({:.1f} %)",
+      c.seed, line.before_mm, line.after_mm, line.reduction_percent, iso.before_mm, iso.after_mm,
+      iso.reduction_percent);
+}
+
+// simulate -> unit calibration -> calibrate -> calibrate --frames -> identify -> verify -> row:
+// the lab's chain from the raw IMS records and robot logs, with the nominal robot file only.
+const std::vector<PlantStep>& plant_steps() {
+  static const std::vector<PlantStep> steps{
+      {"scenarios", step_scenarios},
+      {"simulate-mounting",
+       [](const PlantStepContext& c) {
+         step_simulate(c, plant_files(c.dir).mounting, "mounting");
+       }},
+      {"simulate-identification",
+       [](const PlantStepContext& c) {
+         step_simulate(c, plant_files(c.dir).identification, "identification");
+       }},
+      {"calibrate", step_calibrate},
+      {"calibrate-frames", step_calibrate_frames},
+      {"identify", step_identify},
+      {"verify-seed-line",
+       [](const PlantStepContext& c) {
+         verify_plant(identified_table(c), plant_files(c.dir).seed_line, "", "verify-seed-line",
+                      c.args, c.dir);
+       }},
+      {"verify-iso9283",
+       [](const PlantStepContext& c) {
+         verify_plant(identified_table(c), plant_files(c.dir).iso9283, "100%", "verify-iso9283",
+                      c.args, c.dir);
+       }},
+      {"row", step_row}};
+  return steps;
+}
+
+// One plant, all or nothing: its steps run in a hidden folder, renamed when its row is written.
 void run_plant(std::uint64_t seed, const imscal::calib::RobotDescription& nominal,
                const PopulationArgs& args) {
   const fs::path done = fs::path(args.out) / fmt::format("plant-{}", seed);
   const fs::path dir = fs::path(args.out) / fmt::format(".plant-{}.tmp", seed);
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const sim::PlantDraw plant = sim::draw_plant(nominal, seed);
-  const PlantFiles files = write_plant_scenarios(plant, nominal, args, dir / "plant");
-  const fs::path table = identify_plant(files, args, dir);
-  const VerifiedFigures line =
-      verify_plant(table, files.seed_line, "", "verify-seed-line", args, dir);
-  const VerifiedFigures iso =
-      verify_plant(table, files.iso9283, "100%", "verify-iso9283", args, dir);
-  const auto [header, row] = plant_row(plant, found_orders(dir / "identify"), line, iso);
-  imscal::write_file_atomically(dir / "row.csv", header + "\n" + row + "\n",
-                                imscal::Overwrite::kAllow);
+  const PlantStepContext plant{seed, nominal, args, dir};
+  for (const PlantStep& step : plant_steps()) step.run(plant);
   fs::rename(dir, done);
-  spdlog::info(
-      "population: plant {}: seed-line {:.3f} -> {:.3f} mm ({:.1f} %), ISO 100 % {:.3f} "
-      "-> {:.3f} mm ({:.1f} %)",
-      seed, line.before_mm, line.after_mm, line.reduction_percent, iso.before_mm, iso.after_mm,
-      iso.reduction_percent);
 }
 
 // Reads the finished plants' rows of the range into one table.
@@ -351,9 +426,11 @@ eval::PopulationTable collect_rows(const SeedRange& seeds, const fs::path& out, 
   return table;
 }
 
+// failed < 0: the plants of the range without a row (a workflow engine ran and reported them).
 void write_summary(const SeedRange& seeds, const PopulationArgs& args, int failed) {
   std::string csv;
   const eval::PopulationTable table = collect_rows(seeds, args.out, csv);
+  if (failed < 0) failed = int(seeds.last - seeds.first + 1 - table.rows.size());
   std::string text = fmt::format(
       "imscal population: nominal robot {}, seeds {}-{}, {} cycles per verification; {} plants "
       "finished, {} failed (reductions of the maximum path deviation in %, as measured through "
@@ -371,18 +448,25 @@ void write_summary(const SeedRange& seeds, const PopulationArgs& args, int faile
   std::cout << text;
 }
 
-void run(PopulationArgs args) {
-  const SeedRange seeds = parse_seeds(args.seeds);
-  const fs::path datasets = datasets_dir();
-  if (args.ident_config.empty())
-    args.ident_config = (datasets / "identification" / "ident-default.yaml").string();
-  if (args.calibrate_config.empty())
-    args.calibrate_config = (datasets / "calibration" / "calibrate-default.yaml").string();
-  if (args.sensor.empty()) args.sensor = (datasets / "sensors" / "navigation-grade.yaml").string();
-  if (args.cycles < 1) throw imscal::InputError("", 0, "--cycles", "must be >= 1");
-  const imscal::calib::RobotDescription nominal =
-      imscal::calib::load_robot_description(args.nominal);
-  fs::create_directories(args.out);
+// One named step of one plant (--step), in OUT/plant-SEED, or the range's summary.
+void run_one_step(const SeedRange& seeds, const imscal::calib::RobotDescription& nominal,
+                  const PopulationArgs& args) {
+  if (args.step == "summary") return write_summary(seeds, args, -1);
+  std::string names = "summary";
+  for (const PlantStep& step : plant_steps()) {
+    names += std::string(", ") + step.name;
+    if (args.step != step.name) continue;
+    if (seeds.first != seeds.last)
+      throw imscal::InputError("", 0, "--seeds", "a plant's step takes one seed, not a range");
+    const fs::path dir = fs::path(args.out) / fmt::format("plant-{}", seeds.first);
+    fs::create_directories(dir);
+    return step.run({seeds.first, nominal, args, dir});
+  }
+  throw imscal::InputError("", 0, "--step", "no step '" + args.step + "'; steps: " + names);
+}
+
+void run_plants(const SeedRange& seeds, const imscal::calib::RobotDescription& nominal,
+                const PopulationArgs& args) {
   int failed = 0;
   const std::uint64_t count = seeds.last - seeds.first + 1;
   for (std::uint64_t seed = seeds.first; seed <= seeds.last; ++seed) {
@@ -408,6 +492,22 @@ void run(PopulationArgs args) {
     throw imscal::tools::CheckFailed(fmt::format("{} of {} plants failed", failed, count));
 }
 
+void run(PopulationArgs args) {
+  const SeedRange seeds = parse_seeds(args.seeds);
+  const fs::path datasets = datasets_dir();
+  if (args.ident_config.empty())
+    args.ident_config = (datasets / "identification" / "ident-default.yaml").string();
+  if (args.calibrate_config.empty())
+    args.calibrate_config = (datasets / "calibration" / "calibrate-default.yaml").string();
+  if (args.sensor.empty()) args.sensor = (datasets / "sensors" / "navigation-grade.yaml").string();
+  if (args.cycles < 1) throw imscal::InputError("", 0, "--cycles", "must be >= 1");
+  const imscal::calib::RobotDescription nominal =
+      imscal::calib::load_robot_description(args.nominal);
+  fs::create_directories(args.out);
+  if (args.step.empty()) return run_plants(seeds, nominal, args);
+  run_one_step(seeds, nominal, args);
+}
+
 imscal::tools::CommandRegistration registration{
     "population",
     "The chain on a population of plants drawn around a nominal robot: a row per plant, summary",
@@ -426,6 +526,11 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--sensor", args->sensor,
                      "IMS sensor spec (default datasets/sensors/navigation-grade.yaml)");
       sub.add_option("--timeout-s", args->timeout_s, "time limit of each step of a plant [s]");
+      sub.add_option("--step", args->step,
+                     "run one step of one plant in OUT/plant-SEED (scenarios, simulate-mounting, "
+                     "simulate-identification, calibrate, calibrate-frames, identify, "
+                     "verify-seed-line, verify-iso9283, row), or `summary` of the range; for a "
+                     "workflow engine (workflows/population.smk)");
       sub.callback([args] { run(*args); });
     }};
 }  // namespace

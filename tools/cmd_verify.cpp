@@ -24,6 +24,7 @@
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
+#include "core/payload_plausibility.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
@@ -336,6 +337,11 @@ void run(const VerifyArgs& args) {
                   .string()
             : args.ident_config;
     config = ident::load_identification_config(imscal::ConfigNode::load_file(config_file));
+    // The log's payload against the rating its payload cells are fractions of.
+    imscal::check_payload_series(
+        log->payload_kg, log->time_s, config->nominal_payload_kg,
+        {source, 0, "payload_kg",
+         fmt::format("robot {} ({}: joints.nominal_payload_kg)", log->robot, config_file)});
   }
   if (args.search_order) {
     if (!config || !config->options.transmission_error_input)

@@ -10,6 +10,9 @@
 #include <sstream>
 #include <vector>
 
+#include "calib/mounting_report_json.hpp"
+#include "core/input_error.hpp"
+
 namespace imscal::tools {
 
 namespace fs = std::filesystem;
@@ -75,13 +78,17 @@ std::string mounting_body(const StageWorkspace& ws) {
   const auto dir = stage_dir(ws, "calibrate", why);
   if (!dir) return not_run_note(why);
   const auto frames = read_json_file(*dir / "frames.json");
-  const auto report = read_json_file(*dir / "mounting_report.json");
-  if (!frames || !report)
-    return not_run_note("calibrate left no frames.json/mounting_report.json.");
-  const std::string verdict = report->value("verdict", "?");
+  if (!frames) return not_run_note("calibrate left no frames.json.");
+  std::optional<calib::MountingReport> report;
+  try {
+    report = calib::read_mounting_report(*dir / "mounting_report.json");
+  } catch (const InputError& e) {
+    return not_run_note(e.what());
+  }
+  const std::string verdict = calib::to_string(report->validation.verdict);
   std::string body = fmt::format("<p>Mounting verdict: <b class=\"{}\">{}</b></p>\n",
                                  verdict_class(verdict), esc(verdict));
-  body += list_items(report->value("reasons", json::array()));
+  body += list_items(report->validation.reasons);
   body +=
       "<table>\n<tr><th>estimate</th><th>component</th><th>value</th><th>1&sigma;</th>"
       "<th>unit</th></tr>\n";
@@ -113,7 +120,7 @@ std::string mounting_body(const StageWorkspace& ws) {
     body += "<p>Directions the pose set hardly excites:</p>\n<ul>\n" + weak + "</ul>\n";
   body += fmt::format("<p>Rest poses used: {}; outlier blocks: {}; solver: {}</p>\n",
                       frames->value("rests", json::object()).value("used", 0),
-                      report->value("outlier_count", 0),
+                      report->validation.outlier_count,
                       esc(frames->value("solver", json::object()).value("brief_report", "")));
   return body;
 }

@@ -9,7 +9,9 @@
 #include <sstream>
 
 #include "core/atomic_file.hpp"
+#include "core/input_error.hpp"
 #include "core/version.hpp"
+#include "ident/identification_report.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "tools/report_chain_sections.hpp"
@@ -128,7 +130,19 @@ std::string validation_body(const StageWorkspace& ws) {
   return body;
 }
 
-std::string models_body(const ident::ParameterTable& table, GnuplotRenderer& gnuplot) {
+// The whole table's held-out joint-error fit of `joint` from identification_report.json (its
+// cells blended as the precontrol blends them; ident/table_fit.hpp), or "n/a".
+std::string table_fit_of(const std::optional<ident::IdentificationReport>& report,
+                         const std::string& joint) {
+  if (report)
+    for (const ident::ReportedJoint& j : report->joints)
+      if (j.name == joint) return number(j.table_joint_error_fit_percent);
+  return "n/a";
+}
+
+std::string models_body(const ident::ParameterTable& table,
+                        const std::optional<ident::IdentificationReport>& report,
+                        GnuplotRenderer& gnuplot) {
   std::string body = fmt::format(
       "<p>Robot <b>{}</b>, sample time {} s, {} joints, identified from <code>{}</code> ({} "
       "samples, SHA-256 {}). Model per cell (paper eq. 2): q(k) + a<sub>1</sub> q(k-1) + ... + "
@@ -138,14 +152,17 @@ std::string models_body(const ident::ParameterTable& table, GnuplotRenderer& gnu
       table.source.samples, esc(table.source.sha256));
   body +=
       "<table>\n<tr><th>joint</th><th>backlash l [mdeg]</th><th>1&sigma; [mdeg]</th>"
-      "<th>identified</th><th>cells identified / all</th></tr>\n";
+      "<th>identified</th><th>cells identified / all</th><th>table's joint-error fit [%] "
+      "(held-out, cells blended as the precontrol applies them)</th></tr>\n";
   for (const auto& joint : table.joints) {
     int identified = 0;
     for (const auto& c : joint.cells) identified += c.status == ident::CellStatus::kIdentified;
-    body += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td></tr>\n",
-                        esc(joint.name), number(joint.backlash_l_rad * kDegPerRad * 1000.0),
-                        number(joint.backlash_l_sigma_rad * kDegPerRad * 1000.0),
-                        joint.backlash_identified ? "yes" : "no", identified, joint.cells.size());
+    body += fmt::format(
+        "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} / {}</td><td>{}</td></tr>\n",
+        esc(joint.name), number(joint.backlash_l_rad * kDegPerRad * 1000.0),
+        number(joint.backlash_l_sigma_rad * kDegPerRad * 1000.0),
+        joint.backlash_identified ? "yes" : "no", identified, joint.cells.size(),
+        table_fit_of(report, joint.name));
   }
   body += "</table>\n";
   for (const auto& joint : table.joints) {
@@ -154,7 +171,7 @@ std::string models_body(const ident::ParameterTable& table, GnuplotRenderer& gnu
         "<h3>Joint {}</h3>\n<table class=\"small\">\n<tr><th>cell</th>"
         "<th>operating point (SI)</th><th>status</th><th>na</th><th>nb</th>"
         "<th>dead time [cycles]</th><th>one-step fit [%]</th>"
-        "<th>simulation fit [%]</th><th>joint-error fit [%]</th>"
+        "<th>simulation fit [%]</th><th>cell's own joint-error fit [%]</th>"
         "<th>residual RMS [mdeg]</th><th>spectral radius</th></tr>\n",
         esc(joint.name));
     for (std::size_t c = 0; c < joint.cells.size(); ++c) {
@@ -278,7 +295,13 @@ StageOutcome ReportStage::run(StageWorkspace& workspace) {
   if (const auto dir = workspace.upstream_dir("identify");
       dir && fs::exists(*dir / "parameters.json")) {
     const ident::ParameterTable table = ident::read_parameters_json(*dir / "parameters.json");
-    models = models_body(table, gnuplot);
+    std::optional<ident::IdentificationReport> report;
+    try {
+      report = ident::read_identification_report(*dir / "identification_report.json");
+    } catch (const InputError& e) {
+      spdlog::warn("report: no table fits: {}", e.what());
+    }
+    models = models_body(table, report, gnuplot);
     coverage = coverage_body(table);
   }
   sections += section("models", "Identified error models",

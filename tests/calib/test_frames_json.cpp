@@ -1,4 +1,6 @@
-// calib::read_frames_json against the values written into a frames.json (datasets/FORMAT.md
+// calib::frames_json's document read back by calib::read_frames_json gives the frames, their
+// covariance and the link share written; calib::read_frames_json against the values written into a
+// frames.json (datasets/FORMAT.md
 // §16.2): the rotations from their quaternions, T_S_H's translation from mm, the covariance block
 // of the frames and the optional link share; and its refusals naming file and field. The command
 // line's refusals of --frames are tested in test_calibrate_two_sessions.cpp.
@@ -11,6 +13,7 @@
 
 #include "calib/frames_json.hpp"
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal::calib {
@@ -96,6 +99,39 @@ TEST_F(FramesJsonTest, RefusalsNameTheFileAndTheField) {
       EXPECT_EQ(e.field(), c.field) << e.what();
     }
   }
+}
+
+TEST_F(FramesJsonTest, TheWritersDocumentIsReadBackWithTheSameValues) {
+  FrameCalibrationResult result;
+  result.T_R_W = Eigen::Translation3d(2.0, 1.0, 0.3) * kQ_R_W;
+  result.T_S_H = Eigen::Translation3d(0.0015, -0.0008, -0.1204) *
+                 Eigen::AngleAxisd(0.02, Eigen::Vector3d(1.0, -2.0, 0.5).normalized());
+  result.parameter_names = {"R_W_R.east", "R_W_R.north", "R_W_R.up", "R_S_H.x", "R_S_H.y",
+                            "R_S_H.z",    "p_S_H.x",     "p_S_H.y",  "p_S_H.z", "time_offset"};
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(10, 10) * 1e-4;
+  result.covariance = a * a.transpose();  // symmetric, positive definite
+  result.correlation = Eigen::MatrixXd::Identity(10, 10);
+  result.estimates = {{"link_share (of the drives' viscous friction)",
+                       "",
+                       {"share"},
+                       Eigen::VectorXd::Constant(1, 0.31),
+                       Eigen::VectorXd::Constant(1, 0.07)}};
+  FramesJsonContext context;
+  context.created_by = "imscal 9.8.7";
+  context.robot = "kr16";
+  const auto file = dir_ / "frames.json";
+  std::ofstream(file) << json_text(frames_json(result, context), 1, file.string());
+  const SessionFrames s = read_frames_json(file, "kr16");
+  // Quaternions and mm are written to 17 significant digits: equal to ~1e-15 after the unit
+  // conversions on the way out and back.
+  EXPECT_LT((s.frames.R_W_R - result.T_R_W.linear().transpose()).norm(), 1e-15);
+  EXPECT_LT((s.frames.T_S_H.matrix() - result.T_S_H.matrix()).norm(), 1e-15);
+  EXPECT_EQ(s.frames.covariance, result.covariance.topLeftCorner(9, 9));  // SI as written
+  ASSERT_TRUE(s.link_share.has_value());
+  EXPECT_EQ(*s.link_share, 0.31);
+  EXPECT_EQ(*s.link_share_sigma, 0.07);
+  EXPECT_EQ(s.robot, "kr16");
+  EXPECT_THROW(read_frames_json(file, "ur10"), InputError);
 }
 
 }  // namespace

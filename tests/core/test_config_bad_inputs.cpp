@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -218,6 +219,131 @@ TEST_F(NonRegularInputs, ParameterTableWithARepeatedKeyIsRefused) {
     EXPECT_EQ(e.field(), "robot") << e.what();
     EXPECT_NE(std::string(e.what()).find("appears twice"), std::string::npos) << e.what();
   }
+}
+
+// A payload against the robot's rated payload (core/payload_plausibility.hpp) in every command
+// that takes one: far above the rating (5000 kg on the 16 kg KR 16: a wrong unit or column) is
+// refused with exit 2 naming the file, the field and both masses; above it, but a load (20 kg),
+// a warning. Each command is given only what it reads before the check (no IMS record: the
+// payload is checked before the long work).
+using PayloadPlausibility = test_support::ScratchDirTest;
+
+// `source` with the payload column (the second) of every data line set to `payload_kg`.
+std::string with_payload(const fs::path& source, const std::string& payload_kg) {
+  std::istringstream in(read_file_text(source));
+  std::string out, line;
+  while (std::getline(in, line)) {
+    const auto first = line.find(','), second = line.find(',', first + 1);
+    if (line.empty() || line[0] == '#' || line.rfind("t_s", 0) == 0 || second == std::string::npos)
+      out += line + "\n";
+    else
+      out += line.substr(0, first + 1) + payload_kg + line.substr(second) + "\n";
+  }
+  return out;
+}
+
+TEST_F(PayloadPlausibility, RefusedFarAboveTheRatingInEveryCommandThatTakesAPayload) {
+  const fs::path source(IMSCAL_SOURCE_DIR);
+  const std::string robot = (source / "datasets/robots/kr16.yaml").string();
+  const std::string sensor = (source / "datasets/sensors/navigation-grade.yaml").string();
+  const fs::path log = dir_ / "robot.csv", errors = dir_ / "joint_errors.csv";
+  std::ofstream(log) << with_payload(source / "fuzz/corpus/robot_log/valid.csv", "5000");
+  std::ofstream(errors) << with_payload(source / "fuzz/corpus/joint_errors/small.csv", "5000");
+  std::ofstream(dir_ / "calibrate.yaml")
+      << "imscal-calibration-config: 1\npayload: {mass_kg: 5000}\n";
+  struct Case {
+    std::string name, arguments, file, field;
+  };
+  const std::vector<Case> cases = {
+      {"calibrate config",
+       "calibrate --imu none.csv --robot-log " + log.string() + " --robot " + robot + " --sensor " +
+           sensor + " --config " + (dir_ / "calibrate.yaml").string(),
+       "calibrate.yaml", "payload.mass_kg"},
+      {"calibrate log",
+       "calibrate --imu " + (source / "fuzz/corpus/imu_csv/increments.csv").string() +
+           " --robot-log " + log.string() + " --robot " + robot + " --sensor " + sensor,
+       "robot.csv", "payload_kg"},
+      {"compensate log",
+       "compensate --table " + (source / "fuzz/corpus/parameter_table/table.json").string() +
+           " --robot-log " + log.string(),
+       "robot.csv", "payload_kg"},
+      {"identify",
+       "identify --joint-errors " + errors.string() + " --config " +
+           (source / "datasets/identification/ident-paper.yaml").string(),
+       "joint_errors.csv", "payload_kg"},
+      {"model-joint-errors",
+       "model-joint-errors --joint-errors " + errors.string() + " --robot " + robot,
+       "joint_errors.csv", "payload_kg"},
+      {"diagnose",
+       "diagnose --joint-errors " + errors.string() + " --robot " + robot + " --table " +
+           (source / "fuzz/corpus/parameter_table/table.json").string(),
+       "joint_errors.csv", "payload_kg"},
+      {"verify", "verify --joint-errors " + errors.string() + " --scenario seed-line",
+       "joint_errors.csv", "payload_kg"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path out = dir_ / ("out-" + c.name.substr(0, c.name.find(' '))),
+                   message_file = dir_ / "message.log";
+    EXPECT_EQ(run_imscal(c.arguments + " --out " + out.string(), message_file), 2);
+    const std::string message = read_file_text(message_file);
+    std::printf("%-20s %s", c.name.c_str(), message.c_str());
+    EXPECT_NE(message.find(c.file), std::string::npos) << message;
+    EXPECT_NE(message.find("field '" + c.field + "'"), std::string::npos) << message;
+    EXPECT_NE(message.find("payload 5000 kg"), std::string::npos) << message;
+    EXPECT_NE(message.find("rated payload of 16 kg"), std::string::npos) << message;
+    EXPECT_TRUE(!fs::exists(out) || fs::is_empty(out)) << "an output was left behind";
+  }
+}
+
+// Above the rating but a load the robot can lift (20 kg on the 16 kg KR 16): the command runs and
+// warns with the file, the field, both masses and what follows.
+TEST_F(PayloadPlausibility, AboveTheRatingIsAWarningWithTheReason) {
+  const fs::path source(IMSCAL_SOURCE_DIR), errors = dir_ / "joint_errors.csv";
+  std::ofstream(errors) << with_payload(source / "fuzz/corpus/joint_errors/small.csv", "20");
+  const fs::path log = dir_ / "message.log";
+  EXPECT_EQ(run_imscal("model-joint-errors --joint-errors " + errors.string() + " --robot " +
+                           (source / "datasets/robots/kr16.yaml").string() + " --out " +
+                           (dir_ / "model.csv").string(),
+                       log),
+            0)
+      << read_file_text(log);
+  const std::string message = read_file_text(log);
+  EXPECT_NE(message.find("[warning] " + errors.string() + ": field 'payload_kg': payload 20 kg"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("above the rated payload of 16 kg"), std::string::npos) << message;
+  EXPECT_NE(message.find("outside their rating"), std::string::npos) << message;
+}
+
+// The scenario's program (simulate, verify, population and `imscal run` load it): refused naming
+// the program file and the line of the mass; 20 kg (above the rating, a load) loads with a warning.
+TEST_F(PayloadPlausibility, AScenariosProgramPayloadIsCheckedAgainstThePlantRobot) {
+  const fs::path source(IMSCAL_SOURCE_DIR);
+  const auto scenario_with_payload = [&](const std::string& mass_kg) {
+    std::ofstream(dir_ / "program.yaml")
+        << "name: carry\nstart_joints_deg: [0, -90, 90, 0, 0, 0]\n"
+           "joint_acceleration_deg_s2: [100, 100, 100, 100, 100, 100]\n"
+           "payload: {name: box, mass_kg: "
+        << mass_kg << "}\nsegments:\n  - rest: {duration_s: 1}\n";
+    std::ofstream(dir_ / "scenario.yaml")
+        << "imscal-scenario: 1\nname: carry\nrobot: "
+        << (source / "datasets/robots/kr16.yaml").string() << "\nprogram: program.yaml\nsensor: "
+        << (source / "datasets/sensors/navigation-grade.yaml").string()
+        << "\nimu: {rate_hz: 1000}\nsite: {latitude_deg: 48.78, longitude_deg: 9.18, height_m: "
+           "245}\nbase_in_world: {xyz_m: [0, 0, 0], rpy_deg: [0, 0, 0]}\n";
+    return dir_ / "scenario.yaml";
+  };
+  try {
+    sim::load_scenario(scenario_with_payload("5000"));
+    ADD_FAILURE() << "5000 kg accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(fs::path(e.file()).filename(), "program.yaml") << e.what();
+    EXPECT_EQ(e.line(), 4u) << e.what();
+    EXPECT_EQ(e.field(), "payload.mass_kg") << e.what();
+    EXPECT_NE(std::string(e.what()).find("rated payload of 16 kg"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(sim::load_scenario(scenario_with_payload("20")));
 }
 
 }  // namespace

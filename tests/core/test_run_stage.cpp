@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "core/input_error.hpp"
+#include "core/run_record.hpp"
 #include "core/run_stage.hpp"
 #include "core/sha256.hpp"
 #include "tests/support/scratch_dir.hpp"
@@ -375,6 +376,29 @@ TEST_F(RunStageTest, RefusesForeignFoldersWithoutForce) {
   other.force = true;
   EXPECT_NO_THROW(imscal::run_stages(c.stages, other));
   EXPECT_EQ(read_text(foreign / "thesis.tex"), "precious");
+}
+
+// run.json is read through its reader (core/run_record.hpp): a damaged record is refused naming
+// the file and the field, and left as it is; --force replaces it with this run's record.
+TEST_F(RunStageTest, ADamagedRunRecordIsRefusedNamingTheFieldAndReplacedWithForce) {
+  const fs::path run = dir_ / "run";
+  auto c = chain();
+  imscal::run_stages(c.stages, options(run));
+  const std::string damaged =
+      R"({"schema": "imscal-run-folder", "schema_version": 1, "config": 7, "created_by": "x"})";
+  write_text(run / "run.json", damaged);
+  try {
+    imscal::run_stages(c.stages, options(run));
+    ADD_FAILURE() << "a damaged run.json was accepted";
+  } catch (const imscal::InputError& e) {
+    EXPECT_EQ(e.file(), (run / "run.json").string());
+    EXPECT_EQ(e.field(), "config") << e.what();
+    EXPECT_NE(std::string(e.what()).find("--force"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(read_text(run / "run.json"), damaged);
+  EXPECT_NO_THROW(imscal::run_stages(c.stages, options(run, /*force=*/true)));
+  EXPECT_EQ(imscal::read_run_record(run / "run.json").config,
+            fs::weakly_canonical(options(run).config_file).string());
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -241,6 +242,49 @@ TEST_F(IdentifyCli, OrdersBeyondTheRecordAndAbsurdPayloadRefused) {
   EXPECT_NE(log_text().find("field 'payload_kg': payload 5000 kg"), std::string::npos)
       << log_text();
   EXPECT_FALSE(std::filesystem::exists(dir_ / "out"));
+}
+
+// Every regular file below `folder` (relative path -> content).
+std::map<std::string, std::string> files_below(const std::filesystem::path& folder) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(folder))
+    if (e.is_regular_file())
+      files[std::filesystem::relative(e.path(), folder).string()] =
+          imscal::test_support::read_file_text(e.path());
+  return files;
+}
+
+// All or nothing: a rerun whose writes fail leaves the earlier run's outputs exactly as they
+// were, and says which output and why. A full disk is stood in for by a file-size limit
+// (RLIMIT_FSIZE, SIGXFSZ ignored: a write beyond it fails with EFBIG, as ENOSPC would); a commit
+// that cannot replace an output by a folder of that name.
+TEST_F(IdentifyCli, AFailingWriteLeavesTheEarlierOutputsAsTheyWere) {
+  ASSERT_EQ(identify(), 0) << log_text();
+  const auto out = dir_ / "out";
+  const auto before = files_below(out);
+  ASSERT_EQ(before.size(), 3u);  // identification_report.json, parameters.csv, parameters.json
+  // 16 KiB (ulimit counts 512-byte blocks in sh): smaller than the report, the first file written.
+  const std::string limited = "sh -c 'trap \"\" XFSZ; ulimit -f 32; " + std::string(IMSCAL_BINARY) +
+                              " identify --joint-errors " + (dir_ / "joint_errors.csv").string() +
+                              " --config " + (dir_ / "ident.yaml").string() + " --out " +
+                              out.string() + " --force; echo exit=$?' 2>&1 | cat > " +
+                              (dir_ / "log.txt").string();
+  ASSERT_EQ(std::system(limited.c_str()), 0);
+  EXPECT_NE(log_text().find("exit=3"), std::string::npos) << log_text();
+  EXPECT_NE(log_text().find("File too large"), std::string::npos) << log_text();
+  EXPECT_NE(log_text().find((out / "identification_report.json").string()), std::string::npos)
+      << log_text();
+  EXPECT_EQ(log_text().find(".imscal-staging-"), std::string::npos) << log_text();
+  EXPECT_EQ(files_below(out), before);  // no staging copy left either
+
+  // parameters.json's name taken by a folder: refused before any output is replaced.
+  std::filesystem::remove(out / "parameters.json");
+  std::filesystem::create_directories(out / "parameters.json" / "kept");
+  EXPECT_EQ(identify("--force"), 2) << log_text();
+  EXPECT_NE(log_text().find("parameters.json: is a folder"), std::string::npos) << log_text();
+  auto expected = before;
+  expected.erase("parameters.json");
+  EXPECT_EQ(files_below(out), expected);
 }
 
 TEST_F(IdentifyCli, BadConfigRefusedWithoutOutput) {

@@ -163,6 +163,36 @@ TEST_F(RunCli, IdentificationThatCorrectsNothingIsAFailedCheck) {
   EXPECT_FALSE(fs::exists(dir_ / "out" / "identify" / "parameters.json"));
 }
 
+// A stage that fails (here identify's first output cannot be written: a file-size limit,
+// RLIMIT_FSIZE with SIGXFSZ ignored, stands in for a full disk) is reported with the file the
+// user will look for, <run>/identify/..., and the system's reason: never the stage's hidden
+// staging folder, which is gone when the message is read.
+TEST_F(RunCli, AFailedStagesMessageNamesNoVanishedStagingFolder) {
+  const fs::path config = imscal::test_support::write_campaign(dir_), out = dir_ / "out";
+  // 32 KiB (ulimit counts 512-byte blocks in sh): the identification report is larger, run.log
+  // and the validate stage's files are not.
+  const std::string limited = "sh -c 'trap \"\" XFSZ; ulimit -f 64; " + std::string(IMSCAL_BINARY) +
+                              " run " + config.string() + " --out " + out.string() +
+                              "; echo exit=$?' 2>&1 | cat > " + (dir_ / "log.txt").string();
+  ASSERT_EQ(std::system(limited.c_str()), 0);
+  const std::string text = log();
+  EXPECT_NE(text.find("exit=3"), std::string::npos) << text;
+  EXPECT_NE(text.find((out / "identify" / "identification_report.json").string()),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("File too large"), std::string::npos) << text;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("[error]") != std::string::npos) {
+      EXPECT_EQ(line.find(".staging-"), std::string::npos) << line;
+    }
+  }
+  for (const auto& e : fs::directory_iterator(out)) {
+    EXPECT_NE(e.path().filename().string().rfind(".staging-", 0), 0u) << e.path();
+  }
+  EXPECT_FALSE(fs::exists(out / "identify"));
+}
+
 TEST_F(RunCli, KilledDuringIdentificationResumesToTheSameOutputs) {
   const fs::path config = imscal::test_support::write_campaign(dir_);
   const fs::path reference = dir_ / "reference", out = dir_ / "out";

@@ -1,0 +1,176 @@
+// identification_report.json (ident/identification_report.hpp): an identification written is read
+// back with the same figures (cells, chosen orders, held-out fits, backlash, order search), and a
+// report with a missing or mistyped field is refused naming the file and the field.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "core/input_error.hpp"
+#include "core/json_output.hpp"
+#include "ident/identification_report.hpp"
+#include "tests/support/scratch_dir.hpp"
+
+namespace imscal::ident {
+namespace {
+
+using nlohmann::json;
+using IdentificationReportTest = test_support::ScratchDirTest;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// One joint with an identified cell (sweep, fit, stability, validation) and a cell filled from it.
+JointOutcome sample_joint() {
+  JointOutcome outcome;
+  outcome.seconds = 1.25;
+  JointIdentification& r = outcome.result;
+  r.parameters.name = "A2";
+  r.table_fit = {9.75, 3300};
+  r.parameters.backlash_identified = true;
+  r.parameters.backlash_l_rad = 2.5e-4;
+  r.parameters.cells.resize(2);
+  r.parameters.cells[0].figures.joint_error_fit_percent = 57.25;
+  r.parameters.cells[1].figures.joint_error_fit_percent = kNaN;  // no held-out rows
+  r.backlash.l_rad = 2.5e-4;
+  r.backlash.l_sigma_rad = 1e-5;
+  r.backlash.reversals_found = 7;
+  r.backlash.reversals_used = 5;
+  r.backlash.lag_samples = 3;
+  r.backlash.per_reversal_rad = {2.4e-4, 2.6e-4};
+  CellIdentification identified;
+  identified.cell = 0;
+  identified.label = "speed[0,0.5)";
+  identified.estimation_rows = 4000;
+  identified.validation_rows = 1700;
+  identified.rms_speed_rad_s = 0.21;
+  identified.sweep = OrderSweepResult{};
+  identified.sweep->chosen = ArxStructure{3, 5, 1};
+  identified.fit = ArxFitResult{
+      ArxModel(ArxStructure{3, 5, 0}, Eigen::VectorXd::Zero(3), Eigen::VectorXd::Zero(5)),
+      Eigen::VectorXd::Constant(8, 1e-3), Eigen::MatrixXd::Identity(8, 8) * 1e-6};
+  identified.stability = StabilityCheck{};
+  identified.stability->stable = true;
+  identified.validation = ArxValidationReport{};
+  identified.validation->sample_count = 1690;
+  identified.validation->one_step_fit_percent = 88.5;
+  identified.validation->simulation_fit_percent = 61.0;
+  CellIdentification filled;
+  filled.cell = 1;
+  filled.label = "speed[0.5,2)";
+  filled.status = CellStatus::kFilled;
+  filled.filled_from = 0;
+  filled.reason = "0 estimation rows";
+  r.cells = {identified, filled};
+  return outcome;
+}
+
+IdentificationReportHeader sample_header() {
+  IdentificationReportHeader h{
+      "imscal 9.8.7",     "/d/joint_errors.csv", "ab12", "/d/identify.yaml", 35000, 2, 0.002, 3.5,
+      OrderSearchReport{}};
+  h.order_search->candidates_per_motor_rev = {0.5, 1.0, 2.0};
+  h.order_search->joints = {{"A2", 1.0, 2.0, 4.5, 2.0, {10.0, kNaN, 31.0}}};
+  return h;
+}
+
+TEST_F(IdentificationReportTest, WhatIsWrittenIsReadBack) {
+  const auto file = dir_ / "identification_report.json";
+  const JointOutcome joint = sample_joint();
+  const IdentificationReportHeader header = sample_header();
+  std::ofstream(file) << json_text(identification_report_json(header, {joint}), 1, "");
+  const IdentificationReport read = read_identification_report(file);
+  EXPECT_EQ(read.header.created_by, header.created_by);
+  EXPECT_EQ(read.header.joint_errors_sha256, "ab12");
+  EXPECT_EQ(read.header.samples, 35000u);
+  EXPECT_EQ(read.header.segments, 2u);
+  EXPECT_EQ(read.header.sample_time_s, 0.002);
+  ASSERT_TRUE(read.header.order_search.has_value());
+  const OrderSearchJoint& searched = read.header.order_search->joints.at(0);
+  EXPECT_EQ(searched.chosen_harmonic_per_motor_rev, 2.0);
+  EXPECT_EQ(searched.gain_points, 4.5);
+  EXPECT_TRUE(std::isnan(searched.held_out_joint_error_fit_percent.at(1)));
+  ASSERT_EQ(read.joints.size(), 1u);
+  const ReportedJoint& j = read.joints[0];
+  EXPECT_EQ(j.name, "A2");
+  EXPECT_EQ(j.seconds, 1.25);
+  EXPECT_EQ(j.table_joint_error_fit_percent, 9.75);
+  EXPECT_EQ(j.table_validation_rows, 3300u);
+  EXPECT_TRUE(j.backlash.identified);
+  EXPECT_EQ(j.backlash.l_rad, 2.5e-4);
+  EXPECT_EQ(j.backlash.full_play_rad, 5e-4);
+  EXPECT_EQ(j.backlash.reversals_used, 5u);
+  EXPECT_EQ(j.backlash.per_reversal_l_rad, joint.result.backlash.per_reversal_rad);
+  ASSERT_EQ(j.cells.size(), 2u);
+  const ReportedCell& c = j.cells[0];
+  EXPECT_EQ(c.status, CellStatus::kIdentified);
+  EXPECT_EQ(c.estimation_rows, 4000u);
+  ASSERT_TRUE(c.chosen.has_value());
+  EXPECT_EQ(c.chosen->na, 3);
+  EXPECT_EQ(c.chosen->nb, 5);
+  EXPECT_EQ(c.chosen->dead_time, 1);
+  ASSERT_TRUE(c.validation.has_value());
+  EXPECT_EQ(c.validation->samples, 1690u);
+  EXPECT_EQ(c.validation->simulation_fit_percent, 61.0);
+  EXPECT_EQ(c.validation->joint_error_fit_percent, 57.25);
+  EXPECT_EQ(j.cells[1].status, CellStatus::kFilled);
+  EXPECT_EQ(j.cells[1].filled_from, 0);
+  EXPECT_EQ(j.cells[1].reason, "0 estimation rows");
+  EXPECT_FALSE(j.cells[1].validation.has_value());
+}
+
+TEST_F(IdentificationReportTest, RefusalsNameTheFileAndTheField) {
+  const auto file = dir_ / "identification_report.json";
+  const json good = identification_report_json(sample_header(), {sample_joint()});
+  struct Case {
+    json document;
+    std::string field;
+  };
+  std::vector<Case> cases;
+  const auto with = [&](const json::json_pointer& at, const json& value, std::string field) {
+    json j = good;
+    if (value.is_discarded())
+      j[at.parent_pointer()].erase(at.back());
+    else
+      j[at] = value;
+    cases.push_back({j, std::move(field)});
+  };
+  const json removed(json::value_t::discarded);
+  with("/imscal-identification-report"_json_pointer, removed, "imscal-identification-report");
+  with("/samples"_json_pointer, "many", "samples");
+  with("/joints/0/cells/1/status"_json_pointer, "guessed", "joints[0].cells[1].status");
+  with("/joints/0/cells/0/validation/simulation_fit_percent"_json_pointer, "61",
+       "joints[0].cells[0].validation.simulation_fit_percent");
+  with("/joints/0/backlash/l_rad"_json_pointer, removed, "joints[0].backlash.l_rad");
+  with("/joints/0/cells/0/chosen/na"_json_pointer, 2.5, "joints[0].cells[0].chosen.na");
+  with("/transmission_error_order_search/joints/0/held_out_joint_error_fit_percent"_json_pointer,
+       {1.0}, "transmission_error_order_search.joints[0].held_out_joint_error_fit_percent");
+  with("/joints"_json_pointer, json::object(), "joints");
+  with("/joints/0/table_validation_rows"_json_pointer, removed, "joints[0].table_validation_rows");
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.field);
+    std::ofstream(file, std::ios::trunc) << c.document.dump();
+    try {
+      read_identification_report(file);
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), file.string());
+      EXPECT_EQ(e.field(), c.field) << e.what();
+    }
+  }
+}
+
+// The report `imscal identify` wrote for the shipped campaign (the fuzz target's seed, its
+// criterion curves cut to one point): read whole, six joints of two cells (identify.yaml: two
+// speed bands, one payload band).
+TEST(IdentificationReportFile, TheShippedCampaignsReportIsRead) {
+  const IdentificationReport r =
+      read_identification_report(std::filesystem::path(IMSCAL_SOURCE_DIR) / "fuzz" / "corpus" /
+                                 "identification_report" / "campaign.json");
+  ASSERT_EQ(r.joints.size(), 6u);
+  for (const ReportedJoint& j : r.joints) EXPECT_EQ(j.cells.size(), 2u) << j.name;
+  EXPECT_EQ(r.header.sample_time_s, 0.002);
+}
+
+}  // namespace
+}  // namespace imscal::ident
