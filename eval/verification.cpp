@@ -498,7 +498,10 @@ VerificationResult verify_scenario(const sim::Scenario& scenario,
   std::vector<CompensationRun> compensations;
   std::vector<sim::DesiredJointPath> commands;
   for (const NamedTable& t : tables) {
-    compensations.push_back(run_precontrol(t.table, nominal.description.name, path, compensation));
+    compensations.push_back(
+        options.compensation_runner
+            ? options.compensation_runner(t.table, nominal.description.name, path, compensation)
+            : run_precontrol(t.table, nominal.description.name, path, compensation));
     commands.push_back(command_path(path, compensations.back().offset_rad));
   }
 

@@ -25,6 +25,7 @@
 // table identified from them with an identification config (ident/identification_config.hpp).
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -155,6 +156,11 @@ struct VerificationOptions {
   // true link-side path (a perfect measurement).
   bool measure_with_ims = true;
   std::uint64_t ims_seed = 1;
+  // Computes the offsets of a table along the path (default, when empty: run_precontrol). The
+  // online bridge's benchmark puts the RSI server behind it (bench/bench_rsi_iso9283.cpp).
+  std::function<CompensationRun(const ident::ParameterTable&, const std::string& robot_name,
+                                const sim::DesiredJointPath&, const CompensationOptions&)>
+      compensation_runner;
   int calculation_points = 200;      // ISO 9283 calculation points per segment
   double iso_time_window_s = 0.25;   // a crossing counts within this time of its point
   double deviation_window_s = 0.25;  // path deviation: desired path within this time

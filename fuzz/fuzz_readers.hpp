@@ -2,6 +2,7 @@
 // What each fuzz target feeds its input to, shared by the fuzz targets (fuzz/fuzz_*.cpp) and the
 // regression test that replays the inputs fuzzing once found (tests/core/test_fuzz_regressions).
 // A reader may accept the input or refuse it with an InputError; anything else is a bug.
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -31,6 +32,7 @@
 #include "ims/psins_reader.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
+#include "online/rsi_datagram.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/scenario.hpp"
 #include "tools/run_config.hpp"
@@ -61,6 +63,16 @@ inline void parse_yaml_configs(const std::string& text) {
   } catch (const InputError&) {
   }
   ims::parse_sensor_error_model(root);
+}
+
+// The RSI datagram parser on raw bytes (it takes no file and throws nothing); an accepted
+// datagram's set-points are written back as an answer, as the server does.
+inline void parse_rsi_datagram(std::string_view bytes) {
+  online::RsiRobotDatagram datagram;
+  if (online::parse_rsi_robot_datagram(bytes, &datagram) != online::RsiParseError::kNone) return;
+  std::array<char, 1024> answer{};
+  online::write_rsi_answer(datagram.type_name(), datagram.setpoint_deg, datagram.ipoc,
+                           answer.data(), int(answer.size()));
 }
 
 // Reads `file` with the reader of `target` (the fuzz target's name without "fuzz_"); returns
@@ -101,6 +113,9 @@ inline void read_with(std::string_view target, const std::filesystem::path& file
       read_run_record(file);
     } else if (target == "parameter_table") {
       ident::read_parameters_json(file);
+    } else if (target == "rsi_datagram") {
+      std::ifstream in(file, std::ios::binary);
+      parse_rsi_datagram(std::string(std::istreambuf_iterator<char>(in), {}));
     } else if (target == "yaml_configs") {
       std::ifstream in(file, std::ios::binary);
       parse_yaml_configs(std::string(std::istreambuf_iterator<char>(in), {}));

@@ -46,6 +46,14 @@ const char* to_string(PrecontrolCause cause) {
       return "re-activated";
     case PrecontrolCause::kMissingTorque:
       return "model torque missing";
+    case PrecontrolCause::kInputJump:
+      return "jump of the desired value";
+    case PrecontrolCause::kCallerFault:
+      return "fault reported by the caller";
+    case PrecontrolCause::kEngaging:
+      return "engaging";
+    case PrecontrolCause::kEngaged:
+      return "engaged";
   }
   return "?";
 }
@@ -298,7 +306,8 @@ void Precontrol::model_step(JointModel& joint, double q_desired, double speed, d
 void Precontrol::deactivate(std::uint64_t cycle, int joint, PrecontrolCause cause,
                             double value) noexcept {
   log(cycle, joint, cause, value);
-  if (state_ != PrecontrolState::kActive) return;
+  valid_for_s_ = 0.0;
+  if (state_ != PrecontrolState::kActive && state_ != PrecontrolState::kEngaging) return;
   state_ = PrecontrolState::kFadingOut;
   fade_elapsed_s_ = 0.0;
   for (int j = 0; j < kPrecontrolJoints; ++j) fade_from_[j] = joints_[j].output;
@@ -308,6 +317,17 @@ void Precontrol::reactivate() noexcept {
   log(last_cycle_, -1, PrecontrolCause::kReactivated, 0.0);
   state_ = PrecontrolState::kActive;
   if (started_) restart_models(last_q_, last_torque_);
+}
+
+void Precontrol::fault(std::uint64_t cycle_counter, double code) noexcept {
+  deactivate(cycle_counter, -1, PrecontrolCause::kCallerFault, code);
+}
+
+void Precontrol::start_engaging(std::uint64_t cycle_counter) noexcept {
+  log(cycle_counter, -1, PrecontrolCause::kEngaging, 0.0);
+  state_ = PrecontrolState::kEngaging;
+  engage_elapsed_s_ = 0.0;
+  valid_for_s_ = 0.0;
 }
 
 PrecontrolOutput Precontrol::cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
@@ -322,15 +342,13 @@ PrecontrolOutput Precontrol::cycle(const std::array<double, kPrecontrolJoints>& 
   return run_cycle(q_desired_rad, payload_kg, &model_torque_nm, cycle_counter);
 }
 
-PrecontrolOutput Precontrol::run_cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
-                                       double payload_kg,
-                                       const std::array<double, kPrecontrolJoints>* model_torque_nm,
-                                       std::uint64_t cycle_counter) noexcept {
-  const double dt = options_.caller_cycle_s;
-  PrecontrolOutput out;
+bool Precontrol::accept_input(const std::array<double, kPrecontrolJoints>& q_desired_rad,
+                              double payload_kg,
+                              const std::array<double, kPrecontrolJoints>* model_torque_nm,
+                              std::uint64_t cycle_counter,
+                              std::array<double, kPrecontrolJoints>& torque) noexcept {
   bool valid = std::isfinite(payload_kg);
   for (double q : q_desired_rad) valid = valid && std::isfinite(q);
-  std::array<double, kPrecontrolJoints> torque{};
   if (model_torque_nm != nullptr) {
     torque = *model_torque_nm;
     for (double t : torque) valid = valid && std::isfinite(t);
@@ -345,6 +363,7 @@ PrecontrolOutput Precontrol::run_cycle(const std::array<double, kPrecontrolJoint
   } else if (!started_) {
     restart_models(q_desired_rad, torque);
     started_ = true;
+    if (options_.auto_engage) start_engaging(cycle_counter);
   } else if (cycle_counter != last_cycle_ + 1) {
     const double lost = static_cast<double>(cycle_counter - last_cycle_) - 1.0;
     if (cycle_counter <= last_cycle_ || lost > options_.max_lost_cycles) {
@@ -358,11 +377,59 @@ PrecontrolOutput Precontrol::run_cycle(const std::array<double, kPrecontrolJoint
         }
       }
     }
+  } else if (options_.max_input_speed_rad_s > 0.0) {
+    for (int j = 0; j < kPrecontrolJoints; ++j) {
+      const double speed = (q_desired_rad[j] - last_q_[j]) / options_.caller_cycle_s;
+      if (std::abs(speed) > options_.max_input_speed_rad_s) {
+        deactivate(cycle_counter, j, PrecontrolCause::kInputJump, speed);
+        restart_models(q_desired_rad, torque);
+        break;
+      }
+    }
   }
   if (valid) last_cycle_ = cycle_counter;
+  return valid;
+}
+
+double Precontrol::engagement_gain(bool valid, std::uint64_t cycle_counter) noexcept {
+  if (!options_.auto_engage) return 1.0;
+  const double dt = options_.caller_cycle_s;
+  if (state_ == PrecontrolState::kInactive) {
+    valid_for_s_ = valid ? valid_for_s_ + dt : 0.0;
+    // The models restart from the input of this cycle (accept_input kept it in last_q_ only
+    // for valid input, which this is).
+    if (valid && valid_for_s_ >= options_.reengage_after_s) start_engaging(cycle_counter);
+  }
+  if (state_ != PrecontrolState::kEngaging) return 1.0;
+  if (valid) engage_elapsed_s_ += dt;
+  const double ramp_s = engage_elapsed_s_ - options_.engage_settle_s;
+  if (ramp_s <= 0.0) return 0.0;
+  if (ramp_s >= options_.fade_out_s) {
+    state_ = PrecontrolState::kActive;
+    log(cycle_counter, -1, PrecontrolCause::kEngaged, 0.0);
+    return 1.0;
+  }
+  return 0.5 * (1.0 - std::cos(M_PI * ramp_s / options_.fade_out_s));
+}
+
+PrecontrolOutput Precontrol::run_cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,
+                                       double payload_kg,
+                                       const std::array<double, kPrecontrolJoints>* model_torque_nm,
+                                       std::uint64_t cycle_counter) noexcept {
+  const double dt = options_.caller_cycle_s;
+  PrecontrolOutput out;
+  std::array<double, kPrecontrolJoints> torque{};
+  const bool valid =
+      accept_input(q_desired_rad, payload_kg, model_torque_nm, cycle_counter, torque);
+  const bool was_inactive = state_ == PrecontrolState::kInactive;
+  const double gain = engagement_gain(valid, cycle_counter);
+  if (was_inactive && state_ == PrecontrolState::kEngaging) restart_models(q_desired_rad, torque);
+  // While settling the models' restart transient decays: the supervisor does not judge it.
+  const bool supervise =
+      state_ == PrecontrolState::kActive || engage_elapsed_s_ > options_.engage_settle_s;
 
   bool outside = false;
-  if (valid && state_ == PrecontrolState::kActive) {
+  if (valid && (state_ == PrecontrolState::kActive || state_ == PrecontrolState::kEngaging)) {
     // Model steps at the table's sample time (several per call, or one every few calls).
     ++call_phase_;
     const bool step_now = call_phase_ >= calls_per_step_;
@@ -391,7 +458,7 @@ PrecontrolOutput Precontrol::run_cycle(const std::array<double, kPrecontrolJoint
           error + joint.backlash_l_rad *
                       std::tanh(direction_speed / options_.backlash_velocity_scale_rad_s);
       // Written as !(|x| <= tol) so that a NaN (an overflowing model) deactivates too.
-      if (!(std::abs(raw) <= options_.offset_tolerance_rad[j])) {
+      if (supervise && !(std::abs(raw) <= options_.offset_tolerance_rad[j])) {
         deactivate(cycle_counter, j, PrecontrolCause::kOffsetTolerance, raw);
         break;
       }
@@ -402,7 +469,7 @@ PrecontrolOutput Precontrol::run_cycle(const std::array<double, kPrecontrolJoint
       const double decay = smoother_decay_;  // exp(-w dt)
       joint.smooth = raw + (e0 + (v0 + w * e0) * dt) * decay;
       joint.smooth_rate = (v0 - w * (v0 + w * e0) * dt) * decay;
-      if (!(std::abs(joint.smooth_rate) <= options_.rate_tolerance_rad_s[j])) {
+      if (supervise && !(std::abs(joint.smooth_rate) <= options_.rate_tolerance_rad_s[j])) {
         deactivate(cycle_counter, j, PrecontrolCause::kRateTolerance, joint.smooth_rate);
         break;
       }
@@ -417,13 +484,19 @@ PrecontrolOutput Precontrol::run_cycle(const std::array<double, kPrecontrolJoint
     last_torque_ = torque;
     last_payload_ = payload_kg;
   }
+  compose_output(gain, out);
+  return out;
+}
 
-  // Output: the smoothed offsets, or the fade-out ramp; never a step above the rate limit.
+void Precontrol::compose_output(double engagement_gain, PrecontrolOutput& out) noexcept {
+  // The smoothed offsets, the fade-in or the fade-out ramp; never a step above the rate limit.
+  const double dt = options_.caller_cycle_s;
   double fade = 0.0;
   if (state_ == PrecontrolState::kFadingOut) {
     fade_elapsed_s_ += dt;
     if (fade_elapsed_s_ >= options_.fade_out_s) {
       state_ = PrecontrolState::kInactive;
+      valid_for_s_ = 0.0;
     } else {
       fade = 0.5 * (1.0 + std::cos(M_PI * fade_elapsed_s_ / options_.fade_out_s));
     }
@@ -432,6 +505,7 @@ PrecontrolOutput Precontrol::run_cycle(const std::array<double, kPrecontrolJoint
     JointModel& joint = joints_[j];
     double target = 0.0;
     if (state_ == PrecontrolState::kActive) target = joint.smooth;
+    if (state_ == PrecontrolState::kEngaging) target = joint.smooth * engagement_gain;
     if (state_ == PrecontrolState::kFadingOut) target = fade_from_[j] * fade;
     const double step = options_.rate_limit_rad_s[j] * dt;
     joint.output += std::clamp(target - joint.output, -step, step);
@@ -439,7 +513,6 @@ PrecontrolOutput Precontrol::run_cycle(const std::array<double, kPrecontrolJoint
   }
   out.state = state_;
   out.outside_table = was_outside_;
-  return out;
 }
 
 }  // namespace imscal::ident

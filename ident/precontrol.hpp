@@ -34,7 +34,16 @@
 //   5. the supervisor compares |raw offset| and |rate of the smoothed offset| with per-joint
 //      tolerances: when one is exceeded, or the input is NaN/Inf, or cycles were lost, the
 //      compensation is deactivated and faded out over fade_out_s with a raised-cosine ramp (no
-//      step), and the event is logged with its cause. Re-activation is explicit (reactivate()).
+//      step), and the event is logged with its cause. Re-activation is explicit (reactivate()),
+//      or automatic with PrecontrolOptions::auto_engage (below);
+//   6. engagement (auto_engage): a stream may start, or resume after a fault, in the middle of a
+//      motion, where the models' restart state (at rest at the current desired value) is wrong
+//      and their first outputs are a transient, not the joint's error. The models then run for
+//      engage_settle_s with the supervisor's tolerances not checked and the offset held at zero,
+//      and the offset is then faded in with a raised-cosine ramp over fade_out_s (state
+//      kEngaging); after a deactivation the precontrol re-engages itself once it has had
+//      reengage_after_s of valid, consecutive input. A caller's own fault (fault()) restarts that
+//      wait.
 //
 // Real-time rules inside cycle(): no heap allocation, no exception, no lock, bounded work; the
 // state has a fixed size (kMax* below). Events go to a fixed ring buffer the caller reads
@@ -75,9 +84,16 @@ struct PrecontrolOptions {
   double fade_out_s = 0.2;                       // deactivation ramp
   double backlash_velocity_scale_rad_s = 0.002;  // v_b of the tanh transition
   int max_lost_cycles = 0;  // lost cycles bridged by holding the last input (more: deactivate)
+  // Engagement (see above); off: active from the first cycle, re-activation only explicit.
+  bool auto_engage = false;
+  double engage_settle_s = 0.2;   // models run, offset held at 0, tolerances not checked
+  double reengage_after_s = 0.5;  // valid input needed after a deactivation before re-engaging
+  // > 0: a desired angle moving faster than this between two cycles is a jump of the set-point
+  // (deactivation, cause kInputJump) [rad/s]; 0: not checked.
+  double max_input_speed_rad_s = 0.0;
 };
 
-enum class PrecontrolState : std::uint8_t { kActive, kFadingOut, kInactive };
+enum class PrecontrolState : std::uint8_t { kActive, kFadingOut, kInactive, kEngaging };
 
 enum class PrecontrolCause : std::uint8_t {
   kNone,
@@ -88,6 +104,10 @@ enum class PrecontrolCause : std::uint8_t {
   kOutsideTable,     // operating point outside the identified grid (not a deactivation)
   kReactivated,
   kMissingTorque,  // the table's models need the model torque and the caller gave none
+  kInputJump,      // a desired angle moved faster than max_input_speed_rad_s
+  kCallerFault,    // the caller reported a fault (fault()); value: the caller's code
+  kEngaging,       // (re-)engagement started (auto_engage)
+  kEngaged,        // the offset is fully faded in
 };
 const char* to_string(PrecontrolCause cause);
 
@@ -130,7 +150,14 @@ class Precontrol {
   // values (at rest: zero error) and the offsets rise smoothly from zero.
   void reactivate() noexcept;
 
+  // A fault the caller detected (a malformed or late message, an unknown robot, ...): the
+  // compensation is faded out as for the supervisor's own causes (kCallerFault, `code` logged as
+  // the value) and an automatic re-engagement waits reengage_after_s from here.
+  void fault(std::uint64_t cycle_counter, double code) noexcept;
+
   PrecontrolState state() const noexcept { return state_; }
+  // The options in force, with the per-joint defaults resolved from the table.
+  const PrecontrolOptions& options() const noexcept { return options_; }
   // Events since the last call (oldest first), copied out; the ring keeps the newest
   // kPrecontrolEventCapacity and counts what it dropped.
   int read_events(PrecontrolEvent* out, int capacity) noexcept;
@@ -195,6 +222,15 @@ class Precontrol {
                              const std::array<double, kPrecontrolJoints>* model_torque_nm,
                              std::uint64_t cycle_counter) noexcept;
   void deactivate(std::uint64_t cycle, int joint, PrecontrolCause cause, double value) noexcept;
+  // The input checks of a cycle (validity, counter, jumps); false: the input is not used.
+  bool accept_input(const std::array<double, kPrecontrolJoints>& q_desired_rad, double payload_kg,
+                    const std::array<double, kPrecontrolJoints>* model_torque_nm,
+                    std::uint64_t cycle_counter,
+                    std::array<double, kPrecontrolJoints>& torque) noexcept;
+  // Steps the engagement and re-engagement timers; the fade-in factor of the offset (0..1).
+  double engagement_gain(bool valid, std::uint64_t cycle_counter) noexcept;
+  void start_engaging(std::uint64_t cycle_counter) noexcept;
+  void compose_output(double engagement_gain, PrecontrolOutput& out) noexcept;
   void log(std::uint64_t cycle, int joint, PrecontrolCause cause, double value) noexcept;
 
   PrecontrolOptions options_;
@@ -215,6 +251,8 @@ class Precontrol {
   std::uint64_t last_cycle_ = 0;
   PrecontrolState state_ = PrecontrolState::kActive;
   double fade_elapsed_s_ = 0.0;
+  double engage_elapsed_s_ = 0.0;  // since the (re-)engagement started
+  double valid_for_s_ = 0.0;       // valid consecutive input while inactive
   std::array<double, kPrecontrolJoints> fade_from_{};
   bool was_outside_ = false;
   std::array<PrecontrolEvent, kPrecontrolEventCapacity> events_{};

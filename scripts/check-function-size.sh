@@ -15,7 +15,7 @@ config="{CheckOptions: [{key: readability-function-size.LineThreshold, value: $l
 found=$(mktemp)
 trap 'rm -f "$found"' EXIT
 git ls-files 'core/*.cpp' 'ims/*.cpp' 'calib/*.cpp' 'ident/*.cpp' 'sim/*.cpp' 'eval/*.cpp' \
-  'tools/*.cpp' |
+  'tools/*.cpp' 'online/*.cpp' |
   xargs -P "$(nproc)" -n 4 clang-tidy -p "$build" --quiet --checks='-*,readability-function-size' \
     --config="$config" 2>/dev/null |
   sed -n "s|^$PWD/\([^:]*\):[0-9]*:[0-9]*: warning: function '\([^']*\)' exceeds.*|\1 \2|p" |

@@ -83,6 +83,8 @@ const char* state_name(ident::PrecontrolState s) {
       return "fading_out";
     case ident::PrecontrolState::kInactive:
       return "inactive";
+    case ident::PrecontrolState::kEngaging:
+      return "engaging";
   }
   return "?";
 }
@@ -97,6 +99,9 @@ void run(const CompensateArgs& args) {
   check_log_payload(args, table, log);
   ident::PrecontrolOptions options;
   options.caller_cycle_s = log.cycle_s;
+  // A log may start in the middle of a motion, and a fault need not end the run: the precontrol
+  // engages smoothly and re-engages (ident/precontrol.hpp, auto_engage).
+  options.auto_engage = true;
   if (args.offset_tolerance_rad > 0.0) options.offset_tolerance_rad.fill(args.offset_tolerance_rad);
   auto precontrol = std::make_unique<ident::Precontrol>();
   std::string why;

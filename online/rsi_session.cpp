@@ -1,0 +1,189 @@
+#include "online/rsi_session.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace imscal::online {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / M_PI;
+
+}  // namespace
+
+const char* to_string(RsiFault fault) {
+  switch (fault) {
+    case RsiFault::kMalformed:
+      return "malformed datagram";
+    case RsiFault::kLate:
+      return "late datagram";
+    case RsiFault::kLost:
+      return "lost datagrams";
+    case RsiFault::kDuplicated:
+      return "duplicated IPOC";
+    case RsiFault::kReordered:
+      return "reordered IPOC";
+    case RsiFault::kUnknownRobot:
+      return "unknown robot type";
+    case RsiFault::kOffPath:
+      return "set-point off the loaded path";
+  }
+  return "?";
+}
+
+std::unique_ptr<RsiSession> RsiSession::create(const ident::ParameterTable& table,
+                                               const std::string& robot_name,
+                                               ident::PrecontrolOptions precontrol,
+                                               const RsiSessionOptions& options, std::string* why,
+                                               std::unique_ptr<PathFollower> path) {
+  auto refuse = [&](const std::string& reason) {
+    if (why) *why = reason;
+    return std::unique_ptr<RsiSession>();
+  };
+  if (!(options.cycle_s > 0.0)) return refuse("the RSI cycle must be > 0 s");
+  if (options.ipoc_per_cycle == 0) return refuse("the IPOC step per cycle must be > 0");
+  for (char c : options.sensor_type)
+    if (c == '"' || c == '<' || c == '&') return refuse("the sensor type has '\"', '<' or '&'");
+  if (options.sensor_type.size() > 64) return refuse("the sensor type is longer than 64 bytes");
+  precontrol.caller_cycle_s = options.cycle_s;
+  precontrol.auto_engage = true;
+  std::unique_ptr<RsiSession> session(new RsiSession());
+  std::string reason;
+  if (!ident::Precontrol::create(table, robot_name, precontrol, &session->precontrol_, &reason))
+    return refuse(reason);
+  if (!path && (table.preview_cycles > 0 || session->precontrol_.needs_model_torque()))
+    return refuse(
+        "the table takes the desired path ahead or the model torque: load the program's "
+        "path");
+  session->options_ = options;
+  session->path_ = std::move(path);
+  return session;
+}
+
+void RsiSession::record(std::uint64_t ipoc, RsiFault fault, int detail, double value) noexcept {
+  if (fault_count_ == kRsiFaultCapacity) {
+    fault_head_ = (fault_head_ + 1) % kRsiFaultCapacity;
+    --fault_count_;
+  }
+  faults_[std::size_t((fault_head_ + fault_count_) % kRsiFaultCapacity)] =
+      RsiFaultEvent{ipoc, fault, detail, value};
+  ++fault_count_;
+}
+
+int RsiSession::read_faults(RsiFaultEvent* out, int capacity) noexcept {
+  int n = 0;
+  for (; n < capacity && fault_count_ > 0; ++n, --fault_count_) {
+    out[n] = faults_[std::size_t(fault_head_)];
+    fault_head_ = (fault_head_ + 1) % kRsiFaultCapacity;
+  }
+  return n;
+}
+
+bool RsiSession::judge(const RsiRobotDatagram& d, double receive_time_s) noexcept {
+  const std::uint64_t cycle = d.ipoc / options_.ipoc_per_cycle;
+  in_order_ = !started_ || cycle > last_cycle_;
+  if (!in_order_) {
+    // Not for the precontrol (its counter and its state stay); faded at the next in-order one.
+    record(d.ipoc, cycle == last_cycle_ ? RsiFault::kDuplicated : RsiFault::kReordered, 0,
+           double(last_cycle_ - cycle));
+    pending_fault_ = true;
+    return false;
+  }
+  bool fade = pending_fault_;
+  pending_fault_ = false;
+  if (!options_.robot_type.empty() && d.type_name() != options_.robot_type) {
+    record(d.ipoc, RsiFault::kUnknownRobot, 0, 0.0);
+    fade = true;
+  }
+  if (started_) {
+    const double gap_s = receive_time_s - last_receive_s_;
+    if (options_.late_after_s > 0.0 && gap_s > options_.cycle_s + options_.late_after_s) {
+      record(d.ipoc, RsiFault::kLate, 0, gap_s);
+      fade = true;
+    }
+    // The precontrol's own counter check fades out on a gap; it is logged here by kind too.
+    if (cycle > last_cycle_ + 1)
+      record(d.ipoc, RsiFault::kLost, 0, double(cycle - last_cycle_ - 1));
+  }
+  advanced_ = started_ ? cycle - last_cycle_ : 1;
+  started_ = true;
+  last_cycle_ = cycle;
+  last_receive_s_ = receive_time_s;
+  return fade;
+}
+
+void RsiSession::answer_values(const std::array<double, kRsiAxes>& offset_rad,
+                               std::array<double, kRsiAxes>* values_deg) noexcept {
+  for (int a = 0; a < kRsiAxes; ++a) {
+    const auto i = std::size_t(a);
+    correction_rad_[i] = offset_rad[i];
+    const double absolute_deg = offset_rad[i] * kDegPerRad;
+    if (options_.mode == RsiCorrectionMode::kAbsolute) {
+      (*values_deg)[i] = absolute_deg;
+    } else {
+      // The largest written value within the rate limit's step (rounded towards zero).
+      const double step_deg = std::floor(precontrol_.options().rate_limit_rad_s[i] *
+                                         options_.cycle_s * kDegPerRad * 1e6) /
+                              1e6;
+      const double increment =
+          std::clamp(rsi_written_value(absolute_deg - sent_sum_deg_[i]), -step_deg, step_deg);
+      sent_sum_deg_[i] += increment;
+      (*values_deg)[i] = increment;
+    }
+  }
+}
+
+bool RsiSession::precontrol_input(const std::array<double, kRsiAxes>& setpoint_rad,
+                                  PathSample* input) noexcept {
+  input->q_rad = setpoint_rad;
+  input->payload_kg = options_.payload_kg;
+  if (!path_) return true;
+  const bool on_path = path_->step(setpoint_rad, advanced_, input);
+  // A path without payloads: the session's.
+  if (on_path && input->payload_kg == 0.0) input->payload_kg = options_.payload_kg;
+  return on_path;
+}
+
+int RsiSession::handle(std::string_view datagram, double receive_time_s, char* answer,
+                       int capacity) noexcept {
+  const RsiParseError error = parse_rsi_robot_datagram(datagram, &datagram_);
+  if (error != RsiParseError::kNone) {
+    record(0, RsiFault::kMalformed, int(error), 0.0);
+    pending_fault_ = true;
+    ++refused_;
+    return 0;
+  }
+  const std::uint64_t cycle = datagram_.ipoc / options_.ipoc_per_cycle;
+  bool fade = judge(datagram_, receive_time_s);
+  std::array<double, kRsiAxes> values_deg{};
+  if (in_order_) {
+    std::array<double, ident::kPrecontrolJoints> q_rad{};
+    for (int a = 0; a < kRsiAxes; ++a)
+      q_rad[std::size_t(a)] = datagram_.setpoint_deg[std::size_t(a)] / kDegPerRad;
+    PathSample input;
+    if (!precontrol_input(q_rad, &input)) {
+      record(datagram_.ipoc, RsiFault::kOffPath, 0, 0.0);
+      fade = true;
+    }
+    if (fade) precontrol_.fault(cycle, 0.0);
+    const ident::PrecontrolOutput out =
+        precontrol_.needs_model_torque()
+            ? precontrol_.cycle(input.q_rad, input.payload_kg, input.torque_nm, cycle)
+            : precontrol_.cycle(input.q_rad, input.payload_kg, cycle);
+    state_ = out.state;
+    answer_values(out.offset_rad, &values_deg);
+  } else if (options_.mode == RsiCorrectionMode::kAbsolute) {
+    // The correction held: no precontrol step for a datagram out of order.
+    for (int a = 0; a < kRsiAxes; ++a)
+      values_deg[std::size_t(a)] = correction_rad_[std::size_t(a)] * kDegPerRad;
+  }  // increment mode out of order: zero increments
+  const int bytes =
+      write_rsi_answer(options_.sensor_type, values_deg, datagram_.ipoc, answer, capacity);
+  if (bytes <= 0) {
+    ++refused_;
+    return 0;
+  }
+  ++answered_;
+  return bytes;
+}
+
+}  // namespace imscal::online

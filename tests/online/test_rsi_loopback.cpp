@@ -1,0 +1,131 @@
+// The RSI server through real sockets and real serialisation, against the in-process closed loop
+// (eval/closed_loop.hpp) as truth: the controller emulator (online/rsi_controller_emulator.hpp)
+// plays the seed-line program's set-points over loopback UDP in lock-step, the robot simulator
+// runs on q_d + the corrections it received, and the attained joints equal those of
+// eval::run_closed_loop with the same precontrol; every datagram is answered.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "eval/closed_loop.hpp"
+#include "online/rsi_controller_emulator.hpp"
+#include "sim/motion_planner.hpp"
+#include "sim/motion_program.hpp"
+#include "sim/plant_config.hpp"
+#include "sim/scenario.hpp"
+#include "tests/support/rsi_loopback.hpp"
+
+namespace imscal::online {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Every joint: q̂(k) = 0.5 q̂(k-1) + 0.5 q_d(k-1), one cell: the joint lags its command by about
+// two cycles, a few mrad on the program's moves.
+ident::ParameterTable lag_table() {
+  ident::ParameterTable t;
+  t.robot = "kr16";
+  t.sample_time_s = 0.002;
+  for (int j = 0; j < 6; ++j) {
+    ident::JointParameters joint;
+    joint.name = std::string(1, 'A').append(std::to_string(j + 1));
+    joint.dimensions = {{ident::OperatingQuantity::kSpeed, {0.0, 100.0}}};
+    ident::CellParameters cell;
+    cell.bands = {0};
+    cell.structure = {1, 1, 1};
+    cell.a = {-0.5};
+    cell.b = {0.5};
+    joint.cells = {cell};
+    t.joints.push_back(joint);
+  }
+  return t;
+}
+
+ident::PrecontrolOptions precontrol_options() {
+  ident::PrecontrolOptions o;
+  o.offset_tolerance_rad.fill(0.05);  // the lag on the program's fastest moves stays below
+  o.rate_tolerance_rad_s.fill(5.0);
+  o.auto_engage = true;  // as the server runs it
+  return o;
+}
+
+TEST(RsiLoopback, ClosedLoopThroughSocketsEqualsTheInProcessLoop) {
+  const sim::Scenario scenario =
+      sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets/scenarios/seed-line.yaml");
+  const calib::RobotDescription robot = sim::load_plant_robot(scenario);
+  sim::DesiredJointPath path =
+      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
+  // The first 8 s (the rest and most of the move to the line: every joint moves); 6.6 s under
+  // sanitizers, as tests/eval/test_closed_loop.cpp.
+  const double keep_s = std::getenv("IMSCAL_SANITIZED") ? 6.6 : 8.0;
+  while (path.samples.back().t_s > keep_s) path.samples.pop_back();
+  ASSERT_EQ(path.cycle_s, 0.002);
+
+  // In process: the precontrol settled at the start pose over the engagement (0.4 s) first.
+  constexpr int kWarmUp = 250;
+  eval::CompensationOptions options;
+  options.precontrol = precontrol_options();
+  options.warm_up_cycles = kWarmUp;
+  const sim::PlantConfig config = sim::make_plant_config(robot, scenario);
+  const eval::ClosedLoopRun in_process =
+      eval::run_closed_loop(path, lag_table(), "kr16", eval::simulator_plant(config), options);
+
+  // Through the sockets: the same warm-up at the first set-point, then the path.
+  RsiSessionOptions session;
+  session.cycle_s = path.cycle_s;
+  session.ipoc_per_cycle = 2;
+  test_support::RsiLoopbackServer server(lag_table(), precontrol_options(), session);
+  std::vector<std::array<double, kRsiAxes>> setpoint(kWarmUp + path.samples.size());
+  for (std::size_t k = 0; k < setpoint.size(); ++k) {
+    const Eigen::VectorXd& q = path.samples[k < kWarmUp ? 0 : k - kWarmUp].q_rad;
+    for (int a = 0; a < kRsiAxes; ++a) setpoint[k][std::size_t(a)] = q[a];
+  }
+  UdpSocket controller("127.0.0.1", 0);
+  RsiEmulatorOptions emulator;
+  emulator.cycle_s = path.cycle_s;
+  emulator.ipoc_per_cycle = 2;
+  emulator.answer_timeout_s = 5.0;  // a stalled server thread (loaded machine) is not a miss
+  const RsiEmulatorRun run = emulate_rsi_controller(controller, server.peer(), setpoint, emulator);
+  server.finish();
+  EXPECT_EQ(run.missed, 0u);
+  EXPECT_EQ(server.stats().answered, setpoint.size());
+
+  // The corrections: the set-points travel with 6 decimals of a degree (8.7e-9 rad) and so do
+  // the answers; through this two-cycle model that is < 3e-8 rad.
+  std::vector<calib::JointVector> offsets(path.samples.size());
+  double largest_offset = 0.0, largest_difference = 0.0;
+  for (std::size_t k = 0; k < path.samples.size(); ++k) {
+    offsets[k].resize(6);
+    for (int j = 0; j < 6; ++j) {
+      offsets[k][j] = run.correction_rad[k + kWarmUp][std::size_t(j)];
+      largest_offset = std::max(largest_offset, std::abs(in_process.compensation.offset_rad[k][j]));
+      largest_difference = std::max(
+          largest_difference, std::abs(offsets[k][j] - in_process.compensation.offset_rad[k][j]));
+    }
+  }
+  EXPECT_GT(largest_offset, 1e-3);  // the comparison is not between zeros
+  EXPECT_LT(largest_difference, 3e-8);
+
+  // The robot on the corrections it received: the attained joints as in process (the plant is
+  // smooth in its command: differences of the order of the corrections' 3e-8 rad).
+  const sim::PlantLog through_sockets =
+      eval::simulator_plant(config)(eval::command_path(path, offsets));
+  const auto errors_sockets = eval::joint_errors(path, through_sockets);
+  const auto errors_in_process = eval::joint_errors(path, in_process.compensated);
+  double largest_gap = 0.0;
+  for (std::size_t k = 0; k < errors_sockets.size(); ++k) {
+    largest_gap =
+        std::max(largest_gap, (errors_sockets[k] - errors_in_process[k]).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(largest_gap, 1e-7);
+  std::printf(
+      "largest correction %.3g rad; sockets vs in process: %.3g rad (corrections), "
+      "%.3g rad (attained joints)\n",
+      largest_offset, largest_difference, largest_gap);
+}
+
+}  // namespace
+}  // namespace imscal::online
