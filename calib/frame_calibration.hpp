@@ -230,6 +230,7 @@ struct FrameCalibrationResult {
   // `parameter_names` (rotations as small angles in the left frame: R_W_R, R_S_H; positions;
   // biases; dt) [SI]; correlations derived from it.
   std::vector<std::string> parameter_names;
+  Eigen::VectorXd parameter_values;  // the estimates in that order [SI; rotations: rotation vector]
   Eigen::MatrixXd covariance;
   Eigen::MatrixXd correlation;
   bool covariance_rank_deficient = false;  // pseudo-inverse used; see weak_directions
@@ -249,6 +250,16 @@ struct FrameCalibrationResult {
   int iterations = 0;
   double final_cost = 0.0;
   bool converged = false;
+
+  // An entry of the covariance by name: "<block>.<component>" as in parameter_names (e.g.
+  // "gyro_bias.x", "R_W_R.up", "windup_scale_deviation.A2"), or the block's name alone when it
+  // has one component ("time_offset", "link_share"). Its 1-sigma and its estimate in the
+  // covariance's units (SI; rotations: small angles, their value the rotation vector) [rad, m,
+  // rad/s, m/s^2, s, 1]. Throw std::out_of_range for a parameter not estimated (or when the
+  // covariance failed).
+  double sigma(const std::string& name) const;
+  double value(const std::string& name) const;
+  std::size_t parameter_index(const std::string& name) const;
 };
 
 // Solves the bundle from automatic initial values (with input.known_frames: from those frames,

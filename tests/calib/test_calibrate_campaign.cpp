@@ -70,13 +70,6 @@ struct SeedOutcome {
   std::size_t outliers = 0;
 };
 
-double sigma_of(const FrameCalibrationResult& r, const std::string& name) {
-  for (std::size_t i = 0; i < r.parameter_names.size(); ++i)
-    if (r.parameter_names[i] == name && Eigen::Index(i) < r.covariance.rows())
-      return std::sqrt(std::max(0.0, r.covariance(Eigen::Index(i), Eigen::Index(i))));
-  return std::numeric_limits<double>::quiet_NaN();
-}
-
 // Largest |error_k| / sigma_k of a 3-vector whose sigmas are named prefix.x/y/z; each one is
 // also appended to `all`.
 double worst_sigmas(const FrameCalibrationResult& r, const std::string& prefix,
@@ -84,7 +77,7 @@ double worst_sigmas(const FrameCalibrationResult& r, const std::string& prefix,
   double worst = 0.0;
   const char* axes[3] = {"x", "y", "z"};
   for (int k = 0; k < 3; ++k) {
-    all.push_back(std::abs(error[k]) / sigma_of(r, prefix + "." + axes[k]));
+    all.push_back(std::abs(error[k]) / r.sigma(prefix + "." + axes[k]));
     worst = std::max(worst, all.back());
   }
   return worst;
@@ -189,7 +182,7 @@ SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult&
     const Eigen::Vector3d rotation_error_W =
         ims::quat_log<double>(Eigen::Quaterniond(R_W_R * T_W_R.linear().transpose()));
     o.R_W_tilt_deg = rotation_error_W.head<2>().norm() / kDeg;
-    o.heading_sigmas = std::abs(rotation_error_W.z()) / sigma_of(r, "R_W_R.up");
+    o.heading_sigmas = std::abs(rotation_error_W.z()) / r.sigma("R_W_R.up");
     o.normalised_errors.push_back(o.heading_sigmas);
     // The true link angles at the middle of the first rest (robot clock).
     const double t_first = 0.5 * (in.rests.front().begin_ims_s + in.rests.front().end_ims_s) -
@@ -216,7 +209,7 @@ SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult&
     o.acc_bias_sigmas =
         worst_sigmas(r, "acc_bias", r.biases.acc_m_s2 - acc_bias_true, o.normalised_errors);
     o.dt_sigmas =
-        std::abs(r.time_offset_s - scenario.imu_clock_offset_s) / sigma_of(r, "time_offset.dt");
+        std::abs(r.time_offset_s - scenario.imu_clock_offset_s) / r.sigma("time_offset.dt");
     o.normalised_errors.push_back(o.dt_sigmas);
     o.link_share = r.link_share;
   } catch (const InputError& e) {

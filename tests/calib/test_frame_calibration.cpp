@@ -236,22 +236,22 @@ SeedOutcome run_mounting_seed(std::uint64_t seed) {
   const Eigen::Vector3d error_W =
       ims::quat_log<double>(Eigen::Quaterniond(r.T_R_W.linear().transpose() * T_R_W_true.linear()));
   out.roll_pitch_R_W_deg = error_W.head<2>().norm() / kDeg;
-  const double heading_sigma = std::sqrt(r.covariance(2, 2));
+  const double heading_sigma = r.sigma("R_W_R.up");
   out.heading_sigma_deg = heading_sigma / kDeg;
   out.heading_error_sigma = error_W.z() / heading_sigma;
   out.rotation_S_H_deg = rotation_error_rad(r.T_S_H.linear(), scene.T_S_H().linear()) / kDeg;
   out.translation_S_H_mm = (r.T_S_H.translation() - scene.T_S_H().translation()).norm() * 1e3;
   out.translation_R_W_mm = (r.T_R_W.translation() - T_R_W_true.translation()).norm() * 1e3;
+  const char* axes[3] = {"x", "y", "z"};
   for (int k = 0; k < 3; ++k) {
     out.normalised.push_back((r.biases.gyro_rad_s[k] - scene.sensor_errors.gyro.bias[k]) /
-                             std::sqrt(r.covariance(9 + k, 9 + k)));
+                             r.sigma(std::string("gyro_bias.") + axes[k]));
   }
   for (int k = 0; k < 3; ++k) {
     out.normalised.push_back((r.biases.acc_m_s2[k] - scene.sensor_errors.acc.bias[k]) /
-                             std::sqrt(r.covariance(12 + k, 12 + k)));
+                             r.sigma(std::string("acc_bias.") + axes[k]));
   }
-  out.normalised.push_back((r.time_offset_s - scene.clock_offset_s) /
-                           std::sqrt(r.covariance(15, 15)));
+  out.normalised.push_back((r.time_offset_s - scene.clock_offset_s) / r.sigma("time_offset"));
   out.heading_named = !r.weak_directions.empty() &&
                       r.weak_directions.front().description.find("heading") != std::string::npos;
   return out;

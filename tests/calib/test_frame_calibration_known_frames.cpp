@@ -29,14 +29,6 @@ namespace {
 using test_support::FrameScene;
 constexpr double kDeg = M_PI / 180.0;
 
-double sigma_of(const FrameCalibrationResult& r, const std::string& name) {
-  for (std::size_t i = 0; i < r.parameter_names.size(); ++i)
-    if (r.parameter_names[i] == name)
-      return std::sqrt(std::max(0.0, r.covariance(Eigen::Index(i), Eigen::Index(i))));
-  ADD_FAILURE() << "no covariance entry " << name;
-  return std::nan("");
-}
-
 struct Record {
   FrameScene scene;
   ims::SensorSpec spec;
@@ -113,6 +105,11 @@ void check_recovers_biases_and_clock(const std::vector<std::size_t>& keep) {
     EXPECT_LT((r.T_R_W.linear().transpose() - record.scene.T_W_R.linear()).norm(), 1e-12);
     EXPECT_LT((r.T_S_H.matrix() - record.scene.T_S_H().matrix()).norm(), 1e-12);
     EXPECT_LT((r.covariance.topLeftCorner<9, 9>() - frame_covariance).norm(), 1e-30);
+    // The estimates by name are the result's own fields (the same doubles).
+    EXPECT_EQ(r.value("time_offset"), r.time_offset_s);
+    EXPECT_EQ(r.value("gyro_bias.z"), r.biases.gyro_rad_s.z());
+    EXPECT_EQ(r.value("acc_bias.x"), r.biases.acc_m_s2.x());
+    EXPECT_DOUBLE_EQ(r.sigma("R_W_R.up"), frame_sigma[2]);  // sqrt of its square: a few ulp
     const ims::SensorErrorModel& truth = record.scene.sensor_errors;
     const char* axes[] = {"x", "y", "z"};
     double worst = 0.0;
@@ -120,17 +117,17 @@ void check_recovers_biases_and_clock(const std::vector<std::size_t>& keep) {
                 static_cast<unsigned long long>(seed));
     for (int k = 0; k < 3; ++k) {
       const double g = (r.biases.gyro_rad_s[k] - truth.gyro.bias[k]) /
-                       sigma_of(r, std::string("gyro_bias.") + axes[k]);
-      const double a = (r.biases.acc_m_s2[k] - truth.acc.bias[k]) /
-                       sigma_of(r, std::string("acc_bias.") + axes[k]);
+                       r.sigma(std::string("gyro_bias.") + axes[k]);
+      const double a =
+          (r.biases.acc_m_s2[k] - truth.acc.bias[k]) / r.sigma(std::string("acc_bias.") + axes[k]);
       std::printf("  gyro %s %+.2f (sigma %.3g deg/h)  acc %s %+.2f (sigma %.3g ug)", axes[k], g,
-                  sigma_of(r, std::string("gyro_bias.") + axes[k]) / kDeg * 3600.0, axes[k], a,
-                  sigma_of(r, std::string("acc_bias.") + axes[k]) / 9.80665 * 1e6);
+                  r.sigma(std::string("gyro_bias.") + axes[k]) / kDeg * 3600.0, axes[k], a,
+                  r.sigma(std::string("acc_bias.") + axes[k]) / 9.80665 * 1e6);
       EXPECT_LT(std::abs(g), 3.0) << "gyro bias " << axes[k];
       EXPECT_LT(std::abs(a), 3.0) << "acc bias " << axes[k];
       worst = std::max({worst, std::abs(g), std::abs(a)});
     }
-    const double dt_sigma = sigma_of(r, "time_offset.dt");
+    const double dt_sigma = r.sigma("time_offset.dt");
     const double dt = (r.time_offset_s - record.scene.clock_offset_s) / dt_sigma;
     std::printf("  dt %+.2f (sigma %.3g us; initial error %.3g ms)\n", dt, dt_sigma * 1e6,
                 (in.time_offset_initial_s - record.scene.clock_offset_s) * 1e3);

@@ -47,9 +47,7 @@ HeadingFigure heading_sigma(const RobotDescription& robot, const ims::SensorSpec
   EXPECT_TRUE(r.converged) << r.solver_brief_report;
   HeadingFigure f;
   for (const RestObservation& rest : in.rests) f.rest_time_s += rest.end_ims_s - rest.begin_ims_s;
-  for (std::size_t i = 0; i < r.parameter_names.size(); ++i)
-    if (r.parameter_names[i] == "R_W_R.up")
-      f.sigma_rad = std::sqrt(r.covariance(Eigen::Index(i), Eigen::Index(i)));
+  f.sigma_rad = r.sigma("R_W_R.up");
   return f;
 }
 
