@@ -101,7 +101,7 @@ struct ImuNoiseModel {
   double velocity_floor_m_s = 1e-6;
   double position_floor_m = 2e-6;
   // Output quantisation of the increments (LSB) [rad], [m/s]; 0 if none. The rest means carry
-  // at most one LSB over their duration (added by frame_calibration.cpp).
+  // at most one LSB over their duration (added by calib/frame_noise.cpp).
   double gyro_quantization_rad = 0.0;
   double acc_quantization_m_s = 0.0;
 };

@@ -100,7 +100,7 @@ inline void synthesize_scene_imu(FrameScene& scene, double rate_hz = 1000.0) {
 }
 
 // A unit of `spec` with its turn-on biases drawn (scale factors and misalignments set to zero:
-// the bundle's motions take the sensor's scale as exact, see calib/frame_calibration.cpp),
+// the bundle's motions take the sensor's scale as exact, see calib/frame_bundle.hpp),
 // noise, quantisation; bias instability only if keep_bias_instability.
 inline void corrupt_scene_imu(FrameScene& scene, ims::SensorSpec spec, std::uint64_t seed,
                               bool keep_bias_instability = false) {
