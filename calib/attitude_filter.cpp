@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::calib {
@@ -15,7 +16,6 @@ AttitudeTrack run_attitude_filter(const ToolImuRecord& record,
   if (!record.has_raw_imu) {
     throw InputError(record.file, 0, "gyro_x_dps", "the attitude filter needs raw gyro columns");
   }
-  constexpr double kG = 9.80665;  // m/s^2, the |f| expected at rest
   const auto& t = record.t_s;
   // Start at the first sample with a robot pose (and not a zero placeholder row).
   std::size_t start = 0;
@@ -47,7 +47,8 @@ AttitudeTrack run_attitude_filter(const ToolImuRecord& record,
     if (options.use_gravity) {
       const Eigen::Vector3d f_T = R_T_S * record.acc_m_s2[k + 1];
       const double f_norm = f_T.norm();
-      if (std::abs(f_norm - kG) < options.max_specific_force_deviation * kG &&
+      if (std::abs(f_norm - kStandardGravity_m_s2) <
+              options.max_specific_force_deviation * kStandardGravity_m_s2 &&
           omega_T.norm() < options.max_rate_for_aiding_rad_s) {
         const Eigen::Vector3d up_T = q_B_T.conjugate() * calibration.up_B;
         // Turning the estimate by +(f x up_expected) about T moves up_expected towards f.

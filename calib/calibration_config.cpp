@@ -6,13 +6,12 @@
 #include <numbers>
 
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 
 namespace imscal::calib {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kStandardGravity = 9.80665;  // 1 g [m/s^2] (ug in the file)
 
 // A number from `key` that satisfies `ok`, or `fallback` when the key is absent.
 template <typename Predicate>
@@ -67,12 +66,13 @@ void parse_thresholds(const ConfigNode& node, MountingValidationOptions& v) {
   if (t.repeat_fail_sigma < t.repeat_warn_sigma)
     node.child("repeat_fail_sigma").fail("must not be below repeat_warn_sigma");
   t.repeat_rotation_floor_rad =
-      non_negative(node, "repeat_rotation_floor_deg", t.repeat_rotation_floor_rad / kDeg) * kDeg;
+      non_negative(node, "repeat_rotation_floor_deg", t.repeat_rotation_floor_rad / kRadPerDeg) *
+      kRadPerDeg;
   t.repeat_translation_floor_m =
       non_negative(node, "repeat_translation_floor_mm", t.repeat_translation_floor_m * 1e3) * 1e-3;
   t.slip_sigma = positive(node, "slip_sigma", t.slip_sigma);
   t.max_rotation_sigma_rad =
-      positive(node, "max_rotation_sigma_deg", t.max_rotation_sigma_rad / kDeg) * kDeg;
+      positive(node, "max_rotation_sigma_deg", t.max_rotation_sigma_rad / kRadPerDeg) * kRadPerDeg;
   t.max_translation_sigma_m =
       positive(node, "max_translation_sigma_mm", t.max_translation_sigma_m * 1e3) * 1e-3;
 }
@@ -102,9 +102,11 @@ CalibrationConfig parse_calibration_config(const ConfigNode& root) {
     c.rests.min_duration_s = positive(*r, "min_duration_s", c.rests.min_duration_s);
     c.rests.trim_s = non_negative(*r, "trim_s", c.rests.trim_s);
     c.rests.max_joint_spread_rad =
-        positive(*r, "max_joint_spread_deg", c.rests.max_joint_spread_rad / kDeg) * kDeg;
+        positive(*r, "max_joint_spread_deg", c.rests.max_joint_spread_rad / kRadPerDeg) *
+        kRadPerDeg;
     c.rests.settle_tolerance_rad =
-        non_negative(*r, "settle_tolerance_deg", c.rests.settle_tolerance_rad / kDeg) * kDeg;
+        non_negative(*r, "settle_tolerance_deg", c.rests.settle_tolerance_rad / kRadPerDeg) *
+        kRadPerDeg;
     c.rests.detector_threshold_sigmas =
         positive(*r, "detector_threshold_sigmas", c.rests.detector_threshold_sigmas);
     if (2.0 * c.rests.trim_s >= c.rests.min_duration_s)
@@ -126,7 +128,8 @@ CalibrationConfig parse_calibration_config(const ConfigNode& root) {
     o.huber_scale_sigma = positive(*b, "huber_scale_sigma", o.huber_scale_sigma);
     o.outlier_threshold_sigma = positive(*b, "outlier_threshold_sigma", o.outlier_threshold_sigma);
     o.rate_window_s = positive(*b, "rate_window_s", o.rate_window_s);
-    o.min_rate_rad_s = non_negative(*b, "min_rate_deg_s", o.min_rate_rad_s / kDeg) * kDeg;
+    o.min_rate_rad_s =
+        non_negative(*b, "min_rate_deg_s", o.min_rate_rad_s / kRadPerDeg) * kRadPerDeg;
     if (auto it = b->optional_child("max_iterations")) {
       const long n = it->as_int();
       if (n < 1 || n > 10000) it->fail("expected an integer in [1, 10000]");
@@ -142,10 +145,10 @@ CalibrationConfig parse_calibration_config(const ConfigNode& root) {
                           "deflection_uncertainty_fraction", "joint_sigma_floor_urad"});
     if (p->has("gyro_bias_sigma_deg_per_h"))
       c.priors.gyro_bias_sigma_rad_s =
-          positive(*p, "gyro_bias_sigma_deg_per_h", 1.0) * kDeg / 3600.0;
+          positive(*p, "gyro_bias_sigma_deg_per_h", 1.0) * kRadPerDeg / 3600.0;
     if (p->has("acc_bias_sigma_ug"))
       c.priors.acc_bias_sigma_m_s2 =
-          positive(*p, "acc_bias_sigma_ug", 1.0) * 1e-6 * kStandardGravity;
+          positive(*p, "acc_bias_sigma_ug", 1.0) * 1e-6 * kStandardGravity_m_s2;
     c.priors.deflection_uncertainty_fraction = non_negative(
         *p, "deflection_uncertainty_fraction", c.priors.deflection_uncertainty_fraction);
     c.priors.joint_sigma_floor_rad =

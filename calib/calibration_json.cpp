@@ -6,15 +6,14 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/units.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::calib {
 
 using nlohmann::json;
 
-namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
-}  // namespace
+namespace {}  // namespace
 
 json vector_json(const Eigen::VectorXd& v, double scale) {
   json a = json::array();
@@ -38,8 +37,8 @@ json pose_json(const Eigen::Isometry3d& T) {
   const Eigen::Quaterniond q(T.linear());
   return {{"xyz_mm", vector_json(T.translation(), 1e3)},
           {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
-          {"rpy_deg", vector_json(roll_pitch_yaw(T.linear()), 1.0 / kDeg)},
-          {"rotation_vector_deg", vector_json(ims::quat_log<double>(q), 1.0 / kDeg)}};
+          {"rpy_deg", vector_json(roll_pitch_yaw(T.linear()), 1.0 / kRadPerDeg)},
+          {"rotation_vector_deg", vector_json(ims::quat_log<double>(q), 1.0 / kRadPerDeg)}};
 }
 
 json estimate_json(const EstimatedVector& e) {

@@ -10,12 +10,10 @@
 #include "calib/forward_kinematics.hpp"
 #include "calib/frame_bundle.hpp"
 #include "calib/frame_covariance.hpp"
+#include "core/units.hpp"
 
 namespace imscal::calib {
 namespace {
-
-constexpr double kDegPerRad = 180.0 / M_PI;
-constexpr double kStandardGravity = 9.80665;
 
 // The solution, the solver's summary and the initial values.
 void report_solution(const FrameBundle& b, const FrameStage& first, const FrameStage& final_stage,
@@ -119,8 +117,8 @@ void report_estimates(const FrameBundle& b, const FrameCovariance& cov,
   e.push_back({"acc_bias",
                "ug",
                {"x", "y", "z"},
-               result.biases.acc_m_s2 / kStandardGravity * 1e6,
-               sigma("acc_bias", 3) / kStandardGravity * 1e6});
+               result.biases.acc_m_s2 / kStandardGravity_m_s2 * 1e6,
+               sigma("acc_bias", 3) / kStandardGravity_m_s2 * 1e6});
   if (b.layout.contains("time_offset")) {
     e.push_back({"time_offset",
                  "ms",

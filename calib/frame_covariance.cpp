@@ -7,12 +7,11 @@
 #include <cmath>
 #include <utility>
 
+#include "core/units.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::calib {
 namespace {
-
-constexpr double kDegPerRad = 180.0 / M_PI;
 
 bool try_covariance(ceres::Problem& problem, const std::vector<CovarianceBlock>& blocks,
                     const ceres::Covariance::Options& options, Eigen::MatrixXd* out) {

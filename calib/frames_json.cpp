@@ -13,6 +13,7 @@
 #include "core/input_file.hpp"
 #include "core/json_input.hpp"
 #include "core/sha256.hpp"
+#include "core/units.hpp"
 #include "ims/sensor_error_model.hpp"
 
 namespace imscal::calib {
@@ -142,8 +143,6 @@ void read_link_share(const FramesJson& f, SessionFrames& out) {
   }
 }
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
 json solver_json(const FrameCalibrationResult& result) {
   return {{"converged", result.converged},
           {"iterations", result.iterations},
@@ -190,9 +189,8 @@ json frames_json(const FrameCalibrationResult& result, const FramesJsonContext& 
           {"units", conventions_and_units()["units"]},
           {"T_R_W", pose_json(result.T_R_W)},
           {"T_S_H", pose_json(result.T_S_H)},
-          {"gyro_bias_deg_per_h", vector_json(result.biases.gyro_rad_s, 3600.0 / kDeg)},
-          {"acc_bias_ug",
-           vector_json(result.biases.acc_m_s2, 1e6 / ims::sensor_units::kStandardGravity)},
+          {"gyro_bias_deg_per_h", vector_json(result.biases.gyro_rad_s, 3600.0 / kRadPerDeg)},
+          {"acc_bias_ug", vector_json(result.biases.acc_m_s2, 1e6 / kStandardGravity_m_s2)},
           {"time_offset_ms", result.time_offset_s * 1e3},
           {"gyro_scale_factor_ppm", vector_json(result.gyro_scale_factor, 1e6)},
           {"acc_scale_factor_ppm", vector_json(result.acc_scale_factor, 1e6)},

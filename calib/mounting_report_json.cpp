@@ -8,19 +8,19 @@
 
 #include "calib/calibration_json.hpp"
 #include "core/json_fields.hpp"
+#include "core/units.hpp"
 
 namespace imscal::calib {
 namespace {
 
 using nlohmann::json;
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr const char* kVersionKey = "imscal-mounting-report";
 
 json residual_json(const PoseResidual& r) {
   return {{"label", r.label},
           {"normalised", r.normalised},
-          {"rotation_deg", r.rotation_rad / kDeg},
+          {"rotation_deg", r.rotation_rad / kRadPerDeg},
           {"position_mm", r.position_m * 1e3},
           {"outlier", r.outlier}};
 }
@@ -29,20 +29,21 @@ json mounting_json(const MountingEstimate& e) {
   const Eigen::Matrix<double, 6, 1> s = e.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   json j = {{"T_S_H", pose_json(e.T_S_H)}};
   if (e.has_covariance) {
-    j["sigma_rotation_deg"] = vector_json(s.head<3>(), 1.0 / kDeg);
+    j["sigma_rotation_deg"] = vector_json(s.head<3>(), 1.0 / kRadPerDeg);
     j["sigma_translation_mm"] = vector_json(s.tail<3>(), 1e3);
   }
   return j;
 }
 
 json difference_json(const MountingDifference& d) {
-  return {{"rotation_deg", d.rotation_rad / kDeg},
-          {"translation_mm", d.translation_m * 1e3},
-          {"difference_rotation_deg", vector_json(d.difference.head<3>(), 1.0 / kDeg)},
-          {"difference_translation_mm", vector_json(d.difference.tail<3>(), 1e3)},
-          {"combined_sigma_rotation_deg", vector_json(d.combined_sigma.head<3>(), 1.0 / kDeg)},
-          {"combined_sigma_translation_mm", vector_json(d.combined_sigma.tail<3>(), 1e3)},
-          {"normalised_sigma", std::isfinite(d.normalised) ? json(d.normalised) : json(nullptr)}};
+  return {
+      {"rotation_deg", d.rotation_rad / kRadPerDeg},
+      {"translation_mm", d.translation_m * 1e3},
+      {"difference_rotation_deg", vector_json(d.difference.head<3>(), 1.0 / kRadPerDeg)},
+      {"difference_translation_mm", vector_json(d.difference.tail<3>(), 1e3)},
+      {"combined_sigma_rotation_deg", vector_json(d.combined_sigma.head<3>(), 1.0 / kRadPerDeg)},
+      {"combined_sigma_translation_mm", vector_json(d.combined_sigma.tail<3>(), 1e3)},
+      {"normalised_sigma", std::isfinite(d.normalised) ? json(d.normalised) : json(nullptr)}};
 }
 
 json part_json(const SessionPart& p) {
@@ -62,10 +63,10 @@ json thresholds_json(const MountingThresholds& t, std::size_t segment_rests) {
           {"max_outlier_fraction_warn", t.max_outlier_fraction_warn},
           {"repeat_warn_sigma", t.repeat_warn_sigma},
           {"repeat_fail_sigma", t.repeat_fail_sigma},
-          {"repeat_rotation_floor_deg", t.repeat_rotation_floor_rad / kDeg},
+          {"repeat_rotation_floor_deg", t.repeat_rotation_floor_rad / kRadPerDeg},
           {"repeat_translation_floor_mm", t.repeat_translation_floor_m * 1e3},
           {"slip_sigma", t.slip_sigma},
-          {"max_rotation_sigma_deg", t.max_rotation_sigma_rad / kDeg},
+          {"max_rotation_sigma_deg", t.max_rotation_sigma_rad / kRadPerDeg},
           {"max_translation_sigma_mm", t.max_translation_sigma_m * 1e3},
           {"segment_rests", segment_rests}};
 }
@@ -79,7 +80,7 @@ Verdict verdict_of(const JsonField& field) {
 
 PoseResidual residual_of(const JsonField& f) {
   return {f["label"].text(), f["normalised"].number_or_nan(),
-          f["rotation_deg"].number_or_nan() * kDeg, f["position_mm"].number_or_nan() * 1e-3,
+          f["rotation_deg"].number_or_nan() * kRadPerDeg, f["position_mm"].number_or_nan() * 1e-3,
           f["outlier"].boolean()};
 }
 
@@ -93,7 +94,7 @@ MountingEstimate mounting_of(const JsonField& f) {
     f.refuse("gives one of sigma_rotation_deg and sigma_translation_mm without the other");
   if (rotation) {
     Eigen::Matrix<double, 6, 1> s;
-    s << vector_of(*rotation, 3, 1.0 / kDeg), vector_of(*translation, 3, 1e3);
+    s << vector_of(*rotation, 3, 1.0 / kRadPerDeg), vector_of(*translation, 3, 1e3);
     e.covariance = s.cwiseAbs2().asDiagonal();
     e.has_covariance = true;
   }
@@ -102,11 +103,11 @@ MountingEstimate mounting_of(const JsonField& f) {
 
 MountingDifference difference_of(const JsonField& f) {
   MountingDifference d;
-  d.rotation_rad = f["rotation_deg"].number_or_nan() * kDeg;
+  d.rotation_rad = f["rotation_deg"].number_or_nan() * kRadPerDeg;
   d.translation_m = f["translation_mm"].number_or_nan() * 1e-3;
-  d.difference << vector_of(f["difference_rotation_deg"], 3, 1.0 / kDeg),
+  d.difference << vector_of(f["difference_rotation_deg"], 3, 1.0 / kRadPerDeg),
       vector_of(f["difference_translation_mm"], 3, 1e3);
-  d.combined_sigma << vector_of(f["combined_sigma_rotation_deg"], 3, 1.0 / kDeg),
+  d.combined_sigma << vector_of(f["combined_sigma_rotation_deg"], 3, 1.0 / kRadPerDeg),
       vector_of(f["combined_sigma_translation_mm"], 3, 1e3);
   // Written as null when infinite (a sigma missing and a difference that is not zero).
   d.normalised = f["normalised_sigma"].is_null() ? std::numeric_limits<double>::infinity()
@@ -160,10 +161,10 @@ MountingThresholds thresholds_of(const JsonField& f) {
   t.max_outlier_fraction_warn = f["max_outlier_fraction_warn"].number();
   t.repeat_warn_sigma = f["repeat_warn_sigma"].number();
   t.repeat_fail_sigma = f["repeat_fail_sigma"].number();
-  t.repeat_rotation_floor_rad = f["repeat_rotation_floor_deg"].number() * kDeg;
+  t.repeat_rotation_floor_rad = f["repeat_rotation_floor_deg"].number() * kRadPerDeg;
   t.repeat_translation_floor_m = f["repeat_translation_floor_mm"].number() * 1e-3;
   t.slip_sigma = f["slip_sigma"].number();
-  t.max_rotation_sigma_rad = f["max_rotation_sigma_deg"].number() * kDeg;
+  t.max_rotation_sigma_rad = f["max_rotation_sigma_deg"].number() * kRadPerDeg;
   t.max_translation_sigma_m = f["max_translation_sigma_mm"].number() * 1e-3;
   return t;
 }

@@ -8,12 +8,11 @@
 #include <numbers>
 
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::calib {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 bool starts_with_any(const std::string& name, std::initializer_list<const char*> prefixes) {
   for (const char* p : prefixes)
@@ -40,12 +39,12 @@ const EstimatedVector* find_estimate(const FrameCalibrationResult& r, const std:
 
 // Unit of a reported estimate -> SI factor (only the ones T_S_H is reported in).
 double si_factor(const std::string& unit) {
-  if (unit == "deg") return kDeg;
+  if (unit == "deg") return kRadPerDeg;
   if (unit == "rad") return 1.0;
   if (unit == "mm") return 1e-3;
   if (unit == "m") return 1.0;
   if (unit == "urad") return 1e-6;
-  if (unit == "arcsec") return kDeg / 3600.0;
+  if (unit == "arcsec") return kRadPerDeg / 3600.0;
   return std::numeric_limits<double>::quiet_NaN();
 }
 
@@ -59,13 +58,13 @@ std::string rest_range_text(const std::vector<RestObservation>& rests, std::size
 }
 
 std::string difference_text(const MountingDifference& d) {
-  return fmt::format("{:.4f} deg and {:.4f} mm ({:.1f} sigma)", d.rotation_rad / kDeg,
+  return fmt::format("{:.4f} deg and {:.4f} mm ({:.1f} sigma)", d.rotation_rad / kRadPerDeg,
                      d.translation_m * 1e3, d.normalised);
 }
 
 std::string max_sigma_text(const MountingEstimate& e) {
   const Eigen::Matrix<double, 6, 1> s = e.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  return fmt::format("{:.5f} deg, {:.5f} mm", s.head<3>().maxCoeff() / kDeg,
+  return fmt::format("{:.5f} deg, {:.5f} mm", s.head<3>().maxCoeff() / kRadPerDeg,
                      s.tail<3>().maxCoeff() * 1e3);
 }
 
@@ -212,7 +211,8 @@ MountingValidation assess_mounting(const FrameCalibrationResult& combined,
     std::string message = fmt::format(
         "1-sigma of T_S_H: {:.5f} deg rotation, {:.5f} mm translation (limits {:.5f} deg, "
         "{:.5f} mm)",
-        rot / kDeg, pos * 1e3, t.max_rotation_sigma_rad / kDeg, t.max_translation_sigma_m * 1e3);
+        rot / kRadPerDeg, pos * 1e3, t.max_rotation_sigma_rad / kRadPerDeg,
+        t.max_translation_sigma_m * 1e3);
     if (combined.covariance_rank_deficient)
       message += "; the covariance is rank deficient (pose set does not determine every unknown)";
     for (const auto& w : combined.weak_directions)

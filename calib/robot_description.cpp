@@ -8,11 +8,10 @@
 #include "calib/urdf_robot.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 
 namespace imscal::calib {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // Numbers with a sign requirement; `what` completes "expected ...".
 double number_at_least(const ConfigNode& parent, std::string_view key, double minimum,
@@ -43,7 +42,7 @@ std::string non_empty_string(const ConfigNode& parent, std::string_view key) {
 Eigen::Isometry3d read_pose(const ConfigNode& node) {
   const Eigen::Vector3d xyz = node.child("xyz_m").as_vector3();
   const Eigen::Vector3d rpy_deg = node.child("rpy_deg").as_vector3();
-  return pose_from_xyz_rpy(xyz, rpy_deg * kDegToRad);
+  return pose_from_xyz_rpy(xyz, rpy_deg * kRadPerDeg);
 }
 
 // inertia_kg_m2: [ixx, iyy, izz, ixy, ixz, iyz] about the centre of mass. A physical inertia
@@ -84,7 +83,7 @@ DriveParameters read_drive(const ConfigNode& node) {
   drive.motor_inertia_kg_m2 = non_negative(node, "motor_inertia_kg_m2");
   drive.stiffness_nm_per_rad = positive(node, "stiffness_nm_per_rad");
   drive.damping_nm_s_per_rad = non_negative(node, "damping_nm_s_per_rad");
-  drive.backlash_rad = non_negative(node, "backlash_deg") * kDegToRad;
+  drive.backlash_rad = non_negative(node, "backlash_deg") * kRadPerDeg;
   drive.coulomb_nm = non_negative(node, "coulomb_nm");
   drive.viscous_nm_s_per_rad = non_negative(node, "viscous_nm_s_per_rad");
   return drive;
@@ -112,17 +111,17 @@ void read_joint(const ConfigNode& node, int index, KinematicModel& kinematics,
   joint.name = non_empty_string(node, "name");
   DhParameters& dh = kinematics.dh[index];
   dh.a_m = node.child("a_m").as_double();
-  dh.alpha_rad = node.child("alpha_deg").as_double() * kDegToRad;
+  dh.alpha_rad = node.child("alpha_deg").as_double() * kRadPerDeg;
   dh.d_m = node.child("d_m").as_double();
-  dh.offset_rad = node.child("offset_deg").as_double() * kDegToRad;
+  dh.offset_rad = node.child("offset_deg").as_double() * kRadPerDeg;
 
   const ConfigNode limit_node = node.child("limit_deg");
   const std::vector<double> limit = limit_node.as_doubles();
   if (limit.size() != 2) limit_node.fail("expected [lower, upper] in degrees");
   if (!(limit[0] < limit[1])) limit_node.fail("expected lower < upper");
-  kinematics.lower_limit_rad(index) = limit[0] * kDegToRad;
-  kinematics.upper_limit_rad(index) = limit[1] * kDegToRad;
-  joint.max_velocity_rad_s = positive(node, "max_velocity_deg_s") * kDegToRad;
+  kinematics.lower_limit_rad(index) = limit[0] * kRadPerDeg;
+  kinematics.upper_limit_rad(index) = limit[1] * kRadPerDeg;
+  joint.max_velocity_rad_s = positive(node, "max_velocity_deg_s") * kRadPerDeg;
 
   const ConfigNode link = node.child("link");
   link.require_only_keys({"mass_kg", "com_m", "inertia_kg_m2"});

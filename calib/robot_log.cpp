@@ -8,11 +8,10 @@
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
 #include "core/numeric_table.hpp"
+#include "core/units.hpp"
 
 namespace imscal::calib {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // Finds `<prefix>_<joint>_rad` or `<prefix>_<joint>_deg`; returns the column and the factor to rad.
 std::pair<std::size_t, double> angle_column(const NumericTable& table, const std::string& prefix,
@@ -22,7 +21,7 @@ std::pair<std::size_t, double> angle_column(const NumericTable& table, const std
     if (table.columns[c] == base + "_rad") return {c, 1.0};
     if (table.columns[c] == base + "_deg") {
       used_degrees = true;
-      return {c, kDegToRad};
+      return {c, kRadPerDeg};
     }
   }
   throw InputError(table.file, table.header_line, base + "_rad",

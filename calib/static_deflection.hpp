@@ -21,13 +21,14 @@
 #include <array>
 
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 
 namespace imscal::calib {
 
 struct StaticDeflectionOptions {
   // Gravity in the robot base R [m/s^2]: down along -z_R for a floor-mounted arm; the site's
   // value is R_R_W g_W (ims::EarthModel::gravity_W at the base).
-  Eigen::Vector3d gravity_R_m_s2{0.0, 0.0, -9.80665};
+  Eigen::Vector3d gravity_R_m_s2{0.0, 0.0, -kStandardGravity_m_s2};
   // 1-sigma of the deflection model as a fraction of the modelled deflection (stiffness, masses
   // and backlash known to a few per cent) [1].
   double model_uncertainty_fraction = 0.05;

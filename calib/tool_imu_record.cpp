@@ -14,13 +14,12 @@
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
 #include "core/input_file.hpp"
+#include "core/units.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::calib {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kStandardGravity = 9.80665;  // m/s^2 per g (the unit of acc_*_g)
 constexpr double kMmToM = 1e-3;
 
 const std::vector<std::string> kRobotColumns = {
@@ -226,10 +225,11 @@ ToolImuRecord read_tool_imu_record(const std::filesystem::path& path,
     record.lines.push_back(line_number);
     std::size_t c = 1;
     if (record.has_raw_imu) {
-      record.gyro_rad_s.emplace_back(values[1] * kDegToRad, values[2] * kDegToRad,
-                                     values[3] * kDegToRad);
-      record.acc_m_s2.emplace_back(values[4] * kStandardGravity, values[5] * kStandardGravity,
-                                   values[6] * kStandardGravity);
+      record.gyro_rad_s.emplace_back(values[1] * kRadPerDeg, values[2] * kRadPerDeg,
+                                     values[3] * kRadPerDeg);
+      record.acc_m_s2.emplace_back(values[4] * kStandardGravity_m_s2,
+                                   values[5] * kStandardGravity_m_s2,
+                                   values[6] * kStandardGravity_m_s2);
       c = 7;
     } else {
       Eigen::Quaterniond q(values[1], values[2], values[3], values[4]);
@@ -618,7 +618,7 @@ ToolImuAnalysis check_tool_imu_record(const ToolImuRecord& record,
     finding.size = ratio;
     finding.unit = "ratio";
     finding.is_defect = std::abs(ratio - 1.0) > options.scale_tolerance;
-    const double rad_ratio = M_PI / 180.0;  // what rad/s labelled as deg/s would give
+    const double rad_ratio = kRadPerDeg;  // what rad/s labelled as deg/s would give
     std::string reading;
     if (!finding.is_defect) {
       reading = "the labelled unit deg/s agrees with the robot";

@@ -9,6 +9,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "core/units.hpp"
 #include "eval/gap_bounds.hpp"
 #include "eval/gap_coupling.hpp"
 #include "eval/gap_filters.hpp"
@@ -636,8 +637,6 @@ std::vector<Eigen::MatrixXd> join_columns(const std::vector<Eigen::MatrixXd>& a,
 }
 
 namespace {
-
-constexpr double kArcsecPerRad = 180.0 / M_PI * 3600.0;
 
 // Half the step of a backlash's modelled gap between the two flanks: the medians of its own
 // joint's modelled gap where the shape's first column (the flank) is positive and negative,

@@ -1,4 +1,5 @@
 #include "eval/gap_imu_signals.hpp"
+#include "core/units.hpp"
 
 #include <fmt/format.h>
 
@@ -8,8 +9,6 @@
 
 namespace imscal::eval {
 namespace {
-
-constexpr double kDeg = 180.0 / M_PI;
 
 // The gyro samples the gap is evaluated on: outside the spans the record's own check flags as
 // motion the sensor did not record (kSensorMissedMotion: no model of the sensor bridges a lost
@@ -134,18 +133,18 @@ std::string size_of(ImuGapEffect e, const ImuGapModel& m) {
       return fmt::format("dt = {:.3f} s (sensor clock behind the robot's poses)", m.time_offset_s);
     case ImuGapEffect::kAxisMisalignment:
       return fmt::format("sensor axes turned {:.1f} deg from the tool axes",
-                         Eigen::AngleAxisd(m.R_T_S).angle() * kDeg);
+                         Eigen::AngleAxisd(m.R_T_S).angle() * kDegPerRad);
     case ImuGapEffect::kScaleFactors:
       return fmt::format("scale factors x {:.3f}, y {:.3f}, z {:.3f}", m.scale.x(), m.scale.y(),
                          m.scale.z());
     case ImuGapEffect::kBias:
-      return fmt::format("bias ({:.2f}, {:.2f}, {:.2f}) deg/s", m.bias_rad_s.x() * kDeg,
-                         m.bias_rad_s.y() * kDeg, m.bias_rad_s.z() * kDeg);
+      return fmt::format("bias ({:.2f}, {:.2f}, {:.2f}) deg/s", m.bias_rad_s.x() * kDegPerRad,
+                         m.bias_rad_s.y() * kDegPerRad, m.bias_rad_s.z() * kDegPerRad);
     case ImuGapEffect::kSaturation: {
       std::vector<std::string> axes;
       for (int i = 0; i < 3; ++i)
         if (m.rail_rad_s[i] < 1e299)
-          axes.push_back(fmt::format("{} at {:.0f} deg/s", "xyz"[i], m.rail_rad_s[i] * kDeg));
+          axes.push_back(fmt::format("{} at {:.0f} deg/s", "xyz"[i], m.rail_rad_s[i] * kDegPerRad));
       return fmt::format("rails {}", fmt::join(axes, ", "));
     }
   }
@@ -290,10 +289,10 @@ std::string verdict_of(const ImuGapDiagnosis& d, double excluded_train, double e
       "defects (motion the sensor did not record, calib::check_tool_imu_record): {:.2f} s of "
       "the training and {:.2f} s of the held-out record.",
       d.unit_scale != 1.0 ? ", the gyro divided by the unit check's scale" : "",
-      d.heldout_rms_rad_s * kDeg, d.heldout_rms_modelled_rad_s * kDeg, shrunk,
+      d.heldout_rms_rad_s * kDegPerRad, d.heldout_rms_modelled_rad_s * kDegPerRad, shrunk,
       found.empty() ? std::string("nothing") : fmt::format("{}", fmt::join(found, "; ")),
       absent.empty() ? std::string("none") : fmt::format("{}", fmt::join(absent, ", ")),
-      d.heldout_noise_rad_s * kDeg, excluded_train, excluded_held);
+      d.heldout_noise_rad_s * kDegPerRad, excluded_train, excluded_held);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 #include "eval/gap_report.hpp"
+#include "core/units.hpp"
 
 #include <fmt/format.h>
 
@@ -17,8 +18,6 @@ nlohmann::json shares_json(const std::vector<GapShare>& shares) {
   }
   return a;
 }
-
-constexpr double kArcsec = 180.0 / M_PI * 3600.0;
 
 // Each joint's own test (eval/gap_joint_significance.hpp), one line per joint.
 std::string significance_text(const GapSignals& s, const Diagnosis& d) {
@@ -169,11 +168,12 @@ nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
 std::string diagnosis_text(const GapSignals& s, const Diagnosis& d) {
   std::string t = "imscal gap diagnosis\n====================\n\nGap RMS per joint:";
   for (const auto& j : d.where.joints)
-    t += fmt::format(" {} {:.3g} rad ({:.1f} arcsec);", j.joint, j.rms_rad, j.rms_rad * kArcsec);
+    t += fmt::format(" {} {:.3g} rad ({:.1f} arcsec);", j.joint, j.rms_rad,
+                     j.rms_rad * kArcsecPerRad);
   t += "\n\n" + d.verdict + "\n";
   for (const auto& m : d.measure_next) t += "  - measure next: " + m + "\n";
   t += fmt::format("\nWhere (gap RMS {:.3g} rad = {:.2f} arcsec, {} samples)\n", d.where.rms_rad,
-                   d.where.rms_rad * kArcsec, s.sample_count());
+                   d.where.rms_rad * kArcsecPerRad, s.sample_count());
   for (const auto& j : d.where.joints) {
     t += fmt::format(
         "  {:<4} RMS {:.3g} rad, {:5.1f} % of the gap energy, direction offset {:.3g} rad\n",

@@ -10,6 +10,7 @@
 
 #include "calib/forward_kinematics.hpp"
 #include "calib/jacobian.hpp"
+#include "core/units.hpp"
 #include "ident/arx_model.hpp"
 #include "ident/cell_blending.hpp"
 #include "ident/operating_point.hpp"
@@ -305,7 +306,7 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
   }
   // Torques of the desired motion: the logged payload as a point mass at the tool origin (the
   // log has no centre of mass); the unit-payload torque is the change for 1 kg more.
-  const Eigen::Vector3d gravity(0.0, 0.0, -9.80665);
+  const Eigen::Vector3d gravity(0.0, 0.0, -kStandardGravity_m_s2);
   sim::RigidBodyDynamics dynamics(robot, std::nullopt, gravity);
   sim::RigidBodyDynamics unit(robot, point_mass(1.0), gravity);
   sim::RigidBodyDynamics bare(robot, std::nullopt, gravity);

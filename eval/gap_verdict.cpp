@@ -1,4 +1,5 @@
 #include "eval/gap_verdict.hpp"
+#include "core/units.hpp"
 
 #include <fmt/format.h>
 
@@ -7,8 +8,6 @@
 
 namespace imscal::eval {
 namespace {
-
-constexpr double kArcsecPerRad = 180.0 / M_PI * 3600.0;
 
 // Where the gap lies, and the cells outside the identified range on every joint that runs there.
 std::string where_in_words(const Diagnosis& d) {

@@ -8,12 +8,11 @@
 #include <string>
 #include <tuple>
 
+#include "core/units.hpp"
 #include "ident/precontrol.hpp"
 
 namespace imscal::ident {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 std::vector<double> scaled(const std::vector<double>& v, double factor) {
   std::vector<double> out;
@@ -100,7 +99,7 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
   const ConfigNode joints = root.child("joints");
   joints.require_only_keys(
       {"max_speed_deg_s", "nominal_payload_kg", "gear_ratio", "gear_stiffness_nm_per_rad"});
-  c.max_speed_rad_s = scaled(joints.child("max_speed_deg_s").as_doubles(), kDeg);
+  c.max_speed_rad_s = scaled(joints.child("max_speed_deg_s").as_doubles(), kRadPerDeg);
   for (double v : c.max_speed_rad_s)
     if (!(v > 0.0)) joints.child("max_speed_deg_s").fail("every maximum speed must be > 0");
   c.gear_ratio = per_joint_positive(joints, "gear_ratio", c.max_speed_rad_s.size(), "gear ratio");
@@ -129,12 +128,12 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
         if (q == "position") {
           d.quantity = OperatingQuantity::kPosition;
           if (e.has("bounds_deg_s2")) e.child("bounds_deg_s2").fail("position bounds: bounds_deg");
-          d.bounds_si = scaled(e.child("bounds_deg").as_doubles(), kDeg);
+          d.bounds_si = scaled(e.child("bounds_deg").as_doubles(), kRadPerDeg);
           check_increasing(e.child("bounds_deg"), d.bounds_si);
         } else if (q == "acceleration") {
           d.quantity = OperatingQuantity::kAcceleration;
           if (e.has("bounds_deg")) e.child("bounds_deg").fail("acceleration bounds: bounds_deg_s2");
-          d.bounds_si = scaled(e.child("bounds_deg_s2").as_doubles(), kDeg);
+          d.bounds_si = scaled(e.child("bounds_deg_s2").as_doubles(), kRadPerDeg);
           check_increasing(e.child("bounds_deg_s2"), d.bounds_si);
         } else {
           e.child("quantity").fail("extra dimension must be 'position' or 'acceleration'");
@@ -146,7 +145,7 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
     if (min_rows < 1) cells->child("min_rows").fail("must be >= 1");
     o.min_rows_per_cell = std::size_t(min_rows);
     o.min_rms_speed_rad_s =
-        cells->get_double("min_rms_speed_deg_s", o.min_rms_speed_rad_s / kDeg) * kDeg;
+        cells->get_double("min_rms_speed_deg_s", o.min_rms_speed_rad_s / kRadPerDeg) * kRadPerDeg;
   }
   if (auto model = root.optional_child("model")) {
     model->require_only_keys({"form", "preview_cycles", "model_torque", "direction",
@@ -168,9 +167,9 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
       model->child("preview_cycles").fail("a preview is used only by the inverse form");
     o.model_torque_input = model->get_bool("model_torque", o.model_torque_input);
     o.direction_input = model->get_bool("direction", o.direction_input);
-    o.direction_speed_scale_rad_s =
-        model->get_double("direction_speed_scale_deg_s", o.direction_speed_scale_rad_s / kDeg) *
-        kDeg;
+    o.direction_speed_scale_rad_s = model->get_double("direction_speed_scale_deg_s",
+                                                      o.direction_speed_scale_rad_s / kRadPerDeg) *
+                                    kRadPerDeg;
     if (!(o.direction_speed_scale_rad_s > 0.0))
       model->child("direction_speed_scale_deg_s").fail("must be > 0");
     o.torque_sign_input = model->get_bool("torque_sign", o.torque_sign_input);
@@ -278,7 +277,8 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
         {"enabled", "min_speed_deg_s", "max_lag_s", "settle_s", "window_s", "min_reversals"});
     o.identify_backlash = b->get_bool("enabled", o.identify_backlash);
     auto& bl = o.backlash;
-    bl.min_speed_rad_s = b->get_double("min_speed_deg_s", bl.min_speed_rad_s / kDeg) * kDeg;
+    bl.min_speed_rad_s =
+        b->get_double("min_speed_deg_s", bl.min_speed_rad_s / kRadPerDeg) * kRadPerDeg;
     bl.max_lag_s = b->get_double("max_lag_s", bl.max_lag_s);
     bl.settle_s = b->get_double("settle_s", bl.settle_s);
     bl.window_s = b->get_double("window_s", bl.window_s);

@@ -7,6 +7,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "core/units.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::ims {
@@ -228,7 +229,7 @@ std::unique_ptr<AnalyticTrajectory> load_segments(const ConfigNode& config) {
     start->require_only_keys({"position_m", "rotation_vector_deg"});
     if (auto p = start->optional_child("position_m")) p_start = p->as_vector3();
     if (auto r = start->optional_child("rotation_vector_deg")) {
-      q_start = quat_exp(Eigen::Vector3d(r->as_vector3() * (M_PI / 180.0)));
+      q_start = quat_exp(Eigen::Vector3d(r->as_vector3() * kRadPerDeg));
     }
   }
   const auto segments = config.child("segments").as_sequence();

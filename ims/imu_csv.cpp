@@ -22,14 +22,13 @@
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
 #include "core/input_file.hpp"
+#include "core/units.hpp"
 
 namespace imscal::ims {
 namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kStandardGravity_m_s2 = 9.80665;  // by definition (CGPM 1901)
-constexpr double kDegToRad = std::numbers::pi / 180.0;
 constexpr std::size_t kColumns = 7;
 constexpr std::size_t kValidationBatch = 4096;  // samples; a power of two
 
@@ -56,16 +55,16 @@ struct Unit {
 const std::vector<Unit>& units_of(std::size_t column, ImuQuantity quantity) {
   static const std::vector<Unit> time = {{"s", 1.0, "s"}, {"ms", 1e-3, "ms"}, {"us", 1e-6, "us"}};
   static const std::vector<Unit> rate = {{"rad_s", 1.0, "rad/s"},
-                                         {"deg_s", kDegToRad, "deg/s"},
-                                         {"deg_h", kDegToRad / 3600.0, "deg/h"}};
+                                         {"deg_s", kRadPerDeg, "deg/s"},
+                                         {"deg_h", kRadPerDeg / 3600.0, "deg/h"}};
   static const std::vector<Unit> force = {{"m_s2", 1.0, "m/s^2"},
                                           {"g", kStandardGravity_m_s2, "g"},
                                           {"mg", kStandardGravity_m_s2 * 1e-3, "mg"}};
   static const std::vector<Unit> angle = {{"rad", 1.0, "rad"},
-                                          {"deg", kDegToRad, "deg"},
+                                          {"deg", kRadPerDeg, "deg"},
                                           {"mrad", 1e-3, "mrad"},
                                           {"urad", 1e-6, "urad"},
-                                          {"arcsec", kDegToRad / 3600.0, "arcsec"}};
+                                          {"arcsec", kRadPerDeg / 3600.0, "arcsec"}};
   static const std::vector<Unit> velocity = {
       {"m_s", 1.0, "m/s"}, {"mm_s", 1e-3, "mm/s"}, {"g_s", kStandardGravity_m_s2, "g*s"}};
   if (column == 0) return time;

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "core/units.hpp"
 #include "ims/imu_data.hpp"
 
 namespace imscal::ims {
@@ -43,7 +44,7 @@ struct ImuReadOptions {
   // used and default_gravity_extra_tolerance_m_s2 is added (|g| ranges over 9.78..9.83 m/s^2 on
   // the Earth's surface).
   double gravity_tolerance_m_s2 = 0.2;
-  double default_gravity_m_s2 = 9.80665;  // standard gravity, used when the file has no site
+  double default_gravity_m_s2 = kStandardGravity_m_s2;  // used when the file has no site
   double default_gravity_extra_tolerance_m_s2 = 0.05;
   // Angular rate above max_plausible_rate_rad_s (on every sample) for at least
   // sustained_rate_duration_s is not a robot motion: the values are taken to be in degrees.

@@ -11,11 +11,10 @@
 
 #include "core/input_error.hpp"
 #include "core/input_file.hpp"
+#include "core/units.hpp"
 
 namespace imscal::ims {
 namespace {
-
-constexpr double kArcsecToRad = M_PI / (180.0 * 3600.0);
 
 const char* const kHeaderFields[3][6] = {
     {"pitch0_deg", "roll0_deg", "yaw0_deg", "ve0_m_s", "vn0_m_s", "vu0_m_s"},
@@ -163,7 +162,7 @@ ImuSeries read_psins(const std::filesystem::path& path, PsinsHeader* header_out)
         }
         header.gyro_scale_arcsec_per_count = Eigen::Vector3d(v[0], v[1], v[2]);
         header.acc_scale_ug_s_per_count = Eigen::Vector3d(v[3], v[4], v[5]);
-        gyro_rad_per_count = header.gyro_scale_arcsec_per_count * kArcsecToRad;
+        gyro_rad_per_count = header.gyro_scale_arcsec_per_count * kRadPerArcsec;
         acc_m_s_per_count = header.acc_scale_ug_s_per_count * 1e-6 * header.gravity_m_s2;
       }
       ++headers_read;

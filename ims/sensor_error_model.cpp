@@ -5,6 +5,7 @@
 #include <Eigen/LU>
 
 #include "core/config_node.hpp"
+#include "core/units.hpp"
 
 namespace imscal::ims {
 
@@ -72,7 +73,7 @@ Eigen::Matrix3d parse_misalignment(const ConfigNode& node) {
           "the diagonal of a misalignment matrix must be 0 (scale factors are separate)");
     }
   }
-  return m * sensor_units::kRadPerArcsec;
+  return m * kRadPerArcsec;
 }
 
 TriadErrors parse_triad(const ConfigNode& node, const char* bias_key, double bias_unit_si) {
@@ -91,7 +92,7 @@ std::string vector_yaml(const Eigen::Vector3d& v) {
 }
 
 std::string triad_yaml(const TriadErrors& t, const char* bias_key, double bias_unit_si) {
-  const Eigen::Matrix3d m = t.misalignment / sensor_units::kRadPerArcsec;
+  const Eigen::Matrix3d m = t.misalignment / kRadPerArcsec;
   return fmt::format("  {}: {}\n  scale_factor_ppm: {}\n  misalignment_arcsec: [{}, {}, {}]\n",
                      bias_key, vector_yaml(t.bias / bias_unit_si),
                      vector_yaml(t.scale_factor / sensor_units::kPerPpm),

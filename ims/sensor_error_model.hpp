@@ -27,17 +27,15 @@
 #include <string>
 
 #include "core/config_node.hpp"
+#include "core/units.hpp"
 #include "ims/imu_data.hpp"
 
 namespace imscal::ims {
 
 // Conversions of the file units used by the sensor YAML files into SI.
 namespace sensor_units {
-inline constexpr double kStandardGravity = 9.80665;  // [m/s^2] per g
-inline constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
-inline constexpr double kRadPerArcsec = kRadPerDeg / 3600.0;
 inline constexpr double kRadPerSecPerDegPerHour = kRadPerDeg / 3600.0;
-inline constexpr double kMetrePerSec2PerMicroG = kStandardGravity * 1e-6;
+inline constexpr double kMetrePerSec2PerMicroG = kStandardGravity_m_s2 * 1e-6;
 inline constexpr double kPerPpm = 1e-6;
 }  // namespace sensor_units
 

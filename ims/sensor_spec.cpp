@@ -1,5 +1,6 @@
 #include "ims/sensor_spec.hpp"
 
+#include "core/units.hpp"
 #include "ims/sensor_error_model.hpp"
 
 namespace imscal::ims {
@@ -66,7 +67,7 @@ SensorSpec parse_sensor_spec(const ConfigNode& config) {
   spec.acc = parse_triad(config.child("accelerometer"),
                          {"velocity_random_walk_ug_per_sqrt_hz", kMetrePerSec2PerMicroG, "sigma_ug",
                           "turn_on_bias_sigma_ug", kMetrePerSec2PerMicroG,
-                          "quantization_lsb_m_per_s", 1.0, "range_g", kStandardGravity});
+                          "quantization_lsb_m_per_s", 1.0, "range_g", kStandardGravity_m_s2});
   return spec;
 }
 

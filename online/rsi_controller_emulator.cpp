@@ -8,11 +8,12 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/units.hpp"
+
 namespace imscal::online {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr double kDegPerRad = 180.0 / M_PI;
 
 struct Answer {
   std::uint64_t ipoc = 0;

@@ -3,13 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/units.hpp"
+
 namespace imscal::online {
-namespace {
-
-constexpr double kDegPerRad = 180.0 / M_PI;
-
-}  // namespace
-
 const char* to_string(RsiFault fault) {
   switch (fault) {
     case RsiFault::kMalformed:

@@ -18,6 +18,7 @@
 #include "calib/inverse_kinematics.hpp"
 #include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 #include "sim/cartesian_timing.hpp"
 #include "sim/motion_profile.hpp"
 
@@ -28,7 +29,6 @@ using calib::JointVector;
 using calib::kJointCount;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 // Relative slack on limit checks: the profile meets its limits up to rounding (~1e-15).
 constexpr double kLimitSlack = 1e-9;
 
@@ -113,8 +113,8 @@ std::string Planner::describe_outside_limits(const JointVector& q) const {
   for (int i = 0; i < kJointCount; ++i) {
     if (q(i) < k.lower_limit_rad(i) || q(i) > k.upper_limit_rad(i)) {
       out += fmt::format(" joint {} would reach {:.3f} deg, outside [{:.1f}, {:.1f}] deg;",
-                         robot_.joints[i].name, q(i) * kRadToDeg, k.lower_limit_rad(i) * kRadToDeg,
-                         k.upper_limit_rad(i) * kRadToDeg);
+                         robot_.joints[i].name, q(i) * kDegPerRad,
+                         k.lower_limit_rad(i) * kDegPerRad, k.upper_limit_rad(i) * kDegPerRad);
     }
   }
   return out;
@@ -127,8 +127,8 @@ void Planner::check_within_limits(const ProgramStep& step, const JointVector& q,
     if (q(i) < k.lower_limit_rad(i) || q(i) > k.upper_limit_rad(i)) {
       fail(step,
            fmt::format("{}: joint {} at {:.4f} deg is outside its limits [{:.1f}, {:.1f}] deg",
-                       what, robot_.joints[i].name, q(i) * kRadToDeg,
-                       k.lower_limit_rad(i) * kRadToDeg, k.upper_limit_rad(i) * kRadToDeg));
+                       what, robot_.joints[i].name, q(i) * kDegPerRad,
+                       k.lower_limit_rad(i) * kDegPerRad, k.upper_limit_rad(i) * kDegPerRad));
     }
   }
 }
@@ -366,14 +366,14 @@ std::vector<JointState> Planner::sample_cartesian(const ProgramStep& step,
       if (std::abs(j.qd(i)) > v_max * (1.0 + kLimitSlack)) {
         fail(step, fmt::format("at {:.3f} s ({:.1f} mm along the path): joint {} would turn at "
                                "{:.1f} deg/s, above its max velocity {:.1f} deg/s",
-                               t, s.position * 1e3, robot_.joints[i].name, j.qd(i) * kRadToDeg,
-                               v_max * kRadToDeg));
+                               t, s.position * 1e3, robot_.joints[i].name, j.qd(i) * kDegPerRad,
+                               v_max * kDegPerRad));
       }
       // Between two samples a joint moves at most v_max * cycle; far more means IK jumped.
       if (std::abs(j.q(i) - q_prev(i)) > 2.0 * v_max * cycle_ + 1e-9) {
         fail(step, fmt::format("at {:.3f} s: joint {} jumps by {:.3f} deg in one cycle (IK "
                                "branch change)",
-                               t, robot_.joints[i].name, (j.q(i) - q_prev(i)) * kRadToDeg));
+                               t, robot_.joints[i].name, (j.q(i) - q_prev(i)) * kDegPerRad));
       }
     }
     q_prev = j.q;
@@ -524,8 +524,8 @@ DesiredJointPath Planner::run() {
       throw InputError(
           program_.source, 0, "start_joints_deg",
           fmt::format("joint {} at {:.4f} deg is outside its limits [{:.1f}, {:.1f}] deg",
-                      robot_.joints[i].name, q_(i) * kRadToDeg, k.lower_limit_rad(i) * kRadToDeg,
-                      k.upper_limit_rad(i) * kRadToDeg));
+                      robot_.joints[i].name, q_(i) * kDegPerRad, k.lower_limit_rad(i) * kDegPerRad,
+                      k.upper_limit_rad(i) * kDegPerRad));
     }
   }
   DesiredJointSample first;

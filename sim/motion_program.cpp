@@ -6,11 +6,11 @@
 #include <cmath>
 
 #include "core/config_node.hpp"
+#include "core/units.hpp"
 
 namespace imscal::sim {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kMmToM = 1e-3;
 
 calib::JointVector read_joints(const ConfigNode& node, double scale, bool positive) {
@@ -75,7 +75,7 @@ void read_cartesian(const ConfigNode& node, Eigen::Vector3d& xyz_m,
   xyz_m = node.child("xyz_mm").as_vector3() * kMmToM;
   if (auto r = node.optional_child("rpy_deg")) {
     rotation =
-        calib::pose_from_xyz_rpy(Eigen::Vector3d::Zero(), r->as_vector3() * kDegToRad).linear();
+        calib::pose_from_xyz_rpy(Eigen::Vector3d::Zero(), r->as_vector3() * kRadPerDeg).linear();
   }
 }
 
@@ -125,13 +125,13 @@ ProgramStep read_step(const ConfigNode& item, ProfileKind default_profile, std::
       body.fail("give exactly one target: joints_deg or pose");
     }
     if (auto j = body.optional_child("joints_deg")) {
-      step.target_joints_rad = read_joints(*j, kDegToRad, false);
+      step.target_joints_rad = read_joints(*j, kRadPerDeg, false);
     } else {
       const ConfigNode pose = body.child("pose");
       pose.require_only_keys({"xyz_mm", "rpy_deg"});
       Eigen::Isometry3d T =
           calib::pose_from_xyz_rpy(pose.child("xyz_mm").as_vector3() * kMmToM,
-                                   pose.child("rpy_deg").as_vector3() * kDegToRad);
+                                   pose.child("rpy_deg").as_vector3() * kRadPerDeg);
       step.target_pose = T;
     }
     step.velocity_scale = fraction(body, "velocity_scale");
@@ -168,7 +168,7 @@ ProgramStep read_step(const ConfigNode& item, ProfileKind default_profile, std::
     step.normal.normalize();
     step.radius_m = positive(body.child("radius_mm")) * kMmToM;
     if (auto a = body.optional_child("angle_deg")) {
-      step.angle_rad = a->as_double() * kDegToRad;
+      step.angle_rad = a->as_double() * kRadPerDeg;
       if (step.angle_rad == 0.0) a->fail("angle must not be zero");
     }
     read_path_limits(body, step);
@@ -219,12 +219,12 @@ MotionProgram parse_motion_program(const ConfigNode& root) {
   MotionProgram program;
   program.source = root.file();
   program.name = root.child("name").as_string();
-  program.start_joints_rad = read_joints(root.child("start_joints_deg"), kDegToRad, false);
+  program.start_joints_rad = read_joints(root.child("start_joints_deg"), kRadPerDeg, false);
   if (auto p = root.optional_child("profile")) program.default_profile = read_profile(*p);
   program.max_acceleration_rad_s2 =
-      read_joints(root.child("joint_acceleration_deg_s2"), kDegToRad, true);
+      read_joints(root.child("joint_acceleration_deg_s2"), kRadPerDeg, true);
   if (auto j = root.optional_child("joint_jerk_deg_s3")) {
-    program.max_jerk_rad_s3 = read_joints(*j, kDegToRad, true);
+    program.max_jerk_rad_s3 = read_joints(*j, kRadPerDeg, true);
   }
   program.initial_payload.name = "none";
   if (auto p = root.optional_child("payload")) program.initial_payload = read_payload(*p);

@@ -5,18 +5,17 @@
 #include <string>
 
 #include "core/config_node.hpp"
+#include "core/units.hpp"
 
 namespace imscal::sim {
 namespace {
-
-constexpr double kArcsec = M_PI / 180.0 / 3600.0;
 
 void read_shape(const ConfigNode& node, TransmissionErrorShape& shape) {
   node.require_only_keys({"amplitude_arcsec", "harmonic_per_motor_rev", "phase_deg"});
   if (node.has("amplitude_arcsec")) {
     const double arcsec = node.child("amplitude_arcsec").as_double();
     if (arcsec < 0.0) node.child("amplitude_arcsec").fail("must be >= 0");
-    shape.amplitude_rad = arcsec * kArcsec;
+    shape.amplitude_rad = arcsec * kRadPerArcsec;
   }
   if (node.has("harmonic_per_motor_rev")) {
     const double harmonic = node.child("harmonic_per_motor_rev").as_double();

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 
 namespace imscal {
 class ConfigNode;
@@ -76,7 +77,7 @@ struct PlantConfig {
   bool controller = true;  // false: drive torque 0 (free motion, e.g. for the energy check)
   // Gravity in the robot base R [m/s^2]: the base stands upright (z_R up) unless told otherwise;
   // the coordinator may set the site's local gravity here.
-  Eigen::Vector3d gravity_in_base_m_s2{0.0, 0.0, -9.80665};
+  Eigen::Vector3d gravity_in_base_m_s2{0.0, 0.0, -kStandardGravity_m_s2};
 };
 
 // All effects as JointEffects{} (everything on but the transmission error) unless the `effects`

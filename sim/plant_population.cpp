@@ -1,4 +1,5 @@
 #include "sim/plant_population.hpp"
+#include "core/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,8 +9,6 @@
 
 namespace imscal::sim {
 namespace {
-
-constexpr double kArcminPerRad = 180.0 / M_PI * 60.0;
 
 // Uniform draws in [0, 1) from the top 53 bits of mt19937_64: the same numbers on every standard
 // library (std::uniform_real_distribution's algorithm is not specified).

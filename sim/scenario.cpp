@@ -12,6 +12,7 @@
 #include "core/input_error.hpp"
 #include "core/path_checks.hpp"
 #include "core/payload_plausibility.hpp"
+#include "core/units.hpp"
 
 #ifndef IMSCAL_DATASETS_DIR
 #define IMSCAL_DATASETS_DIR ""
@@ -21,7 +22,6 @@ namespace imscal::sim {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDegToRad = M_PI / 180.0;
 
 double non_negative(const ConfigNode& node) {
   const double value = node.as_double();
@@ -172,7 +172,7 @@ Scenario load_scenario(const fs::path& file) {
   const ConfigNode base = root.child("base_in_world");
   base.require_only_keys({"xyz_m", "rpy_deg", "random_yaw"});
   s.T_W_R = calib::pose_from_xyz_rpy(base.child("xyz_m").as_vector3(),
-                                     base.child("rpy_deg").as_vector3() * kDegToRad);
+                                     base.child("rpy_deg").as_vector3() * kRadPerDeg);
   s.random_base_yaw = base.get_bool("random_yaw", false);
 
   if (const auto mount = root.optional_child("sensor_mount")) {
@@ -184,14 +184,14 @@ Scenario load_scenario(const fs::path& file) {
     const Eigen::Vector3d rpy_deg = mount->has("offset_rpy_deg")
                                         ? mount->child("offset_rpy_deg").as_vector3()
                                         : Eigen::Vector3d::Zero();
-    s.mount_offset = calib::pose_from_xyz_rpy(xyz_mm * 1e-3, rpy_deg * kDegToRad);
+    s.mount_offset = calib::pose_from_xyz_rpy(xyz_mm * 1e-3, rpy_deg * kRadPerDeg);
     if (mount->has("random_position_sigma_mm")) {
       s.mount_random_position_sigma_m =
           non_negative(mount->child("random_position_sigma_mm")) * 1e-3;
     }
     if (mount->has("random_rotation_sigma_deg")) {
       s.mount_random_rotation_sigma_rad =
-          non_negative(mount->child("random_rotation_sigma_deg")) * kDegToRad;
+          non_negative(mount->child("random_rotation_sigma_deg")) * kRadPerDeg;
     }
   }
   s.effects = root.optional_child("effects");

@@ -12,6 +12,7 @@
 #include "core/csv_text.hpp"
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
+#include "core/units.hpp"
 #include "ims/imu_file.hpp"
 #include "ims/nav_trajectory_io.hpp"
 
@@ -73,8 +74,8 @@ std::string flange_csv(const SimulationResult& r) {
 // The biases the record carries, turn-on + in-run, every `every_s` of the IMS clock (the in-run
 // part changes over minutes; its mean over the sample interval at the stamp).
 std::string imu_bias_csv(const SimulationResult& r, double every_s) {
-  constexpr double kDegPerHourPerRadPerSecond = 180.0 / M_PI * 3600.0;
-  constexpr double kMicroGPerMeterPerSecond2 = 1e6 / 9.80665;
+  constexpr double kDegPerHourPerRadPerSecond = kDegPerRad * 3600.0;
+  constexpr double kMicroGPerMeterPerSecond2 = 1e6 / kStandardGravity_m_s2;
   std::string text =
       "# imscal-truth-imu-bias: 1\n"
       "t_s,gyro_bias_x_deg_h,gyro_bias_y_deg_h,gyro_bias_z_deg_h,acc_bias_x_ug,acc_bias_y_ug,"

@@ -16,15 +16,17 @@
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "core/units.hpp"
 #include "ims/coarse_alignment.hpp"
 #include "ims/imu_file.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
 
+using imscal::kRadPerDeg;
+
 using imscal::ims::CoarseAlignment;
-constexpr double kDeg = M_PI / 180.0;
-constexpr double kDegPerHour = kDeg / 3600.0;
+constexpr double kDegPerHour = kRadPerDeg / 3600.0;
 
 struct AlignArgs {
   std::string input;
@@ -69,13 +71,13 @@ nlohmann::json to_json(const CoarseAlignment& a) {
   j["duration_s"] = a.end_s - a.start_s;
   j["first_sample"] = a.first_sample;
   j["sample_count"] = a.sample_count;
-  j["roll_deg"] = a.angles.roll_rad / kDeg;
-  j["pitch_deg"] = a.angles.pitch_rad / kDeg;
-  j["heading_cw_from_north_deg"] = a.angles.heading_rad / kDeg;
-  j["yaw_psins_ccw_from_north_deg"] = a.angles.yaw_rad / kDeg;
-  j["sigma_roll_deg"] = a.sigma_roll_rad / kDeg;
-  j["sigma_pitch_deg"] = a.sigma_pitch_rad / kDeg;
-  j["sigma_heading_deg"] = a.sigma_heading_rad / kDeg;
+  j["roll_deg"] = a.angles.roll_rad / kRadPerDeg;
+  j["pitch_deg"] = a.angles.pitch_rad / kRadPerDeg;
+  j["heading_cw_from_north_deg"] = a.angles.heading_rad / kRadPerDeg;
+  j["yaw_psins_ccw_from_north_deg"] = a.angles.yaw_rad / kRadPerDeg;
+  j["sigma_roll_deg"] = a.sigma_roll_rad / kRadPerDeg;
+  j["sigma_pitch_deg"] = a.sigma_pitch_rad / kRadPerDeg;
+  j["sigma_heading_deg"] = a.sigma_heading_rad / kRadPerDeg;
   j["q_W_S"] = {{"w", a.q_W_S.w()}, {"x", a.q_W_S.x()}, {"y", a.q_W_S.y()}, {"z", a.q_W_S.z()}};
   j["specific_force_m_s2"] = a.specific_force_m_s2;
   j["expected_gravity_m_s2"] = a.expected_gravity_m_s2;
@@ -92,9 +94,10 @@ std::string summary_line(const std::string& label, const CoarseAlignment& a) {
   return fmt::format(
       "{:<10} t_ref {:9.2f} s  heading {:9.4f} +- {:.4f} deg  (PSINS yaw {:9.4f})  pitch {:8.4f} "
       "+- {:.4f} deg  roll {:8.4f} +- {:.4f} deg\n",
-      label, a.t_ref_s, a.angles.heading_rad / kDeg, a.sigma_heading_rad / kDeg,
-      a.angles.yaw_rad / kDeg, a.angles.pitch_rad / kDeg, a.sigma_pitch_rad / kDeg,
-      a.angles.roll_rad / kDeg, a.sigma_roll_rad / kDeg);
+      label, a.t_ref_s, a.angles.heading_rad / kRadPerDeg, a.sigma_heading_rad / kRadPerDeg,
+      a.angles.yaw_rad / kRadPerDeg, a.angles.pitch_rad / kRadPerDeg,
+      a.sigma_pitch_rad / kRadPerDeg, a.angles.roll_rad / kRadPerDeg,
+      a.sigma_roll_rad / kRadPerDeg);
 }
 
 void run(const AlignArgs& args) {
@@ -193,9 +196,9 @@ void run(const AlignArgs& args) {
                                                          {"heading", AngleKind::kHeading}};
       for (const auto& [name, kind] : kinds) {
         const AngleSpread s = angle_spread(windows, kind);
-        spread[std::string(name) + "_mean_deg"] = s.mean_rad / kDeg;
-        spread[std::string(name) + "_std_deg"] = s.std_rad / kDeg;
-        spread[std::string(name) + "_max_minus_min_deg"] = (s.max_rad - s.min_rad) / kDeg;
+        spread[std::string(name) + "_mean_deg"] = s.mean_rad / kRadPerDeg;
+        spread[std::string(name) + "_std_deg"] = s.std_rad / kRadPerDeg;
+        spread[std::string(name) + "_max_minus_min_deg"] = (s.max_rad - s.min_rad) / kRadPerDeg;
       }
       out["window_spread"] = spread;
       text += fmt::format(

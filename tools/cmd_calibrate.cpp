@@ -43,6 +43,7 @@
 #include "core/payload_plausibility.hpp"
 #include "core/progress.hpp"
 #include "core/sha256.hpp"
+#include "core/units.hpp"
 #include "core/version.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ims/imu_conversion.hpp"
@@ -57,8 +58,6 @@ namespace fs = std::filesystem;
 namespace calib = imscal::calib;
 using nlohmann::json;
 using namespace imscal;
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct CalibrateArgs {
   std::string imu;
@@ -195,11 +194,11 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
           e.value[k], k < e.sigma.size() ? e.sigma[k] : 0.0);
     line(fmt::format("  {} [{}]:{}", e.name, e.unit, values));
   }
-  const Eigen::Vector3d rpy_S_H = calib::roll_pitch_yaw(r.T_S_H.linear()) / kDeg;
+  const Eigen::Vector3d rpy_S_H = calib::roll_pitch_yaw(r.T_S_H.linear()) / kRadPerDeg;
   line(fmt::format("  T_S_H: xyz {:.4f} {:.4f} {:.4f} mm, rpy {:.5f} {:.5f} {:.5f} deg",
                    r.T_S_H.translation().x() * 1e3, r.T_S_H.translation().y() * 1e3,
                    r.T_S_H.translation().z() * 1e3, rpy_S_H.x(), rpy_S_H.y(), rpy_S_H.z()));
-  const Eigen::Vector3d rpy_R_W = calib::roll_pitch_yaw(r.T_R_W.linear()) / kDeg;
+  const Eigen::Vector3d rpy_R_W = calib::roll_pitch_yaw(r.T_R_W.linear()) / kRadPerDeg;
   line(
       fmt::format("  T_R_W: xyz {:.4f} {:.4f} {:.4f} mm, rpy {:.5f} {:.5f} {:.5f} deg "
                   "(W origin: the sensor at rest 1)",
@@ -220,11 +219,12 @@ std::string summary_text(const CalibrateArgs& args, const calib::FrameCalibratio
   line("rest residuals (normalised, rotation):");
   for (const auto& p : r.rest_residuals)
     line(fmt::format("  {:<28} {:7.2f} sigma {:10.6f} deg{}", p.label, p.normalised,
-                     p.rotation_rad / kDeg, p.outlier ? "  OUTLIER" : ""));
+                     p.rotation_rad / kRadPerDeg, p.outlier ? "  OUTLIER" : ""));
   line("motion residuals (normalised, rotation, position):");
   for (const auto& p : r.motion_residuals)
     line(fmt::format("  {:<28} {:7.2f} sigma {:10.6f} deg {:9.4f} mm{}", p.label, p.normalised,
-                     p.rotation_rad / kDeg, p.position_m * 1e3, p.outlier ? "  OUTLIER" : ""));
+                     p.rotation_rad / kRadPerDeg, p.position_m * 1e3,
+                     p.outlier ? "  OUTLIER" : ""));
   if (je) {
     line("");
     line(fmt::format(

@@ -27,12 +27,14 @@
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "core/units.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
 
+using imscal::kDegPerRad;
+
 using namespace imscal::calib;
-constexpr double kDeg = 180.0 / M_PI;
 
 struct Args {
   std::string imu;
@@ -49,21 +51,21 @@ nlohmann::json vector_json(const Eigen::Vector3d& v, double scale = 1.0) {
 nlohmann::json calibration_json(const RotationCalibration& c) {
   nlohmann::json j;
   j["q_T_S_wxyz"] = {c.q_T_S.w(), c.q_T_S.x(), c.q_T_S.y(), c.q_T_S.z()};
-  j["rotation_angle_deg"] = Eigen::AngleAxisd(c.q_T_S).angle() * kDeg;
-  j["sigma_rotation_deg"] = vector_json(c.sigma_rotation_rad, kDeg);
-  j["gyro_bias_deg_s_as_labelled"] = vector_json(c.gyro_bias_rad_s, kDeg);
-  j["sigma_gyro_bias_deg_s"] = vector_json(c.sigma_bias_rad_s, kDeg);
+  j["rotation_angle_deg"] = Eigen::AngleAxisd(c.q_T_S).angle() * kDegPerRad;
+  j["sigma_rotation_deg"] = vector_json(c.sigma_rotation_rad, kDegPerRad);
+  j["gyro_bias_deg_s_as_labelled"] = vector_json(c.gyro_bias_rad_s, kDegPerRad);
+  j["sigma_gyro_bias_deg_s"] = vector_json(c.sigma_bias_rad_s, kDegPerRad);
   j["gyro_scale"] = vector_json(c.gyro_scale);
   j["sigma_gyro_scale"] = vector_json(c.sigma_scale);
   j["time_offset_s"] = c.time_offset_s;
   j["sigma_time_offset_s"] = c.sigma_time_offset_s;
   j["sigma_method"] = c.sigma_from_bootstrap ? "moving-block bootstrap" : "covariance";
   j["bootstrap_replicates"] = c.bootstrap_replicates;
-  j["covariance_sigma_rotation_deg"] = vector_json(c.covariance_sigma_rotation_rad, kDeg);
+  j["covariance_sigma_rotation_deg"] = vector_json(c.covariance_sigma_rotation_rad, kDegPerRad);
   j["covariance_sigma_time_offset_s"] = c.covariance_sigma_time_offset_s;
   j["covariance_ok"] = c.covariance_ok;
   j["window_count"] = c.window_count;
-  j["rms_residual_deg"] = c.rms_residual_rad * kDeg;
+  j["rms_residual_deg"] = c.rms_residual_rad * kDegPerRad;
   j["solver"] = c.summary;
   return j;
 }
@@ -73,18 +75,18 @@ void print_calibration(const std::string& title, const RotationCalibration& c) {
       "{}: R_T_S angle {:.3f} deg (1 sigma {:.3f} {:.3f} {:.3f} deg, {}), time offset {:.4f} +- "
       "{:.4f} s,\n  gyro bias {:.4g} {:.4g} {:.4g} deg/s (as labelled), scale {:.5g} {:.5g} "
       "{:.5g}, window residual RMS {:.3f} deg over {} windows\n",
-      title, Eigen::AngleAxisd(c.q_T_S).angle() * kDeg, c.sigma_rotation_rad.x() * kDeg,
-      c.sigma_rotation_rad.y() * kDeg, c.sigma_rotation_rad.z() * kDeg,
+      title, Eigen::AngleAxisd(c.q_T_S).angle() * kDegPerRad, c.sigma_rotation_rad.x() * kDegPerRad,
+      c.sigma_rotation_rad.y() * kDegPerRad, c.sigma_rotation_rad.z() * kDegPerRad,
       c.sigma_from_bootstrap ? "block bootstrap" : "covariance", c.time_offset_s,
-      c.sigma_time_offset_s, c.gyro_bias_rad_s.x() * kDeg, c.gyro_bias_rad_s.y() * kDeg,
-      c.gyro_bias_rad_s.z() * kDeg, c.gyro_scale.x(), c.gyro_scale.y(), c.gyro_scale.z(),
-      c.rms_residual_rad * kDeg, c.window_count);
+      c.sigma_time_offset_s, c.gyro_bias_rad_s.x() * kDegPerRad, c.gyro_bias_rad_s.y() * kDegPerRad,
+      c.gyro_bias_rad_s.z() * kDegPerRad, c.gyro_scale.x(), c.gyro_scale.y(), c.gyro_scale.z(),
+      c.rms_residual_rad * kDegPerRad, c.window_count);
 }
 
 nlohmann::json error_json(const OrientationErrorStats& e) {
-  return {{"rms_deg", e.rms_rad * kDeg},
-          {"max_deg", e.max_rad * kDeg},
-          {"final_deg", e.final_rad * kDeg},
+  return {{"rms_deg", e.rms_rad * kDegPerRad},
+          {"max_deg", e.max_rad * kDegPerRad},
+          {"final_deg", e.final_rad * kDegPerRad},
           {"samples", e.sample_count}};
 }
 
@@ -93,11 +95,11 @@ nlohmann::json segment_json(const SegmentRotation& s) {
           {"end_s", s.end_s},
           {"first_line", s.first_line},
           {"last_line", s.last_line},
-          {"robot_angle_deg", s.robot_angle_rad * kDeg},
-          {"gyro_angle_deg", s.gyro_angle_rad * kDeg},
-          {"difference_deg", s.difference_rad * kDeg},
-          {"loss_deg", s.loss_rad * kDeg},
-          {"axis_tilt_deg", s.axis_tilt_rad * kDeg}};
+          {"robot_angle_deg", s.robot_angle_rad * kDegPerRad},
+          {"gyro_angle_deg", s.gyro_angle_rad * kDegPerRad},
+          {"difference_deg", s.difference_rad * kDegPerRad},
+          {"loss_deg", s.loss_rad * kDegPerRad},
+          {"axis_tilt_deg", s.axis_tilt_rad * kDegPerRad}};
 }
 
 // The findings of the record's checks, printed and as JSON.
@@ -136,8 +138,9 @@ nlohmann::json report_orientation(const ToolImuRecord& record, const ToolImuAnal
         "  [orientation_loss] lines {}-{}, sensor time {:.2f}-{:.2f} s: the robot turned {:.1f} "
         "deg, the gyro {:.1f} deg; {:.1f} deg of rotation about the turn's axis lost (or added), "
         "{:.1f} deg across it\n",
-        loss.first_line, loss.last_line, loss.begin_s, loss.end_s, loss.robot_angle_rad * kDeg,
-        loss.gyro_angle_rad * kDeg, loss.loss_rad * kDeg, loss.axis_tilt_rad * kDeg);
+        loss.first_line, loss.last_line, loss.begin_s, loss.end_s,
+        loss.robot_angle_rad * kDegPerRad, loss.gyro_angle_rad * kDegPerRad,
+        loss.loss_rad * kDegPerRad, loss.axis_tilt_rad * kDegPerRad);
     out["losses"].push_back(segment_json(loss));
   }
   const auto spans =
@@ -146,15 +149,16 @@ nlohmann::json report_orientation(const ToolImuRecord& record, const ToolImuAnal
   std::cout << fmt::format(
       "orientation error of the calibrated gyro against the robot: from the start RMS {:.3f} deg, "
       "max {:.3f} deg over {} samples\n",
-      error.from_start.rms_rad * kDeg, error.from_start.max_rad * kDeg,
+      error.from_start.rms_rad * kDegPerRad, error.from_start.max_rad * kDegPerRad,
       error.from_start.sample_count);
   out["from_start"] = error_json(error.from_start);
   if (restart) {
     std::cout << fmt::format(
         "  restarted from the robot's pose after each of {} lost spans (the spans left out): RMS "
         "{:.3f} deg, max {:.3f} deg over {} of the {} samples\n",
-        spans.size(), error.with_restarts.rms_rad * kDeg, error.with_restarts.max_rad * kDeg,
-        error.with_restarts.sample_count, error.from_start.sample_count);
+        spans.size(), error.with_restarts.rms_rad * kDegPerRad,
+        error.with_restarts.max_rad * kDegPerRad, error.with_restarts.sample_count,
+        error.from_start.sample_count);
     out["with_restarts"] = error_json(error.with_restarts);
     out["restart_times_s"] = error.restart_times_s;
   }
@@ -171,7 +175,7 @@ nlohmann::json report_ahrs(const ToolImuRecord& ahrs) {
     std::cout << fmt::format(
         "AHRS {} (alignment to tool and base fitted on this same record): RMS {:.3f} deg, max "
         "{:.3f} deg over {} samples\n",
-        ahrs.file, error.rms_rad * kDeg, error.max_rad * kDeg, error.sample_count);
+        ahrs.file, error.rms_rad * kDegPerRad, error.max_rad * kDegPerRad, error.sample_count);
     nlohmann::json out = error_json(error);
     out["file"] = ahrs.file;
     out["refused"] = false;

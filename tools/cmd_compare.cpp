@@ -9,10 +9,13 @@
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "core/units.hpp"
 #include "ims/trajectory_comparison.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
+
+using imscal::kDegPerRad;
 namespace ims = imscal::ims;
 
 struct CompareArgs {
@@ -31,19 +34,18 @@ void run(const CompareArgs& args) {
   } catch (const std::invalid_argument& e) {
     throw imscal::InputError(args.estimate, 0, "t_s", e.what());
   }
-  constexpr double kDeg = 180.0 / M_PI;
   std::cout << fmt::format(
       "{} states matched\nposition error: RMS {:.4f} mm, max {:.4f} mm\nattitude error: RMS "
       "{:.6f} deg, max {:.6f} deg\n",
-      c.matched_states, 1e3 * c.position_rms_m, 1e3 * c.position_max_m, kDeg * c.attitude_rms_rad,
-      kDeg * c.attitude_max_rad);
+      c.matched_states, 1e3 * c.position_rms_m, 1e3 * c.position_max_m,
+      kDegPerRad * c.attitude_rms_rad, kDegPerRad * c.attitude_max_rad);
   nlohmann::json j = {{"estimate", args.estimate},
                       {"reference", args.reference},
                       {"matched_states", c.matched_states},
                       {"position_error_rms_mm", 1e3 * c.position_rms_m},
                       {"position_error_max_mm", 1e3 * c.position_max_m},
-                      {"attitude_error_rms_deg", kDeg * c.attitude_rms_rad},
-                      {"attitude_error_max_deg", kDeg * c.attitude_max_rad}};
+                      {"attitude_error_rms_deg", kDegPerRad * c.attitude_rms_rad},
+                      {"attitude_error_max_deg", kDegPerRad * c.attitude_max_rad}};
   if (!std::isnan(c.normalised_error_rms[0])) {
     const auto& n = c.normalised_error_rms;
     std::cout << fmt::format(

@@ -17,13 +17,13 @@
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "core/units.hpp"
 #include "eval/gap_imu_signals.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
 
 using namespace imscal;
-constexpr double kDeg = 180.0 / M_PI;
 
 struct Args {
   std::string imu, held_out, out;
@@ -33,14 +33,15 @@ struct Args {
 nlohmann::json model_json(const eval::ImuGapModel& m) {
   nlohmann::json rails = nlohmann::json::array();
   for (int i = 0; i < 3; ++i) {
-    rails.push_back(m.rail_rad_s[i] < 1e299 ? nlohmann::json(m.rail_rad_s[i] * kDeg) : nullptr);
+    rails.push_back(m.rail_rad_s[i] < 1e299 ? nlohmann::json(m.rail_rad_s[i] * kDegPerRad)
+                                            : nullptr);
   }
   const Eigen::Matrix3d& R = m.R_T_S;
   return {{"time_offset_s", m.time_offset_s},
           {"R_T_S", {R.row(0), R.row(1), R.row(2)}},
-          {"axis_angle_deg", Eigen::AngleAxisd(R).angle() * kDeg},
+          {"axis_angle_deg", Eigen::AngleAxisd(R).angle() * kDegPerRad},
           {"scale_as_labelled", m.scale},
-          {"bias_deg_s_as_labelled", m.bias_rad_s * kDeg},
+          {"bias_deg_s_as_labelled", m.bias_rad_s * kDegPerRad},
           {"rail_deg_s_as_labelled", rails}};
 }
 
@@ -49,7 +50,7 @@ nlohmann::json diagnosis_json(const Args& args, const eval::ImuGapDiagnosis& d) 
   for (const eval::ImuGapStep& s : d.steps) {
     steps.push_back({{"effect", eval::to_string(s.effect)},
                      {"from_unit_check", s.from_unit_check},
-                     {"held_out_rms_deg_s", s.heldout_rms_rad_s * kDeg},
+                     {"held_out_rms_deg_s", s.heldout_rms_rad_s * kDegPerRad},
                      {"held_out_shrinkage_percent", s.heldout_shrinkage_percent},
                      {"size", s.size}});
   }
@@ -58,11 +59,11 @@ nlohmann::json diagnosis_json(const Args& args, const eval::ImuGapDiagnosis& d) 
   return {{"training", args.imu},
           {"held_out", args.held_out},
           {"unit_scale", d.unit_scale},
-          {"held_out_rms_as_labelled_deg_s", d.heldout_rms_as_labelled_rad_s * kDeg},
-          {"training_rms_deg_s", d.training_rms_rad_s * kDeg},
-          {"held_out_rms_deg_s", d.heldout_rms_rad_s * kDeg},
-          {"held_out_rms_modelled_deg_s", d.heldout_rms_modelled_rad_s * kDeg},
-          {"held_out_noise_deg_s", d.heldout_noise_rad_s * kDeg},
+          {"held_out_rms_as_labelled_deg_s", d.heldout_rms_as_labelled_rad_s * kDegPerRad},
+          {"training_rms_deg_s", d.training_rms_rad_s * kDegPerRad},
+          {"held_out_rms_deg_s", d.heldout_rms_rad_s * kDegPerRad},
+          {"held_out_rms_modelled_deg_s", d.heldout_rms_modelled_rad_s * kDegPerRad},
+          {"held_out_noise_deg_s", d.heldout_noise_rad_s * kDegPerRad},
           {"excluded_training_s", d.excluded_training_s},
           {"excluded_held_out_s", d.excluded_heldout_s},
           {"steps", steps},
@@ -85,7 +86,7 @@ void run(const Args& args) {
   std::cout << d.verdict << "\n";
   for (const eval::ImuGapStep& s : d.steps) {
     std::cout << fmt::format("  + {:<18} held-out RMS {:.2f} deg/s ({:.0f} % smaller): {}\n",
-                             eval::to_string(s.effect), s.heldout_rms_rad_s * kDeg,
+                             eval::to_string(s.effect), s.heldout_rms_rad_s * kDegPerRad,
                              s.heldout_shrinkage_percent, s.size);
   }
   if (!args.out.empty()) {

@@ -14,11 +14,14 @@
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "core/numeric_table.hpp"
+#include "core/units.hpp"
 #include "eval/iso9283_path.hpp"
 #include "eval/path_deviation.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
+
+using imscal::kDegPerRad;
 namespace eval = imscal::eval;
 
 struct EvaluateArgs {
@@ -101,7 +104,7 @@ void run(const EvaluateArgs& args) {
                          {"max_path_deviation_mm", d.max_m * 1e3},
                          {"rms_path_deviation_mm", d.rms_m * 1e3}});
   }
-  constexpr double deg = 180.0 / M_PI;
+  constexpr double deg = kDegPerRad;
   auto finite = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
   const nlohmann::json out = {{"commanded", args.commanded},
                               {"cycles", r.cycles},

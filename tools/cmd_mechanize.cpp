@@ -24,6 +24,7 @@
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/output_folder.hpp"
+#include "core/units.hpp"
 #include "ims/coarse_alignment.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/imu_conversion.hpp"
@@ -37,9 +38,10 @@
 
 namespace {
 
+using imscal::kRadPerDeg;
+
 namespace fs = std::filesystem;
 namespace ims = imscal::ims;
-constexpr double kDeg = M_PI / 180.0;
 constexpr const char* kCommandLine = "<command line>";
 
 struct MechanizeArgs {
@@ -145,8 +147,8 @@ Prepared prepare(const MechanizeArgs& args) {
     const Eigen::Vector3d deg =
         parse_triple(args.initial_attitude, "--initial-attitude", "ROLL,PITCH,HEADING (deg)");
     // Heading is clockwise from North; the angle convention's yaw counter-clockwise.
-    p.initial.q_W_S =
-        Eigen::Quaterniond(ims::R_W_S_from_angles(deg.x() * kDeg, deg.y() * kDeg, -deg.z() * kDeg));
+    p.initial.q_W_S = Eigen::Quaterniond(
+        ims::R_W_S_from_angles(deg.x() * kRadPerDeg, deg.y() * kRadPerDeg, -deg.z() * kRadPerDeg));
     p.attitude_source = "command line";
   } else {
     if (!(*args.align_s > 0.0) || record_start + *args.align_s > samples.back().t_s) {
@@ -168,8 +170,8 @@ Prepared prepare(const MechanizeArgs& args) {
     const double level_sigma = std::max(alignment.sigma_roll_rad, alignment.sigma_pitch_rad);
     p.attitude_sigma_rad = {level_sigma, level_sigma, alignment.sigma_heading_rad};
     if (args.heading_deg) {
-      alignment.angles.heading_rad = *args.heading_deg * kDeg;
-      alignment.sigma_heading_rad = args.heading_sigma_deg * kDeg;
+      alignment.angles.heading_rad = *args.heading_deg * kRadPerDeg;
+      alignment.sigma_heading_rad = args.heading_sigma_deg * kRadPerDeg;
       p.initial.q_W_S = Eigen::Quaterniond(ims::R_W_S_from_angles(
           alignment.angles.roll_rad, alignment.angles.pitch_rad, -alignment.angles.heading_rad));
       p.attitude_sigma_rad.z() = alignment.sigma_heading_rad;
@@ -180,9 +182,10 @@ Prepared prepare(const MechanizeArgs& args) {
     p.attitude_source = fmt::format(
         "coarse alignment over the first {} s (roll {:.4f} +- {:.4f}, pitch {:.4f} +- {:.4f}, "
         "heading {:.4f} +- {:.4f} deg{})",
-        *args.align_s, alignment.angles.roll_rad / kDeg, alignment.sigma_roll_rad / kDeg,
-        alignment.angles.pitch_rad / kDeg, alignment.sigma_pitch_rad / kDeg,
-        alignment.angles.heading_rad / kDeg, alignment.sigma_heading_rad / kDeg,
+        *args.align_s, alignment.angles.roll_rad / kRadPerDeg,
+        alignment.sigma_roll_rad / kRadPerDeg, alignment.angles.pitch_rad / kRadPerDeg,
+        alignment.sigma_pitch_rad / kRadPerDeg, alignment.angles.heading_rad / kRadPerDeg,
+        alignment.sigma_heading_rad / kRadPerDeg,
         args.heading_deg ? " from --heading-deg" : " by gyrocompassing");
   }
   p.increments = std::move(series);

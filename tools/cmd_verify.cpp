@@ -25,6 +25,7 @@
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
 #include "core/payload_plausibility.hpp"
+#include "core/units.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
@@ -33,6 +34,8 @@
 #include "tools/command_registry.hpp"
 
 namespace {
+
+using imscal::kDegPerRad;
 namespace fs = std::filesystem;
 namespace eval = imscal::eval;
 namespace ident = imscal::ident;
@@ -63,7 +66,7 @@ void search_orders(const ident::JointErrorLog& log, const eval::ModelTorqueSourc
   config = eval::with_searched_orders(std::move(config), search);
 }
 
-constexpr double kMm = 1e3, kDeg = 180.0 / M_PI;
+constexpr double kMm = 1e3;
 
 json finite(double v) {
   return std::isfinite(v) ? json(v) : json(nullptr);
@@ -77,12 +80,12 @@ json figures_json(const eval::PathFigures& f) {
           {"about_mean_max_mm", f.about_mean_max_m * kMm},
           {"AT_p_mm", f.AT_p_m * kMm},
           {"RT_p_mm", finite(f.RT_p_m * kMm)},
-          {"AT_a_deg", f.AT_abc_rad[0] * kDeg},
-          {"AT_b_deg", f.AT_abc_rad[1] * kDeg},
-          {"AT_c_deg", f.AT_abc_rad[2] * kDeg},
-          {"RT_a_deg", finite(f.RT_abc_rad[0] * kDeg)},
-          {"RT_b_deg", finite(f.RT_abc_rad[1] * kDeg)},
-          {"RT_c_deg", finite(f.RT_abc_rad[2] * kDeg)},
+          {"AT_a_deg", f.AT_abc_rad[0] * kDegPerRad},
+          {"AT_b_deg", f.AT_abc_rad[1] * kDegPerRad},
+          {"AT_c_deg", f.AT_abc_rad[2] * kDegPerRad},
+          {"RT_a_deg", finite(f.RT_abc_rad[0] * kDegPerRad)},
+          {"RT_b_deg", finite(f.RT_abc_rad[1] * kDegPerRad)},
+          {"RT_c_deg", finite(f.RT_abc_rad[2] * kDegPerRad)},
           {"CO_mm", f.CO_m * kMm},
           {"CR_mm", finite(f.CR_m * kMm)},
           {"AV_percent", f.AV_percent},
@@ -98,13 +101,13 @@ const char* kCsvHeader =
 
 std::string csv_row(const eval::VerificationCase& c, const eval::PathFigures& before) {
   const auto& f = c.figures;
-  return fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", c.label,
-                     f.max_path_deviation_m * kMm,
-                     eval::reduction_percent(before.max_path_deviation_m, f.max_path_deviation_m),
-                     f.rms_path_deviation_m * kMm, f.AT_p_m * kMm, f.RT_p_m * kMm,
-                     f.AT_abc_rad[0] * kDeg, f.AT_abc_rad[1] * kDeg, f.AT_abc_rad[2] * kDeg,
-                     f.RT_abc_rad[0] * kDeg, f.RT_abc_rad[1] * kDeg, f.RT_abc_rad[2] * kDeg,
-                     f.CO_m * kMm, f.AV_percent, f.RV_percent, f.FV_m_s, c.inactive_cycles);
+  return fmt::format(
+      "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", c.label, f.max_path_deviation_m * kMm,
+      eval::reduction_percent(before.max_path_deviation_m, f.max_path_deviation_m),
+      f.rms_path_deviation_m * kMm, f.AT_p_m * kMm, f.RT_p_m * kMm, f.AT_abc_rad[0] * kDegPerRad,
+      f.AT_abc_rad[1] * kDegPerRad, f.AT_abc_rad[2] * kDegPerRad, f.RT_abc_rad[0] * kDegPerRad,
+      f.RT_abc_rad[1] * kDegPerRad, f.RT_abc_rad[2] * kDegPerRad, f.CO_m * kMm, f.AV_percent,
+      f.RV_percent, f.FV_m_s, c.inactive_cycles);
 }
 
 std::string text_row(const eval::VerificationCase& c, const eval::PathFigures& before) {
@@ -114,8 +117,8 @@ std::string text_row(const eval::VerificationCase& c, const eval::PathFigures& b
       "{:>7.4f}\n",
       c.label, f.max_path_deviation_m * kMm,
       eval::reduction_percent(before.max_path_deviation_m, f.max_path_deviation_m), f.AT_p_m * kMm,
-      f.RT_p_m * kMm, f.AT_abc_rad[0] * kDeg, f.AT_abc_rad[1] * kDeg, f.AT_abc_rad[2] * kDeg,
-      f.CO_m * kMm, f.AV_percent, f.FV_m_s);
+      f.RT_p_m * kMm, f.AT_abc_rad[0] * kDegPerRad, f.AT_abc_rad[1] * kDegPerRad,
+      f.AT_abc_rad[2] * kDegPerRad, f.CO_m * kMm, f.AV_percent, f.FV_m_s);
 }
 
 std::string path_file(const std::vector<Eigen::Matrix<double, 8, 1>>& rows,

@@ -6,13 +6,14 @@
 #include <string>
 #include <vector>
 
+#include "core/units.hpp"
 #include "eval/model_torque.hpp"
 
 namespace imscal::tools {
 
 struct ModelTorqueOption {
-  std::string robot;                                     // robot description file
-  std::vector<double> gravity_m_s2{0.0, 0.0, -9.80665};  // in the robot base R
+  std::string robot;                                                   // robot description file
+  std::vector<double> gravity_m_s2{0.0, 0.0, -kStandardGravity_m_s2};  // in the robot base R
 
   void add_to(CLI::App& command);
 

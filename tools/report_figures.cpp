@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/units.hpp"
 #include "ident/arx_frequency_response.hpp"
 
 namespace imscal::tools {
@@ -37,7 +38,7 @@ std::vector<std::pair<double, double>> reduce_min_max(std::span<const double> x,
 }
 
 namespace {
-constexpr double kMdegPerRad = 180.0 / std::numbers::pi * 1000.0;
+constexpr double kMdegPerRad = kDegPerRad * 1000.0;
 
 // Data block of one curve, segments separated by a blank line (gnuplot does not join them).
 std::string curve_data(const ident::JointErrorLog& log, const std::vector<double>& value,

@@ -10,6 +10,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 #include "core/version.hpp"
 #include "ident/identification_report.hpp"
 #include "ident/joint_error_io.hpp"
@@ -25,8 +26,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
 std::string esc(const std::string& text) {
   return html_escape(text);

@@ -9,12 +9,12 @@
 #include "calib/orientation_error.hpp"
 #include "calib/rotation_calibration.hpp"
 #include "calib/tool_imu_record.hpp"
+#include "core/units.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::calib {
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
 constexpr double kOffset = 0.08;  // t_sensor = t_robot + offset
 
 Eigen::Vector3d true_rate_T(double t) {
@@ -78,20 +78,20 @@ TEST(RotationCalibration, RecoversSimulatedMountingBiasScaleAndOffset) {
   // Errors left by the simulation itself: the robot poses are slerped between 10 ms samples and
   // the gyro integrated with a trapezoid over 10 ms at rates up to ~1.5 rad/s (a few 1e-4 rad
   // per 0.5 s window); the tolerances allow for that.
-  EXPECT_LT(ims::rotation_angle_between(cal.q_T_S, sim.q_T_S) * kDeg, 0.03);
+  EXPECT_LT(ims::rotation_angle_between(cal.q_T_S, sim.q_T_S) * kDegPerRad, 0.03);
   EXPECT_NEAR(cal.time_offset_s, kOffset, 1e-3);
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(cal.gyro_bias_rad_s[i], sim.bias[i], 2e-4);
     EXPECT_NEAR(cal.gyro_scale[i], sim.scale[i], 2e-3);
   }
-  EXPECT_LT(cal.rms_residual_rad * kDeg, 0.01);
+  EXPECT_LT(cal.rms_residual_rad * kDegPerRad, 0.01);
   EXPECT_NEAR(cal.up_B.z(), 1.0, 1e-4);
   // The mounting's 1 sigma: the 3x3 tangent block of the rotation, positive on every axis and
   // below the 0.03 deg the estimate is held to above (the residuals are ~0.01 deg).
   EXPECT_TRUE(cal.covariance_ok);
   for (int i = 0; i < 3; ++i) {
     EXPECT_GT(cal.sigma_rotation_rad[i], 0.0) << i;
-    EXPECT_LT(cal.sigma_rotation_rad[i] * kDeg, 0.03) << i;
+    EXPECT_LT(cal.sigma_rotation_rad[i] * kDegPerRad, 0.03) << i;
   }
 }
 
@@ -110,13 +110,13 @@ TEST(AttitudeFilter, TracksTheSimulatedToolWithTheTrueCalibration) {
     // Integration error of the 10 ms trapezoid at rates up to 1.5 rad/s and of the slerped
     // reference: measured 0.026 deg RMS, 0.08 deg max; bound 0.15 deg. Gravity aiding is exact
     // here (no lever arm) and must not add error.
-    EXPECT_LT(error.max_rad * kDeg, 0.15) << "gravity " << gravity;
-    EXPECT_LT(error.rms_rad * kDeg, 0.05) << "gravity " << gravity;
+    EXPECT_LT(error.max_rad * kDegPerRad, 0.15) << "gravity " << gravity;
+    EXPECT_LT(error.rms_rad * kDegPerRad, 0.05) << "gravity " << gravity;
     EXPECT_GT(error.sample_count, 2900u);
   }
   // With a wrong bias (0.5 deg/s on every axis) the tilt is held by gravity, the heading is not.
   RotationCalibration wrong = truth;
-  wrong.gyro_bias_rad_s += Eigen::Vector3d::Constant(0.5 / kDeg);
+  wrong.gyro_bias_rad_s += Eigen::Vector3d::Constant(0.5 / kDegPerRad);
   AttitudeFilterOptions no_gravity;
   no_gravity.use_gravity = false;
   const auto free = run_attitude_filter(sim.record, wrong, no_gravity);

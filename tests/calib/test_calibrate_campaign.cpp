@@ -35,6 +35,7 @@
 #include "calib/frame_calibration.hpp"
 #include "calib/rest_poses.hpp"
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 #include "ims/imu_noise.hpp"
 #include "ims/imu_synthesis.hpp"
 #include "ims/sensor_error_model.hpp"
@@ -49,7 +50,6 @@ namespace imscal::calib {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 bool sanitized() {
   return std::getenv("IMSCAL_SANITIZED") != nullptr;
@@ -176,12 +176,12 @@ SeedOutcome run_seed(const sim::Scenario& scenario, const sim::SimulationResult&
     o.S_H_rotation_deg = ims::quat_log<double>(
                              Eigen::Quaterniond(r.T_S_H.linear() * T_S_H_true.linear().transpose()))
                              .norm() /
-                         kDeg;
+                         kRadPerDeg;
     o.S_H_translation_mm = (r.T_S_H.translation() - T_S_H_true.translation()).norm() * 1e3;
     const Eigen::Matrix3d R_W_R = r.T_R_W.linear().transpose();
     const Eigen::Vector3d rotation_error_W =
         ims::quat_log<double>(Eigen::Quaterniond(R_W_R * T_W_R.linear().transpose()));
-    o.R_W_tilt_deg = rotation_error_W.head<2>().norm() / kDeg;
+    o.R_W_tilt_deg = rotation_error_W.head<2>().norm() / kRadPerDeg;
     o.heading_sigmas = std::abs(rotation_error_W.z()) / r.sigma("R_W_R.up");
     o.normalised_errors.push_back(o.heading_sigmas);
     // The true link angles at the middle of the first rest (robot clock).

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "core/sha256.hpp"
+#include "core/units.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/so3.hpp"
@@ -29,7 +30,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using CalibrateCli = test_support::ScratchDirTest;
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 const fs::path kSource(IMSCAL_SOURCE_DIR);
 const fs::path kScenario = fs::path(IMSCAL_TEST_DATA_DIR) / "scenarios" / "mounting-rigid.yaml";
@@ -107,7 +107,7 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
   // 0.05-0.15 deg. The campaign test (test_calibrate_campaign.cpp) reports the figures.
   const Eigen::Quaterniond q_S_H = quaternion_of(frames.at("T_S_H"));
   const Eigen::Quaterniond q_S_H_true = quaternion_of(truth.at("T_S_H"));
-  EXPECT_LT(ims::rotation_angle_between(q_S_H, q_S_H_true), 0.005 * kDeg);
+  EXPECT_LT(ims::rotation_angle_between(q_S_H, q_S_H_true), 0.005 * kRadPerDeg);
   Eigen::Vector3d p_S_H, p_S_H_true;
   for (int i = 0; i < 3; ++i) {
     p_S_H[i] = frames.at("T_S_H").at("xyz_mm").at(i).get<double>() * 1e-3;
@@ -117,7 +117,7 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
   // Tilt of R in W: the vertical of W seen in R (heading is gyrocompass-limited: ~0.1 deg).
   const Eigen::Vector3d up_R = quaternion_of(frames.at("T_R_W")) * Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d up_R_true = quaternion_of(truth.at("T_R_W")) * Eigen::Vector3d::UnitZ();
-  EXPECT_LT(std::acos(std::min(1.0, up_R.dot(up_R_true))), 0.005 * kDeg);
+  EXPECT_LT(std::acos(std::min(1.0, up_R.dot(up_R_true))), 0.005 * kRadPerDeg);
   // Clock offset: 12.3 ms in the scenario; the gyro-rate residuals locate it to 0.0002 ms
   // (1-sigma 0.0002 ms, measured error 0.0001 ms): 0.01 ms leaves room for the sampling.
   EXPECT_NEAR(frames.at("time_offset_ms").get<double>(),

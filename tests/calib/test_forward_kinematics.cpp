@@ -15,15 +15,15 @@
 #include "calib/forward_kinematics.hpp"
 #include "calib/jacobian.hpp"
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 #include "sim/kdl_chain.hpp"
 
+using imscal::kRadPerDeg;
 using imscal::calib::DhConvention;
 using imscal::calib::JointVector;
 using imscal::calib::RobotDescription;
 
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 RobotDescription kr16() {
   return imscal::calib::load_robot_description(IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml");
@@ -118,7 +118,7 @@ TEST(ForwardKinematics, Kr16HomePoseByHand) {
   // elbow at height 0.675 + 0.68, forearm horizontal forward 0.67 m and 0.035 m below it,
   // flange 0.158 m further, facing forward (z_H = x_R, x_H = -z_R).
   JointVector q;
-  q << 0, -90 * kDeg, 90 * kDeg, 0, 0, 0;
+  q << 0, -90 * kRadPerDeg, 90 * kRadPerDeg, 0, 0, 0;
   const Eigen::Isometry3d T_R_H = imscal::calib::forward_kinematics<double>(kr16().kinematics, q);
   const Eigen::Vector3d expected_position(0.26 + 0.67 + 0.158, 0, 0.675 + 0.68 - 0.035);
   EXPECT_LT((T_R_H.translation() - expected_position).norm(), 1e-14);  // rounding of sin(pi/2)

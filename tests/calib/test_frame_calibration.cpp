@@ -20,6 +20,7 @@
 #include "calib/frame_calibration.hpp"
 #include "calib/robot_description.hpp"
 #include "calib/time_offset.hpp"
+#include "core/units.hpp"
 #include "ims/so3.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
@@ -30,7 +31,6 @@ namespace imscal::calib {
 namespace {
 
 using test_support::FrameScene;
-constexpr double kDeg = M_PI / 180.0;
 
 bool sanitized() {
   return std::getenv("IMSCAL_SANITIZED") != nullptr;
@@ -76,17 +76,17 @@ TEST(FrameCalibration, NoiseFreeRecordGivesTheFramesBack) {
   std::printf(
       "noise-free: T_S_H %.3g deg %.3g m, T_R_W roll/pitch %.3g deg heading %.3g deg %.3g m, "
       "dt error %.3g s, gyro bias %.3g rad/s, acc bias %.3g m/s^2\n",
-      rot_S_H / kDeg, pos_S_H, rot_R_W / kDeg, heading_R_W / kDeg, pos_R_W,
+      rot_S_H / kRadPerDeg, pos_S_H, rot_R_W / kRadPerDeg, heading_R_W / kRadPerDeg, pos_R_W,
       r.time_offset_s - scene.clock_offset_s, r.biases.gyro_rad_s.norm(), r.biases.acc_m_s2.norm());
   // What is left is the synthesis (spline of 1 ms poses) and the second-order preintegration
   // (~1e-13 rad, ~3e-7 m/s, ~4e-6 m over 10 s at 1 kHz, calib/imu_preintegration.hpp): shared
   // by 7 motions, the frames come back to ~1e-6 deg and ~1e-6 m.
-  EXPECT_LT(rot_S_H / kDeg, 1e-5);
-  EXPECT_LT(rot_R_W / kDeg, 1e-5);
+  EXPECT_LT(rot_S_H / kRadPerDeg, 1e-5);
+  EXPECT_LT(rot_R_W / kRadPerDeg, 1e-5);
   // The heading trades against the horizontal gyro bias (heading error = bias error /
   // (Omega cos(lat)) = bias / 4.8e-5 rad/s): the ~2e-10 rad/s the synthesis leaves in the rests'
   // Earth rate give ~2e-4 deg, 1/500 of the heading's sigma with the navigation-grade gyros.
-  EXPECT_LT(heading_R_W / kDeg, 1e-3);
+  EXPECT_LT(heading_R_W / kRadPerDeg, 1e-3);
   EXPECT_LT(pos_S_H, 2e-6);
   EXPECT_LT(pos_R_W, 2e-6);
   // dt: the rate windows see the quintic moves' angular accelerations (~1 rad/s^2); the
@@ -116,7 +116,7 @@ TEST(FrameCalibration, JointDeviationPriorsAndScaleFactorsKeepAnExactRecordExact
   test_support::make_kinematic_motion(scene, mounting_poses(), 4.0, 2.5);
   test_support::synthesize_scene_imu(scene);
   ImuNoiseModel noise;
-  noise.gyro_noise_density_rad_per_sqrt_s = 0.002 * kDeg / 60.0;
+  noise.gyro_noise_density_rad_per_sqrt_s = 0.002 * kRadPerDeg / 60.0;
   noise.acc_noise_density_m_s_per_sqrt_s = 2.2e-6 * 9.80665;
   FrameCalibrationInput in = test_support::frame_input(scene, noise);
   for (RestObservation& rest : in.rests) {
@@ -142,7 +142,7 @@ TEST(FrameCalibration, JointDeviationPriorsAndScaleFactorsKeepAnExactRecordExact
   // Gyro scale at rest sees only the Earth rate (7e-5 rad/s): 2e-10 rad/s of synthesis error is
   // 3e-6 relative.
   EXPECT_LT(r.gyro_scale_factor.cwiseAbs().maxCoeff(), 1e-5);
-  EXPECT_LT(rotation_error_rad(r.T_S_H.linear(), scene.T_S_H().linear()) / kDeg, 1e-5);
+  EXPECT_LT(rotation_error_rad(r.T_S_H.linear(), scene.T_S_H().linear()) / kRadPerDeg, 1e-5);
   EXPECT_LT((r.T_S_H.translation() - scene.T_S_H().translation()).norm(), 2e-6);
   // The estimates carry the scale factors with their sigma (reporting units).
   bool has_scale = false;
@@ -235,11 +235,11 @@ SeedOutcome run_mounting_seed(std::uint64_t seed) {
   // R_W_R error as small angles about W (E, N, U): the covariance's tangent.
   const Eigen::Vector3d error_W =
       ims::quat_log<double>(Eigen::Quaterniond(r.T_R_W.linear().transpose() * T_R_W_true.linear()));
-  out.roll_pitch_R_W_deg = error_W.head<2>().norm() / kDeg;
+  out.roll_pitch_R_W_deg = error_W.head<2>().norm() / kRadPerDeg;
   const double heading_sigma = r.sigma("R_W_R.up");
-  out.heading_sigma_deg = heading_sigma / kDeg;
+  out.heading_sigma_deg = heading_sigma / kRadPerDeg;
   out.heading_error_sigma = error_W.z() / heading_sigma;
-  out.rotation_S_H_deg = rotation_error_rad(r.T_S_H.linear(), scene.T_S_H().linear()) / kDeg;
+  out.rotation_S_H_deg = rotation_error_rad(r.T_S_H.linear(), scene.T_S_H().linear()) / kRadPerDeg;
   out.translation_S_H_mm = (r.T_S_H.translation() - scene.T_S_H().translation()).norm() * 1e3;
   out.translation_R_W_mm = (r.T_R_W.translation() - T_R_W_true.translation()).norm() * 1e3;
   const char* axes[3] = {"x", "y", "z"};

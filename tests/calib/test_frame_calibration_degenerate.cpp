@@ -11,18 +11,18 @@
 #include "calib/frame_calibration.hpp"
 #include "calib/hand_eye.hpp"
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 #include "tests/calib/frame_calibration_scenes.hpp"
 
 namespace imscal::calib {
 namespace {
 
 using test_support::FrameScene;
-constexpr double kDeg = M_PI / 180.0;
 
 JointVector joints_deg(double a1, double a2, double a3, double a4, double a5, double a6) {
   JointVector q;
   q << a1, a2, a3, a4, a5, a6;
-  return q * kDeg;
+  return q * kRadPerDeg;
 }
 
 FrameScene scene_with(const std::vector<JointVector>& poses) {
@@ -40,7 +40,7 @@ FrameScene scene_with(const std::vector<JointVector>& poses) {
 
 ImuNoiseModel nominal_noise() {
   ImuNoiseModel n;  // navigation-grade white noise (datasets/sensors/navigation-grade.yaml)
-  n.gyro_noise_density_rad_per_sqrt_s = 0.002 * kDeg / 60.0;
+  n.gyro_noise_density_rad_per_sqrt_s = 0.002 * kRadPerDeg / 60.0;
   n.acc_noise_density_m_s_per_sqrt_s = 2.2e-6 * 9.80665;
   return n;
 }

@@ -21,13 +21,13 @@
 #include "calib/robot_description.hpp"
 #include "calib/time_offset.hpp"
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 #include "tests/calib/frame_calibration_scenes.hpp"
 
 namespace imscal::calib {
 namespace {
 
 using test_support::FrameScene;
-constexpr double kDeg = M_PI / 180.0;
 
 struct Record {
   FrameScene scene;
@@ -91,8 +91,8 @@ FrameCalibrationInput known_frames_input(const Record& record, const std::vector
 void check_recovers_biases_and_clock(const std::vector<std::size_t>& keep) {
   // A frame covariance as an earlier session reports it (0.001 deg, 0.01 mm; heading 0.06 deg).
   Eigen::Matrix<double, 9, 1> frame_sigma;
-  frame_sigma << 0.001 * kDeg, 0.001 * kDeg, 0.06 * kDeg, 0.001 * kDeg, 0.001 * kDeg, 0.002 * kDeg,
-      1e-5, 1e-5, 2e-5;
+  frame_sigma << 0.001 * kRadPerDeg, 0.001 * kRadPerDeg, 0.06 * kRadPerDeg, 0.001 * kRadPerDeg,
+      0.001 * kRadPerDeg, 0.002 * kRadPerDeg, 1e-5, 1e-5, 2e-5;
   const Eigen::Matrix<double, 9, 9> frame_covariance =
       frame_sigma.cwiseProduct(frame_sigma).asDiagonal();
   for (std::uint64_t seed : {1u, 2u, 3u}) {
@@ -121,7 +121,7 @@ void check_recovers_biases_and_clock(const std::vector<std::size_t>& keep) {
       const double a =
           (r.biases.acc_m_s2[k] - truth.acc.bias[k]) / r.sigma(std::string("acc_bias.") + axes[k]);
       std::printf("  gyro %s %+.2f (sigma %.3g deg/h)  acc %s %+.2f (sigma %.3g ug)", axes[k], g,
-                  r.sigma(std::string("gyro_bias.") + axes[k]) / kDeg * 3600.0, axes[k], a,
+                  r.sigma(std::string("gyro_bias.") + axes[k]) / kRadPerDeg * 3600.0, axes[k], a,
                   r.sigma(std::string("acc_bias.") + axes[k]) / 9.80665 * 1e6);
       EXPECT_LT(std::abs(g), 3.0) << "gyro bias " << axes[k];
       EXPECT_LT(std::abs(a), 3.0) << "acc bias " << axes[k];

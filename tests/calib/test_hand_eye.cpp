@@ -22,6 +22,7 @@
 #include "calib/forward_kinematics.hpp"
 #include "calib/hand_eye.hpp"
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 
 using imscal::bench::frame_error;
 using imscal::bench::HandEyeScenario;
@@ -30,9 +31,9 @@ using imscal::bench::make_hand_eye_scenario;
 using imscal::calib::HandEyeUnobservable;
 using imscal::calib::solve_robot_world_hand_eye;
 
-namespace {
+using imscal::kRadPerDeg;
 
-constexpr double kDeg = M_PI / 180.0;
+namespace {
 
 const imscal::calib::KinematicModel& kr16() {
   static const imscal::calib::RobotDescription robot =
@@ -125,8 +126,8 @@ TEST(HandEye, NoisyPosesGiveErrorsAtTheNoiseLevel) {
   const auto x = frame_error(result.T_S_H, s.truth.T_S_H);
   // The rotation of Z and X averages 20 poses of sigma 0.001 deg per axis: their error is about
   // sigma*sqrt(3/20) ~ 4e-4 deg; 5 sigma of a single pose (0.005 deg) is a loose 3-sigma bound.
-  EXPECT_LT(z.rotation_rad, 0.005 * kDeg);
-  EXPECT_LT(x.rotation_rad, 0.005 * kDeg);
+  EXPECT_LT(z.rotation_rad, 0.005 * kRadPerDeg);
+  EXPECT_LT(x.rotation_rad, 0.005 * kRadPerDeg);
   // Translation: 0.02 mm position noise plus 1.7e-5 rad times lever arms of up to ~3 m
   // (~0.05 mm); averaged over 20 poses ~0.02 mm. 0.1 mm is a loose bound.
   EXPECT_LT(z.translation_m, 0.1e-3);
@@ -145,7 +146,7 @@ TEST(HandEye, SmallRelativeRotationsAreDroppedAndReported) {
   const imscal::bench::HandEyeEstimate& t = s.truth;
   Eigen::Isometry3d T_R_H = s.T_R_H[4];
   T_R_H.linear() =
-      T_R_H.linear() * Eigen::AngleAxisd(1.0 * kDeg, Eigen::Vector3d::UnitZ()).matrix();
+      T_R_H.linear() * Eigen::AngleAxisd(1.0 * kRadPerDeg, Eigen::Vector3d::UnitZ()).matrix();
   s.T_R_H.push_back(T_R_H);
   s.T_W_S.push_back(t.T_R_W.inverse() * T_R_H * t.T_S_H.inverse());
   const auto result = solve_robot_world_hand_eye(s.T_R_H, s.T_W_S);
@@ -154,8 +155,8 @@ TEST(HandEye, SmallRelativeRotationsAreDroppedAndReported) {
     if (d.from_pose == 4 && d.to_pose == 10) {
       found = true;
       // The relative rotation is exactly the 1 deg turn (1e-12: round-off of the quaternion log).
-      EXPECT_NEAR(d.robot_rotation_rad, 1.0 * kDeg, 1e-12);
-      EXPECT_NEAR(d.ims_rotation_rad, 1.0 * kDeg, 1e-12);
+      EXPECT_NEAR(d.robot_rotation_rad, 1.0 * kRadPerDeg, 1e-12);
+      EXPECT_NEAR(d.ims_rotation_rad, 1.0 * kRadPerDeg, 1e-12);
     }
   }
   EXPECT_TRUE(found);

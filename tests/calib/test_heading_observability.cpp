@@ -15,13 +15,12 @@
 #include "calib/calibration_config.hpp"
 #include "calib/frame_calibration.hpp"
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 #include "ims/sensor_spec.hpp"
 #include "tests/calib/frame_calibration_scenes.hpp"
 
 namespace imscal::calib {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 bool sanitized() {
   return std::getenv("IMSCAL_SANITIZED") != nullptr;
@@ -58,7 +57,7 @@ TEST(HeadingObservability, SigmaFallsAsOneOverTheSquareRootOfTheRestTime) {
       std::filesystem::path(IMSCAL_SOURCE_DIR) / "datasets" / "sensors" / "navigation-grade.yaml");
   const ims::EarthModel earth(test_support::FrameScene{}.site);
   const double horizontal_earth_rate = earth.earth_rate_W().head<2>().norm();  // [rad/s]
-  const double goal_rad = 0.005 * kDeg;
+  const double goal_rad = 0.005 * kRadPerDeg;
   // Rests of 8, 32, 128 s (32 s at most under the sanitizers: 8 poses, a 270 s record). Shorter
   // rests are not in the 1 / sqrt(T) regime: with 1 s of each 2 s rest used, the moves between
   // them (2.5 s each) add gyrocompassing of their own and the bias is not yet the rests' alone
@@ -76,8 +75,9 @@ TEST(HeadingObservability, SigmaFallsAsOneOverTheSquareRootOfTheRestTime) {
         "rests of %4.0f s (%6.1f s in all): heading 1-sigma %.4f deg, sigma * sqrt(T) %.4f "
         "deg sqrt(s), %.2f x the closed form ARW / (Omega cos(lat) sqrt(T)); 0.005 deg needs "
         "%.0f s (%.1f h) of rest\n",
-        rest_s, f.rest_time_s, f.sigma_rad / kDeg, f.sigma_rad * std::sqrt(f.rest_time_s) / kDeg,
-        f.sigma_rad / closed_form, f.rest_time_s * std::pow(f.sigma_rad / goal_rad, 2.0),
+        rest_s, f.rest_time_s, f.sigma_rad / kRadPerDeg,
+        f.sigma_rad * std::sqrt(f.rest_time_s) / kRadPerDeg, f.sigma_rad / closed_form,
+        f.rest_time_s * std::pow(f.sigma_rad / goal_rad, 2.0),
         f.rest_time_s * std::pow(f.sigma_rad / goal_rad, 2.0) / 3600.0);
     // The bias is estimated from the same rests, so the closed form is a lower bound; the poses
     // turn the sensor far enough that the bias costs less than a factor 2.

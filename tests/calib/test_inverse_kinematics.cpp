@@ -11,6 +11,7 @@
 #include "calib/forward_kinematics.hpp"
 #include "calib/inverse_kinematics.hpp"
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 #include "sim/kdl_chain.hpp"
 
 using imscal::calib::ArmConfiguration;
@@ -22,9 +23,10 @@ using imscal::calib::InverseKinematics;
 using imscal::calib::JointVector;
 using imscal::calib::KinematicModel;
 
+using imscal::kRadPerDeg;
+
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 // Away from singularities: wrist centre >= 5 cm from the shoulder singularity, |sin| of the
 // elbow and wrist bends >= 0.05 (~3 deg). Closer, the condition number of J grows as 1/measure
 // and 1e-10 rad would no longer follow from 1e-16 pose rounding.
@@ -189,15 +191,15 @@ TEST(InverseKinematics, Kr16FlagsMatchThePhysicalPose) {
   // Home pose with a bent wrist: shoulder front (wrist centre in front of A1), elbow up
   // (the elbow is above the shoulder-wrist line), A5 > 0: no flip.
   JointVector q;
-  q << 0, -90 * kDeg, 90 * kDeg, 0, 30 * kDeg, 0;
+  q << 0, -90 * kRadPerDeg, 90 * kRadPerDeg, 0, 30 * kRadPerDeg, 0;
   EXPECT_EQ(ik.configuration_of(q), (ArmConfiguration{true, true, false}));
-  q(4) = -30 * kDeg;  // A5 < 0: flipped wrist
+  q(4) = -30 * kRadPerDeg;  // A5 < 0: flipped wrist
   EXPECT_EQ(ik.configuration_of(q), (ArmConfiguration{true, true, true}));
-  q(2) = -10 * kDeg;  // forearm bent upwards past the stretched position: elbow down
+  q(2) = -10 * kRadPerDeg;  // forearm bent upwards past the stretched position: elbow down
   EXPECT_EQ(ik.configuration_of(q), (ArmConfiguration{true, false, true}));
-  q << 0, -90 * kDeg, 90 * kDeg, 0, 30 * kDeg, 0;
-  q(1) = -150 * kDeg;  // upper arm leaning back 60 deg past vertical and the forearm
-  q(2) = 30 * kDeg;    // pointing up and back: wrist centre behind A1
+  q << 0, -90 * kRadPerDeg, 90 * kRadPerDeg, 0, 30 * kRadPerDeg, 0;
+  q(1) = -150 * kRadPerDeg;  // upper arm leaning back 60 deg past vertical and the forearm
+  q(2) = 30 * kRadPerDeg;    // pointing up and back: wrist centre behind A1
   EXPECT_FALSE(ik.configuration_of(q).shoulder_front);
 }
 
@@ -225,7 +227,7 @@ TEST(InverseKinematics, FailsClearlyAtUnreachableAndSingularPoses) {
   const InverseKinematics ik(model);
   const ArmConfiguration front_up{true, true, false};
   JointVector q;
-  q << 0.3, -70 * kDeg, 100 * kDeg, 0.5, 40 * kDeg, 0.2;
+  q << 0.3, -70 * kRadPerDeg, 100 * kRadPerDeg, 0.5, 40 * kRadPerDeg, 0.2;
   const Eigen::Isometry3d reachable = imscal::calib::forward_kinematics<double>(model, q);
 
   Eigen::Isometry3d far = reachable;
@@ -261,7 +263,7 @@ TEST(InverseKinematics, SolveNearestStaysOnThePhysicalBranchAcrossTheWristSingul
   const KinematicModel model = kr16();
   const InverseKinematics ik(model);
   JointVector q_true, q_encoders;
-  q_true << 0.3, -70 * kDeg, 100 * kDeg, 0.5, -1e-3, 0.2;
+  q_true << 0.3, -70 * kRadPerDeg, 100 * kRadPerDeg, 0.5, -1e-3, 0.2;
   q_encoders = q_true;
   q_encoders(4) = 2e-3;
   const Eigen::Isometry3d pose = imscal::calib::forward_kinematics<double>(model, q_true);
@@ -275,7 +277,7 @@ TEST(InverseKinematics, SolveNearestStaysOnThePhysicalBranchAcrossTheWristSingul
   // 1e-9 rad: the pose is exact, but the wrist bend of 1 mrad amplifies rounding ~1e3 times.
   EXPECT_LT((nearest.q - q_true).cwiseAbs().maxCoeff(), 1e-9);
   // Away from the singularity both give the same, the encoders' branch.
-  q_true(4) = q_encoders(4) = 40 * kDeg;
+  q_true(4) = q_encoders(4) = 40 * kRadPerDeg;
   const Eigen::Isometry3d away = imscal::calib::forward_kinematics<double>(model, q_true);
   EXPECT_LT((ik.solve_nearest(away, q_encoders).q - q_true).cwiseAbs().maxCoeff(), 1e-10);
 }
@@ -284,7 +286,8 @@ TEST(InverseKinematics, ReportsPosesOutsideTheJointLimits) {
   const KinematicModel model = kr16();
   const InverseKinematics ik(model);
   JointVector q;
-  q << 0.3, 60 * kDeg, 40 * kDeg, 0.5, 40 * kDeg, 0.2;  // A2 = +60 deg > its +35 deg limit
+  q << 0.3, 60 * kRadPerDeg, 40 * kRadPerDeg, 0.5, 40 * kRadPerDeg,
+      0.2;  // A2 = +60 deg > its +35 deg limit
   const Eigen::Isometry3d T_R_H = imscal::calib::forward_kinematics<double>(model, q);
   const IkResult limited = ik.solve(T_R_H, ik.configuration_of(q));
   EXPECT_EQ(limited.status, IkStatus::kOutsideJointLimits);

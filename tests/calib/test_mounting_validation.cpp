@@ -16,6 +16,7 @@
 #include "calib/calibration_config.hpp"
 #include "calib/mounting_validation.hpp"
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 #include "ims/sensor_spec.hpp"
 #include "ims/so3.hpp"
 #include "tests/calib/frame_calibration_scenes.hpp"
@@ -23,7 +24,6 @@
 namespace imscal::calib {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 namespace fs = std::filesystem;
 
 Eigen::Isometry3d pose(const Eigen::Vector3d& rotation_vector, const Eigen::Vector3d& t) {
@@ -74,8 +74,8 @@ const MountingCheck* find_check(const MountingValidation& v, const std::string& 
 }
 
 TEST(MountingValidation, DifferenceMatchesItsClosedForm) {
-  const double angle = 0.01 * kDeg, shift = 0.2e-3;
-  const double sa = 0.001 * kDeg, sb = 0.002 * kDeg, ta = 0.01e-3, tb = 0.03e-3;
+  const double angle = 0.01 * kRadPerDeg, shift = 0.2e-3;
+  const double sa = 0.001 * kRadPerDeg, sb = 0.002 * kRadPerDeg, ta = 0.01e-3, tb = 0.03e-3;
   const FrameCalibrationResult a =
       result_with(pose(Eigen::Vector3d(0, 0, angle), Eigen::Vector3d(shift, 0, 0)), sa, ta);
   const FrameCalibrationResult b = result_with(Eigen::Isometry3d::Identity(), sb, tb);
@@ -97,7 +97,7 @@ TEST(MountingValidation, DifferenceMatchesItsClosedForm) {
                          "deg",
                          {"x", "y", "z"},
                          Eigen::Vector3d::Zero(),
-                         Eigen::Vector3d::Constant(sa / kDeg)});
+                         Eigen::Vector3d::Constant(sa / kRadPerDeg)});
   c.estimates.push_back({"T_S_H.translation",
                          "mm",
                          {"x", "y", "z"},
@@ -118,8 +118,8 @@ TEST(MountingValidation, SegmentsCoverEveryRestOnce) {
 }
 
 TEST(MountingValidation, VerdictFollowsTheThresholds) {
-  const MountingThresholds t;                     // 3 / 5 sigma, floors 0.002 deg and 0.02 mm
-  const double rs = 0.001 * kDeg, ts = 0.005e-3;  // 1-sigma of each half
+  const MountingThresholds t;                           // 3 / 5 sigma, floors 0.002 deg and 0.02 mm
+  const double rs = 0.001 * kRadPerDeg, ts = 0.005e-3;  // 1-sigma of each half
   const FrameCalibrationResult base = result_with(Eigen::Isometry3d::Identity(), rs, ts);
   const double combined = std::sqrt(2.0) * ts;  // translation sigma of a difference of halves
   auto halves_shifted = [&](double sigmas, double sigma) {
@@ -164,9 +164,10 @@ TEST(MountingValidation, VerdictFollowsTheThresholds) {
   FrameCalibrationResult unconverged = base;
   unconverged.converged = false;
   EXPECT_EQ(assess_mounting(unconverged, {}, {}, t).verdict, Verdict::kFail);
-  EXPECT_EQ(assess_mounting(result_with(Eigen::Isometry3d::Identity(), 0.006 * kDeg, ts), {}, {}, t)
-                .verdict,
-            Verdict::kWarn);
+  EXPECT_EQ(
+      assess_mounting(result_with(Eigen::Isometry3d::Identity(), 0.006 * kRadPerDeg, ts), {}, {}, t)
+          .verdict,
+      Verdict::kWarn);
   FrameCalibrationResult no_covariance = base;
   no_covariance.covariance.resize(0, 0);
   EXPECT_EQ(assess_mounting(no_covariance, {}, {}, t).verdict, Verdict::kWarn);
@@ -182,10 +183,10 @@ TEST(MountingValidation, VerdictFollowsTheThresholds) {
 
 TEST(MountingValidation, SegmentJumpIsASlipBetweenItsRests) {
   const MountingThresholds t;
-  const double rs = 0.001 * kDeg, ts = 0.005e-3;
+  const double rs = 0.001 * kRadPerDeg, ts = 0.005e-3;
   const FrameCalibrationResult base = result_with(Eigen::Isometry3d::Identity(), rs, ts, 14);
-  const FrameCalibrationResult moved =
-      result_with(pose(Eigen::Vector3d(0.02 * kDeg, 0, 0), Eigen::Vector3d::Zero()), rs, ts, 14);
+  const FrameCalibrationResult moved = result_with(
+      pose(Eigen::Vector3d(0.02 * kRadPerDeg, 0, 0), Eigen::Vector3d::Zero()), rs, ts, 14);
   const std::vector<SessionPart> segments = {part(base, 0, 4), part(base, 5, 9),
                                              part(moved, 10, 13)};
   const MountingValidation v = assess_mounting(base, {}, segments, t);
@@ -200,11 +201,11 @@ TEST(MountingValidation, SegmentJumpIsASlipBetweenItsRests) {
 
 TEST(MountingValidation, SessionsCompareLikeHalves) {
   const MountingThresholds t;
-  const double rs = 0.001 * kDeg, ts = 0.005e-3;
+  const double rs = 0.001 * kRadPerDeg, ts = 0.005e-3;
   const FrameCalibrationResult a = result_with(Eigen::Isometry3d::Identity(), rs, ts);
   // 0.01 deg about z: 7.1 combined sigma, above the 0.002 deg floor -> fail.
   const FrameCalibrationResult b =
-      result_with(pose(Eigen::Vector3d(0, 0, 0.01 * kDeg), Eigen::Vector3d::Zero()), rs, ts);
+      result_with(pose(Eigen::Vector3d(0, 0, 0.01 * kRadPerDeg), Eigen::Vector3d::Zero()), rs, ts);
   EXPECT_EQ(compare_sessions(a, a, t).level, Verdict::kPass);
   EXPECT_EQ(compare_sessions(a, b, t).level, Verdict::kFail);
 }
@@ -214,7 +215,7 @@ TEST(MountingValidation, SessionsCompareLikeHalves) {
 JointVector joints_deg(double a1, double a2, double a3, double a4, double a5, double a6) {
   JointVector q;
   q << a1, a2, a3, a4, a5, a6;
-  return q * kDeg;
+  return q * kRadPerDeg;
 }
 
 // The 14 poses of datasets/programs/mounting.yaml.
@@ -243,8 +244,8 @@ void simulate_session(SimulatedSession& s, const std::optional<Eigen::Isometry3d
   auto& scene = s.scene;
   scene.kinematics = robot.kinematics;
   scene.T_W_R = calib::pose_from_xyz_rpy(Eigen::Vector3d(2.0, 1.0, 0.0),
-                                         Eigen::Vector3d(0.0, 0.0, 30.0 * kDeg));
-  scene.T_H_S = robot.tool.T_H_T * pose(Eigen::Vector3d(0.3, -0.2, 0.5) * kDeg,
+                                         Eigen::Vector3d(0.0, 0.0, 30.0 * kRadPerDeg));
+  scene.T_H_S = robot.tool.T_H_T * pose(Eigen::Vector3d(0.3, -0.2, 0.5) * kRadPerDeg,
                                         Eigen::Vector3d(1.5, -0.8, 0.4) * 1e-3);
   test_support::make_kinematic_motion(scene, mounting_poses(), 6.0, 3.0);
   test_support::synthesize_scene_imu(scene);
@@ -291,7 +292,7 @@ TEST(MountingValidation, CleanSessionPassesAndSlippedMountIsLocated) {
     // 0.05 deg about x_S and 0.3 mm: a knock on the adapter plate; 25x / 15x the floors.
     SimulatedSession slipped;
     simulate_session(slipped,
-                     pose(Eigen::Vector3d(0.05 * kDeg, 0, 0), Eigen::Vector3d(0, 0.3e-3, 0)));
+                     pose(Eigen::Vector3d(0.05 * kRadPerDeg, 0, 0), Eigen::Vector3d(0, 0.3e-3, 0)));
     const FrameCalibrationResult combined = calibrate_frames(slipped.input);
     const MountingValidation v = validate_mounting(slipped.input, {}, combined, options);
     for (const auto& c : v.checks)
@@ -302,7 +303,8 @@ TEST(MountingValidation, CleanSessionPassesAndSlippedMountIsLocated) {
     EXPECT_TRUE(v.segment_comparisons[1].slipped);   // rests 6-10 vs 11-14
     // The located difference is the slip: 0.05 deg within 20 % (each segment's estimate has
     // ~0.001 deg noise, and the combined rests of a segment do not see every axis equally).
-    EXPECT_NEAR(v.segment_comparisons[1].difference.rotation_rad, 0.05 * kDeg, 0.01 * kDeg);
+    EXPECT_NEAR(v.segment_comparisons[1].difference.rotation_rad, 0.05 * kRadPerDeg,
+                0.01 * kRadPerDeg);
     bool named = false;
     for (const auto& r : v.reasons)
       named |= r.find("mount slipped between rest 10 and rest 11") != std::string::npos;

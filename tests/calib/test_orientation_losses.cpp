@@ -15,11 +15,11 @@
 #include "calib/orientation_losses.hpp"
 #include "calib/rotation_calibration.hpp"
 #include "calib/tool_imu_record.hpp"
+#include "core/units.hpp"
 
 namespace imscal::calib {
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
 const std::string kDir = std::string(IMSCAL_TEST_DATA_DIR) + "/real/abb-mems/";
 // The losses use the estimate, not its sigma: no bootstrap (saves 40 solves per record).
 const RotationCalibrationOptions kNoBootstrap = [] {
@@ -70,8 +70,8 @@ TEST(OrientationLosses, ExactGyroLosesNothing) {
     // Each segment is one 90 deg turn; rest margins add nothing. The gyro and the robot poses
     // come from the same rates; what differs is the trapezoid at the turn's two rate steps
     // (half a sample at 90 deg/s: 0.45 deg each side). Bounds: 2 deg and 1 deg.
-    EXPECT_NEAR(s.robot_angle_rad * kDeg, 90.0, 2.0);
-    EXPECT_LT(s.loss_rad * kDeg, 1.0);
+    EXPECT_NEAR(s.robot_angle_rad * kDegPerRad, 90.0, 2.0);
+    EXPECT_LT(s.loss_rad * kDegPerRad, 1.0);
   }
   EXPECT_TRUE(check.losses.empty());
 }
@@ -88,7 +88,7 @@ TEST(OrientationLosses, DroppedReadingsInOneTurnAreListedWithTheirSize) {
   EXPECT_LE(loss.begin_s, 3.4);
   EXPECT_GE(loss.end_s, 3.6);
   // 18 deg +- the trapezoid's half samples at the two added rate steps (0.9 deg each).
-  EXPECT_NEAR(loss.loss_rad * kDeg, 18.0, 2.0);
+  EXPECT_NEAR(loss.loss_rad * kDegPerRad, 18.0, 2.0);
 
   // Restarted after the loss, the track carries no error of it; from the start it keeps 18 deg
   // through the third turn. Gravity aiding off: the synthetic accelerometer is exact, but the
@@ -99,8 +99,8 @@ TEST(OrientationLosses, DroppedReadingsInOneTurnAreListedWithTheirSize) {
   const auto error =
       orientation_error_with_restarts(record, calibration, lost_spans({}, check), filter);
   ASSERT_EQ(error.restart_times_s.size(), 1u);
-  EXPECT_GT(error.from_start.final_rad * kDeg, 15.0);
-  EXPECT_LT(error.with_restarts.max_rad * kDeg, 2.0);
+  EXPECT_GT(error.from_start.final_rad * kDegPerRad, 15.0);
+  EXPECT_LT(error.with_restarts.max_rad * kDegPerRad, 2.0);
 }
 
 TEST(OrientationLosses, RealPartialLossInOneTurnIsFlagged) {
@@ -112,20 +112,20 @@ TEST(OrientationLosses, RealPartialLossInOneTurnIsFlagged) {
     fmt::print(
         "  segment {:.2f}-{:.2f} s: robot {:.1f} deg, gyro {:.1f} deg, difference {:.2f} deg, "
         "about the turn axis {:.2f} deg, across it {:.2f} deg\n",
-        s.begin_s, s.end_s, s.robot_angle_rad * kDeg, s.gyro_angle_rad * kDeg,
-        s.difference_rad * kDeg, s.loss_rad * kDeg, s.axis_tilt_rad * kDeg);
+        s.begin_s, s.end_s, s.robot_angle_rad * kDegPerRad, s.gyro_angle_rad * kDegPerRad,
+        s.difference_rad * kDegPerRad, s.loss_rad * kDegPerRad, s.axis_tilt_rad * kDegPerRad);
   }
   const auto error =
       orientation_error_with_restarts(record, calibration, lost_spans(analysis, check));
   fmt::print("from the start RMS {:.2f} deg, with {} restarts RMS {:.2f} deg\n",
-             error.from_start.rms_rad * kDeg, error.restart_times_s.size(),
-             error.with_restarts.rms_rad * kDeg);
+             error.from_start.rms_rad * kDegPerRad, error.restart_times_s.size(),
+             error.with_restarts.rms_rad * kDegPerRad);
   // The record's one partial loss (SOURCE.md: about 30 deg in one turn) is listed, 15-40 deg.
   ASSERT_GE(check.losses.size(), 1u);
   double largest = 0.0;
   for (const auto& loss : check.losses) largest = std::max(largest, loss.loss_rad);
-  EXPECT_GT(largest * kDeg, 15.0);
-  EXPECT_LT(largest * kDeg, 40.0);
+  EXPECT_GT(largest * kDegPerRad, 15.0);
+  EXPECT_LT(largest * kDegPerRad, 40.0);
   // Restarting after it removes the error it leaves behind.
   EXPECT_LT(error.with_restarts.rms_rad, 0.5 * error.from_start.rms_rad);
 }
@@ -146,7 +146,7 @@ TEST(OrientationLosses, EveryMissedMotionSpanIsALoss) {
     const auto& [begin_s, end_s] = analysis.missed_motion_spans_s[i];
     EXPECT_LT(check.losses[i].begin_s, end_s);
     EXPECT_GT(check.losses[i].end_s, begin_s);
-    EXPECT_GT(check.losses[i].loss_rad * kDeg, 8.0);
+    EXPECT_GT(check.losses[i].loss_rad * kDegPerRad, 8.0);
   }
 }
 
@@ -164,7 +164,7 @@ TEST(OrientationLosses, WithoutANetAxisTheWholeDifferenceIsLoss) {
   const OrientationLossCheck check =
       find_orientation_losses(record, RotationCalibration{}, options);
   ASSERT_EQ(check.losses.size(), 1u);
-  EXPECT_NEAR(check.losses.front().loss_rad * kDeg, 18.0, 2.0);
+  EXPECT_NEAR(check.losses.front().loss_rad * kDegPerRad, 18.0, 2.0);
   EXPECT_DOUBLE_EQ(check.losses.front().loss_rad, check.losses.front().difference_rad);
   EXPECT_EQ(check.losses.front().axis_tilt_rad, 0.0);
 }

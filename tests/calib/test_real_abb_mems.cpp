@@ -30,13 +30,13 @@
 #include "calib/orientation_losses.hpp"
 #include "calib/rotation_calibration.hpp"
 #include "calib/tool_imu_record.hpp"
+#include "core/units.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::calib {
 namespace {
 
 const std::string kDir = std::string(IMSCAL_TEST_DATA_DIR) + "/real/abb-mems/";
-constexpr double kDeg = 180.0 / M_PI;
 const char* kSeq1 = "V_500_Sequencia1";
 const char* kSeq3 = "V_500_Sequencia3";
 
@@ -60,10 +60,11 @@ Calibrated calibrate(const std::string& sequence, const std::string& sensor) {
       "{} calibrated on {}: {} windows ({} skipped), residual RMS {:.3f} -> {:.3f} deg, {} "
       "windows above 3 Cauchy scales\n  R_T_S angle {:.2f} deg, 1 sigma {} deg; time offset "
       "{:.4f} +- {:.4f} s; bias {} +- {} deg/s (as labelled); scale {} +- {}\n",
-      sensor, sequence, c.window_count, c.skipped_window_count, c.initial_rms_residual_rad * kDeg,
-      c.rms_residual_rad * kDeg, c.outlier_window_count, Eigen::AngleAxisd(c.q_T_S).angle() * kDeg,
-      v3(c.sigma_rotation_rad, kDeg), c.time_offset_s, c.sigma_time_offset_s,
-      v3(c.gyro_bias_rad_s, kDeg), v3(c.sigma_bias_rad_s, kDeg), v3(c.gyro_scale),
+      sensor, sequence, c.window_count, c.skipped_window_count,
+      c.initial_rms_residual_rad * kDegPerRad, c.rms_residual_rad * kDegPerRad,
+      c.outlier_window_count, Eigen::AngleAxisd(c.q_T_S).angle() * kDegPerRad,
+      v3(c.sigma_rotation_rad, kDegPerRad), c.time_offset_s, c.sigma_time_offset_s,
+      v3(c.gyro_bias_rad_s, kDegPerRad), v3(c.sigma_bias_rad_s, kDegPerRad), v3(c.gyro_scale),
       v3(c.sigma_scale));
   return out;
 }
@@ -101,20 +102,20 @@ SplitResult evaluate(const Calibrated& cal, const std::string& test_sequence,
   fmt::print(
       "  applied to {}: imscal orientation error RMS {:.2f} deg, max {:.2f} deg (from the start, "
       "{} samples)",
-      test_sequence, result.imscal_from_start.rms_rad * kDeg,
-      result.imscal_from_start.max_rad * kDeg, result.imscal_from_start.sample_count);
+      test_sequence, result.imscal_from_start.rms_rad * kDegPerRad,
+      result.imscal_from_start.max_rad * kDegPerRad, result.imscal_from_start.sample_count);
   if (result.restart_count > 0) {
     fmt::print(
         "; {} segments losing 5 deg or more; re-initialised after each of the {} lost spans, "
         "those spans left out: RMS {:.2f}, max {:.2f} deg",
-        result.loss_count, result.restart_count, result.imscal_after_missed.rms_rad * kDeg,
-        result.imscal_after_missed.max_rad * kDeg);
+        result.loss_count, result.restart_count, result.imscal_after_missed.rms_rad * kDegPerRad,
+        result.imscal_after_missed.max_rad * kDegPerRad);
   }
   fmt::print(
       "\n  XSENS MTi-30 on {} (alignment fitted on it, offset {:.3f} s): RMS {:.2f} deg, max "
       "{:.2f} deg ({} samples)\n",
-      test_sequence, alignment.time_offset_s, result.xsens.rms_rad * kDeg,
-      result.xsens.max_rad * kDeg, result.xsens.sample_count);
+      test_sequence, alignment.time_offset_s, result.xsens.rms_rad * kDegPerRad,
+      result.xsens.max_rad * kDegPerRad, result.xsens.sample_count);
   return result;
 }
 
@@ -140,8 +141,8 @@ TEST_P(RealAbbMems, CalibrateOnOneSequenceTrackTheOther) {
       "{}: R_T_S from the two sequences differ by {:.3f} deg, about T x, y, z {} deg; combined 1 "
       "sigma {} deg (block bootstrap, at least the covariance), {} deg (covariance of independent "
       "windows)\n",
-      sensor, rotation_difference * kDeg, v3(difference, kDeg), v3(combined_sigma, kDeg),
-      v3(covariance_sigma, kDeg));
+      sensor, rotation_difference * kDegPerRad, v3(difference, kDegPerRad),
+      v3(combined_sigma, kDegPerRad), v3(covariance_sigma, kDegPerRad));
   const SplitResult on3 = evaluate(cal1, kSeq3, sensor);
   const SplitResult on1 = evaluate(cal3, kSeq1, sensor);
 
@@ -154,7 +155,7 @@ TEST_P(RealAbbMems, CalibrateOnOneSequenceTrackTheOther) {
   // and 0.4 LSM9DS0); about T y they do not (3.3 and 3.9 sigma): a difference between path 1 and
   // path 3 that resampling one record cannot see (a motion-dependent error the model lacks).
   // Asserted: x and z within 3 sigma, y within 5.
-  EXPECT_LT(rotation_difference * kDeg, 5.0);
+  EXPECT_LT(rotation_difference * kDegPerRad, 5.0);
   EXPECT_LT(std::abs(difference.x()), 3.0 * combined_sigma.x());
   EXPECT_LT(std::abs(difference.z()), 3.0 * combined_sigma.z());
   EXPECT_LT(std::abs(difference.y()), 5.0 * combined_sigma.y());
@@ -162,7 +163,7 @@ TEST_P(RealAbbMems, CalibrateOnOneSequenceTrackTheOther) {
     const auto& c = cal->calibration;
     // The calibrated fit explains the windows to about a degree (measured 0.7-1.2 deg RMS per
     // axis over 0.5 s windows of up to 200 deg).
-    EXPECT_LT(c.rms_residual_rad * kDeg, 2.0);
+    EXPECT_LT(c.rms_residual_rad * kDegPerRad, 2.0);
     // Clock offset near the check's cross-correlation value (measured 0.080-0.093 s).
     EXPECT_NEAR(c.time_offset_s, 0.09, 0.03);
     // Scale: MPU9150 in deg/s as labelled (measured 0.979-1.021 per axis); LSM9DS0 ~1/64 of
@@ -178,9 +179,9 @@ TEST_P(RealAbbMems, CalibrateOnOneSequenceTrackTheOther) {
   // complex turns; LSM9DS0: 2 spans): MPU9150 2.53, LSM9DS0 4.76, XSENS 22.3. imscal beats the
   // XSENS by a factor 4-10 in every split; asserted: at least 2x better, and absolute bounds
   // with ~60 % margin over the measured values.
-  EXPECT_LT(on1.imscal_from_start.rms_rad * kDeg, 5.0);
+  EXPECT_LT(on1.imscal_from_start.rms_rad * kDegPerRad, 5.0);
   EXPECT_LT(on1.imscal_after_missed.rms_rad, 0.5 * on1.xsens.rms_rad);
-  EXPECT_LT(on3.imscal_after_missed.rms_rad * kDeg, 8.0);
+  EXPECT_LT(on3.imscal_after_missed.rms_rad * kDegPerRad, 8.0);
   EXPECT_LT(on3.imscal_after_missed.rms_rad, 0.5 * on3.xsens.rms_rad);
   // Sequence 1 loses no motion: no segment loses 5 deg, nothing to re-initialise.
   EXPECT_EQ(on1.loss_count, 0u);

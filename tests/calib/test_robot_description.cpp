@@ -11,14 +11,16 @@
 #include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 
 using imscal::ConfigNode;
 using imscal::InputError;
 using imscal::calib::RobotDescription;
 
+using imscal::kRadPerDeg;
+
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 const char* const kKr16Path = IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml";
 
 std::string kr16_text() {
@@ -64,9 +66,9 @@ TEST(RobotDescription, Kr16MatchesItsPublicSource) {
   const double upper_deg[] = {185, 35, 154, 350, 130, 350};
   const double speed_deg_s[] = {156, 156, 156, 330, 330, 615};
   for (int i = 0; i < 6; ++i) {
-    EXPECT_DOUBLE_EQ(robot.kinematics.lower_limit_rad(i), lower_deg[i] * kDeg);
-    EXPECT_DOUBLE_EQ(robot.kinematics.upper_limit_rad(i), upper_deg[i] * kDeg);
-    EXPECT_DOUBLE_EQ(robot.joints[i].max_velocity_rad_s, speed_deg_s[i] * kDeg);
+    EXPECT_DOUBLE_EQ(robot.kinematics.lower_limit_rad(i), lower_deg[i] * kRadPerDeg);
+    EXPECT_DOUBLE_EQ(robot.kinematics.upper_limit_rad(i), upper_deg[i] * kRadPerDeg);
+    EXPECT_DOUBLE_EQ(robot.joints[i].max_velocity_rad_s, speed_deg_s[i] * kRadPerDeg);
     EXPECT_EQ(robot.joints[i].name, fmt::format("A{}", i + 1));
   }
   // The DH lengths are the URDF's (and the OPW parameters') link lengths.
@@ -76,24 +78,25 @@ TEST(RobotDescription, Kr16MatchesItsPublicSource) {
   EXPECT_DOUBLE_EQ(robot.kinematics.dh[2].a_m, 0.035);
   EXPECT_DOUBLE_EQ(robot.kinematics.dh[3].d_m, -0.67);
   EXPECT_DOUBLE_EQ(robot.kinematics.dh[5].d_m, -0.158);
-  EXPECT_DOUBLE_EQ(robot.kinematics.dh[2].offset_rad, 90 * kDeg);
+  EXPECT_DOUBLE_EQ(robot.kinematics.dh[2].offset_rad, 90 * kRadPerDeg);
   // Moving mass + the ~87 kg base stated in the file make the data sheet's ~235 kg.
   double moving_kg = 0.0;
   for (const auto& joint : robot.joints) moving_kg += joint.link.mass_kg;
   EXPECT_NEAR(moving_kg + 87.0, 235.0, 1.0);  // the file's stated split, to its rounding
   // Conversions at the boundary: 3 arcmin of backlash on A2.
-  EXPECT_NEAR(robot.joints[1].drive.backlash_rad, 3.0 / 60.0 * kDeg, 1e-6 * kDeg);
+  EXPECT_NEAR(robot.joints[1].drive.backlash_rad, 3.0 / 60.0 * kRadPerDeg, 1e-6 * kRadPerDeg);
   // Tool 0.12 m out along z_H.
   EXPECT_LT((robot.tool.T_H_T.translation() - Eigen::Vector3d(0, 0, 0.12)).norm(), 1e-15);
 }
 
 TEST(RobotDescription, RollPitchYawFollowsUrdf) {
   // URDF rpy = fixed-axis x, y, z: R = Rz(yaw) Ry(pitch) Rx(roll). Pitch 90 deg turns x into -z.
-  const Eigen::Isometry3d pose = imscal::calib::pose_from_xyz_rpy({1, 2, 3}, {0, 90 * kDeg, 0});
+  const Eigen::Isometry3d pose =
+      imscal::calib::pose_from_xyz_rpy({1, 2, 3}, {0, 90 * kRadPerDeg, 0});
   EXPECT_LT((pose.linear() * Eigen::Vector3d::UnitX() + Eigen::Vector3d::UnitZ()).norm(), 1e-15);
   // Roll then yaw by 90 deg: y -> z (roll) -> z (yaw keeps z); x -> x -> y.
   const Eigen::Isometry3d ry =
-      imscal::calib::pose_from_xyz_rpy({0, 0, 0}, {90 * kDeg, 0, 90 * kDeg});
+      imscal::calib::pose_from_xyz_rpy({0, 0, 0}, {90 * kRadPerDeg, 0, 90 * kRadPerDeg});
   EXPECT_LT((ry.linear() * Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitZ()).norm(), 1e-15);
   EXPECT_LT((ry.linear() * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm(), 1e-15);
   EXPECT_EQ(pose.translation(), Eigen::Vector3d(1, 2, 3));

@@ -13,13 +13,13 @@
 
 #include "calib/tool_imu_record.hpp"
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal::calib {
 namespace {
 
 const std::string kDir = std::string(IMSCAL_TEST_DATA_DIR) + "/real/abb-mems/";
-constexpr double kDeg = 180.0 / M_PI;
 
 std::string path(const std::string& sequence, const std::string& sensor) {
   return kDir + "V_500_Sequencia" + sequence + "/" + sensor + ".csv";
@@ -136,14 +136,14 @@ TEST(ToolImuRecord, DetectsEveryListedDefectOnTheRealFiles) {
         EXPECT_LT(1.0 / analysis.gyro_scale_ratio, 75.0);
         // "the sensor axes are not aligned with the tool frame": x and y swapped (~94 deg).
         EXPECT_TRUE(axes[0].is_defect);
-        EXPECT_NEAR(analysis.misalignment_rad * kDeg, 90.0, 10.0);
+        EXPECT_NEAR(analysis.misalignment_rad * kDegPerRad, 90.0, 10.0);
       } else {
         // MPU9150: deg/s is right (measured ratio 0.987-1.012); its axes are within ~4 deg of
         // the tool's, reported but below the 5 deg threshold (measured 3.96 and 4.16 deg).
         EXPECT_FALSE(scale[0].is_defect);
         EXPECT_NEAR(analysis.gyro_scale_ratio, 1.0, 0.05);
-        EXPECT_LT(analysis.misalignment_rad * kDeg, 6.0);
-        EXPECT_GT(analysis.misalignment_rad * kDeg, 1.0);
+        EXPECT_LT(analysis.misalignment_rad * kDegPerRad, 6.0);
+        EXPECT_GT(analysis.misalignment_rad * kDegPerRad, 1.0);
         // "gyro saturation near 500 deg/s on MPU9150": a flat top on z at its largest reading,
         // 448.96 / 449.34 deg/s in the two files (numpy max |gyro_z_dps|).
         bool z_rail = false;

@@ -1,4 +1,5 @@
 // ISO 9283 path characteristics on paths whose answers are computed by hand (in the comments).
+#include "core/units.hpp"
 #include "eval/iso9283_path.hpp"
 
 #include <gtest/gtest.h>
@@ -7,8 +8,6 @@
 
 namespace imscal::eval {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // A straight line along +x at speed v from x = 0 to x = 0.8 m, sampled every dt, displaced by
 // `offset`, rotated by `rotation` relative to the commanded (identity) attitude.
@@ -41,14 +40,14 @@ TEST(Iso9283Path, AccuracyAndRepeatabilityOfThreeParallelCycles) {
 TEST(Iso9283Path, OrientationAccuracyAndRepeatability) {
   const PoseSeries commanded = line(0.5, 0.002, Eigen::Vector3d::Zero());
   const auto about_z = [](double deg) {
-    return Eigen::Quaterniond(Eigen::AngleAxisd(deg * kDeg, Eigen::Vector3d::UnitZ()));
+    return Eigen::Quaterniond(Eigen::AngleAxisd(deg * kRadPerDeg, Eigen::Vector3d::UnitZ()));
   };
   const std::vector<PoseSeries> cycles = {line(0.5, 0.001, {0, 0, 0}, about_z(0.1)),
                                           line(0.5, 0.001, {0, 0, 0}, about_z(0.3))};
   const Iso9283PathResult r = iso9283_path(commanded, cycles, 0.5);
   // c: mean 0.2 deg -> AT_c = 0.2 deg; RT_c = 3 sqrt((0.1^2 + 0.1^2) / 1) deg = 0.42426 deg.
-  EXPECT_NEAR(r.AT_abc_rad.z(), 0.2 * kDeg, 1e-12);
-  EXPECT_NEAR(r.RT_abc_rad.z(), 3.0 * std::sqrt(0.02) * kDeg, 1e-12);
+  EXPECT_NEAR(r.AT_abc_rad.z(), 0.2 * kRadPerDeg, 1e-12);
+  EXPECT_NEAR(r.RT_abc_rad.z(), 3.0 * std::sqrt(0.02) * kRadPerDeg, 1e-12);
   EXPECT_NEAR(r.AT_abc_rad.x(), 0.0, 1e-15);
   EXPECT_NEAR(r.AT_p_m, 0.0, 1e-12);
 }

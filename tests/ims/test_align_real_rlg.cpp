@@ -14,13 +14,12 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "core/units.hpp"
 #include "ims/coarse_alignment.hpp"
 #include "ims/psins_reader.hpp"
 
 namespace imscal::ims {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 class RealRlgAlignment : public ::testing::Test {
  protected:
@@ -43,11 +42,11 @@ void print(const char* label, const CoarseAlignment& a) {
       "{:>14} t_ref {:7.1f} s  heading {:8.4f} +- {:6.4f} deg (PSINS yaw {:8.4f})  pitch {:7.4f} "
       "+- {:6.4f}  roll {:7.4f} +- {:6.4f} deg  |f| {:.5f} m/s^2  Earth rate horiz {:.3f} "
       "(expected {:.3f}) deg/h  blocks {}/{}\n",
-      label, a.t_ref_s, a.angles.heading_rad / kDeg, a.sigma_heading_rad / kDeg,
-      a.angles.yaw_rad / kDeg, a.angles.pitch_rad / kDeg, a.sigma_pitch_rad / kDeg,
-      a.angles.roll_rad / kDeg, a.sigma_roll_rad / kDeg, a.specific_force_m_s2,
-      a.earth_rate_horizontal_rad_s / kDeg * 3600,
-      a.expected_earth_rate_horizontal_rad_s / kDeg * 3600, a.blocks_used,
+      label, a.t_ref_s, a.angles.heading_rad / kRadPerDeg, a.sigma_heading_rad / kRadPerDeg,
+      a.angles.yaw_rad / kRadPerDeg, a.angles.pitch_rad / kRadPerDeg,
+      a.sigma_pitch_rad / kRadPerDeg, a.angles.roll_rad / kRadPerDeg, a.sigma_roll_rad / kRadPerDeg,
+      a.specific_force_m_s2, a.earth_rate_horizontal_rad_s / kRadPerDeg * 3600,
+      a.expected_earth_rate_horizontal_rad_s / kRadPerDeg * 3600, a.blocks_used,
       a.blocks_used + a.blocks_rejected);
 }
 
@@ -57,7 +56,7 @@ TEST_F(RealRlgAlignment, WholeRecordHeadingMatchesStatedYaw) {
       align_at_rest(*series_, SampleRange{0, series_->samples.size()}, earth);
   print("whole record", all);
   // The file states yaw0 = -90.6 deg as "maybe inaccurate" (one decimal); the goal is 0.5 deg.
-  EXPECT_NEAR(all.angles.yaw_rad / kDeg, header_.initial_yaw_deg, 0.5);
+  EXPECT_NEAR(all.angles.yaw_rad / kRadPerDeg, header_.initial_yaw_deg, 0.5);
   // A navigation-grade RLG at rest must see the horizontal Earth rate (12.43 deg/h here): 1 %
   // allows a horizontal gyro bias of 0.12 deg/h, far above such a gyro's bias.
   EXPECT_NEAR(all.earth_rate_horizontal_rad_s / all.expected_earth_rate_horizontal_rad_s, 1.0,
@@ -75,7 +74,7 @@ TEST_F(RealRlgAlignment, FiveMinuteWindowsAgree) {
   for (std::size_t j = 0; j < windows.size(); ++j) {
     print(fmt::format("window {}", j).c_str(), windows[j]);
     // Each window alone must also match the stated yaw (same 0.5 deg goal as above).
-    EXPECT_NEAR(windows[j].angles.yaw_rad / kDeg, header_.initial_yaw_deg, 0.5);
+    EXPECT_NEAR(windows[j].angles.yaw_rad / kRadPerDeg, header_.initial_yaw_deg, 0.5);
   }
   const AngleSpread heading = angle_spread(windows, AngleKind::kHeading);
   const AngleSpread pitch = angle_spread(windows, AngleKind::kPitch);
@@ -86,12 +85,13 @@ TEST_F(RealRlgAlignment, FiveMinuteWindowsAgree) {
       "spread over {} windows of 300 s: heading std {:.4f} deg (max-min {:.4f}), mean reported "
       "heading sigma {:.4f} deg; pitch std {:.4f} deg (max-min {:.4f}); roll std {:.4f} deg "
       "(max-min {:.4f})\n",
-      windows.size(), heading.std_rad / kDeg, (heading.max_rad - heading.min_rad) / kDeg,
-      mean_sigma / kDeg, pitch.std_rad / kDeg, (pitch.max_rad - pitch.min_rad) / kDeg,
-      roll.std_rad / kDeg, (roll.max_rad - roll.min_rad) / kDeg);
+      windows.size(), heading.std_rad / kRadPerDeg,
+      (heading.max_rad - heading.min_rad) / kRadPerDeg, mean_sigma / kRadPerDeg,
+      pitch.std_rad / kRadPerDeg, (pitch.max_rad - pitch.min_rad) / kRadPerDeg,
+      roll.std_rad / kRadPerDeg, (roll.max_rad - roll.min_rad) / kRadPerDeg);
   // Goal of the issue: disjoint 5-minute windows agree within 0.1 deg (1 sigma = std of the
   // window headings).
-  EXPECT_LT(heading.std_rad / kDeg, 0.1);
+  EXPECT_LT(heading.std_rad / kRadPerDeg, 0.1);
   // The reported sigma must not be optimistic: the observed spread may exceed the mean reported
   // sigma only by the sampling scatter of a std from 6 values (upper 99 % of chi with 5 dof: 1.9).
   EXPECT_LT(heading.std_rad, 1.9 * mean_sigma);

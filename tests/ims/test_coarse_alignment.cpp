@@ -9,13 +9,13 @@
 #include <random>
 #include <vector>
 
+#include "core/units.hpp"
 #include "ims/coarse_alignment.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::ims {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 const Site kSite{48.78, 9.18, 300.0};  // Stuttgart: horizontal Earth rate 9.9 deg/h
 
 struct Noise {
@@ -63,14 +63,14 @@ double wrapped(double a) {
 
 TEST(AttitudeAngles, ConventionsOfTheAngles) {
   // Y axis pointing East (PSINS yaw -90 deg): heading 90 deg clockwise from North.
-  const AttitudeAngles east = attitude_angles(R_W_S_from_angles(0.0, 0.0, -90.0 * kDeg));
-  EXPECT_NEAR(east.heading_rad, 90.0 * kDeg, 1e-12);  // exact up to rounding
-  EXPECT_NEAR(east.yaw_rad, -90.0 * kDeg, 1e-12);
+  const AttitudeAngles east = attitude_angles(R_W_S_from_angles(0.0, 0.0, -90.0 * kRadPerDeg));
+  EXPECT_NEAR(east.heading_rad, 90.0 * kRadPerDeg, 1e-12);  // exact up to rounding
+  EXPECT_NEAR(east.yaw_rad, -90.0 * kRadPerDeg, 1e-12);
   // Nose up: +Y above the horizontal gives positive pitch.
-  const Eigen::Matrix3d up = R_W_S_from_angles(0.0, 10.0 * kDeg, 0.0);
+  const Eigen::Matrix3d up = R_W_S_from_angles(0.0, 10.0 * kRadPerDeg, 0.0);
   EXPECT_GT(up.col(1).z(), 0.0);
   // Positive roll puts the X (right) axis below the horizontal.
-  const Eigen::Matrix3d rolled = R_W_S_from_angles(10.0 * kDeg, 0.0, 0.0);
+  const Eigen::Matrix3d rolled = R_W_S_from_angles(10.0 * kRadPerDeg, 0.0, 0.0);
   EXPECT_LT(rolled.col(0).z(), 0.0);
   // Round trip through the angles.
   const AttitudeAngles a = attitude_angles(R_W_S_from_angles(0.1, -0.2, 2.5));
@@ -89,7 +89,8 @@ TEST(CoarseAlignment, NoiseFreeStaticRecordGivesTheTrueAttitude) {
                                      {0.3, -0.2, -0.4}};
   for (const auto& att : attitudes_deg) {
     for (ImuQuantity quantity : {ImuQuantity::kIncrements, ImuQuantity::kRates}) {
-      const Eigen::Matrix3d R = R_W_S_from_angles(att[0] * kDeg, att[1] * kDeg, att[2] * kDeg);
+      const Eigen::Matrix3d R =
+          R_W_S_from_angles(att[0] * kRadPerDeg, att[1] * kRadPerDeg, att[2] * kRadPerDeg);
       const ImuSeries series = static_record(earth, R, 100.0, 120.0, quantity);
       const CoarseAlignment a = align_at_rest(series, SampleRange{0, series.samples.size()}, earth);
       // The model is exact for a static record; what remains is the first-order rotation
@@ -97,9 +98,9 @@ TEST(CoarseAlignment, NoiseFreeStaticRecordGivesTheTrueAttitude) {
       // Earth rotation (~(Omega T/16)^2/24 ~ 1e-8): 1e-7 rad (0.02 arcsec) holds both.
       EXPECT_LT(rotation_angle_between(a.q_W_S, Eigen::Quaterniond(R)), 1e-7)
           << att[0] << " " << att[1] << " " << att[2];
-      EXPECT_NEAR(wrapped(a.angles.heading_rad + att[2] * kDeg), 0.0, 1e-7);
-      EXPECT_NEAR(a.angles.roll_rad, att[0] * kDeg, 1e-7);
-      EXPECT_NEAR(a.angles.pitch_rad, att[1] * kDeg, 1e-7);
+      EXPECT_NEAR(wrapped(a.angles.heading_rad + att[2] * kRadPerDeg), 0.0, 1e-7);
+      EXPECT_NEAR(a.angles.roll_rad, att[0] * kRadPerDeg, 1e-7);
+      EXPECT_NEAR(a.angles.pitch_rad, att[1] * kRadPerDeg, 1e-7);
       // The horizontal Earth rate comes out of the data, not the model: 1e-6 relative.
       EXPECT_NEAR(a.earth_rate_horizontal_rad_s / a.expected_earth_rate_horizontal_rad_s, 1.0,
                   1e-6);
@@ -115,7 +116,8 @@ TEST(CoarseAlignment, NoiseFreeStaticRecordGivesTheTrueAttitude) {
 // The reported 1-sigma must match the scatter of the angles over independent noise draws.
 void check_sigma_against_scatter(const Noise& noise, int draws, bool check_tilt) {
   const EarthModel earth(kSite);
-  const Eigen::Matrix3d R = R_W_S_from_angles(1.5 * kDeg, -2.0 * kDeg, 63.0 * kDeg);
+  const Eigen::Matrix3d R =
+      R_W_S_from_angles(1.5 * kRadPerDeg, -2.0 * kRadPerDeg, 63.0 * kRadPerDeg);
   const AttitudeAngles truth = attitude_angles(R);
   std::mt19937_64 rng(20261121);
   double sum_err[3] = {0, 0, 0}, sum_sq_err[3] = {0, 0, 0}, sum_var[3] = {0, 0, 0};
@@ -177,7 +179,8 @@ TEST(CoarseAlignment, SigmaMatchesScatterWithBothNoises) {
 // degrees.
 TEST(CoarseAlignment, RobustToATiltStepAndAPush) {
   const EarthModel earth(kSite);
-  const Eigen::Matrix3d R0 = R_W_S_from_angles(0.5 * kDeg, 1.0 * kDeg, -90.0 * kDeg);
+  const Eigen::Matrix3d R0 =
+      R_W_S_from_angles(0.5 * kRadPerDeg, 1.0 * kRadPerDeg, -90.0 * kRadPerDeg);
   const Eigen::Vector3d tilt_axis_S = Eigen::Vector3d(1.0, 0.3, 0.0).normalized();
   const double tilt_rad = 2e-3, tilt_start = 30.0, tilt_length = 2.0;
   const double push_m = 0.02, push_start = 80.0, push_length = 1.0;
@@ -254,7 +257,7 @@ TEST(CoarseAlignment, RobustToATiltStepAndAPush) {
   Eigen::Matrix3d R_S_W;
   R_S_W << north.cross(up), north, up;
   const AttitudeAngles plain = attitude_angles(R_S_W.transpose());
-  EXPECT_GT(std::abs(wrapped(plain.heading_rad - true_angles.heading_rad)), 1.0 * kDeg);
+  EXPECT_GT(std::abs(wrapped(plain.heading_rad - true_angles.heading_rad)), 1.0 * kRadPerDeg);
 }
 
 TEST(CoarseAlignment, RejectsTooShortIntervalsAndPolarSites) {

@@ -9,11 +9,10 @@
 #include <vector>
 
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 #include "sim/desired_path.hpp"
 
 namespace imscal::sim::test {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // The default robot of the plant tests (datasets/robots/kr16.yaml), read once.
 inline const calib::RobotDescription& kr16() {
@@ -25,7 +24,7 @@ inline const calib::RobotDescription& kr16() {
 // Upper arm vertical, forearm horizontal, hand tilted: gravity loads A2, A3, A5.
 inline calib::JointVector home() {
   calib::JointVector q;
-  q << 0.0, -90.0 * kDeg, 90.0 * kDeg, 0.0, 45.0 * kDeg, 0.0;
+  q << 0.0, -90.0 * kRadPerDeg, 90.0 * kRadPerDeg, 0.0, 45.0 * kRadPerDeg, 0.0;
   return q;
 }
 

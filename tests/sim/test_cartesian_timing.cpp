@@ -14,6 +14,7 @@
 #include "calib/forward_kinematics.hpp"
 #include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
+#include "core/units.hpp"
 #include "sim/cartesian_timing.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_profile.hpp"
@@ -30,7 +31,6 @@ using test::program;
 using test::range;
 using test::robot;
 using test::segment;
-constexpr double kDeg = M_PI / 180.0;
 
 // The planned arc-length profile of a Cartesian segment, recomputed from its recorded limits.
 MotionProfile planned_profile(const PathSegment& seg, double length) {
@@ -128,7 +128,7 @@ TEST(ChooseTiming, VelocityLimitSlowsUniformly) {
 // the programmed velocity, the path acceleration r a1 (plateau of the profile stretched to whole
 // cycles; to the search's 1e-4), the other joints still.
 TEST(CartesianTiming, CircleAboutAxisOneRampsToTheAxisOneLimit) {
-  const double r = 1.0, a1 = 200 * kDeg, j1 = 2000 * kDeg;
+  const double r = 1.0, a1 = 200 * kRadPerDeg, j1 = 2000 * kRadPerDeg;
   // Path acceleration 1.5 r a1; jerk 1.5 r j1 (ramp stretch 1.5 leaves it at 2/3 of A1's jerk);
   // velocity 0.8 m/s (0.8 rad/s on A1, max 2.7) reaches the plateau (v j' >= a'^2).
   const double A = 1.5 * r * a1, J = 1.5 * r * j1, V = 0.8;
@@ -137,8 +137,8 @@ TEST(CartesianTiming, CircleAboutAxisOneRampsToTheAxisOneLimit) {
       "  - circ: {{via_mm: [{:.17g}, {:.17g}, 800], to: {{xyz_mm: [{:.17g}, {:.17g}, 800], "
       "rpy_deg: [180, 0, 150]}}, orientation: slerp, velocity_m_s: {}, acceleration_m_s2: "
       "{:.17g}, jerk_m_s3: {:.17g}, label: arc}}\n",
-      1e3 * std::cos(75 * kDeg), 1e3 * std::sin(75 * kDeg), 1e3 * std::cos(150 * kDeg),
-      1e3 * std::sin(150 * kDeg), V, A, J);
+      1e3 * std::cos(75 * kRadPerDeg), 1e3 * std::sin(75 * kRadPerDeg),
+      1e3 * std::cos(150 * kRadPerDeg), 1e3 * std::sin(150 * kRadPerDeg), V, A, J);
   const MotionProgram p = program(segments);
   const DesiredJointPath path = plan_motion(robot(), p);
   const PathSegment& arc = segment(path, "arc");
@@ -149,7 +149,7 @@ TEST(CartesianTiming, CircleAboutAxisOneRampsToTheAxisOneLimit) {
   EXPECT_NEAR(timing.programmed_use.acceleration_ratio, 1.5, 1.5 * 2e-3);
   EXPECT_EQ(timing.programmed_use.acceleration_joint, 0);
   EXPECT_EQ(timing.planned.velocity, V);  // k = 1 exactly: the speed is kept
-  const double length = r * 150 * kDeg;
+  const double length = r * 150 * kRadPerDeg;
   const MotionProfile profile = planned_profile(arc, length);
   EXPECT_LE(profile.peak_acceleration(), r * a1 * (1 + kJointLimitTolerance));
   EXPECT_GE(profile.peak_acceleration(), r * a1 * (1 - 2e-4));
@@ -184,7 +184,8 @@ TEST(CartesianTiming, CircleAboutAxisOneRampsToTheAxisOneLimit) {
 // the test pose: its programmed timing takes A3 to 5x its acceleration and 16x its jerk limit.
 // The planned one: every joint within its limits, the same circle and orientation, only slower.
 TEST(CartesianTiming, SmallCircleIsSlowedOntoTheSameCircle) {
-  const Eigen::Isometry3d start = fk((JointVector() << 10, -60, 80, 20, 50, 30).finished() * kDeg);
+  const Eigen::Isometry3d start =
+      fk((JointVector() << 10, -60, 80, 20, 50, 30).finished() * kRadPerDeg);
   const Eigen::Vector3d p0 = start.translation();
   const Eigen::Vector3d centre = p0 + Eigen::Vector3d(0, 0.02, 0);
   const std::string segments = fmt::format(

@@ -15,14 +15,15 @@
 
 #include "calib/forward_kinematics.hpp"
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 #include "sim/kdl_chain.hpp"
 
 using imscal::calib::JointVector;
 using imscal::calib::RobotDescription;
 
-namespace {
+using imscal::kRadPerDeg;
 
-constexpr double kDeg = M_PI / 180.0;
+namespace {
 
 RobotDescription kr16() {
   return imscal::calib::load_robot_description(IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml");
@@ -210,7 +211,7 @@ TEST(KdlChain, Kr16FirstResonancesAreInTheStatedBand) {
   KDL::Chain chain = imscal::sim::build_kdl_chain(robot, options);
   KDL::ChainDynParam dyn(chain, KDL::Vector(0, 0, -9.81));
   JointVector home;
-  home << 0, -90 * kDeg, 90 * kDeg, 0, 45 * kDeg, 0;
+  home << 0, -90 * kRadPerDeg, 90 * kRadPerDeg, 0, 45 * kRadPerDeg, 0;
   KDL::JntSpaceInertiaMatrix mass(6);
   ASSERT_GE(dyn.JntToMass(to_kdl(home), mass), 0);
   for (int i = 0; i < 6; ++i) {
@@ -223,7 +224,7 @@ TEST(KdlChain, Kr16FirstResonancesAreInTheStatedBand) {
   // The file also says that A1 drops to ~8 Hz with the arm stretched forward (q = 0); +-1 Hz
   // is the rounding of that statement.
   JointVector stretched = JointVector::Zero();
-  stretched(4) = 45 * kDeg;
+  stretched(4) = 45 * kRadPerDeg;
   ASSERT_GE(dyn.JntToMass(to_kdl(stretched), mass), 0);
   const double f1 = std::sqrt(robot.joints[0].drive.stiffness_nm_per_rad / mass(0, 0)) / (2 * M_PI);
   std::printf("A1 stretched: M_11 %.4g kg m^2, locked-motor resonance %.1f Hz\n", mass(0, 0), f1);

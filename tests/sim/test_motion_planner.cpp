@@ -14,6 +14,7 @@
 #include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
+#include "core/units.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_profile.hpp"
 #include "sim/motion_program.hpp"
@@ -29,7 +30,6 @@ using test::program;
 using test::range;
 using test::robot;
 using test::segment;
-constexpr double kDeg = M_PI / 180.0;
 
 // test::kHeader's joint limits.
 const MotionProgram& header_program() {
@@ -219,7 +219,7 @@ TEST(MotionPlanner, LinSlerpTurnsProportionallyToTheDistance) {
   const Eigen::Isometry3d start = fk(p.start_joints_rad);
   const Eigen::Vector3d p0 = start.translation(), p1(1.2, 0.3, 0.9);
   const Eigen::Matrix3d R1 =
-      calib::pose_from_xyz_rpy(Eigen::Vector3d::Zero(), Eigen::Vector3d(150, 20, 30) * kDeg)
+      calib::pose_from_xyz_rpy(Eigen::Vector3d::Zero(), Eigen::Vector3d(150, 20, 30) * kRadPerDeg)
           .linear();
   const double L = (p1 - p0).norm();
   // Truth: the geodesic R0 -> R1 via Eigen's quaternion slerp at sigma = s / L.
@@ -241,7 +241,8 @@ TEST(MotionPlanner, CircThroughViaPointAndFullCircle) {
   // Start p0; via p0 + (100, 100, 0) mm, target p0 + (200, 0, 0) mm: by construction the circle
   // is horizontal with centre p0 + (100, 0, 0) mm and radius 100 mm (half circle). Then a full
   // circle about a centre 80 mm further along y turning about +z.
-  const Eigen::Isometry3d start = fk((JointVector() << 10, -60, 80, 20, 50, 30).finished() * kDeg);
+  const Eigen::Isometry3d start =
+      fk((JointVector() << 10, -60, 80, 20, 50, 30).finished() * kRadPerDeg);
   const Eigen::Vector3d p0 = start.translation();
   const Eigen::Vector3d via = p0 + Eigen::Vector3d(0.1, 0.1, 0),
                         to = p0 + Eigen::Vector3d(0.2, 0, 0);
@@ -356,7 +357,7 @@ TEST(MotionPlanner, RefusesCartesianMoveBeyondAJointLimit) {
   // A robot whose A1 stops at 12 deg; the start has q1 = 10 deg, and moving in -y turns A1
   // positively (axis 1 points down), so the line leaves the range after a few cm.
   calib::RobotDescription narrow = robot();
-  narrow.kinematics.upper_limit_rad(0) = 12.0 * kDeg;
+  narrow.kinematics.upper_limit_rad(0) = 12.0 * kRadPerDeg;
   try {
     plan_motion(narrow, program(R"(
   - lin: {by: {xyz_mm: [0, -300, 0]}, velocity_m_s: 0.2, acceleration_m_s2: 1, jerk_m_s3: 10,
@@ -386,7 +387,7 @@ TEST(MotionPlanner, RefusesPassingThroughTheWristSingularity) {
   // (0, -60, 80, 0, 10, 0) to (0, -40, 80, 0, -10, 0) the orientation is the same, so a constant-
   // orientation line between the two flange positions must take A5 through 0 (axes 4 and 6
   // aligned). Both ends are regular poses.
-  const JointVector q_end = (JointVector() << 0, -40, 80, 0, -10, 0).finished() * kDeg;
+  const JointVector q_end = (JointVector() << 0, -40, 80, 0, -10, 0).finished() * kRadPerDeg;
   const Eigen::Vector3d target = fk(q_end).translation() * 1e3;
   const std::string segments = fmt::format(
       "  - ptp: {{joints_deg: [0, -60, 80, 0, 10, 0]}}\n"

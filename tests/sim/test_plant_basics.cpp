@@ -11,15 +11,16 @@
 #include "sim/plant_simulator.hpp"
 #include "tests/sim/plant_test_paths.hpp"
 
+using imscal::kRadPerArcsec;
+using imscal::kRadPerDeg;
+
 namespace {
 
 using imscal::ConfigNode;
 using imscal::InputError;
 using imscal::calib::JointVector;
 using namespace imscal::sim;
-using test::kDeg;
 using test::kr16;
-constexpr double kArcsec = kDeg / 3600.0;
 
 PlantConfig parse(const std::string& yaml) {
   const ConfigNode root = ConfigNode::load_string(yaml, "scenario.yaml");
@@ -57,11 +58,11 @@ integration_step_s: 0.00025
   EXPECT_FALSE(config.effects[0].transmission_error);
   EXPECT_DOUBLE_EQ(config.effects[3].dead_time_s, 0.004);
   EXPECT_DOUBLE_EQ(config.effects[2].coulomb_velocity_scale_rad_s, 0.02);
-  EXPECT_NEAR(config.effects[1].transmission_error_shape.amplitude_rad, 10 * kArcsec, 1e-15);
+  EXPECT_NEAR(config.effects[1].transmission_error_shape.amplitude_rad, 10 * kRadPerArcsec, 1e-15);
   EXPECT_DOUBLE_EQ(config.effects[1].transmission_error_shape.harmonic_per_motor_rev, 2.0);
   EXPECT_NEAR(config.effects[1].transmission_error_shape.phase_rad, M_PI / 2, 1e-15);
   EXPECT_FALSE(config.effects[5].elastic_gear);
-  EXPECT_NEAR(config.effects[5].transmission_error_shape.amplitude_rad, 5 * kArcsec, 1e-15);
+  EXPECT_NEAR(config.effects[5].transmission_error_shape.amplitude_rad, 5 * kRadPerArcsec, 1e-15);
   EXPECT_DOUBLE_EQ(config.effects[5].transmission_error_shape.harmonic_per_motor_rev, 2.0);
 }
 
@@ -117,7 +118,8 @@ TEST(PlantStart, AtRestWithoutTransient) {
   PlantConfig config = make_plant_config(kr16(), nullptr);
   for (JointEffects& e : config.effects) e.transmission_error = true;
   JointVector pose;
-  pose << 30 * kDeg, -50 * kDeg, 60 * kDeg, 20 * kDeg, 40 * kDeg, 10 * kDeg;
+  pose << 30 * kRadPerDeg, -50 * kRadPerDeg, 60 * kRadPerDeg, 20 * kRadPerDeg, 40 * kRadPerDeg,
+      10 * kRadPerDeg;
   DesiredJointPath path = test::build_path(pose, 1.0, {}, 1);
   Payload load{"5 kg", {}};
   load.body.mass_kg = 5.0;

@@ -13,12 +13,13 @@
 #include "sim/rigid_body_dynamics.hpp"
 #include "tests/sim/plant_test_paths.hpp"
 
+using imscal::kRadPerDeg;
+
 namespace {
 
 using imscal::calib::JointVector;
 using namespace imscal::sim;
 using test::home;
-using test::kDeg;
 using test::kr16;
 constexpr int kN = 6;
 constexpr double kCycle = 0.002;
@@ -48,7 +49,7 @@ double deflection(const PlantSample& s, int joint) {
 // A1 by +90 deg in 2 s (0.3 s ramps, cruise 0.92 rad/s), rest, and back.
 DesiredJointPath a1_there_and_back() {
   JointVector target = home();
-  target(0) += 90.0 * kDeg;
+  target(0) += 90.0 * kRadPerDeg;
   return test::build_path(home(), 0.2, {{target, 2.0, 0.3, 0.5, 0}, {home(), 2.0, 0.3, 0.5, 0}});
 }
 
@@ -58,7 +59,8 @@ TEST(PlantEffects, MotorInertiaAddsReflectedInertiaTorque) {
   PlantConfig no_motor = ideal_config();
   for (int i = 0; i < 3; ++i) no_motor.effects[i].motor_inertia = false;
   JointVector target;
-  target << 60 * kDeg, -60 * kDeg, 60 * kDeg, 60 * kDeg, 0 * kDeg, 90 * kDeg;
+  target << 60 * kRadPerDeg, -60 * kRadPerDeg, 60 * kRadPerDeg, 60 * kRadPerDeg, 0 * kRadPerDeg,
+      90 * kRadPerDeg;
   const DesiredJointPath path = test::build_path(home(), 0.1, {{target, 1.2, 0.4, 0.2, 0}});
   const PlantLog with = simulate_plant(config, path, kCycle);
   const PlantLog without = simulate_plant(no_motor, path, kCycle);
@@ -97,8 +99,8 @@ TEST(PlantEffects, ElasticGearDeflectsByGravityOverStiffness) {
       if (i < 3) config.effects[i].motor_inertia = motor_inertia;  // wrist: see ideal_config
     }
     JointVector target = home();
-    target(1) = -50.0 * kDeg;  // A2 forward: the arm leans out, gravity torque on A2 grows
-    target(2) = 60.0 * kDeg;
+    target(1) = -50.0 * kRadPerDeg;  // A2 forward: the arm leans out, gravity torque on A2 grows
+    target(2) = 60.0 * kRadPerDeg;
     const DesiredJointPath path = test::build_path(home(), 0.1, {{target, 1.0, 0.3, 2.0, 0}});
     const PlantLog log = simulate_plant(config, path, kCycle);
     const PlantSample& end = log.samples.back();
@@ -117,7 +119,7 @@ TEST(PlantEffects, ElasticGearDeflectsByGravityOverStiffness) {
   }
   // The ideal plant has no deflection at all.
   JointVector target = home();
-  target(1) = -50.0 * kDeg;
+  target(1) = -50.0 * kRadPerDeg;
   const DesiredJointPath path = test::build_path(home(), 0.1, {{target, 1.0, 0.3, 0.2, 0}});
   const PlantLog rigid = simulate_plant(ideal_config(), path, kCycle);
   EXPECT_LT(std::abs(deflection(rigid.samples.back(), 1)), 1e-12);
@@ -225,7 +227,7 @@ TEST(PlantEffects, LinkBearingFrictionHoldsAnUnloadedLinkInsideItsPlay) {
       e.link_friction_fraction = fraction;
     }
     JointVector target = home();
-    target(5) += 60.0 * kDeg;
+    target(5) += 60.0 * kRadPerDeg;
     const DesiredJointPath path = test::build_path(home(), 0.2, {{target, 0.6, 0.2, 3.0, 0}});
     const PlantLog log = simulate_plant(config, path, kCycle);
     // RMS link speed of A6 over the last 2 s of the 3 s rest [rad/s].
@@ -248,12 +250,12 @@ TEST(PlantEffects, LinkBearingFrictionHoldsAnUnloadedLinkInsideItsPlay) {
 
 TEST(PlantEffects, TransmissionErrorIsPeriodicInMotorAngle) {
   PlantConfig config = ideal_config();
-  const double amplitude = 20.0 / 3600.0 * kDeg;
-  const double phase = 30.0 * kDeg;
+  const double amplitude = 20.0 / 3600.0 * kRadPerDeg;
+  const double phase = 30.0 * kRadPerDeg;
   config.effects[0].transmission_error = true;
   config.effects[0].transmission_error_shape = {amplitude, 2.0, phase};
   JointVector target = home();
-  target(0) += 5.0 * kDeg;  // 5 deg at the link = 2.2 motor revolutions (N = 160)
+  target(0) += 5.0 * kRadPerDeg;  // 5 deg at the link = 2.2 motor revolutions (N = 160)
   const DesiredJointPath path = test::build_path(home(), 0.1, {{target, 2.0, 0.5, 2.5, 0}});
   const PlantLog log = simulate_plant(config, path, kCycle);
   const double n = kr16().joints[0].drive.gear_ratio;
@@ -280,7 +282,7 @@ TEST(PlantEffects, TransmissionErrorIsPeriodicInMotorAngle) {
 TEST(PlantEffects, PayloadChangesGravityTorqueByMassTimesLever) {
   PlantConfig config = ideal_config();
   JointVector pose;
-  pose << 20 * kDeg, -40 * kDeg, 70 * kDeg, 10 * kDeg, 30 * kDeg, 0.0;
+  pose << 20 * kRadPerDeg, -40 * kRadPerDeg, 70 * kRadPerDeg, 10 * kRadPerDeg, 30 * kRadPerDeg, 0.0;
   DesiredJointPath path =
       test::build_path(home(), 0.1, {{pose, 1.0, 0.3, 2.5, 0}, {pose, 0.0, 0.0, 2.5, 1}});
   Payload load{"5 kg", {}};

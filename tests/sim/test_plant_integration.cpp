@@ -10,12 +10,13 @@
 #include "sim/plant_simulator.hpp"
 #include "tests/sim/plant_test_paths.hpp"
 
+using imscal::kRadPerDeg;
+
 namespace {
 
 using imscal::calib::JointVector;
 using namespace imscal::sim;
 using test::home;
-using test::kDeg;
 using test::kr16;
 constexpr int kN = 6;
 
@@ -62,7 +63,8 @@ TEST(PlantIntegration, HalvingTheStepChangesFollowingErrorByLessThanOnePercent) 
   PlantConfig fine = coarse;
   fine.integration_step_s = 0.5 * coarse.integration_step_s;
   JointVector target;
-  target << 50 * kDeg, -60 * kDeg, 60 * kDeg, -40 * kDeg, 70 * kDeg, 120 * kDeg;
+  target << 50 * kRadPerDeg, -60 * kRadPerDeg, 60 * kRadPerDeg, -40 * kRadPerDeg, 70 * kRadPerDeg,
+      120 * kRadPerDeg;
   const double move_s = test::sanitized() ? 0.8 : 1.5;
   DesiredJointPath path = test::build_path(
       home(), 0.1, {{target, move_s, 0.4, 0.3, 0}, {home(), move_s, 0.4, 0.3, 0}}, 1);
@@ -82,8 +84,8 @@ TEST(PlantIntegration, HalvingTheStepChangesFollowingErrorByLessThanOnePercent) 
     peak = peak.cwiseMax(error_a.cwiseAbs());
     change = change.cwiseMax((error_a - error_b).cwiseAbs());
   }
-  std::cout << "peak following error [deg]: " << (peak / kDeg).transpose() << "\n"
-            << "max change on halving [deg]: " << (change / kDeg).transpose() << "\n";
+  std::cout << "peak following error [deg]: " << (peak / kRadPerDeg).transpose() << "\n"
+            << "max change on halving [deg]: " << (change / kRadPerDeg).transpose() << "\n";
   for (int i = 0; i < kN; ++i) {
     ASSERT_GT(peak(i), 1e-3) << "joint " << i;  // every joint moves with a real following error
     // The brief's criterion: halving the step changes the result by < 1 %.

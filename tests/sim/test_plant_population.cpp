@@ -8,6 +8,7 @@
 #include <set>
 
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 #include "sim/drive_model.hpp"
 #include "sim/plant_population.hpp"
 #include "sim/scenario.hpp"
@@ -21,7 +22,6 @@ namespace fs = std::filesystem;
 using PlantPopulation = test_support::ScratchDirTest;
 const fs::path kDatasets = fs::path(IMSCAL_SOURCE_DIR) / "datasets";
 const fs::path kNominal = kDatasets / "robots" / "kr16.yaml";
-constexpr double kArcmin = M_PI / 180.0 / 60.0;
 
 // Smallest and largest of the values seen.
 struct Span {
@@ -146,12 +146,12 @@ TEST_F(PlantPopulation, ADrawnPlantLoadsAsDrawnAndSimulates) {
                 j.velocity_gain, 1e-12);
     EXPECT_EQ(config.effects[i].backlash, j.play_arcmin > 0.0);
     if (j.play_arcmin > 0.0) {
-      EXPECT_NEAR(p.drive.backlash_rad / kArcmin, j.play_arcmin, 1e-10);
+      EXPECT_NEAR(p.drive.backlash_rad / kRadPerArcmin, j.play_arcmin, 1e-10);
     }
     EXPECT_NEAR(config.effects[i].dead_time_s, plant.dead_time_cycles * 0.002, 1e-15);
     ASSERT_EQ(config.effects[i].further_transmission_error_shapes.size() + 1,
               j.transmission_error.size());
-    EXPECT_NEAR(config.effects[i].transmission_error_shape.amplitude_rad / kArcmin * 60.0,
+    EXPECT_NEAR(config.effects[i].transmission_error_shape.amplitude_rad / kRadPerArcmin * 60.0,
                 j.transmission_error[0].amplitude_arcsec, 1e-10);
   }
   EXPECT_NEAR(config.payload_mass_factor, plant.payload_mass, 1e-15);

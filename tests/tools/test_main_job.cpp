@@ -21,12 +21,15 @@
 #include "core/numeric_table.hpp"
 #include "core/run_stage.hpp"
 #include "core/sha256.hpp"
+#include "core/units.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "tests/support/frames_json.hpp"
 #include "tests/support/record_figure.hpp"
 #include "tests/support/scratch_dir.hpp"
 #include "tests/tools/browser_check.hpp"
 #include "tests/tools/run_campaign.hpp"
+
+using imscal::kRadPerDeg;
 
 namespace {
 namespace fs = std::filesystem;
@@ -37,7 +40,6 @@ using imscal::test_support::run_imscal;
 using nlohmann::json;
 
 const fs::path kCampaign = fs::path(IMSCAL_SOURCE_DIR) / "datasets" / "campaign";
-constexpr double kDeg = M_PI / 180.0;
 
 using MainJob = imscal::test_support::ScratchDirTest;
 
@@ -99,7 +101,7 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
   const json mounting = json::parse(read_file_text(out / "calibrate" / "mounting_report.json"));
   EXPECT_NE(mounting.at("verdict"), "fail") << mounting.at("reasons").dump(1);
   EXPECT_LT(quaternion_of(frames.at("T_S_H")).angularDistance(quaternion_of(truth.at("T_S_H"))),
-            0.005 * kDeg);
+            0.005 * kRadPerDeg);
   for (int i = 0; i < 3; ++i)
     EXPECT_NEAR(frames.at("T_S_H").at("xyz_mm").at(i).get<double>(),
                 truth.at("T_S_H").at("xyz_m").at(i).get<double>() * 1e3, 0.05);
@@ -107,8 +109,8 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
   const Eigen::Quaterniond q_R_W_true = quaternion_of(truth.at("T_R_W"));
   const Eigen::Vector3d up_R = q_R_W * Eigen::Vector3d::UnitZ();
   EXPECT_LT(std::acos(std::min(1.0, up_R.dot(q_R_W_true * Eigen::Vector3d::UnitZ()))),
-            0.005 * kDeg);
-  EXPECT_LT(q_R_W.angularDistance(q_R_W_true), 0.5 * kDeg);
+            0.005 * kRadPerDeg);
+  EXPECT_LT(q_R_W.angularDistance(q_R_W_true), 0.5 * kRadPerDeg);
 
   // Measured joint angles (IMS trajectory + inverse kinematics) against the link truth, printed
   // (RMS 0.030 / 0.045 / 0.059 / 0.040 / 0.038 / 0.035 mrad, A1..A6; 0.13 / 0.31 / 0.28 on A1..A3
