@@ -218,8 +218,7 @@ std::string diagnosis_text(const GapSignals& s, const Diagnosis& d) {
                      c.fit.shape, c.fit.size_text,
                      c.fit.coupling.empty() ? "" : "; coupled " + c.fit.coupling);
   t += "\nAmbiguity groups (modelled gaps the data cannot tell apart: they differ by at most a "
-       "tenth "
-       "of what they leave)\n";
+       "tenth of what they leave)\n";
   if (d.ambiguity_groups.empty()) t += "  none\n";
   for (std::size_t g = 0; g < d.ambiguity_groups.size(); ++g) {
     const auto& grp = d.ambiguity_groups[g];
