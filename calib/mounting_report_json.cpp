@@ -93,8 +93,11 @@ MountingEstimate mounting_of(const JsonField& f) {
   if (rotation.has_value() != translation.has_value())
     f.refuse("gives one of sigma_rotation_deg and sigma_translation_mm without the other");
   if (rotation) {
+    // Read before the comma initializer: a refusal thrown inside one aborts in Eigen's destructor.
+    const Eigen::VectorXd rotation_rad = vector_of(*rotation, 3, 1.0 / kRadPerDeg);
+    const Eigen::VectorXd translation_m = vector_of(*translation, 3, 1e3);
     Eigen::Matrix<double, 6, 1> s;
-    s << vector_of(*rotation, 3, 1.0 / kRadPerDeg), vector_of(*translation, 3, 1e3);
+    s << rotation_rad, translation_m;
     e.covariance = s.cwiseAbs2().asDiagonal();
     e.has_covariance = true;
   }
@@ -105,10 +108,15 @@ MountingDifference difference_of(const JsonField& f) {
   MountingDifference d;
   d.rotation_rad = f["rotation_deg"].number_or_nan() * kRadPerDeg;
   d.translation_m = f["translation_mm"].number_or_nan() * 1e-3;
-  d.difference << vector_of(f["difference_rotation_deg"], 3, 1.0 / kRadPerDeg),
-      vector_of(f["difference_translation_mm"], 3, 1e3);
-  d.combined_sigma << vector_of(f["combined_sigma_rotation_deg"], 3, 1.0 / kRadPerDeg),
-      vector_of(f["combined_sigma_translation_mm"], 3, 1e3);
+  // Each part read before its comma initializer (see mounting_of).
+  const Eigen::VectorXd difference_rad =
+      vector_of(f["difference_rotation_deg"], 3, 1.0 / kRadPerDeg);
+  const Eigen::VectorXd difference_m = vector_of(f["difference_translation_mm"], 3, 1e3);
+  const Eigen::VectorXd sigma_rad =
+      vector_of(f["combined_sigma_rotation_deg"], 3, 1.0 / kRadPerDeg);
+  const Eigen::VectorXd sigma_m = vector_of(f["combined_sigma_translation_mm"], 3, 1e3);
+  d.difference << difference_rad, difference_m;
+  d.combined_sigma << sigma_rad, sigma_m;
   // Written as null when infinite (a sigma missing and a difference that is not zero).
   d.normalised = f["normalised_sigma"].is_null() ? std::numeric_limits<double>::infinity()
                                                  : f["normalised_sigma"].number();
