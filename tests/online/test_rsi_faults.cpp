@@ -12,6 +12,7 @@
 #include <set>
 
 #include "online/rsi_controller_emulator.hpp"
+#include "tests/support/lag_table.hpp"
 #include "tests/support/rsi_loopback.hpp"
 
 namespace imscal::online {
@@ -23,22 +24,7 @@ constexpr std::size_t kFaultSpacing = 400;  // 1.6 s: fade 0.2 + wait 0.5 + enga
 
 // q̂(k) = 0.9 q̂(k-1) + 0.1 q_d(k-1) at 2 ms (the RSI cycle runs two model steps per call).
 ident::ParameterTable lag_table() {
-  ident::ParameterTable t;
-  t.robot = "kr16";
-  t.sample_time_s = 0.002;
-  for (int j = 0; j < 6; ++j) {
-    ident::JointParameters joint;
-    joint.name = std::string(1, 'A').append(std::to_string(j + 1));
-    joint.dimensions = {{ident::OperatingQuantity::kSpeed, {0.0, 100.0}}};
-    ident::CellParameters cell;
-    cell.bands = {0};
-    cell.structure = {1, 1, 1};
-    cell.a = {-0.9};
-    cell.b = {0.1};
-    joint.cells = {cell};
-    t.joints.push_back(joint);
-  }
-  return t;
+  return test_support::lag_table(-0.9, 0.1);
 }
 
 ident::PrecontrolOptions precontrol_options() {

@@ -16,6 +16,7 @@
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
 #include "sim/scenario.hpp"
+#include "tests/support/lag_table.hpp"
 #include "tests/support/rsi_loopback.hpp"
 
 namespace imscal::online {
@@ -26,22 +27,7 @@ namespace fs = std::filesystem;
 // Every joint: q̂(k) = 0.5 q̂(k-1) + 0.5 q_d(k-1), one cell: the joint lags its command by about
 // two cycles, a few mrad on the program's moves.
 ident::ParameterTable lag_table() {
-  ident::ParameterTable t;
-  t.robot = "kr16";
-  t.sample_time_s = 0.002;
-  for (int j = 0; j < 6; ++j) {
-    ident::JointParameters joint;
-    joint.name = std::string(1, 'A').append(std::to_string(j + 1));
-    joint.dimensions = {{ident::OperatingQuantity::kSpeed, {0.0, 100.0}}};
-    ident::CellParameters cell;
-    cell.bands = {0};
-    cell.structure = {1, 1, 1};
-    cell.a = {-0.5};
-    cell.b = {0.5};
-    joint.cells = {cell};
-    t.joints.push_back(joint);
-  }
-  return t;
+  return test_support::lag_table(-0.5, 0.5);
 }
 
 ident::PrecontrolOptions precontrol_options() {

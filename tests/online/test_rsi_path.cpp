@@ -16,6 +16,7 @@
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
 #include "sim/scenario.hpp"
+#include "tests/support/lag_table.hpp"
 #include "tests/support/rsi_loopback.hpp"
 
 namespace imscal::online {
@@ -90,23 +91,9 @@ TEST(PathFollower, RefusesCyclesThatAreNotWholeSamples) {
 
 // q̂(k) = 0.5 q̂(k-1) + 0.5 x(k-1) with x = q_d(k + 20): an inverse-form table with a preview.
 ident::ParameterTable preview_table() {
-  ident::ParameterTable t;
-  t.robot = "kr16";
-  t.sample_time_s = 0.002;
+  ident::ParameterTable t = test_support::lag_table(-0.5, 0.5);
   t.model_form = ident::TableForm::kInverse;
   t.preview_cycles = 20;
-  for (int j = 0; j < 6; ++j) {
-    ident::JointParameters joint;
-    joint.name = std::string(1, 'A').append(std::to_string(j + 1));
-    joint.dimensions = {{ident::OperatingQuantity::kSpeed, {0.0, 100.0}}};
-    ident::CellParameters cell;
-    cell.bands = {0};
-    cell.structure = {1, 1, 1};
-    cell.a = {-0.5};
-    cell.b = {0.5};
-    joint.cells = {cell};
-    t.joints.push_back(joint);
-  }
   return t;
 }
 

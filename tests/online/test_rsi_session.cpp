@@ -16,27 +16,13 @@
 
 #include "online/rsi_controller_emulator.hpp"
 #include "tests/support/allocation_counter.hpp"
+#include "tests/support/lag_table.hpp"
 
 namespace imscal::online {
 namespace {
 
 ident::ParameterTable lag_table() {
-  ident::ParameterTable t;
-  t.robot = "kr16";
-  t.sample_time_s = 0.002;
-  for (int j = 0; j < 6; ++j) {
-    ident::JointParameters joint;
-    joint.name = std::string(1, 'A').append(std::to_string(j + 1));
-    joint.dimensions = {{ident::OperatingQuantity::kSpeed, {0.0, 100.0}}};
-    ident::CellParameters cell;
-    cell.bands = {0};
-    cell.structure = {1, 1, 1};
-    cell.a = {-0.9};
-    cell.b = {0.1};
-    joint.cells = {cell};
-    t.joints.push_back(joint);
-  }
-  return t;
+  return test_support::lag_table(-0.9, 0.1);
 }
 
 std::unique_ptr<RsiSession> make(RsiCorrectionMode mode) {

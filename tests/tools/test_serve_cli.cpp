@@ -12,6 +12,7 @@
 #include "calib/robot_log.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "online/rsi_controller_emulator.hpp"
+#include "tests/support/lag_table.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
 
@@ -24,22 +25,7 @@ using test_support::run_imscal;
 class ServeCli : public test_support::ScratchDirTest {};
 
 ident::ParameterTable lag_table() {
-  ident::ParameterTable t;
-  t.robot = "kr16";
-  t.sample_time_s = 0.002;
-  for (int j = 0; j < 6; ++j) {
-    ident::JointParameters joint;
-    joint.name = std::string(1, 'A').append(std::to_string(j + 1));
-    joint.dimensions = {{ident::OperatingQuantity::kSpeed, {0.0, 100.0}}};
-    ident::CellParameters cell;
-    cell.bands = {0};
-    cell.structure = {1, 1, 1};
-    cell.a = {-0.9};
-    cell.b = {0.1};
-    joint.cells = {cell};
-    t.joints.push_back(joint);
-  }
-  return t;
+  return test_support::lag_table(-0.9, 0.1);
 }
 
 // A free port (the system's pick, released again: another process could take it meanwhile,
