@@ -24,6 +24,7 @@
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "core/output_folder.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
@@ -135,9 +136,8 @@ void print_parameters(const KinematicCalibration& c) {
 }
 
 void run(const Args& args) {
-  if (!args.force && std::filesystem::exists(args.out)) {
-    throw imscal::InputError(args.out, 0, "", "output exists; use --force to overwrite it");
-  }
+  imscal::prepare_output_file(args.out,
+                              args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
   const RobotDescription robot = load_robot_description(args.robot);
   std::vector<TrackerPose> fit, held_out;
   std::string split;

@@ -27,6 +27,7 @@
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "core/output_folder.hpp"
 #include "core/units.hpp"
 #include "tools/command_registry.hpp"
 
@@ -42,6 +43,7 @@ struct Args {
   std::string calibration_from;
   std::string out;
   bool no_restart = false;
+  bool force = false;
 };
 
 nlohmann::json vector_json(const Eigen::Vector3d& v, double scale = 1.0) {
@@ -188,6 +190,8 @@ nlohmann::json report_ahrs(const ToolImuRecord& ahrs) {
 }
 
 void run(const Args& args) {
+  const auto overwrite = args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse;
+  if (!args.out.empty()) imscal::prepare_output_file(args.out, overwrite);
   nlohmann::json report;
   const ToolImuRecord record = read_tool_imu_record(args.imu);
   // An unreadable AHRS file is bad input (exit 2) before any work; one that reads but does not
@@ -218,7 +222,7 @@ void run(const Args& args) {
   report["orientation"] = report_orientation(record, analysis, applied, source, !args.no_restart);
   if (ahrs) report["ahrs_orientation_error"] = report_ahrs(*ahrs);
   if (!args.out.empty())
-    imscal::write_file_atomically(args.out, imscal::json_text(report, 2, args.out));
+    imscal::write_file_atomically(args.out, imscal::json_text(report, 2, args.out), overwrite);
 }
 
 imscal::tools::CommandRegistration registration{
@@ -234,6 +238,7 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--out", args->out, "JSON report (written atomically)");
       sub.add_flag("--no-restart", args->no_restart,
                    "Do not restart the orientation from the robot's pose after a lost span");
+      sub.add_flag("--force", args->force, "Overwrite an existing output");
       sub.callback([args] { run(*args); });
     }};
 

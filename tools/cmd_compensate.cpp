@@ -90,9 +90,8 @@ const char* state_name(ident::PrecontrolState s) {
 }
 
 void run(const CompensateArgs& args) {
-  if (!args.force && std::filesystem::exists(args.out)) {
-    throw imscal::InputError(args.out, 0, "", "output exists; use --force to overwrite it");
-  }
+  imscal::prepare_output_file(args.out,
+                              args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
   const ident::ParameterTable table = ident::read_parameters_json(args.table);
   const imscal::calib::RobotLog log = imscal::calib::read_robot_log_csv(
       args.robot_log, table.robot, "the parameter table " + args.table);
@@ -150,9 +149,6 @@ void run(const CompensateArgs& args) {
                    ident::to_string(events[std::size_t(i)].cause), events[std::size_t(i)].value);
     }
   }
-  // A missing folder of --out is created, as every command creates its output folder.
-  const std::filesystem::path folder = std::filesystem::path(args.out).parent_path();
-  if (!folder.empty()) imscal::create_output_folder(folder);
   imscal::write_file_atomically(
       args.out, csv.str(), args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
   spdlog::info("compensate: {} cycles, {} active, {} events; wrote {}", log.samples.size(), active,

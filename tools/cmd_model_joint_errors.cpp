@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/input_error.hpp"
+#include "core/output_folder.hpp"
 #include "core/payload_plausibility.hpp"
 #include "eval/model_joint_errors.hpp"
 #include "ident/joint_error_io.hpp"
@@ -28,8 +29,7 @@ struct ModelJointErrorsArgs {
 
 void run(const ModelJointErrorsArgs& args) {
   const Overwrite overwrite = args.force ? Overwrite::kAllow : Overwrite::kRefuse;
-  if (overwrite == Overwrite::kRefuse && std::filesystem::exists(args.out))
-    throw InputError(args.out, 0, "--out", "exists already (--force replaces it)");
+  prepare_output_file(args.out, overwrite);
   const ident::JointErrorLog measured = ident::read_joint_errors_csv(args.joint_errors);
   std::optional<sim::Scenario> scenario;
   if (!args.scenario.empty()) scenario = sim::load_scenario(sim::resolve_scenario(args.scenario));

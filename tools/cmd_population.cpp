@@ -23,6 +23,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/output_folder.hpp"
 #include "core/subprocess.hpp"
 #include "eval/population_summary.hpp"
 #include "ident/identification_report.hpp"
@@ -436,15 +437,18 @@ void write_summary(const SeedRange& seeds, const PopulationArgs& args, int faile
       "finished, {} failed (reductions of the maximum path deviation in %, as measured through "
       "the IMS chain)\n",
       args.nominal, seeds.first, seeds.last, args.cycles, table.rows.size(), failed);
+  std::vector<fs::path> outputs{"summary.txt"};
   if (!table.rows.empty()) {
     for (const char* figure : {"seed_line_reduction_percent", "iso100_reduction_percent",
                                "seed_line_true_reduction_percent", "iso100_true_reduction_percent"})
       text += eval::summarize_figure(table, figure, kFigures);
-    imscal::write_file_atomically(fs::path(args.out) / "population.csv", csv,
-                                  imscal::Overwrite::kAllow);
+    outputs.emplace_back("population.csv");
   }
-  imscal::write_file_atomically(fs::path(args.out) / "summary.txt", text,
-                                imscal::Overwrite::kAllow);
+  // The table and its summary are published together (a rerun replaces both).
+  imscal::OutputFolder folder(args.out, outputs, imscal::Overwrite::kAllow);
+  if (!table.rows.empty()) imscal::write_file_atomically(folder.staged("population.csv"), csv);
+  imscal::write_file_atomically(folder.staged("summary.txt"), text);
+  folder.commit();
   std::cout << text;
 }
 
@@ -503,7 +507,7 @@ void run(PopulationArgs args) {
   if (args.cycles < 1) throw imscal::InputError("", 0, "--cycles", "must be >= 1");
   const imscal::calib::RobotDescription nominal =
       imscal::calib::load_robot_description(args.nominal);
-  fs::create_directories(args.out);
+  imscal::create_output_folder(args.out);
   if (args.step.empty()) return run_plants(seeds, nominal, args);
   run_one_step(seeds, nominal, args);
 }
