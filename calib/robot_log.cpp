@@ -112,6 +112,7 @@ RobotLog read_robot_log_csv(const std::filesystem::path& file, const std::string
                                  table.columns.size(), expected_columns));
   }
   log.samples.resize(table.rows());
+  log.sample_lines.assign(table.lines.begin(), table.lines.end());
   for (std::size_t r = 0; r < table.rows(); ++r) {
     RobotLogSample& s = log.samples[r];
     s.t_s = table.at(r, time_column);

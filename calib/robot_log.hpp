@@ -31,6 +31,7 @@ struct RobotLog {
   double cycle_s = 0.002;
   std::array<std::string, kJointCount> joint_names{"A1", "A2", "A3", "A4", "A5", "A6"};
   std::vector<RobotLogSample> samples;
+  std::vector<std::size_t> sample_lines;  // 1-based file line of each sample (empty: not read)
 };
 
 void write_robot_log_csv(const std::filesystem::path& file, const RobotLog& log,

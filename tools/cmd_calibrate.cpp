@@ -52,6 +52,7 @@
 #include "ims/sensor_spec.hpp"
 #include "ims/zupt_options.hpp"
 #include "tools/command_registry.hpp"
+#include "tools/joint_limit_checks.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -141,6 +142,7 @@ Inputs read_inputs(const CalibrateArgs& args) {
                      "the IMS file does not state its site (site_latitude_deg, "
                      "site_longitude_deg, site_height_m): gravity and Earth rate need it");
   in.log = calib::read_robot_log_csv(args.robot_log, in.robot.name);
+  tools::check_robot_log_joint_limits(in.log, args.robot_log, in.robot);
   std::vector<double> payload_kg, t_s;
   for (const calib::RobotLogSample& sample : in.log.samples) {
     payload_kg.push_back(sample.payload_kg);

@@ -26,6 +26,7 @@
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
 #include "tools/command_registry.hpp"
+#include "tools/joint_limit_checks.hpp"
 
 namespace {
 
@@ -84,12 +85,15 @@ nlohmann::json calibration_json(const KinematicCalibration& c) {
 }
 
 // The fit and held-out sets: from two files, or alternate rows of one.
-void split_poses(const Args& args, std::vector<TrackerPose>& fit,
+void split_poses(const Args& args, const RobotDescription& robot, std::vector<TrackerPose>& fit,
                  std::vector<TrackerPose>& held_out, std::string& split) {
   const TrackerPoses poses = read_tracker_poses(args.poses);
+  imscal::tools::check_tracker_pose_limits(poses, robot);
   if (!args.held_out.empty()) {
     fit = poses.poses;
-    held_out = read_tracker_poses(args.held_out).poses;
+    const TrackerPoses judged = read_tracker_poses(args.held_out);
+    imscal::tools::check_tracker_pose_limits(judged, robot);
+    held_out = judged.poses;
     split = fmt::format("fitted on every row of {}, held out: every row of {}", args.poses,
                         args.held_out);
     return;
@@ -141,7 +145,7 @@ void run(const Args& args) {
   const RobotDescription robot = load_robot_description(args.robot);
   std::vector<TrackerPose> fit, held_out;
   std::string split;
-  split_poses(args, fit, held_out, split);
+  split_poses(args, robot, fit, held_out, split);
   KinematicCalibrationOptions options;
   options.min_independence = args.min_independence;
   options.estimate_geometry = false;

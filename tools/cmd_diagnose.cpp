@@ -22,6 +22,7 @@
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "tools/command_registry.hpp"
+#include "tools/joint_limit_checks.hpp"
 #include "tools/report_gnuplot.hpp"
 
 namespace {
@@ -132,6 +133,7 @@ void run(const DiagnoseArgs& args) {
   imscal::check_payload_series(
       real.payload_kg, real.time_s, robot.nominal_payload_kg,
       {args.joint_errors, 0, "payload_kg", fmt::format("robot {} ({})", robot.name, robot.source)});
+  imscal::tools::check_joint_error_limits(real, args.joint_errors, robot);
   std::vector<std::vector<double>> sim_errors;
   std::optional<ident::ParameterTable> table;
   if (!args.table.empty()) {

@@ -30,6 +30,7 @@
 #include "ident/joint_identification.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "tools/command_registry.hpp"
+#include "tools/joint_limit_checks.hpp"
 #include "tools/model_torque_option.hpp"
 
 namespace {
@@ -195,6 +196,9 @@ void run(const IdentifyArgs& args) {
         fmt::format("{} maximum speeds, but {} has {} joints ({})", config.max_speed_rad_s.size(),
                     args.joint_errors, log.joint_count(), fmt::join(log.joint_names, ", ")));
   check_payload_plausible(log, config, args);
+  if (!args.model_torque.robot.empty())
+    imscal::tools::check_joint_error_limits(
+        log, args.joint_errors, imscal::calib::load_robot_description(args.model_torque.robot));
   check_orders_fit_record(log, config, config_node, args.config, args.joint_errors);
   imscal::OutputFolder folder(args.out, output_names(config),
                               args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);

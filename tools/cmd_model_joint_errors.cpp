@@ -18,6 +18,7 @@
 #include "ident/joint_error_io.hpp"
 #include "sim/scenario.hpp"
 #include "tools/command_registry.hpp"
+#include "tools/joint_limit_checks.hpp"
 
 namespace {
 using namespace imscal;
@@ -40,6 +41,7 @@ void run(const ModelJointErrorsArgs& args) {
       measured.payload_kg, measured.time_s, nominal.description.nominal_payload_kg,
       {args.joint_errors, 0, "payload_kg",
        "robot " + nominal.description.name + " (" + nominal.description.source + ")"});
+  tools::check_joint_error_limits(measured, args.joint_errors, nominal.description);
   ident::JointErrorLog model;
   try {
     model = eval::nominal_model_joint_errors(measured, nominal, scenario ? &*scenario : nullptr);

@@ -22,6 +22,7 @@
 #include "online/rsi_session.hpp"
 #include "online/udp_socket.hpp"
 #include "tools/command_registry.hpp"
+#include "tools/joint_limit_checks.hpp"
 #include "tools/model_torque_option.hpp"
 
 namespace {
@@ -55,6 +56,9 @@ std::unique_ptr<online::PathFollower> load_path(const ServeArgs& args,
                                                 const ident::ParameterTable& table) {
   const imscal::calib::RobotLog log = imscal::calib::read_robot_log_csv(
       args.path, table.robot, "the parameter table " + args.table);
+  if (!args.model_torque.robot.empty())
+    imscal::tools::check_robot_log_joint_limits(
+        log, args.path, imscal::calib::load_robot_description(args.model_torque.robot));
   online::LoadedPath path;
   path.cycle_s = log.cycle_s;
   const std::size_t n = log.samples.size();

@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -143,9 +144,12 @@ std::vector<const eval::VerificationCase*> all_cases(const eval::VerificationRes
   return cases;
 }
 
+// A command's outputs by their path in the output folder, published together at the end.
+using OutputFiles = std::map<fs::path, std::string>;
+
+// The scenario's outputs, in `dir` (relative to the output folder).
 void write_scenario(const fs::path& dir, const eval::VerificationResult& r, const VerifyArgs& args,
-                    imscal::Overwrite overwrite) {
-  imscal::create_output_folder(dir);
+                    OutputFiles& files) {
   const auto& before = r.before.figures;
   json cases = json::array();
   std::string csv = kCsvHeader, text;
@@ -230,11 +234,10 @@ void write_scenario(const fs::path& dir, const eval::VerificationResult& r, cons
                     {"table", args.table.empty() ? json(nullptr) : json(args.table)},
                     {"measured_by", args.measure_with_ims ? "ims chain" : "true link angles"},
                     {"cases", cases}};
-  imscal::write_file_atomically(dir / "verification.json",
-                                imscal::json_text(doc, 1, (dir / "verification.json").string()),
-                                overwrite);
-  imscal::write_file_atomically(dir / "verification.csv", csv, overwrite);
-  imscal::write_file_atomically(dir / "verification.txt", text, overwrite);
+  files[dir / "verification.json"] =
+      imscal::json_text(doc, 1, (dir / "verification.json").string());
+  files[dir / "verification.csv"] = csv;
+  files[dir / "verification.txt"] = text;
   std::cout << text;
 
   // Fig. 5 and 6 series (cycle 0): before = uncompensated, after = the first table.
@@ -253,8 +256,8 @@ void write_scenario(const fs::path& dir, const eval::VerificationResult& r, cons
     fig6 += fmt::format("{},{},{},{}\n", b.t_s[k], b.arc_length_m[k] * kMm, b.deviation_m[k] * kMm,
                         a && k < a->deviation_m.size() ? a->deviation_m[k] * kMm : 0.0);
   }
-  imscal::write_file_atomically(dir / "fig5_paths.csv", fig5, overwrite);
-  imscal::write_file_atomically(dir / "fig6_deviation.csv", fig6, overwrite);
+  files[dir / "fig5_paths.csv"] = fig5;
+  files[dir / "fig6_deviation.csv"] = fig6;
   const std::string fig5_gp =
       "set terminal svg size 1000,450\nset output 'fig5.svg'\nset datafile separator ','\n"
       "set key autotitle columnhead\nset multiplot layout 1,2 title 'desired and attained "
@@ -272,36 +275,62 @@ void write_scenario(const fs::path& dir, const eval::VerificationResult& r, cons
       ")'\nset xlabel 'time [s]'\n"
       "set ylabel 'path deviation [mm]'\nplot 'fig6_deviation.csv' u 1:3 w l t 'uncalibrated', "
       "'' u 1:4 w l t 'calibrated'\n";
-  imscal::write_file_atomically(dir / "fig5.gp", fig5_gp, overwrite);
-  imscal::write_file_atomically(dir / "fig6.gp", fig6_gp, overwrite);
-  if (std::system("command -v gnuplot > /dev/null 2>&1") == 0) {
-    for (const char* gp : {"fig5.gp", "fig6.gp"}) {
-      const std::string cmd = fmt::format("cd '{}' && gnuplot {} 2> /dev/null", dir.string(), gp);
-      if (std::system(cmd.c_str()) != 0) spdlog::warn("gnuplot failed on {}", gp);
-    }
-  } else {
-    spdlog::info("gnuplot not found: run `gnuplot fig5.gp fig6.gp` in {} for the SVGs",
-                 dir.string());
-  }
+  files[dir / "fig5.gp"] = fig5_gp;
+  files[dir / "fig6.gp"] = fig6_gp;
   // Path files for `imscal evaluate`.
-  imscal::write_file_atomically(dir / "commanded.csv",
-                                path_file(r.desired_poses, "commanded flange path"), overwrite);
+  files[dir / "commanded.csv"] = path_file(r.desired_poses, "commanded flange path");
   for (std::size_t c = 0; c < r.attained_poses.size(); ++c) {
     const std::string label = c == 0 ? r.before.label : r.after[c - 1].label;
     for (std::size_t j = 0; j < r.attained_poses[c].size(); ++j) {
-      imscal::write_file_atomically(
-          dir / fmt::format("attained_{}_{}.csv", slug(label), j),
-          path_file(r.attained_poses[c][j], fmt::format("{}, cycle {}", label, j)), overwrite);
+      files[dir / fmt::format("attained_{}_{}.csv", slug(label), j)] =
+          path_file(r.attained_poses[c][j], fmt::format("{}, cycle {}", label, j));
     }
   }
+}
+
+// The figures' SVGs from their gnuplot scripts, in a published scenario folder: derived from
+// the published CSV files, so drawn after them.
+void plot_figures(const fs::path& dir) {
+  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) {
+    spdlog::info("gnuplot not found: run `gnuplot fig5.gp fig6.gp` in {} for the SVGs",
+                 dir.string());
+    return;
+  }
+  for (const char* gp : {"fig5.gp", "fig6.gp"}) {
+    const std::string cmd = fmt::format("cd '{}' && gnuplot {} 2> /dev/null", dir.string(), gp);
+    if (std::system(cmd.c_str()) != 0) spdlog::warn("gnuplot failed on {}", gp);
+  }
+}
+
+// Every output of the command staged and published together (core/output_folder.hpp): the
+// scenarios' files, and the truth joint errors and the identified table when there are any.
+void publish(const fs::path& out, const OutputFiles& files, const ident::JointErrorLog* truth,
+             const ident::ParameterTable* identified, imscal::Overwrite overwrite) {
+  std::vector<fs::path> outputs;
+  for (const auto& [name, text] : files) outputs.push_back(name);
+  if (truth) outputs.emplace_back("joint_errors_truth.csv");
+  if (identified) outputs.emplace_back("parameters.json");
+  imscal::OutputFolder folder(out, outputs, overwrite);
+  for (const auto& [name, text] : files) imscal::write_file_atomically(folder.staged(name), text);
+  if (truth) ident::write_joint_errors_csv(folder.staged("joint_errors_truth.csv"), *truth);
+  if (identified) ident::write_parameters_json(folder.staged("parameters.json"), *identified);
+  folder.commit();
 }
 
 void run(const VerifyArgs& args) {
   const auto overwrite = args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse;
   const fs::path out(args.out);
-  if (!args.force && fs::exists(out / "verification.json"))
-    throw imscal::InputError(out.string(), 0, "", "output exists; use --force");
+  // Existing outputs are refused before the work (the output folder checks them again).
+  for (const auto& name : args.scenarios) {
+    const fs::path earlier = out /
+                             imscal::sim::load_scenario(imscal::sim::resolve_scenario(name)).name /
+                             "verification.json";
+    if (!args.force && fs::exists(earlier))
+      throw imscal::InputError(earlier.string(), 0, "--out",
+                               "exists already (use --force to replace it)");
+  }
   std::vector<eval::NamedTable> tables;
+  std::optional<ident::ParameterTable> identified;
   // Joint errors: from a file, or the simulator's truth of a scenario.
   std::optional<ident::JointErrorLog> log;
   std::string source;
@@ -312,9 +341,7 @@ void run(const VerifyArgs& args) {
     spdlog::info("verify: simulating {} for the truth joint errors", args.identify_scenario);
     log = eval::simulate_truth_joint_errors(
         imscal::sim::load_scenario(imscal::sim::resolve_scenario(args.identify_scenario)));
-    imscal::create_output_folder(out);
     source = (out / "joint_errors_truth.csv").string();
-    ident::write_joint_errors_csv(source, *log, overwrite);
   }
   if (args.table.empty() && !log) {
     throw imscal::InputError("", 0, "--table",
@@ -358,7 +385,7 @@ void run(const VerifyArgs& args) {
     spdlog::info("verify: identifying the table from {}", source);
     const eval::IdentifiedTable t = eval::identify_table(*log, *config, source, &torque_model);
     for (const auto& f : t.failed_joints) spdlog::warn("verify: not identified: {}", f);
-    ident::write_parameters_json(out / "parameters.json", t.table, overwrite);
+    identified = t.table;
     tables.push_back({"compensated", t.table});
   }
   if (log && args.ablation) {
@@ -379,6 +406,7 @@ void run(const VerifyArgs& args) {
   options.compensation.inversion_iterations = args.inversion_iterations;
   if (args.offset_tolerance_rad > 0.0)
     options.compensation.precontrol.offset_tolerance_rad.fill(args.offset_tolerance_rad);
+  OutputFiles files;
   for (const auto& name : args.scenarios) {
     const imscal::sim::Scenario scenario =
         imscal::sim::load_scenario(imscal::sim::resolve_scenario(name));
@@ -389,8 +417,12 @@ void run(const VerifyArgs& args) {
     } catch (const std::invalid_argument& e) {
       throw imscal::InputError(scenario.file.string(), 0, "", e.what());
     }
-    write_scenario(out / scenario.name, r, args, overwrite);
+    write_scenario(scenario.name, r, args, files);
   }
+  publish(out, files, args.identify_scenario.empty() ? nullptr : &*log,
+          identified ? &*identified : nullptr, overwrite);
+  for (const auto& name : args.scenarios)
+    plot_figures(out / imscal::sim::load_scenario(imscal::sim::resolve_scenario(name)).name);
 }
 
 imscal::tools::CommandRegistration registration{

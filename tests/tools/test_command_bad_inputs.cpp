@@ -34,10 +34,10 @@ const std::string kJointErrors = (kSource / "fuzz/corpus/joint_errors/small.csv"
 const std::string kPoses = (kSource / "fuzz/corpus/tracker_poses/ipa-series-c-head.csv").string();
 const std::string kToolImu = (kSource / "fuzz/corpus/tool_imu_record/mpu9150-head.csv").string();
 
-// `source` with field `column` (0-based) of line `line` (1-based) replaced by `value`.
-std::string with_field(const std::string& source, std::size_t line, std::size_t column,
+// `text` with field `column` (0-based) of line `line` (1-based) replaced by `value`.
+std::string with_field(const std::string& text_in, std::size_t line, std::size_t column,
                        const std::string& value) {
-  std::istringstream in(read_file_text(source));
+  std::istringstream in(text_in);
   std::string out, text;
   for (std::size_t n = 1; std::getline(in, text); ++n) {
     if (n == line) {
@@ -49,6 +49,12 @@ std::string with_field(const std::string& source, std::size_t line, std::size_t 
     out += text + "\n";
   }
   return out;
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  for (auto at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+  return text;
 }
 
 class CommandBadInputs : public test_support::ScratchDirTest {
@@ -66,12 +72,6 @@ class CommandBadInputs : public test_support::ScratchDirTest {
 struct CommandLine {
   std::string name, arguments;
 };
-
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-  for (auto at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
-    text.replace(at, from.size(), to);
-  return text;
-}
 
 TEST_F(CommandBadInputs, MissingFileFolderAndNamedPipeAreRefusedAtOnceWithExitTwo) {
   const std::vector<CommandLine> commands = {
@@ -91,6 +91,11 @@ TEST_F(CommandBadInputs, MissingFileFolderAndNamedPipeAreRefusedAtOnceWithExitTw
       {"population --nominal", "population --nominal INPUT --seeds 1 --out OUT"},
       {"mechanize --input", "mechanize --input INPUT --initial-attitude 0,0,0 --out OUT"},
       {"run", "run INPUT --out OUT"},
+      {"calibrate --config",
+       "calibrate --imu " + (kSource / "fuzz/corpus/imu_csv/increments.csv").string() +
+           " --robot-log " + (kSource / "fuzz/corpus/robot_log/valid.csv").string() + " --robot " +
+           kKr16 + " --sensor " + (kSource / "datasets/sensors/navigation-grade.yaml").string() +
+           " --config INPUT --out OUT"},
       {"identify --config",
        "identify --joint-errors " + kJointErrors + " --config INPUT --out OUT"},
   };
@@ -119,6 +124,21 @@ TEST_F(CommandBadInputs, MissingFileFolderAndNamedPipeAreRefusedAtOnceWithExitTw
   }
 }
 
+// A joint angle beyond the robot's limit (A2 of the KR 16: 35 deg) by more than the margin of
+// core/joint_limit_plausibility.hpp, in every file of joint angles a command checks against its
+// robot: refused with exit 2 naming file, line and column.
+std::string joint_errors_with_a2(const std::string& q_rad) {
+  std::string text = read_file_text(kJointErrors);
+  for (std::size_t column : {3, 9, 15}) text = with_field(text, 6, column, q_rad);
+  return text;
+}
+
+std::string robot_log_with_a2(const std::string& q_rad) {
+  std::string text = read_file_text(kSource / "fuzz/corpus/robot_log/valid.csv");
+  for (std::size_t column : {3, 9}) text = with_field(text, 7, column, q_rad);
+  return text;
+}
+
 // A bad field in an input file of each of the newer commands: exit 2 naming file, line and field.
 TEST_F(CommandBadInputs, ABadFieldIsRefusedWithFileLineAndField) {
   struct Case {
@@ -130,18 +150,39 @@ TEST_F(CommandBadInputs, ABadFieldIsRefusedWithFileLineAndField) {
        "serve --table " + kTable + " --port 0 --robot " + kKr16 +
            " --idle-timeout-s 1 --path INPUT",
        "robot.csv:3", "cycle_s"},
-      {"calibrate-kinematics: text for a joint angle", "poses.csv", with_field(kPoses, 3, 7, "abc"),
+      {"calibrate-kinematics: text for a joint angle", "poses.csv",
+       with_field(read_file_text(kPoses), 3, 7, "abc"),
        "calibrate-kinematics --robot " + kUr10 + " --poses INPUT --out OUT", "poses.csv:3",
        "q1_shoulder_pan_rad"},
-      {"check-tool-imu: text for a rate", "imu.csv", with_field(kToolImu, 3, 1, "abc"),
-       "check-tool-imu --imu INPUT --out OUT", "imu.csv:3", "gyro_x_dps"},
-      {"diagnose-tool-imu: text for a rate", "imu.csv", with_field(kToolImu, 3, 1, "abc"),
+      {"check-tool-imu: text for a rate", "imu.csv",
+       with_field(read_file_text(kToolImu), 3, 1, "abc"), "check-tool-imu --imu INPUT --out OUT",
+       "imu.csv:3", "gyro_x_dps"},
+      {"diagnose-tool-imu: text for a rate", "imu.csv",
+       with_field(read_file_text(kToolImu), 3, 1, "abc"),
        "diagnose-tool-imu --imu INPUT --held-out " + kToolImu + " --out OUT", "imu.csv:3",
        "gyro_x_dps"},
       {"model-joint-errors: a corrupted sample", "joint_errors.csv",
-       with_field(kJointErrors, 6, 2, "253"),
+       with_field(read_file_text(kJointErrors), 6, 2, "253"),
        "model-joint-errors --joint-errors INPUT --robot " + kKr16 + " --out OUT",
        "joint_errors.csv:6", "q_measured_A1_rad"},
+      {"model-joint-errors: A2 at 57 deg", "joint_errors.csv", joint_errors_with_a2("1.0"),
+       "model-joint-errors --joint-errors INPUT --robot " + kKr16 + " --out OUT",
+       "joint_errors.csv:6", "q_desired_A2_rad"},
+      {"serve: a path with A2 at 57 deg", "robot.csv", robot_log_with_a2("1.0"),
+       "serve --table " + kTable + " --port 0 --robot " + kKr16 +
+           " --idle-timeout-s 1 --path INPUT",
+       "robot.csv:7", "q_desired_A2_rad"},
+      {"compensate: a log with A2 at 57 deg", "robot.csv", robot_log_with_a2("1.0"),
+       "compensate --table " + kTable + " --robot " + kKr16 + " --robot-log INPUT --out OUT",
+       "robot.csv:7", "q_desired_A2_rad"},
+      {"calibrate-kinematics: q1 at 401 deg on the UR10", "poses.csv",
+       with_field(read_file_text(kPoses), 3, 7, "7.0"),
+       "calibrate-kinematics --robot " + kUr10 + " --poses INPUT --out OUT", "poses.csv:3",
+       "q1_rad"},
+      {"compensate: the log of another robot than the table's", "robot.csv",
+       replaced(read_file_text(kSource / "fuzz/corpus/robot_log/valid.csv"), "# robot: kr16",
+                "# robot: kr6"),
+       "compensate --table " + kTable + " --robot-log INPUT --out OUT", "robot.csv:2", "robot"},
       {"population: a robot file that is no URDF", "robot.urdf",
        read_file_text(kSource / "tests/data/bad_inputs/configs/robot-urdf-not-xml.urdf"),
        "population --nominal INPUT --seeds 1 --out OUT", "robot.urdf", ""},
@@ -202,6 +243,18 @@ TEST_F(CommandBadInputs, OutputsThatExistOrAreTheWrongKindAreRefusedWithExitTwo)
       << message_;
   EXPECT_NE(message_.find("is a file, not a folder"), std::string::npos) << message_;
   EXPECT_EQ(read_file_text(dir_ / "a_file"), "not a folder\n");
+  // A joint within the margin beyond its limit (A2 at 37.2 deg, 2.2 deg beyond): a warning with
+  // file, line, column and limit, and the command runs.
+  std::ofstream(dir_ / "near.csv") << joint_errors_with_a2("0.65");
+  EXPECT_EQ(run("model-joint-errors --joint-errors " + (dir_ / "near.csv").string() + " --robot " +
+                kKr16 + " --out " + (dir_ / "near_model.csv").string()),
+            0)
+      << message_;
+  EXPECT_NE(message_.find("[warning] " + (dir_ / "near.csv").string() +
+                          ":6: field 'q_desired_A2_rad': 0.65 rad (37.24 deg) is 2.24 deg beyond "
+                          "joint A2's upper limit of 35 deg"),
+            std::string::npos)
+      << message_;
   // A missing folder of an output file is created.
   const fs::path nested = dir_ / "new" / "sub" / "model.csv";
   EXPECT_EQ(run(file_outputs[3].arguments + " --out " + nested.string()), 0) << message_;
