@@ -133,11 +133,11 @@ TEST_F(VerifyCli, AFailingWriteLeavesTheEarlierOutputsAsTheyWere) {
   const fs::path table = dir_ / "zero.json", out = dir_ / "out";
   ident::write_parameters_json(table, zero_error_table("kr16"));
   const std::string arguments = "verify --table " + table.string() +
-                                " --scenario seed-line --segments \"line -y\" --cycles 2 --out " +
+                                " --scenario seed-line --segments \"line -y\" --cycles 1 --out " +
                                 out.string();
   ASSERT_EQ(run(arguments, dir_ / "verify.log"), 0) << read(dir_ / "verify.log");
   const auto before = files_below(out);
-  ASSERT_GE(before.size(), 11u);
+  ASSERT_GE(before.size(), 9u);  // scenario files, path files of one cycle before and after
   const std::string limited = "sh -c 'trap \"\" XFSZ; ulimit -f 16; " + std::string(IMSCAL_BINARY) +
                               " " + arguments + " --seed 7 --force; echo exit=$?' > " +
                               (dir_ / "limited.log").string() + " 2>&1";
