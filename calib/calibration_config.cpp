@@ -82,7 +82,7 @@ void parse_thresholds(const ConfigNode& node, MountingValidationOptions& v) {
 CalibrationConfig parse_calibration_config(const ConfigNode& root) {
   root.require_only_keys({"imscal-calibration-config", "sensor", "robot", "payload", "rests",
                           "time_offset", "bundle", "priors", "validation", "joint_errors",
-                          "first_rest_position_m", "unit_calibration"});
+                          "first_rest_position_m", "unit_calibration", "heading_reference"});
   const ConfigNode version = root.child("imscal-calibration-config");
   if (version.as_int() != 1) version.fail("unknown config version; expected 1");
   CalibrationConfig c;
@@ -158,6 +158,16 @@ CalibrationConfig parse_calibration_config(const ConfigNode& root) {
   c.joint_errors = root.get_bool("joint_errors", c.joint_errors);
   if (auto p = root.optional_child("first_rest_position_m"))
     c.first_rest_position_W_m = p->as_vector3();
+  if (auto h = root.optional_child("heading_reference")) {
+    h->require_only_keys({"yaw_deg", "sigma_deg"});
+    HeadingReference reference;
+    reference.yaw_rad = h->child("yaw_deg").as_double() * kRadPerDeg;
+    const ConfigNode sigma = h->child("sigma_deg");
+    if (!(sigma.as_double() > 0.0)) sigma.fail("expected a number > 0 (the reference's 1-sigma)");
+    reference.sigma_rad = sigma.as_double() * kRadPerDeg;
+    reference.source = fmt::format("{} line {} heading_reference", h->file(), h->line());
+    c.heading_reference = reference;
+  }
   return c;
 }
 

@@ -79,6 +79,7 @@ FrameCalibrationInput bundle_input(const SessionInputs& in, const CalibrationCon
   frame_input.source = in.source;
   frame_input.first_rest_position_W_m = config.first_rest_position_W_m;
   if (in.previous) frame_input.known_frames = in.previous->frames;
+  frame_input.heading_reference = config.heading_reference;
   return frame_input;
 }
 

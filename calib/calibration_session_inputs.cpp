@@ -4,10 +4,13 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include "core/input_error.hpp"
 #include "core/payload_plausibility.hpp"
+#include "core/units.hpp"
 #include "ims/imu_conversion.hpp"
 #include "ims/imu_file.hpp"
 #include "ims/sensor_error_model.hpp"
@@ -104,11 +107,40 @@ void read_robot_log(const SessionFiles& files, LoadedSession& s) {
                                  imu_begin, imu_end, files.robot_log, log_begin, log_end, margin));
 }
 
+// "DEG,SIGMA_DEG" of --heading-reference.
+HeadingReference heading_reference_of(const std::string& text) {
+  const auto refuse = [&](const std::string& why) {
+    throw InputError(
+        "command line", 0, "--heading-reference",
+        fmt::format("'{}': {}; expected YAW_DEG,SIGMA_DEG (e.g. 30.0,0.01)", text, why));
+  };
+  const std::size_t comma = text.find(',');
+  if (comma == std::string::npos) refuse("no comma");
+  HeadingReference reference;
+  double yaw_deg = 0.0, sigma_deg = 0.0;
+  try {
+    std::size_t used_yaw = 0, used_sigma = 0;
+    yaw_deg = std::stod(text.substr(0, comma), &used_yaw);
+    sigma_deg = std::stod(text.substr(comma + 1), &used_sigma);
+    if (used_yaw != comma || used_sigma != text.size() - comma - 1) refuse("not two numbers");
+  } catch (const std::logic_error&) {
+    refuse("not two numbers");
+  }
+  if (!std::isfinite(yaw_deg) || !(sigma_deg > 0.0) || !std::isfinite(sigma_deg))
+    refuse("the yaw must be finite and the sigma a number > 0");
+  reference.yaw_rad = yaw_deg * kRadPerDeg;
+  reference.sigma_rad = sigma_deg * kRadPerDeg;
+  reference.source = "--heading-reference " + text;
+  return reference;
+}
+
 }  // namespace
 
 LoadedSession read_session_inputs(const SessionFiles& files) {
   LoadedSession s;
   read_config_robot_sensor(files, s);
+  if (!files.heading_reference.empty())
+    s.options.config.heading_reference = heading_reference_of(files.heading_reference);
   // The earlier session's frames before the (long) records: a wrong file fails fast.
   if (!files.frames.empty())
     s.inputs.previous = read_frames_json(files.frames, s.inputs.robot.name);

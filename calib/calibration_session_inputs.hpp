@@ -21,6 +21,9 @@ struct SessionFiles {
   std::string config;            // empty: the built-in defaults
   std::string unit_calibration;  // empty: the config's (if any)
   std::string frames;            // an earlier session's frames.json; empty: estimate the frames
+  // "DEG,SIGMA_DEG": a surveyed yaw of T_W_R with its 1-sigma (calib/frame_calibration.hpp,
+  // HeadingReference), instead of the config's heading_reference; empty: the config's.
+  std::string heading_reference;
 };
 
 struct LoadedSession {

@@ -70,6 +70,14 @@ void estimates(Lines& line, const FrameCalibrationResult& r) {
                   "(W origin: the sensor at rest 1)",
                   r.T_R_W.translation().x() * 1e3, r.T_R_W.translation().y() * 1e3,
                   r.T_R_W.translation().z() * 1e3, rpy_R_W.x(), rpy_R_W.y(), rpy_R_W.z()));
+  if (!r.heading || !r.heading->reference) return;
+  const HeadingEstimate& h = *r.heading;
+  line(fmt::format(
+      "  base heading (yaw of T_W_R): {:.4f} +- {:.4f} deg with the reference {:.4f} +- {:.4f} "
+      "deg ({}); the IMS alone (Earth rate): {:.4f} +- {:.4f} deg",
+      h.yaw_rad / kRadPerDeg, h.sigma_rad / kRadPerDeg, h.reference->yaw_rad / kRadPerDeg,
+      h.reference->sigma_rad / kRadPerDeg, h.reference->source, h.ims_only_yaw_rad / kRadPerDeg,
+      h.ims_only_sigma_rad / kRadPerDeg));
 }
 
 void checks_and_residuals(Lines& line, const FrameCalibrationResult& r,

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "calib/forward_kinematics.hpp"
 #include "core/input_error.hpp"
 
@@ -29,6 +31,18 @@ const ims::Site& checked_site(const FrameCalibrationInput& input, const std::str
                      fmt::format("{} rest poses; at least 3 are needed (T_R_W and T_S_H from "
                                  "rotations about two different axes)",
                                  input.rests.size()));
+  }
+  if (const auto& heading = input.heading_reference) {
+    if (frames_known)
+      throw InputError(source, 0, "heading_reference",
+                       "a heading reference (" + heading->source + ") with the frames held at " +
+                           input.known_frames->source +
+                           ": the base's heading is that session's, not estimated here");
+    if (!(heading->sigma_rad > 0.0) || !std::isfinite(heading->sigma_rad) ||
+        !std::isfinite(heading->yaw_rad))
+      throw InputError(source, 0, "heading_reference",
+                       fmt::format("{}: expected a finite yaw and a sigma > 0, got {} +- {} rad",
+                                   heading->source, heading->yaw_rad, heading->sigma_rad));
   }
   return input.site;
 }

@@ -1,5 +1,6 @@
 // `imscal calibrate --imu FILE --robot-log FILE --robot ROBOT.yaml --sensor SPEC.yaml
-//  [--config YAML] [--unit-calibration YAML] [--frames PREVIOUS/frames.json] --out DIR [--force]`:
+//  [--config YAML] [--unit-calibration YAML] [--frames PREVIOUS/frames.json]
+//  [--heading-reference YAW_DEG,SIGMA_DEG] --out DIR [--force]`:
 //  the wrist/sensor calibration of the paper (calib::calibrate_session,
 //  calib/calibration_session.hpp). Writes, all or nothing (core/output_folder.hpp), the files of
 //  datasets/FORMAT.md §16:
@@ -139,6 +140,11 @@ tools::CommandRegistration registration{
           "biases and the clock offset are estimated, from as few as 1 rest (e.g. identification "
           "runs); the mounting report then gives this record's residuals against those frames. "
           "Refused: another robot, another format version, missing or NaN values");
+      sub.add_option("--heading-reference", f.heading_reference,
+                     "YAW_DEG,SIGMA_DEG: a surveyed heading of the robot base, the yaw of T_W_R "
+                     "(its x axis counterclockwise from East) with its 1-sigma, as a prior in the "
+                     "bundle; the IMS-only heading is reported beside it. Default: the config's "
+                     "heading_reference");
       sub.add_option("--out", args->out, "Output folder")->required();
       sub.add_flag("--force", args->force, "Replace existing outputs");
       sub.callback([args] { run(*args); });
