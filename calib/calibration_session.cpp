@@ -160,6 +160,9 @@ SessionResult calibrate_session(const SessionInputs& in, const SessionOptions& o
   const CalibrationConfig& config = options.config;
   if (!in.imu.site)
     throw InputError(in.source, 0, "site", "the IMS record states no site (gravity, Earth rate)");
+  check_heading_reference(config.heading_reference,
+                          in.previous ? std::optional(in.previous->frames) : std::nullopt,
+                          in.source);
   SessionResult out;
   find_rests_and_time_offset(in, config, progress, out);
 

@@ -300,6 +300,13 @@ struct FrameCalibrationResult {
 FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
                                         const FrameCalibrationOptions& options = {});
 
+// Throws InputError (source, field heading_reference) for a reference with held frames (they hold
+// R_W_R) or without a finite yaw and a sigma > 0; calibrate_frames checks it, callers may check
+// before long work.
+void check_heading_reference(const std::optional<HeadingReference>& heading,
+                             const std::optional<KnownFrames>& known_frames,
+                             const std::string& source);
+
 // A known T_R_W (e.g. simulation truth with W's origin at the site) moved to this file's
 // convention: W's origin at the sensor's position at the first rest pose, given the true T_S_H
 // and the true link-side joint angles of that pose.
