@@ -112,7 +112,6 @@ json structure_json(const IdentifiedStructure& s) {
           {"nominal_compliance_rad_per_nm", number_or_null(s.nominal_compliance_rad_per_nm)},
           {"stiffness_nm_per_rad", estimate_json(s.stiffness_nm_per_rad)},
           {"direction_offset_rad", estimate_json(s.direction_offset_rad)},
-          {"friction_torque_nm", estimate_json(s.friction_torque_nm)},
           {"transmission_error_harmonic_per_motor_rev",
            number_or_null(s.transmission_error_harmonic_per_motor_rev)},
           {"transmission_error_amplitude_rad", estimate_json(s.transmission_error_amplitude_rad)},
@@ -219,7 +218,6 @@ IdentifiedStructure structure_of(const JsonField& f) {
   s.nominal_compliance_rad_per_nm = f["nominal_compliance_rad_per_nm"].number_or_nan();
   s.stiffness_nm_per_rad = estimate_of(f["stiffness_nm_per_rad"]);
   s.direction_offset_rad = estimate_of(f["direction_offset_rad"]);
-  s.friction_torque_nm = estimate_of(f["friction_torque_nm"]);
   s.transmission_error_harmonic_per_motor_rev =
       f["transmission_error_harmonic_per_motor_rev"].number_or_nan();
   s.transmission_error_amplitude_rad = estimate_of(f["transmission_error_amplitude_rad"]);

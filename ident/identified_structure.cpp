@@ -28,22 +28,12 @@ StructureEstimate propagated(double value, const Eigen::VectorXd& gradient,
 }
 
 // A compliance within kSignificantSigmas σ of zero (or below it) is a rigid drive as far as the
-// data tell: its inverse and the friction level through it are then not defined.
+// data tell: its inverse is then not defined.
 constexpr double kSignificantSigmas = 3.0;
 
 bool compliance_is_significant(const StaticGains& g, int torque) {
   return torque >= 0 &&
          g.gain(torque) > kSignificantSigmas * std::sqrt(g.covariance(torque, torque));
-}
-
-void set_friction(IdentifiedStructure& s, const StaticGains& g, int torque, int direction) {
-  if (direction < 0 || !compliance_is_significant(g, torque)) return;
-  // offset / compliance: ∂/∂offset = 1 / c, ∂/∂c = -offset / c².
-  const double c = g.gain(torque), d = g.gain(direction);
-  Eigen::VectorXd gradient = Eigen::VectorXd::Zero(g.gain.size());
-  gradient(direction) = 1.0 / c;
-  gradient(torque) = -d / (c * c);
-  s.friction_torque_nm = propagated(d / c, gradient, g.covariance);
 }
 
 void set_transmission_error(IdentifiedStructure& s, const StaticGains& g, int sin_input,
@@ -116,7 +106,6 @@ IdentifiedStructure structure_of_gains(const StaticGains& g, std::span<const Tab
     s.stiffness_nm_per_rad = {1.0 / c, s.compliance_rad_per_nm.sigma / (c * c)};
   }
   s.direction_offset_rad = gain_estimate(g, direction);
-  set_friction(s, g, torque, direction);
   set_transmission_error(s, g, index_of(inputs, TableInput::kTransmissionErrorSin),
                          index_of(inputs, TableInput::kTransmissionErrorCos));
   return s;

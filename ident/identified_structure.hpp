@@ -7,11 +7,13 @@
 // A(1) = 1 + Σ α_i, C_e(1) = Σ_l c_e,l. Read per further input (ident/exogenous_inputs.hpp):
 //  * model torque τ: g is the joint error per N m the joint carries, the drive's static
 //    compliance [rad/(N m)] (the gear's 1 / k where the position loop holds the motor without a
-//    standing error); its inverse the stiffness [N m/rad], defined where the compliance is more
-//    than 3σ above zero (otherwise the data show a rigid drive: stiffness and friction NaN);
-//  * direction tanh(q̇ / s) (±1 while moving): g is the offset the direction of motion adds
-//    [rad], half the step at a reversal (Coulomb friction seen through the drive's compliance);
-//    g / compliance is that offset as a link-side torque [N m], the friction level the data show;
+//    standing error, plus the loop's own static compliance where it has one); its inverse the
+//    stiffness [N m/rad], defined where the compliance is more than 3σ above zero (otherwise the
+//    data show a rigid drive: stiffness NaN);
+//  * direction tanh(q̇ / s) (±1 while moving): g is the offset the direction of motion adds as
+//    the speed tends to zero [rad], half the step at a reversal. It is not the Coulomb friction
+//    through the gear's compliance: on the simulated KR 16 (A4: 10 N m through 3e4 N m/rad,
+//    69″) it is 9″, the rest taken by the increments' terms and the position loop;
 //  * transmission error sin(φ), cos(φ): the pair of gains (g_s, g_c) is the error
 //    A sin(φ + ψ) with amplitude A = √(g_s² + g_c²) [rad] and phase ψ = atan2(g_c, g_s) [rad].
 // 1σ by first-order propagation (delta method) of the least-squares covariance σ_e² (ΦᵀΦ)⁻¹ of
@@ -43,7 +45,6 @@ struct IdentifiedStructure {
   StructureEstimate compliance_rad_per_nm;
   StructureEstimate stiffness_nm_per_rad;
   StructureEstimate direction_offset_rad;
-  StructureEstimate friction_torque_nm;
   StructureEstimate transmission_error_amplitude_rad;
   StructureEstimate transmission_error_phase_rad;
   // The values the identification was given (NaN where it had none): the config's gear

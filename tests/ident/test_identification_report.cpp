@@ -128,7 +128,7 @@ TEST_F(IdentificationReportTest, WhatIsWrittenIsReadBack) {
   EXPECT_EQ(j.structure->compliance_rad_per_nm.sigma, 1e-7);
   EXPECT_EQ(j.structure->nominal_compliance_rad_per_nm, 2.2e-6);
   EXPECT_EQ(j.structure->transmission_error_phase_rad.sigma, 0.125);
-  EXPECT_FALSE(j.structure->friction_torque_nm.identified());  // NaN written as null, read as NaN
+  EXPECT_FALSE(j.structure->stiffness_nm_per_rad.identified());  // NaN written as null, read as NaN
 }
 
 TEST_F(IdentificationReportTest, RefusalsNameTheFileAndTheField) {

@@ -21,12 +21,12 @@ constexpr TableInput kInputs[] = {TableInput::kModelTorque, TableInput::kDirecti
                                   TableInput::kTransmissionErrorCos};
 
 // e(k) = 0.6 e(k-1) + 0.02 w(k) + 0.01 w(k-1) + Σ c x + noise: A(1) = 0.4, so the static gains
-// are compliance 4e-6 / 0.4 = 1e-5 rad/(N m), direction 2e-5 / 0.4 = 5e-5 rad (friction
-// 5e-5 / 1e-5 = 5 N m), transmission error sin 4e-5 / 0.4 = 1e-4 and cos -2e-5 / 0.4 = -5e-5 rad.
+// are compliance 4e-6 / 0.4 = 1e-5 rad/(N m), direction 2e-5 / 0.4 = 5e-5 rad, transmission
+// error sin 4e-5 / 0.4 = 1e-4 and cos -2e-5 / 0.4 = -5e-5 rad.
 constexpr double kA1 = -0.6;
 const std::vector<double> kTorqueTaps{1e-6, 2e-6, 1e-6}, kDirectionTaps{2e-5}, kSinTaps{3e-5, 1e-5},
     kCosTaps{-1e-5, -1e-5};
-constexpr double kCompliance = 1e-5, kDirectionOffset = 5e-5, kFriction = 5.0;
+constexpr double kCompliance = 1e-5, kDirectionOffset = 5e-5;
 constexpr double kSinGain = 1e-4, kCosGain = -5e-5;
 
 ArxStructure synthetic_structure() {
@@ -93,14 +93,13 @@ TEST(IdentifiedStructure, StaticGainsAreTheClosedFormOfTheCoefficients) {
   EXPECT_NEAR(s.compliance_rad_per_nm.value, kCompliance, 5 * s.compliance_rad_per_nm.sigma);
   EXPECT_NEAR(s.stiffness_nm_per_rad.value, 1.0 / kCompliance, 5 * s.stiffness_nm_per_rad.sigma);
   EXPECT_NEAR(s.direction_offset_rad.value, kDirectionOffset, 5 * s.direction_offset_rad.sigma);
-  EXPECT_NEAR(s.friction_torque_nm.value, kFriction, 5 * s.friction_torque_nm.sigma);
   EXPECT_NEAR(s.transmission_error_amplitude_rad.value, std::hypot(kSinGain, kCosGain),
               5 * s.transmission_error_amplitude_rad.sigma);
   EXPECT_NEAR(s.transmission_error_phase_rad.value, std::atan2(kCosGain, kSinGain),
               5 * s.transmission_error_phase_rad.sigma);
   // The σ are small against the values (a synthetic record rich in every input): under 2 %.
   EXPECT_LT(s.compliance_rad_per_nm.sigma, 0.02 * kCompliance);
-  EXPECT_LT(s.friction_torque_nm.sigma, 0.02 * kFriction);
+  EXPECT_LT(s.direction_offset_rad.sigma, 0.02 * kDirectionOffset);
 }
 
 TEST(IdentifiedStructure, OneSigmaCoversTheTruthAsANormalOneShould) {
@@ -108,7 +107,7 @@ TEST(IdentifiedStructure, OneSigmaCoversTheTruthAsANormalOneShould) {
   // standard deviation is 1.04 %, so [92 %, 98.5 %] fails a correct σ with < 0.5 % probability
   // and a σ off by a factor 1.3 (coverage 87.5 % or 99.6 %) almost always.
   constexpr int kDraws = 400;
-  std::vector<int> covered(6, 0);
+  std::vector<int> covered(5, 0);
   const auto within_two_sigma = [](const StructureEstimate& e, double truth) {
     return std::abs(e.value - truth) <= 2.0 * e.sigma;
   };
@@ -117,10 +116,9 @@ TEST(IdentifiedStructure, OneSigmaCoversTheTruthAsANormalOneShould) {
     covered[0] += within_two_sigma(s.compliance_rad_per_nm, kCompliance);
     covered[1] += within_two_sigma(s.stiffness_nm_per_rad, 1.0 / kCompliance);
     covered[2] += within_two_sigma(s.direction_offset_rad, kDirectionOffset);
-    covered[3] += within_two_sigma(s.friction_torque_nm, kFriction);
-    covered[4] +=
+    covered[3] +=
         within_two_sigma(s.transmission_error_amplitude_rad, std::hypot(kSinGain, kCosGain));
-    covered[5] += within_two_sigma(s.transmission_error_phase_rad, std::atan2(kCosGain, kSinGain));
+    covered[4] += within_two_sigma(s.transmission_error_phase_rad, std::atan2(kCosGain, kSinGain));
   }
   for (std::size_t q = 0; q < covered.size(); ++q) {
     const double share = double(covered[q]) / kDraws;
@@ -154,14 +152,12 @@ TEST(IdentifiedStructure, CellsCombineByInverseVariance) {
   EXPECT_NEAR(s.compliance_rad_per_nm.sigma, 1.0 / std::sqrt(w0 + w1), 1e-12 * kCompliance);
 }
 
-TEST(IdentifiedStructure, ARigidDriveHasNoStiffnessNorFrictionLevel) {
-  // A compliance of 0.5σ: the data cannot tell it from a rigid drive, so 1 / c (and the offset
-  // through it) would be noise; the offset itself is still reported.
+TEST(IdentifiedStructure, ARigidDriveHasNoStiffness) {
+  // A compliance of 0.5σ: the data cannot tell it from a rigid drive, so 1 / c would be noise.
   StaticGains g{Eigen::Vector2d(0.5e-8, 5e-5), Eigen::Vector2d(1e-16, 1e-12).asDiagonal()};
   const IdentifiedStructure s = structure_of_gains(g, std::span(kInputs).first(2));
   EXPECT_DOUBLE_EQ(s.compliance_rad_per_nm.value, 0.5e-8);
   EXPECT_FALSE(s.stiffness_nm_per_rad.identified());
-  EXPECT_FALSE(s.friction_torque_nm.identified());
   EXPECT_DOUBLE_EQ(s.direction_offset_rad.value, 5e-5);
 }
 
