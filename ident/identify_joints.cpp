@@ -11,6 +11,19 @@
 #include "core/version.hpp"
 
 namespace imscal::ident {
+namespace {
+
+IdentifiedStructure structure_beside_config(const JointIdentification& result,
+                                            const IdentificationConfig& config, std::size_t joint) {
+  IdentifiedStructure s = identified_structure(result, extra_inputs_of(config.options));
+  if (joint < config.gear_stiffness_nm_per_rad.size())
+    s.nominal_compliance_rad_per_nm = 1.0 / config.gear_stiffness_nm_per_rad[joint];
+  if (config.options.transmission_error_input)
+    s.transmission_error_harmonic_per_motor_rev = config.transmission_error_harmonic(joint);
+  return s;
+}
+
+}  // namespace
 
 ParameterTable parameter_table_header(const JointErrorLog& log, const IdentificationConfig& config,
                                       DataSource source) {
@@ -67,6 +80,8 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
       } catch (...) {
         errors[j] = std::current_exception();
       }
+      if (!errors[j])
+        outcomes[j].structure = structure_beside_config(outcomes[j].result, config, j);
       outcomes[j].seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const std::lock_guard lock(done_mutex);
