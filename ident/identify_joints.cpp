@@ -9,6 +9,7 @@
 
 #include "core/input_error.hpp"
 #include "core/version.hpp"
+#include "ident/identification_config_record.hpp"
 
 namespace imscal::ident {
 namespace {
@@ -23,10 +24,18 @@ IdentifiedStructure structure_beside_config(const JointIdentification& result,
   return s;
 }
 
+// The config with its durations in counts of the log's cycle (ident/
+// identification_config_record.hpp), checked against the log.
+IdentificationConfig for_log(const IdentificationConfig& config, const JointErrorLog& log) {
+  if (config.resolved_cycle_s == log.cycle_s) return config;
+  return resolve_for_record(config, log.robot, log.cycle_s, "the joint errors");
+}
+
 }  // namespace
 
-ParameterTable parameter_table_header(const JointErrorLog& log, const IdentificationConfig& config,
-                                      DataSource source) {
+ParameterTable parameter_table_header(const JointErrorLog& log,
+                                      const IdentificationConfig& given_config, DataSource source) {
+  const IdentificationConfig config = for_log(given_config, log);
   ParameterTable table;
   table.robot = log.robot;
   table.sample_time_s = log.cycle_s;
@@ -41,8 +50,9 @@ ParameterTable parameter_table_header(const JointErrorLog& log, const Identifica
 }
 
 std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
-                                          const IdentificationConfig& config, unsigned threads,
-                                          const JointDoneCallback& on_done) {
+                                          const IdentificationConfig& given_config,
+                                          unsigned threads, const JointDoneCallback& on_done) {
+  const IdentificationConfig config = for_log(given_config, log);
   const std::size_t joints = log.joint_count();
   std::vector<JointOutcome> outcomes(joints);
   std::vector<std::exception_ptr> errors(joints);
