@@ -18,9 +18,9 @@
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
 #include "online/path_follower.hpp"
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
 #include "sim/scenario.hpp"
-#include "tests/support/rsi_loopback.hpp"
+#include "tests/support/loopback_server.hpp"
 
 namespace {
 
@@ -81,13 +81,13 @@ eval::CompensationRun through_sockets(const ident::ParameterTable& table,
   online::RsiSessionOptions session;
   session.cycle_s = path.cycle_s;
   session.ipoc_per_cycle = 2;
-  test_support::RsiLoopbackServer server(table, options.precontrol, session, std::move(follower));
+  test_support::LoopbackServer server(table, options.precontrol, session, std::move(follower));
   online::UdpSocket controller("127.0.0.1", 0);
-  online::RsiEmulatorOptions emulator;
+  online::EmulatorOptions emulator;
   emulator.cycle_s = path.cycle_s;
   emulator.ipoc_per_cycle = 2;
-  const online::RsiEmulatorRun run =
-      online::emulate_rsi_controller(controller, server.peer(), setpoint, emulator);
+  const online::EmulatorRun run =
+      online::emulate_controller(controller, server.peer(), setpoint, emulator);
   server.finish();
   eval::CompensationRun out;
   for (std::size_t k = 0; k < path.samples.size(); ++k) {

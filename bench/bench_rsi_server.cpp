@@ -9,7 +9,7 @@
 //    percentile, maximum, and the heap allocations inside the calls (counted by replacing
 //    operator new). Goal: p99.9 < 50 us.
 //  - BM_RsiLockStepLoopback: 10^6 datagrams through loopback UDP in lock-step (the emulator of
-//    online/rsi_controller_emulator.hpp against the server loop in a thread): missed answers
+//    online/controller_emulator.hpp against the server loop in a thread): missed answers
 //    (goal 0) and the round trip.
 //  - BM_RsiPaced4ms: the controller's real pacing, one datagram every 4 ms for 30 s: the share of
 //    answers later than 1 ms after their datagram was sent, and the latency's percentiles.
@@ -27,11 +27,11 @@
 #include <vector>
 
 #include "ident/precontrol.hpp"
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
 #include "online/rsi_session.hpp"
 #include "tests/support/allocation_counter.hpp"
 #include "tests/support/arx_systems.hpp"
-#include "tests/support/rsi_loopback.hpp"
+#include "tests/support/loopback_server.hpp"
 
 namespace {
 
@@ -126,22 +126,22 @@ void BM_RsiSessionDatagram(benchmark::State& state) {
 }
 BENCHMARK(BM_RsiSessionDatagram)->Unit(benchmark::kMillisecond)->Iterations(1);
 
-RsiEmulatorRun run_over_loopback(std::size_t datagrams, bool paced) {
+EmulatorRun run_over_loopback(std::size_t datagrams, bool paced) {
   RsiSessionOptions options;
   options.payload_kg = 8.0;
-  test_support::RsiLoopbackServer server(order_32_table(), keep_active(), options);
+  test_support::LoopbackServer server(order_32_table(), keep_active(), options);
   std::vector<std::array<double, kRsiAxes>> q(datagrams);
   for (std::size_t k = 0; k < datagrams; ++k) q[k] = setpoint(k);
   UdpSocket controller("127.0.0.1", 0);
-  RsiEmulatorOptions emulator;
+  EmulatorOptions emulator;
   emulator.paced = paced;
   emulator.answer_timeout_s = paced ? 0.004 : 0.5;  // paced: an answer after the cycle is missed
-  return emulate_rsi_controller(controller, server.peer(), q, emulator);
+  return emulate_controller(controller, server.peer(), q, emulator);
 }
 
 void BM_RsiLockStepLoopback(benchmark::State& state) {
   constexpr std::size_t kDatagrams = 1000000;
-  RsiEmulatorRun run;
+  EmulatorRun run;
   for (auto _ : state) run = run_over_loopback(kDatagrams, false);
   state.counters["datagrams"] = double(kDatagrams);
   state.counters["missed"] = double(run.missed);
@@ -153,7 +153,7 @@ BENCHMARK(BM_RsiLockStepLoopback)->Unit(benchmark::kSecond)->Iterations(1);
 
 void BM_RsiPaced4ms(benchmark::State& state) {
   constexpr std::size_t kDatagrams = 7500;  // 30 s
-  RsiEmulatorRun run;
+  EmulatorRun run;
   for (auto _ : state) run = run_over_loopback(kDatagrams, true);
   std::vector<double> us;
   std::size_t late = 0;

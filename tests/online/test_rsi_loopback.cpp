@@ -1,5 +1,5 @@
 // The RSI server through real sockets and real serialisation, against the in-process closed loop
-// (eval/closed_loop.hpp) as truth: the controller emulator (online/rsi_controller_emulator.hpp)
+// (eval/closed_loop.hpp) as truth: the controller emulator (online/controller_emulator.hpp)
 // plays the seed-line program's set-points over loopback UDP in lock-step, the robot simulator
 // runs on q_d + the corrections it received, and the attained joints equal those of
 // eval::run_closed_loop with the same precontrol; every datagram is answered.
@@ -11,13 +11,13 @@
 #include <filesystem>
 
 #include "eval/closed_loop.hpp"
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
 #include "sim/scenario.hpp"
 #include "tests/support/lag_table.hpp"
-#include "tests/support/rsi_loopback.hpp"
+#include "tests/support/loopback_server.hpp"
 
 namespace imscal::online {
 namespace {
@@ -63,18 +63,18 @@ TEST(RsiLoopback, ClosedLoopThroughSocketsEqualsTheInProcessLoop) {
   RsiSessionOptions session;
   session.cycle_s = path.cycle_s;
   session.ipoc_per_cycle = 2;
-  test_support::RsiLoopbackServer server(lag_table(), precontrol_options(), session);
+  test_support::LoopbackServer server(lag_table(), precontrol_options(), session);
   std::vector<std::array<double, kRsiAxes>> setpoint(kWarmUp + path.samples.size());
   for (std::size_t k = 0; k < setpoint.size(); ++k) {
     const Eigen::VectorXd& q = path.samples[k < kWarmUp ? 0 : k - kWarmUp].q_rad;
     for (int a = 0; a < kRsiAxes; ++a) setpoint[k][std::size_t(a)] = q[a];
   }
   UdpSocket controller("127.0.0.1", 0);
-  RsiEmulatorOptions emulator;
+  EmulatorOptions emulator;
   emulator.cycle_s = path.cycle_s;
   emulator.ipoc_per_cycle = 2;
   emulator.answer_timeout_s = 5.0;  // a stalled server thread (loaded machine) is not a miss
-  const RsiEmulatorRun run = emulate_rsi_controller(controller, server.peer(), setpoint, emulator);
+  const EmulatorRun run = emulate_controller(controller, server.peer(), setpoint, emulator);
   server.finish();
   EXPECT_EQ(run.missed, 0u);
   EXPECT_EQ(server.stats().answered, setpoint.size());

@@ -1,5 +1,5 @@
 // `imscal serve` end to end: the command serves a parameter table on a loopback port; the
-// controller emulator (online/rsi_controller_emulator.hpp) drives it, with a malformed datagram
+// controller emulator (online/controller_emulator.hpp) drives it, with a malformed datagram
 // and a lost one among 1000; every datagram sent in order is answered, the command logs the
 // faults and stops after its idle timeout with exit code 0. A table the interface cannot feed
 // (with preview) without the program's path is refused with exit code 2, naming the field; with
@@ -11,7 +11,7 @@
 
 #include "calib/robot_log.hpp"
 #include "ident/parameter_table_io.hpp"
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
 #include "tests/support/lag_table.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
@@ -60,12 +60,12 @@ TEST_F(ServeCli, ServesTheControllerAndLogsItsFaults) {
   std::vector<std::array<double, kRsiAxes>> setpoint(1000);
   for (std::size_t k = 0; k < setpoint.size(); ++k)
     for (int a = 0; a < kRsiAxes; ++a) setpoint[k][std::size_t(a)] = 0.1 * std::sin(0.004 * k);
-  RsiEmulatorOptions options;
+  EmulatorOptions options;
   options.first_ipoc = 1004;
   options.answer_timeout_s =
       2.0;  // a stalled server (loaded machine) is not a missed answer  // after the probe's
   options.faults = {{300, InjectedFault::kMalformed}, {600, InjectedFault::kDrop}};
-  const RsiEmulatorRun run = emulate_rsi_controller(controller, peer, setpoint, options);
+  const EmulatorRun run = emulate_controller(controller, peer, setpoint, options);
   server.join();
   const std::string log = read_file_text(dir_ / "serve.log");
   EXPECT_EQ(exit_code, 0) << log;
@@ -119,10 +119,10 @@ TEST_F(ServeCli, FollowsALoadedPathForATableWithPreview) {
     for (int a = 0; a < kRsiAxes; ++a) q[std::size_t(a)] = path.samples[k].q_desired_rad[a];
     setpoint.push_back(q);
   }
-  RsiEmulatorOptions options;
+  EmulatorOptions options;
   options.first_ipoc = 1004;
   options.answer_timeout_s = 2.0;  // a stalled server (loaded machine) is not a missed answer
-  const RsiEmulatorRun run = emulate_rsi_controller(controller, peer, setpoint, options);
+  const EmulatorRun run = emulate_controller(controller, peer, setpoint, options);
   server.join();
   const std::string log = read_file_text(dir_ / "serve.log");
   EXPECT_EQ(exit_code, 0) << log;
