@@ -56,7 +56,9 @@ bool copy_joints(const egm::EgmJoints& from, int* count, std::array<double, kEgm
 EgmParseError EgmCodec::parse_robot(std::string_view bytes, EgmRobotDatagram* out) noexcept {
   if (bytes.size() > std::size_t(kEgmMaxDatagramBytes)) return EgmParseError::kTooLong;
   egm::EgmRobot& robot = messages_->robot;
-  if (!robot.ParseFromArray(bytes.data(), int(bytes.size()))) return EgmParseError::kNotProtobuf;
+  // Partial parse and our own check of the required fields: ParseFromArray logs the missing ones.
+  if (!robot.ParsePartialFromArray(bytes.data(), int(bytes.size())) || !robot.IsInitialized())
+    return EgmParseError::kNotProtobuf;
   if (!robot.has_header() || !robot.header().has_seqno()) return EgmParseError::kMissingHeader;
   if (robot.header().mtype() != egm::EgmHeader::MSGTYPE_DATA) return EgmParseError::kNotData;
   if (!robot.has_feedback() || !robot.feedback().has_joints())
@@ -121,7 +123,8 @@ int EgmCodec::write_robot(const EgmRobotDatagram& d, char* buffer, int capacity)
 bool EgmCodec::parse_sensor(std::string_view bytes, std::uint32_t* seqno,
                             std::array<double, kEgmAxes>* planned_deg) noexcept {
   egm::EgmSensor sensor;
-  if (!sensor.ParseFromArray(bytes.data(), int(bytes.size()))) return false;
+  if (!sensor.ParsePartialFromArray(bytes.data(), int(bytes.size())) || !sensor.IsInitialized())
+    return false;
   if (!sensor.has_header() || !sensor.header().has_seqno() || !sensor.has_planned() ||
       sensor.planned().joints().joints_size() != kEgmAxes)
     return false;
