@@ -150,7 +150,7 @@ TEST(RsiPath, APreviewTableThroughSocketsGetsThePathAhead) {
     ++moving;
   ASSERT_LT(moving + 200, loaded.q_rad.size());
   // From 100 cycles after it (the model forgets the missed start by 0.5^100), the corrections
-  // equal the in-process ones within the written values' rounding (see test_rsi_loopback).
+  // equal the in-process ones within the written values' rounding (see test_interface_loopback).
   double largest = 0.0, largest_difference = 0.0;
   for (std::size_t k = moving + 100; k < path.samples.size(); ++k) {
     for (int j = 0; j < 6; ++j) {
