@@ -314,7 +314,8 @@ TEST(CalibrateCampaign, MountingScenarioAsShipped) {
   if (sanitized()) {
     // The first 60 s hold poses 1-7, of which only pose 4 is still for the IMS (see below): the
     // stillness check leaves 1-2 rests and the chain refuses with its defined message (the
-    // bundle itself runs under the sanitizers in MountingRigid and MountingWithoutBacklash).
+    // bundle itself runs under the sanitizers in MountingRigid and MountingWithoutBacklash,
+    // which also carry the initial clock offset's check there: a refused session returns none).
     EXPECT_EQ(f.calibrated, 0u);
     EXPECT_NE(f.first_refusal.find("at least 3 are needed"), std::string::npos) << f.first_refusal;
     return;
