@@ -16,6 +16,7 @@
 
 #include "calib/robot_description.hpp"
 #include "core/atomic_file.hpp"
+#include "core/joint_limit_plausibility.hpp"
 
 namespace imscal::calib {
 
@@ -46,5 +47,13 @@ std::string format_robot_log_csv(const RobotLog& log);
 RobotLog read_robot_log_csv(const std::filesystem::path& file,
                             const std::string& expected_robot = "",
                             const std::string& expected_by = "the robot description");
+
+// The robot's joint limits by joint name (core/joint_limit_plausibility.hpp).
+std::vector<JointLimit> joint_limits_of(const RobotDescription& robot);
+
+// The log's desired and internal angles against the robot's joint limits: a warning beyond a
+// limit, InputError (file, line, column, limit) beyond the margin. Returns the samples beyond.
+std::size_t check_robot_log_joint_limits(const RobotLog& log, const std::string& file,
+                                         const RobotDescription& robot);
 
 }  // namespace imscal::calib

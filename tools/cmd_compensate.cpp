@@ -19,7 +19,6 @@
 #include "ident/parameter_table_io.hpp"
 #include "ident/precontrol.hpp"
 #include "tools/command_registry.hpp"
-#include "tools/joint_limit_checks.hpp"
 #include "tools/model_torque_option.hpp"
 
 namespace {
@@ -98,7 +97,7 @@ void run(const CompensateArgs& args) {
       args.robot_log, table.robot, "the parameter table " + args.table);
   check_log_payload(args, table, log);
   if (!args.model_torque.robot.empty())
-    imscal::tools::check_robot_log_joint_limits(
+    imscal::calib::check_robot_log_joint_limits(
         log, args.robot_log, imscal::calib::load_robot_description(args.model_torque.robot));
   ident::PrecontrolOptions options;
   options.caller_cycle_s = log.cycle_s;

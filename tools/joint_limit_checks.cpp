@@ -9,15 +9,6 @@
 namespace imscal::tools {
 namespace {
 
-std::vector<JointLimit> limits_of(const calib::RobotDescription& robot) {
-  std::vector<JointLimit> limits;
-  for (int j = 0; j < calib::kJointCount; ++j)
-    limits.push_back({robot.joints[std::size_t(j)].name.empty() ? fmt::format("{}", j + 1)
-                                                                : robot.joints[std::size_t(j)].name,
-                      robot.kinematics.lower_limit_rad[j], robot.kinematics.upper_limit_rad[j]});
-  return limits;
-}
-
 std::string limits_label(const calib::RobotDescription& robot) {
   return fmt::format("robot {} ({})", robot.name, robot.source);
 }
@@ -28,24 +19,6 @@ std::function<std::size_t(std::size_t)> lines_of(const std::vector<std::size_t>&
 
 }  // namespace
 
-std::size_t check_robot_log_joint_limits(const calib::RobotLog& log, const std::string& file,
-                                         const calib::RobotDescription& robot) {
-  std::vector<std::vector<double>> values(2 * calib::kJointCount);
-  for (const calib::RobotLogSample& s : log.samples)
-    for (int j = 0; j < calib::kJointCount; ++j) {
-      values[std::size_t(j)].push_back(s.q_desired_rad[j]);
-      values[std::size_t(calib::kJointCount + j)].push_back(s.q_internal_rad[j]);
-    }
-  std::vector<JointAngleColumn> columns;
-  for (std::size_t j = 0; j < std::size_t(calib::kJointCount); ++j) {
-    columns.push_back({fmt::format("q_desired_{}_rad", log.joint_names[j]), j, values[j]});
-    columns.push_back(
-        {fmt::format("q_internal_{}_rad", log.joint_names[j]), j, values[calib::kJointCount + j]});
-  }
-  return check_joint_limits(columns, limits_of(robot),
-                            {file, lines_of(log.sample_lines), limits_label(robot)});
-}
-
 std::size_t check_joint_error_limits(const ident::JointErrorLog& log, const std::string& file,
                                      const calib::RobotDescription& robot) {
   std::vector<JointAngleColumn> columns;
@@ -55,7 +28,7 @@ std::size_t check_joint_error_limits(const ident::JointErrorLog& log, const std:
     columns.push_back({fmt::format("q_measured_{}_rad", name), j, log.q_measured_rad[j]});
     columns.push_back({fmt::format("q_internal_{}_rad", name), j, log.q_internal_rad[j]});
   }
-  return check_joint_limits(columns, limits_of(robot),
+  return check_joint_limits(columns, calib::joint_limits_of(robot),
                             {file, lines_of(log.sample_lines), limits_label(robot)});
 }
 
@@ -70,7 +43,7 @@ std::size_t check_tracker_pose_limits(const calib::TrackerPoses& poses,
   std::vector<JointAngleColumn> columns;
   for (std::size_t j = 0; j < std::size_t(calib::kJointCount); ++j)
     columns.push_back({fmt::format("q{}_rad", j + 1), j, values[j]});
-  return check_joint_limits(columns, limits_of(robot),
+  return check_joint_limits(columns, calib::joint_limits_of(robot),
                             {poses.file, lines_of(lines), limits_label(robot)});
 }
 
