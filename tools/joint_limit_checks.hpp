@@ -5,6 +5,7 @@
 #include <string>
 
 #include "calib/robot_description.hpp"
+#include "calib/robot_log.hpp"
 #include "calib/tracker_poses.hpp"
 #include "ident/joint_error_io.hpp"
 
