@@ -16,6 +16,7 @@
 #include <memory>
 
 #include "core/input_error.hpp"
+#include "core/progress_channel.hpp"
 #include "eval/verification_session.hpp"
 #include "tools/command_registry.hpp"
 
@@ -52,11 +53,13 @@ void run(VerifyArgs args) {
   if (args.offset_tolerance_rad > 0.0)
     args.session.verification.compensation.precontrol.offset_tolerance_rad.fill(
         args.offset_tolerance_rad);
-  eval::verify_session(args.session, out, overwrite,
-                       [](const fs::path& dir, const std::string& text) {
-                         std::cout << text;
-                         draw_figures(dir);
-                       });
+  eval::verify_session(
+      args.session, out, overwrite,
+      [](const fs::path& dir, const std::string& text) {
+        std::cout << text;
+        draw_figures(dir);
+      },
+      imscal::progress_channel());
 }
 
 imscal::tools::CommandRegistration registration{
