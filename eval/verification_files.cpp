@@ -12,6 +12,7 @@
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
 #include "core/units.hpp"
+#include "eval/path_evaluation.hpp"
 
 namespace imscal::eval {
 
@@ -73,15 +74,6 @@ std::string text_row(const VerificationCase& c, const PathFigures& before) {
       reduction_percent(before.max_path_deviation_m, f.max_path_deviation_m), f.AT_p_m * kMm,
       f.RT_p_m * kMm, f.AT_abc_rad[0] * kDegPerRad, f.AT_abc_rad[1] * kDegPerRad,
       f.AT_abc_rad[2] * kDegPerRad, f.CO_m * kMm, f.AV_percent, f.FV_m_s);
-}
-
-std::string path_file(const std::vector<Eigen::Matrix<double, 8, 1>>& rows,
-                      const std::string& what) {
-  std::string s = "# imscal-path: 1\n# frame: R (robot base), flange H\n# content: " + what +
-                  "\nt_s,x_m,y_m,z_m,qw,qx,qy,qz\n";
-  for (const auto& r : rows)
-    s += fmt::format("{},{},{},{},{},{},{},{}\n", r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7]);
-  return s;
 }
 
 std::string slug(std::string s) {
@@ -247,14 +239,14 @@ void write_figure_scripts(const fs::path& dir, const std::string& scenario, Over
 
 // Path files for `imscal evaluate`.
 void write_path_files(const fs::path& dir, const VerificationResult& r, Overwrite overwrite) {
-  write_file_atomically(dir / "commanded.csv", path_file(r.desired_poses, "commanded flange path"),
-                        overwrite);
+  write_file_atomically(dir / "commanded.csv",
+                        path_file_text(r.desired_poses, "commanded flange path"), overwrite);
   for (std::size_t c = 0; c < r.attained_poses.size(); ++c) {
     const std::string label = c == 0 ? r.before.label : r.after[c - 1].label;
     for (std::size_t j = 0; j < r.attained_poses[c].size(); ++j) {
       write_file_atomically(
           dir / fmt::format("attained_{}_{}.csv", slug(label), j),
-          path_file(r.attained_poses[c][j], fmt::format("{}, cycle {}", label, j)), overwrite);
+          path_file_text(r.attained_poses[c][j], fmt::format("{}, cycle {}", label, j)), overwrite);
     }
   }
 }
