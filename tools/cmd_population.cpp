@@ -6,6 +6,7 @@
 #include <iostream>
 #include <memory>
 
+#include "core/progress_channel.hpp"
 #include "eval/population_study.hpp"
 #include "tools/command_registry.hpp"
 #include "tools/stage_subcommand.hpp"
@@ -30,7 +31,12 @@ void run(PopulationArgs args) {
     std::cout << eval::run_population_step(args.step, seeds, nominal, study);
     return;
   }
-  const int failed = eval::run_population(seeds, nominal, study);
+  const imscal::ProgressCallback progress = imscal::progress_channel();
+  const int failed = eval::run_population(
+      seeds, nominal, study,
+      [&progress](std::uint64_t seed, std::uint64_t number_in_range, std::uint64_t count) {
+        progress(fmt::format("plant {}", seed), double(number_in_range - 1) / double(count));
+      });
   std::cout << eval::write_population_summary(seeds, study, failed);
   if (failed > 0)
     throw imscal::tools::CheckFailed(
