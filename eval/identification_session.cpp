@@ -13,6 +13,7 @@
 #include "core/payload_plausibility.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
+#include "ident/identification_config_record.hpp"
 #include "ident/parameter_table_io.hpp"
 
 namespace imscal::eval {
@@ -29,8 +30,8 @@ void attach_session_model_torques(ident::JointErrorLog& log,
   if (!config.options.model_torque_input) return;
   if (!options.model_torque)
     throw InputError(options.config, 0, "model.model_torque", "no rigid-body model given");
-  const ModelTorqueSource model =
-      options.model_torque(log.robot, options.joint_errors, options.config, "model.model_torque");
+  const ModelTorqueSource model = options.model_torque(
+      log.robot, options.joint_errors, options.config, "model.model_torque", log.cycle_s);
   spdlog::info("identify: model torques of {} along the {} path", model.robot.name,
                torque_along_measured_path(config.options) ? "measured" : "desired");
   attach_model_torques(log, model, config.options);
@@ -119,7 +120,10 @@ PreparedIdentification prepare_identification(const IdentificationSessionOptions
   p.options = options;
   p.log = ident::read_joint_errors_csv(options.joint_errors);
   const ConfigNode config_node = ConfigNode::load_file(options.config);
-  p.config = ident::load_identification_config(config_node);
+  std::vector<std::string> warnings;
+  p.config = ident::resolve_for_record(ident::load_identification_config(config_node), p.log.robot,
+                                       p.log.cycle_s, options.joint_errors, &warnings);
+  for (const std::string& w : warnings) spdlog::warn("identify: {}", w);
   attach_session_model_torques(p.log, p.config, options);
   if (p.config.max_speed_rad_s.size() != p.log.joint_count())
     throw InputError(

@@ -28,12 +28,12 @@ struct IdentificationSessionOptions {
   std::string joint_errors;   // joint_errors.csv
   std::string config;         // identification config
   bool search_order = false;  // the transmission error's order per joint from the data
-  // The rigid-body model for the data of robot `data_robot` (file `data_file`), asked only when
-  // the config's models take the model torque; `needed_by_file` and `needed_by_field` name what
-  // asked, for its InputError (tools/model_torque_option.hpp).
+  // The rigid-body model for the data of robot `data_robot` (file `data_file`, sample time
+  // data_cycle_s), asked only when the config's models take the model torque; `needed_by_file`
+  // and `needed_by_field` name what asked, for its InputError (tools/model_torque_option.hpp).
   std::function<ModelTorqueSource(const std::string& data_robot, const std::string& data_file,
                                   const std::string& needed_by_file,
-                                  const std::string& needed_by_field)>
+                                  const std::string& needed_by_field, double data_cycle_s)>
       model_torque;
 };
 

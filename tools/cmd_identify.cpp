@@ -28,8 +28,9 @@ void run(const IdentifyArgs& args) {
   eval::IdentificationSessionOptions options = args.session;
   options.model_torque = [&args](const std::string& robot, const std::string& data_file,
                                  const std::string& needed_by_file,
-                                 const std::string& needed_by_field) {
-    return args.model_torque.source(robot, data_file, needed_by_file, needed_by_field);
+                                 const std::string& needed_by_field, double data_cycle_s) {
+    return args.model_torque.source(robot, data_file, needed_by_file, needed_by_field,
+                                    data_cycle_s);
   };
   eval::PreparedIdentification prepared = eval::prepare_identification(options);
   imscal::OutputFolder folder(args.out, eval::identification_output_names(prepared.config),
