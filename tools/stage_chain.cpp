@@ -76,16 +76,6 @@ std::unique_ptr<Stage> make_calibrate_stage(const RunConfig& config) {
                                     "--config",    config.calibrate->config.string(),
                                     "--out",       out.string()};
   };
-  // `imscal calibrate` logs "<step>: done in <s> s" after each of its steps, in this order.
-  spec.progress_of_line = [](const std::string& line) -> std::optional<double> {
-    static const std::vector<std::pair<std::string, double>> steps = {
-        {"read: done", 0.1},    {"time offset: done", 0.2}, {"bundle: done", 0.4},
-        {"halves: done", 0.55}, {"segments: done", 0.7},    {"joint errors: done", 0.95},
-        {"write: done", 1.0}};
-    for (const auto& [text, fraction] : steps)
-      if (line.find(text) != std::string::npos) return fraction;
-    return std::nullopt;
-  };
   spec.success_message = "frames calibrated, mounting verdict and joint errors written";
   return std::make_unique<SubcommandStage>(std::move(spec));
 }

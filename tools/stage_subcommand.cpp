@@ -53,9 +53,6 @@ StageOutcome SubcommandStage::run(StageWorkspace& workspace) {
     const std::string text(line);
     if (const auto at = text.find("[error] "); at != std::string::npos)
       last_error = text.substr(at + 8);
-    if (spec_.progress_of_line)
-      if (const std::optional<double> fraction = spec_.progress_of_line(text))
-        workspace.progress(std::clamp(*fraction, 0.0, 1.0));
   };
   spdlog::info("{}: {}", tag, fmt::join(argv, " "));
   const SubprocessResult result = run_subprocess(argv, options);

@@ -24,9 +24,6 @@ struct SubcommandSpec {
                                          const std::filesystem::path& out)>
       arguments;
   std::function<StageInputs()> inputs;
-  // For a subcommand that does not report through the progress channel: the stage's progress in
-  // [0, 1] that a log line of the child tells, if any (empty: none).
-  std::function<std::optional<double>(const std::string& line)> progress_of_line;
   std::string success_message;  // the stage's one-line result when the child ends with 0
 };
 

@@ -177,8 +177,6 @@ TEST_F(IdentifyCli, JointThatCannotBeIdentifiedGetsTheNeutralModel) {
   EXPECT_FALSE(neutral.cells[0].reason.empty());
 }
 
-// A log in which no joint moved: a table of neutral models corrects nothing, so identify fails
-// the check (exit 1), names the reason per joint and writes none of its outputs.
 // The progress channel (core/progress_channel.hpp): with the variable set, as `imscal run` sets
 // it for its stages, each finished joint is one progress line, the last at 1; without it, none.
 TEST_F(IdentifyCli, ReportsEachJointThroughTheProgressChannelWhenAsked) {
@@ -202,6 +200,8 @@ TEST_F(IdentifyCli, ReportsEachJointThroughTheProgressChannelWhenAsked) {
   EXPECT_EQ(fractions.back(), 1.0);
 }
 
+// A log in which no joint moved: a table of neutral models corrects nothing, so identify fails
+// the check (exit 1), names the reason per joint and writes none of its outputs.
 TEST_F(IdentifyCli, NoJointIdentifiedIsAFailedCheckWithoutOutput) {
   ident::JointErrorLog log = ident::read_joint_errors_csv(dir_ / "joint_errors.csv");
   for (std::size_t j = 0; j < log.joint_count(); ++j) {
