@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 
@@ -19,6 +20,7 @@
 #include "core/payload_plausibility.hpp"
 #include "eval/gap_analysis.hpp"
 #include "eval/gap_report.hpp"
+#include "eval/gap_windows.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "tools/command_registry.hpp"
@@ -34,6 +36,7 @@ struct DiagnoseArgs {
   bool force = false;
   bool figures = false;
   double gnuplot_timeout_s = 30.0;
+  double max_analysed_s = eval::AnalysisWindows{}.max_s;
 };
 
 constexpr const char* kSvgProlog = "<?xml version=\"1.0\" encoding=\"utf-8\" standalone=\"no\"?>\n";
@@ -116,6 +119,26 @@ std::string model_error_figure(imscal::tools::GnuplotRenderer& gnuplot, const ev
                         650);
 }
 
+// A record longer than max_s [s]: its analysed windows only (eval/gap_windows.hpp), in both the
+// real joint errors and the sim's.
+void keep_analysed_windows(double max_s, ident::JointErrorLog& real,
+                           std::vector<std::vector<double>>& sim_errors) {
+  eval::AnalysisWindows windows;
+  windows.max_s = max_s;
+  const std::vector<bool> keep = eval::analysed_samples(real.time_s, windows);
+  const auto kept = std::size_t(std::count(keep.begin(), keep.end(), true));
+  if (kept == keep.size()) return;
+  std::size_t windows_count = 0;
+  for (std::size_t k = 0; k < keep.size(); ++k)
+    windows_count += keep[k] && (k == 0 || !keep[k - 1]);
+  spdlog::info(
+      "diagnose: a {:.0f} s record: analysed on {} windows spread over it, {} of {} "
+      "samples (--max-analysed-s {})",
+      real.time_s.back() - real.time_s.front(), windows_count, kept, keep.size(), max_s);
+  real = eval::keep_samples(real, keep);
+  sim_errors = eval::keep_samples(sim_errors, keep);
+}
+
 void run(const DiagnoseArgs& args) {
   const auto overwrite = args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse;
   std::vector<fs::path> outputs = {"report.json", "report.txt"};
@@ -123,7 +146,7 @@ void run(const DiagnoseArgs& args) {
     for (const char* f : {"gap-spectrum.svg", "gap-where.svg", "gap-model-error.svg"})
       outputs.push_back(f);
   imscal::OutputFolder folder(args.out, outputs, overwrite);
-  const ident::JointErrorLog real = ident::read_joint_errors_csv(args.joint_errors);
+  ident::JointErrorLog real = ident::read_joint_errors_csv(args.joint_errors);
   const imscal::calib::RobotDescription robot = imscal::calib::load_robot_description(args.robot);
   if (robot.name != real.robot)
     throw imscal::InputError(args.joint_errors, 2, "robot",
@@ -160,6 +183,7 @@ void run(const DiagnoseArgs& args) {
                                              sim.time_s[k], real.time_s[k]));
     sim_errors = eval::measured_joint_errors(sim);
   }
+  keep_analysed_windows(args.max_analysed_s, real, sim_errors);
   eval::GapSignals signals;
   try {
     signals = eval::make_gap_signals(real, sim_errors, robot, table ? &*table : nullptr);
@@ -215,6 +239,10 @@ imscal::tools::CommandRegistration registration{
       sub.add_flag("--figures", args->figures,
                    "also write SVG figures (gnuplot): gap-spectrum.svg, gap-where.svg, "
                    "gap-model-error.svg");
+      sub.add_option("--max-analysed-s", args->max_analysed_s,
+                     "a longer record is analysed on windows of 30 s spread over it, this long "
+                     "in all [s]; 0: the whole record")
+          ->check(CLI::NonNegativeNumber);
       sub.add_option("--gnuplot-timeout", args->gnuplot_timeout_s,
                      "time limit of gnuplot per figure [s]")
           ->check(CLI::PositiveNumber);
