@@ -1,13 +1,13 @@
 #pragma once
 // The part of a long record the gap diagnosis analyses. Its candidate fits hold regressor columns
-// over every analysed sample (eval/gap_candidates.hpp; ~19 kB per sample at the 2 ms cycle), so
+// over every analysed sample (eval/gap_candidates.hpp; 19-31 kB per sample at the 2 ms cycle), so
 // its memory grows with the record. A record longer than `max_s` is analysed on windows of
 // `window_s` spread evenly over it, first and last included, `max_s` in all: the effects the
 // diagnosis looks for are stationary over a session (their parameters are constants) except the
-// thermal drift, whose time span the spread windows keep; 120 s of 2 ms samples (60 000 rows, 2x
-// the held-out rows of the shipped 70 s campaign that its headline figures come from) keep >= 300
-// rows per parameter of the largest candidate, and the windows' 30 s hold the longest time scale
-// of a candidate's filters (0.3 s) a hundredfold. Each window is its own run (filters restart).
+// thermal drift, whose time span the spread windows keep. 90 s of 2 ms samples are 45 000 rows,
+// more than the shipped 70 s campaign's 34 650 that the diagnosis' headline figures come from; a
+// window's 30 s hold the longest time scale of a candidate's filters (0.3 s) a hundredfold. Each
+// window is its own run (the filters restart at its start, as at a gap in the record).
 #include <cstddef>
 #include <vector>
 
@@ -16,7 +16,7 @@
 namespace imscal::eval {
 
 struct AnalysisWindows {
-  double max_s = 120.0;    // analysed in all; 0: the whole record
+  double max_s = 90.0;     // analysed in all; 0: the whole record
   double window_s = 30.0;  // each window's length
 };
 

@@ -44,17 +44,17 @@ TEST(GapWindows, AShortRecordIsKeptWhole) {
   EXPECT_TRUE(std::all_of(long_keep.begin(), long_keep.end(), [](bool b) { return b; }));
 }
 
-TEST(GapWindows, ALongRecordKeepsFourSpreadWindowsOfThirtySeconds) {
+TEST(GapWindows, ALongRecordKeepsThreeSpreadWindowsOfThirtySeconds) {
   const auto log = log_of(600.0);
-  const auto keep = analysed_samples(log.time_s, AnalysisWindows{});  // 120 s in 30 s windows
+  const auto keep = analysed_samples(log.time_s, AnalysisWindows{});  // 90 s in 30 s windows
   const auto kept = keep_samples(log, keep);
-  // 4 x 30 s of 2 ms samples: 15000 each (each window [start, start + 30 s)); one sample more
+  // 3 x 30 s of 2 ms samples: 15000 each (each window [start, start + 30 s)); one sample more
   // or less per window where a start falls on a sample within rounding.
-  EXPECT_NEAR(double(kept.sample_count()), 4.0 * 15000.0, 4.0);
-  ASSERT_EQ(kept.segment_starts.size(), 4u);
-  // Starts every (600 - 30) / 3 = 190 s: 0, 190, 380, 570 s, to a sample.
-  for (std::size_t i = 0; i < 4; ++i)
-    EXPECT_NEAR(kept.time_s[kept.segment_starts[i]], 190.0 * double(i), 1.01 * kCycleS);
+  EXPECT_NEAR(double(kept.sample_count()), 3.0 * 15000.0, 3.0);
+  ASSERT_EQ(kept.segment_starts.size(), 3u);
+  // Starts every (600 - 30) / 2 = 285 s: 0, 285, 570 s, to a sample.
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_NEAR(kept.time_s[kept.segment_starts[i]], 285.0 * double(i), 1.01 * kCycleS);
   EXPECT_NEAR(kept.time_s.back(), 600.0 - kCycleS, 1e-9);
   // The series follow their samples: q_desired is the original index.
   const std::size_t second = kept.segment_starts[1];
@@ -68,13 +68,13 @@ TEST(GapWindows, ALongRecordKeepsFourSpreadWindowsOfThirtySeconds) {
 }
 
 TEST(GapWindows, ASegmentBoundaryInsideAWindowStaysOne) {
-  // A 1 s gap at 200 s (sample 100000): inside the second window (~190.3 .. 220.3 s).
-  const auto log = log_of(600.0, 100000);
+  // A 1 s gap at 300 s (sample 150000): inside the second window (285.5 .. 315.5 s).
+  const auto log = log_of(600.0, 150000);
   const auto kept = keep_samples(log, analysed_samples(log.time_s, AnalysisWindows{}));
-  EXPECT_EQ(kept.segment_starts.size(), 5u);
+  EXPECT_EQ(kept.segment_starts.size(), 4u);
   const auto segments = kept.segments();
-  ASSERT_EQ(segments.size(), 5u);
-  EXPECT_NEAR(kept.time_s[segments[2].first], 201.0, 1e-9);  // the sample after the gap
+  ASSERT_EQ(segments.size(), 4u);
+  EXPECT_NEAR(kept.time_s[segments[2].first], 301.0, 1e-9);  // the sample after the gap
 }
 
 }  // namespace
