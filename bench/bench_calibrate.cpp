@@ -3,14 +3,17 @@
 // datasets/programs/mounting.yaml cycled for 10 minutes (6 s rests, 3 s quintic joint moves, a
 // kinematic record as in tests/calib/frame_calibration_scenes.hpp), the navigation-grade IMS at
 // 1 kHz with its noise; the initial time offset by cross-correlation (also outside). Timed:
-// calibrate_frames (cutting, preintegration, initial values, two solves, covariance).
+// calibrate_frames (cutting, preintegration, initial values, two solves, covariance). Beside it
+// the whole `imscal calibrate` command on the shipped campaign, as a child process.
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <filesystem>
 
 #include "calib/frame_calibration.hpp"
 #include "calib/robot_description.hpp"
 #include "calib/time_offset.hpp"
+#include "core/subprocess.hpp"
 #include "tests/calib/frame_calibration_scenes.hpp"
 
 namespace {
@@ -82,6 +85,33 @@ void BM_CalibrateTenMinutes1kHz(benchmark::State& state) {
   state.counters["converged"] = converged ? 1.0 : 0.0;
 }
 BENCHMARK(BM_CalibrateTenMinutes1kHz)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+// The whole command as a user meets it on the shipped campaign (70 s at 1 kHz): `imscal
+// calibrate` as a child process, reading the files, the time offset, the bundle, the joint errors
+// and the outputs, wall time. calibrate_frames above is only its bundle.
+void BM_CalibrateCommandCampaign(benchmark::State& state) {
+  const std::filesystem::path campaign =
+      std::filesystem::path(IMSCAL_SOURCE_DIR) / "datasets/campaign";
+  const std::filesystem::path out =
+      std::filesystem::temp_directory_path() / "imscal-bench-calibrate";
+  imscal::SubprocessOptions options;
+  options.timeout_s = 600.0;
+  for (auto _ : state) {
+    std::filesystem::remove_all(out);
+    const auto start = std::chrono::steady_clock::now();
+    const auto result = imscal::run_subprocess(
+        {IMSCAL_BINARY, "calibrate", "--imu", (campaign / "imu.csv").string(), "--robot-log",
+         (campaign / "robot.csv").string(), "--config", (campaign / "calibrate.yaml").string(),
+         "--out", out.string()},
+        options);
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (result.exit_code != 0)
+      state.SkipWithError(("imscal calibrate failed:\n" + result.output).c_str());
+  }
+  std::filesystem::remove_all(out);
+}
+BENCHMARK(BM_CalibrateCommandCampaign)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(3);
 
 }  // namespace
 
