@@ -6,8 +6,8 @@
 // for the identification) repeated to the length, on the campaign's scenario with the IMS at 2 kHz,
 // with the campaign's configs (the paper's line in the verify stage). Timed: the imscal binary's
 // `run` as a child process, wall time (UseManualTime), and its peak resident memory (wait4's
-// rusage: the largest of the child and its stages' subprocesses). The shipped 70 s campaign at 1
-// kHz is the baseline in the same run.
+// rusage: the largest of the child and its stages' subprocesses) and CPU time. The shipped 70 s
+// campaign at 1 kHz is the baseline in the same run.
 //   bench/bench_lab_scale --benchmark_counters_tabular=true
 //   bench/bench_lab_scale --benchmark_filter='Run/(0|5)/'   (the baseline and 5 minutes only)
 #include <benchmark/benchmark.h>
