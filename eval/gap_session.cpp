@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -38,8 +39,32 @@ std::vector<std::vector<double>> sim_log_joint_errors(const GapSessionOptions& a
 
 }  // namespace
 
+namespace {
+
+// A record longer than max_s [s]: its analysed windows only (eval/gap_windows.hpp), in both the
+// real joint errors and the sim's.
+void keep_analysed_windows(double max_s, ident::JointErrorLog& real,
+                           std::vector<std::vector<double>>& sim_errors) {
+  AnalysisWindows windows;
+  windows.max_s = max_s;
+  const std::vector<bool> keep = analysed_samples(real.time_s, windows);
+  const auto kept = std::size_t(std::count(keep.begin(), keep.end(), true));
+  if (kept == keep.size()) return;
+  std::size_t windows_count = 0;
+  for (std::size_t k = 0; k < keep.size(); ++k)
+    windows_count += keep[k] && (k == 0 || !keep[k - 1]);
+  spdlog::info(
+      "diagnose: a {:.0f} s record: analysed on {} windows spread over it, {} of {} "
+      "samples (--max-analysed-s {})",
+      real.time_s.back() - real.time_s.front(), windows_count, kept, keep.size(), max_s);
+  real = keep_samples(real, keep);
+  sim_errors = keep_samples(sim_errors, keep);
+}
+
+}  // namespace
+
 GapSession diagnose_gap_session(const GapSessionOptions& args) {
-  const ident::JointErrorLog real = ident::read_joint_errors_csv(args.joint_errors);
+  ident::JointErrorLog real = ident::read_joint_errors_csv(args.joint_errors);
   const calib::RobotDescription robot = calib::load_robot_description(args.robot);
   if (robot.name != real.robot)
     throw InputError(args.joint_errors, 2, "robot",
@@ -64,6 +89,7 @@ GapSession diagnose_gap_session(const GapSessionOptions& args) {
   } else {
     sim_errors = sim_log_joint_errors(args, real);
   }
+  keep_analysed_windows(args.max_analysed_s, real, sim_errors);
   GapSession session;
   try {
     session.signals = make_gap_signals(real, sim_errors, robot, table ? &*table : nullptr);

@@ -9,6 +9,7 @@
 
 #include "eval/gap_diagnosis.hpp"
 #include "eval/gap_signals.hpp"
+#include "eval/gap_windows.hpp"
 
 namespace imscal::eval {
 
@@ -17,6 +18,9 @@ struct GapSessionOptions {
   std::string table;             // sim: parameters.json; or
   std::string sim_joint_errors;  // sim: joint_errors.csv
   std::string robot;             // robot description
+  // A record longer than this [s] is analysed on windows spread over it (eval/gap_windows.hpp);
+  // 0: the whole record.
+  double max_analysed_s = AnalysisWindows{}.max_s;
 };
 
 struct GapSession {

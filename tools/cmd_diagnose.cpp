@@ -92,6 +92,10 @@ imscal::tools::CommandRegistration registration{
       sub.add_flag("--figures", args->figures,
                    "also write SVG figures (gnuplot): gap-spectrum.svg, gap-where.svg, "
                    "gap-model-error.svg");
+      sub.add_option("--max-analysed-s", args->session.max_analysed_s,
+                     "a longer record is analysed on windows of 30 s spread over it, this long "
+                     "in all [s]; 0: the whole record")
+          ->check(CLI::NonNegativeNumber);
       sub.add_option("--gnuplot-timeout", args->gnuplot_timeout_s,
                      "time limit of gnuplot per figure [s]")
           ->check(CLI::PositiveNumber);
