@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <numbers>
 
 #include "core/input_error.hpp"
+#include "core/parallel_tasks.hpp"
 #include "core/units.hpp"
 #include "ims/so3.hpp"
 
@@ -377,24 +379,27 @@ MountingValidation validate_mounting(const FrameCalibrationInput& input,
   FrameCalibrationOptions part_options = options;
   part_options.report_progress = false;
 
-  std::vector<SessionPart> halves;
-  for (std::size_t h = 0; h < half_ranges.size(); ++h) {
-    report("halves");
-    const auto [first, last] = half_ranges[h];
-    halves.push_back(calibrate_part(input, part_options, first, last,
-                                    fmt::format("{} half ({})", h == 0 ? "first" : "second",
-                                                rest_range_text(input.rests, first, last))));
-    done += 1.0;
-  }
-  std::vector<SessionPart> segments;
-  for (std::size_t s = 0; s < segment_ranges.size(); ++s) {
-    report("segments");
-    const auto [first, last] = segment_ranges[s];
-    segments.push_back(calibrate_part(
-        input, part_options, first, last,
-        fmt::format("segment {} ({})", s + 1, rest_range_text(input.rests, first, last))));
-    done += 1.0;
-  }
+  // The halves and segments are independent bundles: on the cores (core/parallel_tasks.hpp), each
+  // into its own slot.
+  std::vector<std::pair<std::size_t, std::size_t>> ranges = half_ranges;
+  ranges.insert(ranges.end(), segment_ranges.begin(), segment_ranges.end());
+  std::vector<SessionPart> parts(ranges.size());
+  report(half_ranges.empty() ? "segments" : "halves");
+  run_parallel_tasks(ranges.size(), [&](std::size_t i) {
+    const auto [first, last] = ranges[i];
+    const std::string where = rest_range_text(input.rests, first, last);
+    const std::string label =
+        i < half_ranges.size() ? fmt::format("{} half ({})", i == 0 ? "first" : "second", where)
+                               : fmt::format("segment {} ({})", i - half_ranges.size() + 1, where);
+    parts[i] = calibrate_part(input, part_options, first, last, label);
+  });
+  done = total;
+  std::vector<SessionPart> halves(
+      std::make_move_iterator(parts.begin()),
+      std::make_move_iterator(parts.begin() + std::ptrdiff_t(half_ranges.size())));
+  std::vector<SessionPart> segments(
+      std::make_move_iterator(parts.begin() + std::ptrdiff_t(half_ranges.size())),
+      std::make_move_iterator(parts.end()));
   report("segments");
   return assess_mounting(combined, std::move(halves), std::move(segments), vo.thresholds);
 }

@@ -8,6 +8,7 @@
 
 #include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
+#include "core/parallel_tasks.hpp"
 
 namespace imscal::calib {
 namespace {
@@ -209,9 +210,10 @@ TimeOffsetResult estimate_time_offset(const RateMagnitudeSeries& robot,
         fmt::format("step {:.4g} s too coarse for the range +-{:.4g} s", step, max_lag));
   }
   std::vector<double> rho(2 * half_count + 1);
-  for (int m = -half_count; m <= half_count; ++m) {
-    rho[m + half_count] = correlation_at(robot, ims, w, m * step);
-  }
+  // Independent lags: on the cores.
+  run_parallel_tasks(rho.size(), [&](std::size_t i) {
+    rho[i] = correlation_at(robot, ims, w, (int(i) - half_count) * step);
+  });
   result.lags_evaluated = rho.size();
   const int best = static_cast<int>(std::max_element(rho.begin(), rho.end()) - rho.begin());
   if (best == 0 || best == static_cast<int>(rho.size()) - 1) {

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 
+#include "core/parallel_tasks.hpp"
 #include "eval/gap_selection.hpp"
 #include "eval/gap_verdict.hpp"
 
@@ -146,6 +148,68 @@ void test_joints(const GapSignals& s, const DiagnosisOptions& o,
   }
 }
 
+// A fitted candidate's held-out figures: per held-out row the reduction of the squared gap summed
+// over the joints it acts on (and on its own joint), their shrinkage and block-bootstrap p-values.
+CandidateResult score_candidate(const GapSignals& s, const DiagnosisOptions& o, CandidateFit fit,
+                                const Rows& rows, std::size_t block, std::uint64_t seed) {
+  const double e0 = heldout_energy(s.gap_rad, rows);
+  CandidateResult r;
+  std::vector<double> d(rows.heldout.size(), 0.0), d_joint(rows.heldout.size(), 0.0);
+  double gain = 0.0, ej0 = 0.0, joint_gain = 0.0;
+  for (std::size_t jj = 0; jj < s.joint_count(); ++jj) {
+    const auto& p = fit.prediction[jj];
+    if (p.empty()) continue;
+    const auto& g = s.gap_rad[jj];
+    for (std::size_t i = 0; i < rows.heldout.size(); ++i) {
+      const std::size_t k = rows.heldout[i];
+      const double res = g[k] - p[k];
+      const double di = g[k] * g[k] - res * res;
+      d[i] += di;
+      gain += di;
+      if (jj == fit.joint) joint_gain += di, d_joint[i] += di;
+    }
+  }
+  for (std::size_t k : rows.heldout) ej0 += s.gap_rad[fit.joint][k] * s.gap_rad[fit.joint][k];
+  const double e = e0 - gain;
+  r.shrinkage_percent = e0 > 0.0 ? 100.0 * (1.0 - std::sqrt(std::max(e, 0.0) / e0)) : 0.0;
+  r.joint_shrinkage_percent =
+      ej0 > 0.0 ? 100.0 * (1.0 - std::sqrt(std::max(ej0 - joint_gain, 0.0) / ej0)) : 0.0;
+  r.p_value = block_bootstrap_p_value(d, block, o.bootstrap_resamples, seed);
+  r.supported = r.p_value < o.alpha && r.shrinkage_percent >= o.min_shrinkage_percent;
+  r.joint_p_value = block_bootstrap_p_value(d_joint, block, o.bootstrap_resamples, seed + 1);
+  r.joint_supported =
+      r.joint_p_value < o.alpha && r.joint_shrinkage_percent >= o.min_shrinkage_percent;
+  r.fit = std::move(fit);
+  return r;
+}
+
+// Every candidate on every joint, in (kind, joint) order: the fits and their figures are
+// independent tasks on the cores (core/parallel_tasks.hpp); the bootstrap seeds are dealt in that
+// order, two per fitted candidate, as one thread would, so the result does not depend on the
+// threads.
+std::vector<CandidateResult> fit_every_candidate(const GapSignals& s, const DiagnosisOptions& o,
+                                                 const std::vector<bool>& training,
+                                                 const Rows& rows, std::size_t block,
+                                                 std::uint64_t& seed) {
+  const std::size_t nj = s.joint_count();
+  std::vector<std::optional<CandidateFit>> fits(std::size_t(kEffectKindCount) * nj);
+  run_parallel_tasks(fits.size(), [&](std::size_t i) {
+    fits[i] = fit_candidate(effect_kind_from_index(int(i / nj)), s, i % nj, training);
+  });
+  std::vector<std::uint64_t> seeds(fits.size(), 0);
+  for (std::size_t i = 0; i < fits.size(); ++i)
+    if (fits[i]) seeds[i] = seed, seed += 2;
+  std::vector<std::optional<CandidateResult>> scored(fits.size());
+  run_parallel_tasks(fits.size(), [&](std::size_t i) {
+    if (fits[i]) scored[i] = score_candidate(s, o, std::move(*fits[i]), rows, block, seeds[i]);
+    fits[i].reset();
+  });
+  std::vector<CandidateResult> out;
+  for (auto& r : scored)
+    if (r) out.push_back(std::move(*r));
+  return out;
+}
+
 }  // namespace
 
 std::string candidate_label(const GapSignals& s, const CandidateFit& fit) {
@@ -170,13 +234,14 @@ double block_bootstrap_p_value(const std::vector<double>& d, std::size_t block, 
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<std::size_t> start(0, m - block);
   const std::size_t blocks = (m + block - 1) / block;
+  // Every block's sum, once: a resample is then `blocks` additions, not m.
+  std::vector<double> block_sum(m - block + 1, 0.0);
+  for (std::size_t s0 = 0; s0 < block_sum.size(); ++s0)
+    for (std::size_t i = 0; i < block; ++i) block_sum[s0] += d[s0 + i];
   int not_positive = 0;
   for (int r = 0; r < resamples; ++r) {
     double sum = 0.0;
-    for (std::size_t b = 0; b < blocks; ++b) {
-      const std::size_t s0 = start(rng);
-      for (std::size_t i = 0; i < block; ++i) sum += d[s0 + i];
-    }
+    for (std::size_t b = 0; b < blocks; ++b) sum += block_sum[start(rng)];
     if (sum <= 0.0) ++not_positive;
   }
   return (1.0 + not_positive) / (1.0 + resamples);
@@ -198,45 +263,10 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
   const double m = double(std::max<std::size_t>(rows.heldout.size(), 1));
   out.heldout_rms_rad = std::sqrt(e0 / m);
   out.heldout_rms_modelled_rad = out.heldout_rms_rad;
-  auto shrink = [&](double energy_after) {
-    return e0 > 0.0 ? 100.0 * (1.0 - std::sqrt(std::max(energy_after, 0.0) / e0)) : 0.0;
-  };
 
   // Every candidate on every joint.
   std::uint64_t seed = o.seed;
-  for (int kind = 0; kind < kEffectKindCount; ++kind)
-    for (std::size_t j = 0; j < s.joint_count(); ++j) {
-      auto fit = fit_candidate(effect_kind_from_index(kind), s, j, training);
-      if (!fit) continue;
-      CandidateResult r;
-      // Per held-out row the reduction of the squared gap summed over the joints it acts on.
-      std::vector<double> d(rows.heldout.size(), 0.0), d_joint(rows.heldout.size(), 0.0);
-      double gain = 0.0, ej0 = 0.0, joint_gain = 0.0;
-      for (std::size_t jj = 0; jj < s.joint_count(); ++jj) {
-        const auto& p = fit->prediction[jj];
-        if (p.empty()) continue;
-        const auto& g = s.gap_rad[jj];
-        for (std::size_t i = 0; i < rows.heldout.size(); ++i) {
-          const std::size_t k = rows.heldout[i];
-          const double res = g[k] - p[k];
-          const double di = g[k] * g[k] - res * res;
-          d[i] += di;
-          gain += di;
-          if (jj == fit->joint) joint_gain += di, d_joint[i] += di;
-        }
-      }
-      for (std::size_t k : rows.heldout) ej0 += s.gap_rad[fit->joint][k] * s.gap_rad[fit->joint][k];
-      r.shrinkage_percent = shrink(e0 - gain);
-      r.joint_shrinkage_percent =
-          ej0 > 0.0 ? 100.0 * (1.0 - std::sqrt(std::max(ej0 - joint_gain, 0.0) / ej0)) : 0.0;
-      r.p_value = block_bootstrap_p_value(d, block, o.bootstrap_resamples, seed++);
-      r.supported = r.p_value < o.alpha && r.shrinkage_percent >= o.min_shrinkage_percent;
-      r.joint_p_value = block_bootstrap_p_value(d_joint, block, o.bootstrap_resamples, seed++);
-      r.joint_supported =
-          r.joint_p_value < o.alpha && r.joint_shrinkage_percent >= o.min_shrinkage_percent;
-      r.fit = std::move(*fit);
-      out.candidates.push_back(std::move(r));
-    }
+  out.candidates = fit_every_candidate(s, o, training, rows, block, seed);
   // Ranked by held-out shrinkage less a parsimony charge of 0.5 percentage points per parameter:
   // of two candidates that explain the same (a drift that nests an offset), the simpler first.
   const auto score = [](const CandidateResult& c) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 
+#include "core/parallel_tasks.hpp"
 #include "eval/gap_bounds.hpp"
 
 namespace imscal::eval {
@@ -139,11 +140,15 @@ constexpr std::size_t kJointRefitsPerStep = 3;
 int weakest_member(const Context& x, const std::vector<CandidateFit>& set, const Refit& full) {
   int weakest = -1;
   double least = 0.0;
-  for (std::size_t i = 1; i < set.size(); ++i) {
+  // The refits without each member on the cores; their gains (and seeds) in order.
+  std::vector<Refit> without(set.size());
+  run_parallel_tasks(set.size() - 1, [&](std::size_t m) {
     std::vector<CandidateFit> rest = set;
-    rest.erase(rest.begin() + std::ptrdiff_t(i));
-    const Refit without = refit(x.s, rest, x.training, x.heldout);
-    const Gain g = x.gain(without, full, set[i].joint);
+    rest.erase(rest.begin() + std::ptrdiff_t(m + 1));
+    without[m + 1] = refit(x.s, rest, x.training, x.heldout);
+  });
+  for (std::size_t i = 1; i < set.size(); ++i) {
+    const Gain g = x.gain(without[i], full, set[i].joint);
     if (x.significant(g)) continue;
     if (weakest < 0 || g.whole_pp < least) weakest = int(i), least = g.whole_pp;
   }
@@ -174,23 +179,27 @@ struct Trial {
 std::optional<Trial> forward_step(const Context& x, const std::vector<std::size_t>& pool,
                                   const std::vector<CandidateFit>& set, const Refit& model,
                                   const GapSignals& on_residual, std::vector<bool>& tried) {
+  // The scores and the trials are independent tasks (core/parallel_tasks.hpp), each writing its
+  // own slot; the order they are then used in is the serial one.
   std::vector<std::pair<double, std::size_t>> scored;
   for (std::size_t c : pool)
-    if (!tried[c]) scored.emplace_back(residual_score(x, c, model), c);
+    if (!tried[c]) scored.emplace_back(0.0, c);
+  run_parallel_tasks(scored.size(), [&](std::size_t i) {
+    scored[i].first = residual_score(x, scored[i].second, model);
+  });
   std::sort(scored.begin(), scored.end());
   if (scored.size() > kJointRefitsPerStep) scored.resize(kJointRefitsPerStep);
-  std::vector<Trial> trials;
-  for (const auto& [residual_energy, c] : scored) {
-    Trial t;
-    t.candidate = c;
+  std::vector<Trial> trials(scored.size());
+  run_parallel_tasks(scored.size(), [&](std::size_t i) {
+    Trial& t = trials[i];
+    t.candidate = scored[i].second;
     t.set = set;
-    t.set.push_back(refined(x, c, on_residual));
+    t.set.push_back(refined(x, t.candidate, on_residual));
     t.refit = refit(x.s, t.set, x.training, x.heldout);
     const CandidateFit& added = t.set.back();
     const double own = double(added.parameters.size() - added.coupling_parameter_count);
     t.score = x.shrink(t.refit.energy) - kParsimonyPercentPerParameter * own;
-    trials.push_back(std::move(t));
-  }
+  });
   std::stable_sort(trials.begin(), trials.end(),
                    [](const Trial& a, const Trial& b) { return a.score > b.score; });
   for (Trial& t : trials) {

@@ -25,6 +25,7 @@
 #include "core/json_output.hpp"
 #include "core/output_folder.hpp"
 #include "core/progress.hpp"
+#include "core/progress_channel.hpp"
 #include "core/version.hpp"
 #include "ident/joint_error_io.hpp"
 #include "tools/command_registry.hpp"
@@ -82,6 +83,22 @@ void write_outputs(const CalibrateArgs& args, OutputFolder& folder,
   folder.commit();
 }
 
+// The share of the whole command done when a step of the session is `fraction` through (the
+// bundle and the mounting validation it is followed by take about half of the work).
+double overall_fraction(const std::string& stage, double fraction) {
+  struct Span {
+    const char* stage;
+    double begin, end;
+  };
+  static constexpr Span kSpans[] = {{"rests", 0.1, 0.15},
+                                    {"time offset", 0.15, 0.2},
+                                    {"bundle", 0.2, 0.7},
+                                    {"joint errors", 0.7, 0.95}};
+  for (const Span& s : kSpans)
+    if (stage == s.stage) return s.begin + fraction * (s.end - s.begin);
+  return 0.1;
+}
+
 void run(const CalibrateArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   // Refuse existing outputs before any work (exit 2 through InputError); the config decides
@@ -93,15 +110,20 @@ void run(const CalibrateArgs& args) {
   { OutputFolder check(args.out, outputs, overwrite); }
 
   Progress progress;
+  const ProgressCallback channel = progress_channel();
   progress.update("read", 0.0);
   const calib::LoadedSession loaded = calib::read_session_inputs(args.files);
   const calib::SessionResult session = calib::calibrate_session(
-      loaded.inputs, loaded.options,
-      [&](const std::string& stage, double fraction) { progress.update(stage, fraction); });
+      loaded.inputs, loaded.options, [&](const std::string& stage, double fraction) {
+        progress.update(stage, fraction);
+        channel(stage, overall_fraction(stage, fraction));
+      });
   progress.update("write", 0.0);
+  channel("write", 0.95);
   OutputFolder folder(args.out, outputs, overwrite);
   write_outputs(args, folder, loaded, session);
   progress.finish();
+  channel("write", 1.0);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const calib::MountingValidation& validation = session.validation;

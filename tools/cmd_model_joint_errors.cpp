@@ -14,11 +14,11 @@
 #include "core/input_error.hpp"
 #include "core/output_folder.hpp"
 #include "core/payload_plausibility.hpp"
+#include "eval/joint_error_limits.hpp"
 #include "eval/model_joint_errors.hpp"
 #include "ident/joint_error_io.hpp"
 #include "sim/scenario.hpp"
 #include "tools/command_registry.hpp"
-#include "tools/joint_limit_checks.hpp"
 
 namespace {
 using namespace imscal;
@@ -41,7 +41,7 @@ void run(const ModelJointErrorsArgs& args) {
       measured.payload_kg, measured.time_s, nominal.description.nominal_payload_kg,
       {args.joint_errors, 0, "payload_kg",
        "robot " + nominal.description.name + " (" + nominal.description.source + ")"});
-  tools::check_joint_error_limits(measured, args.joint_errors, nominal.description);
+  eval::check_joint_error_limits(measured, args.joint_errors, nominal.description);
   ident::JointErrorLog model;
   try {
     model = eval::nominal_model_joint_errors(measured, nominal, scenario ? &*scenario : nullptr);

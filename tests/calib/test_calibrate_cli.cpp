@@ -8,13 +8,17 @@
 // refused and leaves the outputs alone, and bad input exits 2 naming file, line and field.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
+#include <string>
+#include <vector>
 
+#include "core/progress_channel.hpp"
 #include "core/sha256.hpp"
 #include "core/units.hpp"
 #include "ident/joint_error_io.hpp"
@@ -64,9 +68,20 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
   const fs::path unit = dir_ / "unit-calibration.yaml";
   std::ofstream(unit) << ims::to_yaml(lab);
 
-  // 0 = pass/warn, 1 = verdict fail with the outputs written: both are a finished run.
+  // 0 = pass/warn, 1 = verdict fail with the outputs written: both are a finished run. Run as
+  // `imscal run` runs its stages, with the progress channel (core/progress_channel.hpp) asked for.
+  ::setenv(kProgressChannelVariable, "1", 1);
   const int status = run(calibrate_arguments(sim, out, unit), dir_ / "cal.log");
+  ::unsetenv(kProgressChannelVariable);
   ASSERT_TRUE(status == 0 || status == 1) << status << "\n" << read(dir_ / "cal.log");
+  // Its steps through the channel, in order, never going back, the last at 1.
+  std::vector<double> fractions;
+  std::istringstream lines(read(dir_ / "cal.log"));
+  for (std::string line; std::getline(lines, line);)
+    if (const auto report = parse_progress_line(line)) fractions.push_back(report->fraction);
+  ASSERT_GE(fractions.size(), 5u) << read(dir_ / "cal.log");
+  EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
+  EXPECT_EQ(fractions.back(), 1.0);
   for (const char* file :
        {"frames.json", "mounting_report.json", "summary.txt", "joint_errors.csv"}) {
     SCOPED_TRACE(file);

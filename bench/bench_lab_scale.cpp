@@ -1,0 +1,202 @@
+// Lab-scale records through the main command (goals: a 30-minute session at 2 kHz through
+// `imscal run` < 60 s wall on 2 cores and < 2 GB peak memory; the cost per recorded minute flat
+// at 5, 15 and 30 minutes). Each session is simulated once, outside the timing, into a temporary
+// folder (kept for the next run: /tmp/imscal-bench-lab-scale-MINUTES/): the shipped campaign's
+// program (datasets/programs/campaign.yaml: rest poses for the frame calibration, full-speed moves
+// for the identification) repeated to the length, on the campaign's scenario with the IMS at 2 kHz,
+// with the campaign's configs (the paper's line in the verify stage). Timed: the imscal binary's
+// `run` as a child process, wall time (UseManualTime), and its peak resident memory (wait4's
+// rusage: the largest of the child and its stages' subprocesses) and CPU time. The shipped 70 s
+// campaign at 1 kHz is the baseline in the same run.
+//   bench/bench_lab_scale --benchmark_counters_tabular=true
+//   bench/bench_lab_scale --benchmark_filter='Run/(0|5)/'   (the baseline and 5 minutes only)
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+namespace fs = std::filesystem;
+
+const fs::path kSource(IMSCAL_SOURCE_DIR);
+
+struct ChildRun {
+  double wall_s = 0.0;
+  double peak_rss_mb = 0.0;
+  double cpu_s = 0.0;  // user + system time of the child and its stages
+};
+
+// Runs imscal with `arguments`, its output into `log`; throws when it fails.
+ChildRun run_imscal(const std::vector<std::string>& arguments, const fs::path& log) {
+  std::vector<std::string> words{IMSCAL_BINARY};
+  words.insert(words.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (auto& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  const auto start = std::chrono::steady_clock::now();
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    if (!freopen(log.c_str(), "w", stdout) || !freopen(log.c_str(), "a", stderr)) _exit(126);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  rusage usage{};
+  if (wait4(pid, &status, 0, &usage) != pid) throw std::runtime_error("wait4 failed");
+  ChildRun r;
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.peak_rss_mb = double(usage.ru_maxrss) / 1024.0;  // ru_maxrss in KiB on Linux
+  r.cpu_s = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+            1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw std::runtime_error("imscal " + arguments.front() + " failed, see " + log.string());
+  return r;
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_text(const fs::path& file, const std::string& text) {
+  std::ofstream out(file);
+  out << text;
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+}
+
+// The campaign program with its moves and rests after the first (alignment) rest repeated to
+// fill `minutes`.
+std::string session_program(int minutes) {
+  const std::string campaign = read_text(kSource / "datasets/programs/campaign.yaml");
+  const std::size_t segments = campaign.find("segments:\n");
+  const std::size_t first = campaign.find('\n', campaign.find("- rest:", segments)) + 1;
+  const std::string head = campaign.substr(0, first), body = campaign.substr(first);
+  const double body_s = 60.0;  // 13 poses: 12 moves and 12 rests of 4 s, ~61 s
+  const int repeats = std::max(1, int(std::ceil((minutes * 60.0 - 10.0) / body_s)));
+  std::string out = head;
+  for (int i = 0; i < repeats; ++i) out += body;
+  return out;
+}
+
+// A session folder <root>/datasets/session/ laid out like datasets/campaign/ (whose configs it
+// copies; their ../robots etc. resolve through links to the shipped folders).
+fs::path make_session(const fs::path& root, int minutes) {
+  const fs::path data = root / "datasets";
+  fs::create_directories(root);
+  fs::create_directories(data / "programs");
+  fs::create_directories(data / "scenarios");
+  fs::create_directories(data / "session");
+  for (const char* shared : {"robots", "sensors"})
+    if (!fs::exists(data / shared))
+      fs::create_directory_symlink(kSource / "datasets" / shared, data / shared);
+  fs::copy_file(kSource / "datasets/programs/seed-line.yaml", data / "programs/seed-line.yaml",
+                fs::copy_options::overwrite_existing);
+  write_text(data / "programs/session.yaml", session_program(minutes));
+  std::string scenario = read_text(kSource / "datasets/scenarios/campaign.yaml");
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = scenario.find(from);
+    if (at == std::string::npos) throw std::runtime_error("campaign scenario: no " + from);
+    scenario.replace(at, from.size(), to);
+  };
+  replace("programs/campaign.yaml", "programs/session.yaml");
+  replace("rate_hz: 1000", "rate_hz: 2000");
+  replace("output_interval_s: 0.001", "output_interval_s: 0.0005");
+  write_text(data / "scenarios/session.yaml", scenario);
+  const fs::path sim = root / "sim", session = data / "session";
+  run_imscal({"simulate", "--scenario", (data / "scenarios/session.yaml").string(), "--out",
+              sim.string(), "--force"},
+             root / "simulate.log");
+  fs::rename(sim / "imu.csv", session / "imu.csv");
+  fs::rename(sim / "robot.csv", session / "robot.csv");
+  // The unit's lab calibration: the drawn scale factors and misalignments, biases zero (as
+  // datasets/campaign/regenerate.sh writes it).
+  std::istringstream errors(read_text(sim / "truth/sensor_errors.yaml"));
+  std::string unit, line;
+  while (std::getline(errors, line)) {
+    if (line.rfind("  bias_deg_per_h:", 0) == 0) line = "  bias_deg_per_h: [0, 0, 0]";
+    if (line.rfind("  bias_ug:", 0) == 0) line = "  bias_ug: [0, 0, 0]";
+    unit += line + "\n";
+  }
+  write_text(session / "unit-calibration.yaml", unit);
+  fs::remove_all(sim);
+  for (const char* config : {"run.yaml", "calibrate.yaml", "identify.yaml", "verify-line.yaml"})
+    fs::copy_file(kSource / "datasets/campaign" / config, session / config,
+                  fs::copy_options::overwrite_existing);
+  return session / "run.yaml";
+}
+
+// The recorded length [min]: the last time stamp of the robot log.
+double record_minutes(const fs::path& run_config) {
+  std::ifstream in(run_config.parent_path() / "robot.csv");
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  return std::stod(last.substr(0, last.find(','))) / 60.0;
+}
+
+// Each stage's wall time as `imscal run` prints it ("calibrate 12.3 s, ..."), from its output.
+std::string stage_times(const fs::path& log) {
+  std::istringstream in(read_text(log));
+  std::string line, out;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string stage, what, status, seconds, unit;
+    if (!(words >> stage >> what >> status >> seconds >> unit) || what != "ran" || unit != "s")
+      continue;
+    out += (out.empty() ? "" : " ") + stage + " " + seconds;
+  }
+  return out;
+}
+
+// Argument 0: the shipped campaign (70 s at 1 kHz); otherwise a session of that many minutes,
+// simulated on the first run and kept in the temporary folder for the next (delete it to
+// simulate again).
+void BM_LabScaleRun(benchmark::State& state) {
+  const int minutes = int(state.range(0));
+  const fs::path root =
+      fs::temp_directory_path() / ("imscal-bench-lab-scale-" + std::to_string(minutes));
+  const fs::path kept = root / "datasets/session/run.yaml";
+  const fs::path config = minutes == 0       ? kSource / "datasets/campaign/run.yaml"
+                          : fs::exists(kept) ? kept
+                                             : (fs::remove_all(root), make_session(root, minutes));
+  fs::create_directories(root);
+  const double recorded_min = record_minutes(config);
+  ChildRun r;
+  for (auto _ : state) {
+    fs::remove_all(root / "run");
+    r = run_imscal({"run", config.string(), "--out", (root / "run").string()}, root / "run.log");
+    state.SetIterationTime(r.wall_s);
+  }
+  state.SetLabel(stage_times(root / "run.log"));
+  state.counters["record_min"] = recorded_min;
+  state.counters["wall_s"] = r.wall_s;
+  state.counters["s_per_record_min"] = r.wall_s / recorded_min;
+  state.counters["peak_rss_MB"] = r.peak_rss_mb;
+  state.counters["cpu_s"] = r.cpu_s;  // on a loaded machine the steadier figure (threads add up)
+  fs::remove_all(root / "run");
+}
+
+BENCHMARK(BM_LabScaleRun)
+    ->Arg(0)
+    ->Arg(5)
+    ->Arg(15)
+    ->Arg(30)
+    ->UseManualTime()
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();
