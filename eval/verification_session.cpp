@@ -170,6 +170,15 @@ struct WorkFolder {
   }
 };
 
+// A message about a file in the work folder, naming the file it is written for instead.
+std::string named_as_published(std::string message, const fs::path& work, const fs::path& out) {
+  const std::string from = work.string(), to = out.string();
+  for (std::size_t at = message.find(from); at != std::string::npos;
+       at = message.find(from, at + to.size()))
+    message.replace(at, from.size(), to);
+  return message;
+}
+
 // Every file the session wrote into `work`, published together into `out`
 // (core/output_folder.hpp).
 void publish(const fs::path& work, const fs::path& out, Overwrite overwrite) {
@@ -206,7 +215,14 @@ void verify_session(const VerificationSessionOptions& options, const fs::path& o
       throw InputError(scenario.file.string(), 0, "", e.what());
     }
     const fs::path dir = work.path / scenario.name;
-    const std::string text = write_verification_files(dir, r, record, Overwrite::kAllow);
+    std::string text;
+    try {
+      text = write_verification_files(dir, r, record, Overwrite::kAllow);
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::runtime_error& e) {  // a failed write: the file it was written for
+      throw std::runtime_error(named_as_published(e.what(), work.path, out));
+    }
     if (on_scenario) on_scenario(dir, text);
   }
   publish(work.path, out, overwrite);
