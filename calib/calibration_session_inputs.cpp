@@ -86,6 +86,7 @@ void read_robot_log(const SessionFiles& files, LoadedSession& s) {
   const RobotDescription& robot = s.inputs.robot;
   RobotLog& log = s.inputs.log;
   log = read_robot_log_csv(files.robot_log, robot.name);
+  check_robot_log_joint_limits(log, files.robot_log, robot);
   std::vector<double> payload_kg, t_s;
   for (const RobotLogSample& sample : log.samples) {
     payload_kg.push_back(sample.payload_kg);

@@ -9,6 +9,7 @@
 
 #include "calib/kinematic_calibration.hpp"
 #include "calib/robot_description.hpp"
+#include "calib/tracker_pose_limits.hpp"
 #include "calib/tracker_poses.hpp"
 #include "core/input_error.hpp"
 
@@ -63,12 +64,16 @@ nlohmann::json calibration_json(const KinematicCalibration& c) {
 }
 
 // The fit and held-out sets: from two files, or alternate rows of one.
-void split_poses(const KinematicSessionOptions& args, std::vector<TrackerPose>& fit,
-                 std::vector<TrackerPose>& held_out, std::string& split) {
+void split_poses(const KinematicSessionOptions& args, const RobotDescription& robot,
+                 std::vector<TrackerPose>& fit, std::vector<TrackerPose>& held_out,
+                 std::string& split) {
   const TrackerPoses poses = read_tracker_poses(args.poses);
+  check_tracker_pose_limits(poses, robot);
   if (!args.held_out.empty()) {
     fit = poses.poses;
-    held_out = read_tracker_poses(args.held_out).poses;
+    const TrackerPoses judged = read_tracker_poses(args.held_out);
+    check_tracker_pose_limits(judged, robot);
+    held_out = judged.poses;
     split = fmt::format("fitted on every row of {}, held out: every row of {}", args.poses,
                         args.held_out);
     return;
@@ -122,7 +127,7 @@ KinematicSession calibrate_kinematics_session(const KinematicSessionOptions& arg
   const RobotDescription robot = load_robot_description(args.robot);
   std::vector<TrackerPose> fit, held_out;
   std::string split;
-  split_poses(args, fit, held_out, split);
+  split_poses(args, robot, fit, held_out, split);
   KinematicCalibrationOptions options;
   options.min_independence = args.min_independence;
   options.estimate_geometry = false;

@@ -112,6 +112,7 @@ RobotLog read_robot_log_csv(const std::filesystem::path& file, const std::string
                                  table.columns.size(), expected_columns));
   }
   log.samples.resize(table.rows());
+  log.sample_lines.assign(table.lines.begin(), table.lines.end());
   for (std::size_t r = 0; r < table.rows(); ++r) {
     RobotLogSample& s = log.samples[r];
     s.t_s = table.at(r, time_column);
@@ -146,6 +147,38 @@ RobotLog read_robot_log_csv(const std::filesystem::path& file, const std::string
     spdlog::warn("{}: joint angles given in degrees; converted to rad", table.file);
   }
   return log;
+}
+
+std::vector<JointLimit> joint_limits_of(const RobotDescription& robot) {
+  std::vector<JointLimit> limits;
+  for (int j = 0; j < kJointCount; ++j)
+    limits.push_back({robot.joints[std::size_t(j)].name.empty() ? fmt::format("{}", j + 1)
+                                                                : robot.joints[std::size_t(j)].name,
+                      robot.kinematics.lower_limit_rad[j], robot.kinematics.upper_limit_rad[j]});
+  return limits;
+}
+
+std::size_t check_robot_log_joint_limits(const RobotLog& log, const std::string& file,
+                                         const RobotDescription& robot) {
+  std::vector<std::vector<double>> values(2 * kJointCount);
+  for (const RobotLogSample& s : log.samples)
+    for (int j = 0; j < kJointCount; ++j) {
+      values[std::size_t(j)].push_back(s.q_desired_rad[j]);
+      values[std::size_t(kJointCount + j)].push_back(s.q_internal_rad[j]);
+    }
+  std::vector<JointAngleColumn> columns;
+  for (std::size_t j = 0; j < std::size_t(kJointCount); ++j) {
+    columns.push_back({fmt::format("q_desired_{}_rad", log.joint_names[j]), j, values[j]});
+    columns.push_back(
+        {fmt::format("q_internal_{}_rad", log.joint_names[j]), j, values[kJointCount + j]});
+  }
+  return check_joint_limits(columns, joint_limits_of(robot),
+                            {file,
+                             [&log](std::size_t k) {
+                               return k < log.sample_lines.size() ? log.sample_lines[k]
+                                                                  : std::size_t{0};
+                             },
+                             fmt::format("robot {} ({})", robot.name, robot.source)});
 }
 
 }  // namespace imscal::calib

@@ -16,6 +16,7 @@
 
 #include "calib/robot_description.hpp"
 #include "core/atomic_file.hpp"
+#include "core/joint_limit_plausibility.hpp"
 
 namespace imscal::calib {
 
@@ -31,6 +32,7 @@ struct RobotLog {
   double cycle_s = 0.002;
   std::array<std::string, kJointCount> joint_names{"A1", "A2", "A3", "A4", "A5", "A6"};
   std::vector<RobotLogSample> samples;
+  std::vector<std::size_t> sample_lines;  // 1-based file line of each sample (empty: not read)
 };
 
 void write_robot_log_csv(const std::filesystem::path& file, const RobotLog& log,
@@ -45,5 +47,13 @@ std::string format_robot_log_csv(const RobotLog& log);
 RobotLog read_robot_log_csv(const std::filesystem::path& file,
                             const std::string& expected_robot = "",
                             const std::string& expected_by = "the robot description");
+
+// The robot's joint limits by joint name (core/joint_limit_plausibility.hpp).
+std::vector<JointLimit> joint_limits_of(const RobotDescription& robot);
+
+// The log's desired and internal angles against the robot's joint limits: a warning beyond a
+// limit, InputError (file, line, column, limit) beyond the margin. Returns the samples beyond.
+std::size_t check_robot_log_joint_limits(const RobotLog& log, const std::string& file,
+                                         const RobotDescription& robot);
 
 }  // namespace imscal::calib

@@ -29,6 +29,18 @@ void create_output_folder(const fs::path& folder) {
   }
 }
 
+void prepare_output_file(const fs::path& file, Overwrite overwrite) {
+  std::error_code error;
+  if (fs::is_directory(file, error)) {
+    throw InputError(file.string(), 0, "--out",
+                     "is a folder, not a file; --out names the output file");
+  }
+  if (overwrite == Overwrite::kRefuse && fs::exists(file, error)) {
+    throw InputError(file.string(), 0, "--out", "exists already (use --force to replace it)");
+  }
+  if (file.has_parent_path()) create_output_folder(file.parent_path());
+}
+
 OutputFolder::OutputFolder(fs::path folder, std::vector<fs::path> outputs, Overwrite overwrite)
     : folder_(std::move(folder)), outputs_(std::move(outputs)) {
   for (const fs::path& relative : outputs_) {

@@ -16,6 +16,12 @@ namespace imscal {
 // the folder cannot be created.
 void create_output_folder(const std::filesystem::path& folder);
 
+// A command's single output file, checked before any work: InputError (exit 2) when the path
+// names a folder, or names an existing file and `overwrite` is kRefuse; a missing folder of the
+// file is created (as every command creates its output folder). The file itself is written later
+// with write_file_atomically.
+void prepare_output_file(const std::filesystem::path& file, Overwrite overwrite);
+
 class OutputFolder {
  public:
   // `outputs`: the files this command will write, relative to `folder`. With Overwrite::kRefuse

@@ -8,7 +8,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <map>
@@ -145,7 +147,9 @@ class FolderLock {
     const fs::path lock_file = folder / kLockName;
     fd_ = ::open(lock_file.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
     if (fd_ < 0)
-      throw InputError(folder.string(), 0, "", "cannot create the run folder's lock file");
+      throw InputError(
+          (folder / kLockName).string(), 0, "",
+          std::string("cannot create the run folder's lock file: ") + std::strerror(errno));
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
       ::close(fd_);
       throw InputError(folder.string(), 0, "",

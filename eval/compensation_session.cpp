@@ -131,6 +131,9 @@ CompensationRunSummary compensate_robot_log(const CompensationSessionOptions& ar
   const calib::RobotLog log =
       calib::read_robot_log_csv(args.robot_log, table.robot, "the parameter table " + args.table);
   check_log_payload(args, table, log);
+  if (!args.robot.empty())
+    calib::check_robot_log_joint_limits(log, args.robot_log,
+                                        calib::load_robot_description(args.robot));
   ident::PrecontrolOptions options;
   options.caller_cycle_s = log.cycle_s;
   // A log may start in the middle of a motion, and a fault need not end the run: the precontrol

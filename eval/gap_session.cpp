@@ -12,6 +12,7 @@
 #include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
 #include "core/payload_plausibility.hpp"
+#include "eval/joint_error_limits.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
 
@@ -73,6 +74,7 @@ GapSession diagnose_gap_session(const GapSessionOptions& args) {
   check_payload_series(
       real.payload_kg, real.time_s, robot.nominal_payload_kg,
       {args.joint_errors, 0, "payload_kg", fmt::format("robot {} ({})", robot.name, robot.source)});
+  check_joint_error_limits(real, args.joint_errors, robot);
   std::vector<std::vector<double>> sim_errors;
   std::optional<ident::ParameterTable> table;
   if (!args.table.empty()) {

@@ -11,6 +11,7 @@
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "core/payload_plausibility.hpp"
+#include "eval/joint_error_limits.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config_record.hpp"
@@ -32,6 +33,7 @@ void attach_session_model_torques(ident::JointErrorLog& log,
     throw InputError(options.config, 0, "model.model_torque", "no rigid-body model given");
   const ModelTorqueSource model = options.model_torque(
       log.robot, options.joint_errors, options.config, "model.model_torque", log.cycle_s);
+  check_joint_error_limits(log, options.joint_errors, model.robot);
   spdlog::info("identify: model torques of {} along the {} path", model.robot.name,
                torque_along_measured_path(config.options) ? "measured" : "desired");
   attach_model_torques(log, model, config.options);

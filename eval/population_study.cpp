@@ -9,6 +9,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
+#include "core/output_folder.hpp"
 #include "core/subprocess.hpp"
 #include "eval/population_row.hpp"
 #include "eval/population_summary.hpp"
@@ -279,13 +280,18 @@ std::string write_population_summary(const SeedRange& seeds, const PopulationStu
       "finished, {} failed (reductions of the maximum path deviation in %, as measured through "
       "the IMS chain)\n",
       args.nominal, seeds.first, seeds.last, args.cycles, table.rows.size(), failed);
+  std::vector<fs::path> outputs{"summary.txt"};
   if (!table.rows.empty()) {
     for (const char* figure : {"seed_line_reduction_percent", "iso100_reduction_percent",
                                "seed_line_true_reduction_percent", "iso100_true_reduction_percent"})
       text += summarize_figure(table, figure, population_figure_columns());
-    write_file_atomically(args.out / "population.csv", csv, Overwrite::kAllow);
+    outputs.emplace_back("population.csv");
   }
-  write_file_atomically(args.out / "summary.txt", text, Overwrite::kAllow);
+  // The table and its summary are published together (a rerun replaces both).
+  OutputFolder folder(args.out, outputs, Overwrite::kAllow);
+  if (!table.rows.empty()) write_file_atomically(folder.staged("population.csv"), csv);
+  write_file_atomically(folder.staged("summary.txt"), text);
+  folder.commit();
   return text;
 }
 

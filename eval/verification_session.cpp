@@ -3,8 +3,12 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
 #include <optional>
 #include <stdexcept>
+#include <system_error>
+#include <vector>
 
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
@@ -27,9 +31,15 @@ struct JointErrorSource {
   std::string file;
 };
 
-// From a file, or the simulator's truth of a scenario (written to OUT/joint_errors_truth.csv).
-JointErrorSource joint_error_source(const VerificationSessionOptions& options, const fs::path& out,
-                                    Overwrite overwrite) {
+// Where a session's files are published (`out`, the names its files and messages give) and
+// where they are written until then (`work`, a hidden folder inside `out`).
+struct SessionFolders {
+  fs::path out, work;
+};
+
+// From a file, or the simulator's truth of a scenario (OUT/joint_errors_truth.csv).
+JointErrorSource joint_error_source(const VerificationSessionOptions& options,
+                                    const SessionFolders& folders) {
   JointErrorSource source;
   if (!options.joint_errors.empty()) {
     source.log = ident::read_joint_errors_csv(options.joint_errors);
@@ -38,9 +48,8 @@ JointErrorSource joint_error_source(const VerificationSessionOptions& options, c
     spdlog::info("verify: simulating {} for the truth joint errors", options.identify_scenario);
     source.log = simulate_truth_joint_errors(
         sim::load_scenario(sim::resolve_scenario(options.identify_scenario)));
-    create_output_folder(out);
-    source.file = (out / "joint_errors_truth.csv").string();
-    ident::write_joint_errors_csv(source.file, *source.log, overwrite);
+    source.file = (folders.out / "joint_errors_truth.csv").string();
+    ident::write_joint_errors_csv(folders.work / "joint_errors_truth.csv", *source.log);
   }
   return source;
 }
@@ -78,8 +87,8 @@ void search_orders(const ident::JointErrorLog& log, const ModelTorqueSource& tor
 std::vector<NamedTable> session_tables(const VerificationSessionOptions& options,
                                        const JointErrorSource& source,
                                        const std::optional<ident::IdentificationConfig>& config,
-                                       const ModelTorqueSource& torque_model, const fs::path& out,
-                                       Overwrite overwrite) {
+                                       const ModelTorqueSource& torque_model,
+                                       const SessionFolders& folders) {
   std::vector<NamedTable> tables;
   if (!options.table.empty()) {
     tables.push_back({"compensated", ident::read_parameters_json(options.table)});
@@ -87,7 +96,7 @@ std::vector<NamedTable> session_tables(const VerificationSessionOptions& options
     spdlog::info("verify: identifying the table from {}", source.file);
     const IdentifiedTable t = identify_table(*source.log, *config, source.file, &torque_model);
     for (const auto& f : t.failed_joints) spdlog::warn("verify: not identified: {}", f);
-    ident::write_parameters_json(out / "parameters.json", t.table, overwrite);
+    ident::write_parameters_json(folders.work / "parameters.json", t.table);
     tables.push_back({"compensated", t.table});
   }
   if (source.log && options.ablation) {
@@ -105,8 +114,8 @@ std::vector<NamedTable> session_tables(const VerificationSessionOptions& options
 // The tables of the session: the joint errors' robot checked against the scenarios' nominal
 // robot, whose rigid-body model (never the plant's) serves the multi-input tables.
 std::vector<NamedTable> prepare_tables(const VerificationSessionOptions& options,
-                                       const fs::path& out, Overwrite overwrite) {
-  const JointErrorSource source = joint_error_source(options, out, overwrite);
+                                       const SessionFolders& folders) {
+  const JointErrorSource source = joint_error_source(options, folders);
   if (options.table.empty() && !source.log)
     throw InputError("", 0, "--table", "give --table, --joint-errors or --identify-scenario");
   const ModelTorqueSource torque_model = scenario_model_torque(sim::load_scenario(
@@ -125,7 +134,60 @@ std::vector<NamedTable> prepare_tables(const VerificationSessionOptions& options
                        "needs joint errors and a config with the transmission error");
     search_orders(*source.log, torque_model, *config);
   }
-  return session_tables(options, source, config, torque_model, out, overwrite);
+  return session_tables(options, source, config, torque_model, folders);
+}
+
+// An earlier session's outputs are refused before any work (the output folder checks every file
+// again when it publishes).
+void refuse_earlier_outputs(const VerificationSessionOptions& options, const fs::path& out,
+                            Overwrite overwrite) {
+  if (overwrite == Overwrite::kAllow) return;
+  std::vector<fs::path> earlier;
+  for (const std::string& name : options.scenarios)
+    earlier.push_back(out / sim::load_scenario(sim::resolve_scenario(name)).name /
+                      "verification.json");
+  if (options.table.empty()) earlier.push_back(out / "parameters.json");
+  if (!options.identify_scenario.empty()) earlier.push_back(out / "joint_errors_truth.csv");
+  for (const fs::path& file : earlier)
+    if (fs::exists(file))
+      throw InputError(file.string(), 0, "--out", "exists already (use --force to replace it)");
+}
+
+// The session's work folder, removed however the session ends.
+struct WorkFolder {
+  fs::path path;
+  explicit WorkFolder(const fs::path& out)
+      : path(out / fmt::format(".imscal-verify-work-{}", ::getpid())) {
+    create_output_folder(out);
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  WorkFolder(const WorkFolder&) = delete;
+  WorkFolder& operator=(const WorkFolder&) = delete;
+  ~WorkFolder() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
+// A message about a file in the work folder, naming the file it is written for instead.
+std::string named_as_published(std::string message, const fs::path& work, const fs::path& out) {
+  const std::string from = work.string(), to = out.string();
+  for (std::size_t at = message.find(from); at != std::string::npos;
+       at = message.find(from, at + to.size()))
+    message.replace(at, from.size(), to);
+  return message;
+}
+
+// Every file the session wrote into `work`, published together into `out`
+// (core/output_folder.hpp).
+void publish(const fs::path& work, const fs::path& out, Overwrite overwrite) {
+  std::vector<fs::path> names;
+  for (const auto& entry : fs::recursive_directory_iterator(work))
+    if (entry.is_regular_file()) names.push_back(fs::relative(entry.path(), work));
+  OutputFolder folder(out, names, overwrite);
+  for (const fs::path& name : names) fs::rename(work / name, folder.staged(name));
+  folder.commit();
 }
 
 }  // namespace
@@ -134,7 +196,9 @@ void verify_session(const VerificationSessionOptions& options, const fs::path& o
                     Overwrite overwrite, const ScenarioVerified& on_scenario,
                     const VerificationSessionProgress& progress) {
   if (progress) progress("tables", 0.0);
-  const std::vector<NamedTable> tables = prepare_tables(options, out, overwrite);
+  refuse_earlier_outputs(options, out, overwrite);
+  const WorkFolder work(out);
+  const std::vector<NamedTable> tables = prepare_tables(options, {out, work.path});
   const VerificationRecord record{options.verification.seed,
                                   options.verification.compensation.look_ahead_cycles,
                                   options.verification.compensation.inversion_iterations,
@@ -150,10 +214,18 @@ void verify_session(const VerificationSessionOptions& options, const fs::path& o
     } catch (const std::invalid_argument& e) {
       throw InputError(scenario.file.string(), 0, "", e.what());
     }
-    const fs::path dir = out / scenario.name;
-    const std::string text = write_verification_files(dir, r, record, overwrite);
+    const fs::path dir = work.path / scenario.name;
+    std::string text;
+    try {
+      text = write_verification_files(dir, r, record, Overwrite::kAllow);
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::runtime_error& e) {  // a failed write: the file it was written for
+      throw std::runtime_error(named_as_published(e.what(), work.path, out));
+    }
     if (on_scenario) on_scenario(dir, text);
   }
+  publish(work.path, out, overwrite);
   if (progress) progress("done", 1.0);
 }
 

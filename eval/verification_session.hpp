@@ -28,13 +28,17 @@ struct VerificationSessionOptions {
 
 // Stage ("tables" or the scenario's name) and the fraction of the session done, in [0, 1].
 using VerificationSessionProgress = std::function<void(const std::string& stage, double fraction)>;
-// Called after each scenario's files are written into `dir`, with its text report.
+// Called after each scenario's files are written into `dir` (the session's work folder, published
+// with every other output at the end: files added there, such as figures, are published too),
+// with its text report.
 using ScenarioVerified =
     std::function<void(const std::filesystem::path& dir, const std::string& report_text)>;
 
 // Runs the session into `out`: joint_errors_truth.csv (truth joint errors), parameters.json (a
-// table identified here), and a folder per scenario. InputError on bad input (no table source,
-// robots that differ, a scenario the verification refuses).
+// table identified here), and a folder per scenario, all published together at the end
+// (core/output_folder.hpp); with Overwrite::kRefuse an earlier session's outputs are refused
+// before any work. InputError on bad input (no table source, robots that differ, a scenario the
+// verification refuses).
 void verify_session(const VerificationSessionOptions& options, const std::filesystem::path& out,
                     Overwrite overwrite, const ScenarioVerified& on_scenario = {},
                     const VerificationSessionProgress& progress = {});

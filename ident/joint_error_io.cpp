@@ -207,6 +207,7 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
     if (row[1] < 0.0) throw InputError(file, line, "payload_kg", "negative payload");
     check_joint_errors_plausible(row, log.joint_names, file, line);
     log.time_s.push_back(row[0]);
+    log.sample_lines.push_back(line);
     log.payload_kg.push_back(row[1]);
     for (std::size_t j = 0; j < joints; ++j) {
       log.q_desired_rad[j].push_back(row[2 + j]);

@@ -40,6 +40,7 @@ struct JointErrorLog {
   std::vector<std::vector<double>> model_torque_nm;
   // First sample of every segment (a run without gaps); segment_starts[0] == 0.
   std::vector<std::size_t> segment_starts{0};
+  std::vector<std::size_t> sample_lines;  // 1-based file line of each sample (empty: not read)
   std::size_t first_data_line = 0;  // 1-based line of the first sample (0: not read from a file)
 
   std::size_t sample_count() const { return time_s.size(); }

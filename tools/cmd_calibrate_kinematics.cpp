@@ -18,6 +18,7 @@
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "core/output_folder.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
@@ -29,9 +30,8 @@ struct Args {
 };
 
 void run(const Args& args) {
-  if (!args.force && std::filesystem::exists(args.out)) {
-    throw imscal::InputError(args.out, 0, "", "output exists; use --force to overwrite it");
-  }
+  imscal::prepare_output_file(args.out,
+                              args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
   const imscal::calib::KinematicSession s =
       imscal::calib::calibrate_kinematics_session(args.session);
   std::cout << s.text;

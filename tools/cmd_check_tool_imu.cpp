@@ -18,6 +18,7 @@
 #include "calib/tool_imu_check_session.hpp"
 #include "core/atomic_file.hpp"
 #include "core/json_output.hpp"
+#include "core/output_folder.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
@@ -25,13 +26,16 @@ namespace {
 struct Args {
   imscal::calib::ToolImuCheckSessionOptions session;
   std::string out;
+  bool force = false;
 };
 
 void run(const Args& args) {
+  const auto overwrite = args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse;
+  if (!args.out.empty()) imscal::prepare_output_file(args.out, overwrite);
   const nlohmann::json report = imscal::calib::check_tool_imu_session(
       args.session, [](const std::string& text) { std::cout << text; });
   if (!args.out.empty())
-    imscal::write_file_atomically(args.out, imscal::json_text(report, 2, args.out));
+    imscal::write_file_atomically(args.out, imscal::json_text(report, 2, args.out), overwrite);
 }
 
 imscal::tools::CommandRegistration registration{
@@ -48,6 +52,7 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--out", args->out, "JSON report (written atomically)");
       sub.add_flag("--no-restart", args->session.no_restart,
                    "Do not restart the orientation from the robot's pose after a lost span");
+      sub.add_flag("--force", args->force, "Overwrite an existing output");
       sub.callback([args] { run(*args); });
     }};
 

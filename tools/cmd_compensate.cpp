@@ -23,9 +23,8 @@ struct CompensateArgs {
 };
 
 void run(const CompensateArgs& args) {
-  if (!args.force && std::filesystem::exists(args.out)) {
-    throw imscal::InputError(args.out, 0, "", "output exists; use --force to overwrite it");
-  }
+  imscal::prepare_output_file(args.out,
+                              args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
   imscal::eval::CompensationSessionOptions options = args.session;
   options.robot = args.model_torque.robot;
   options.model_torque = [&args](const std::string& robot, const std::string& data_file,
@@ -34,9 +33,6 @@ void run(const CompensateArgs& args) {
     return args.model_torque.source(robot, data_file, needed_by_file, needed_by_field);
   };
   const imscal::eval::CompensationRunSummary run = imscal::eval::compensate_robot_log(options);
-  // A missing folder of --out is created, as every command creates its output folder.
-  const std::filesystem::path folder = std::filesystem::path(args.out).parent_path();
-  if (!folder.empty()) imscal::create_output_folder(folder);
   imscal::write_file_atomically(
       args.out, run.offsets_csv,
       args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);

@@ -17,6 +17,7 @@
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "core/output_folder.hpp"
 #include "core/units.hpp"
 #include "eval/gap_imu_signals.hpp"
 #include "tools/command_registry.hpp"
@@ -73,9 +74,8 @@ nlohmann::json diagnosis_json(const Args& args, const eval::ImuGapDiagnosis& d) 
 }
 
 void run(const Args& args) {
-  if (!args.out.empty() && !args.force && std::filesystem::exists(args.out)) {
-    throw InputError(args.out, 0, "", "output exists; use --force to overwrite it");
-  }
+  if (!args.out.empty())
+    prepare_output_file(args.out, args.force ? Overwrite::kAllow : Overwrite::kRefuse);
   const calib::ToolImuRecord training = calib::read_tool_imu_record(args.imu);
   const calib::ToolImuRecord held_out = calib::read_tool_imu_record(args.held_out);
   if (!training.has_raw_imu || !held_out.has_raw_imu) {

@@ -12,7 +12,9 @@
 #include <string>
 
 #include "core/input_error.hpp"
+#include "core/output_folder.hpp"
 #include "core/payload_plausibility.hpp"
+#include "eval/joint_error_limits.hpp"
 #include "eval/model_joint_errors.hpp"
 #include "ident/joint_error_io.hpp"
 #include "sim/scenario.hpp"
@@ -28,8 +30,7 @@ struct ModelJointErrorsArgs {
 
 void run(const ModelJointErrorsArgs& args) {
   const Overwrite overwrite = args.force ? Overwrite::kAllow : Overwrite::kRefuse;
-  if (overwrite == Overwrite::kRefuse && std::filesystem::exists(args.out))
-    throw InputError(args.out, 0, "--out", "exists already (--force replaces it)");
+  prepare_output_file(args.out, overwrite);
   const ident::JointErrorLog measured = ident::read_joint_errors_csv(args.joint_errors);
   std::optional<sim::Scenario> scenario;
   if (!args.scenario.empty()) scenario = sim::load_scenario(sim::resolve_scenario(args.scenario));
@@ -40,6 +41,7 @@ void run(const ModelJointErrorsArgs& args) {
       measured.payload_kg, measured.time_s, nominal.description.nominal_payload_kg,
       {args.joint_errors, 0, "payload_kg",
        "robot " + nominal.description.name + " (" + nominal.description.source + ")"});
+  eval::check_joint_error_limits(measured, args.joint_errors, nominal.description);
   ident::JointErrorLog model;
   try {
     model = eval::nominal_model_joint_errors(measured, nominal, scenario ? &*scenario : nullptr);

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <memory>
 
+#include "core/output_folder.hpp"
 #include "core/progress_channel.hpp"
 #include "eval/population_study.hpp"
 #include "tools/command_registry.hpp"
@@ -26,7 +27,7 @@ void run(PopulationArgs args) {
   const eval::PopulationStudyOptions study = eval::with_defaults(args.study);
   const imscal::calib::RobotDescription nominal =
       imscal::calib::load_robot_description(study.nominal);
-  std::filesystem::create_directories(study.out);
+  imscal::create_output_folder(study.out);
   if (!args.step.empty()) {
     std::cout << eval::run_population_step(args.step, seeds, nominal, study);
     return;

@@ -57,6 +57,9 @@ struct ServeArgs {
 online::LoadedPath load_path(const ServeArgs& args, const ident::ParameterTable& table) {
   const imscal::calib::RobotLog log = imscal::calib::read_robot_log_csv(
       args.path, table.robot, "the parameter table " + args.table);
+  if (!args.model_torque.robot.empty())
+    imscal::calib::check_robot_log_joint_limits(
+        log, args.path, imscal::calib::load_robot_description(args.model_torque.robot));
   online::LoadedPath path;
   path.cycle_s = log.cycle_s;
   const std::size_t n = log.samples.size();

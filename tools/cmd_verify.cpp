@@ -15,7 +15,6 @@
 #include <iostream>
 #include <memory>
 
-#include "core/input_error.hpp"
 #include "core/progress_channel.hpp"
 #include "eval/verification_session.hpp"
 #include "tools/command_registry.hpp"
@@ -48,8 +47,6 @@ void draw_figures(const fs::path& dir) {
 void run(VerifyArgs args) {
   const auto overwrite = args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse;
   const fs::path out(args.out);
-  if (!args.force && fs::exists(out / "verification.json"))
-    throw imscal::InputError(out.string(), 0, "", "output exists; use --force");
   if (args.offset_tolerance_rad > 0.0)
     args.session.verification.compensation.precontrol.offset_tolerance_rad.fill(
         args.offset_tolerance_rad);

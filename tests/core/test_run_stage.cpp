@@ -4,8 +4,10 @@
 // not change stays skipped; a run killed (SIGKILL) in the middle of a stage leaves no visible
 // half-written folder and, resumed, gives the same bytes as an uninterrupted run; failures and
 // refusals leave nothing behind.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -376,6 +378,33 @@ TEST_F(RunStageTest, RefusesForeignFoldersWithoutForce) {
   other.force = true;
   EXPECT_NO_THROW(imscal::run_stages(c.stages, other));
   EXPECT_EQ(read_text(foreign / "thesis.tex"), "precious");
+}
+
+// A run refused because another run holds the folder's lock leaves that run's run.json as it
+// is, even with --force and another config; once the lock is free the first config runs on.
+TEST_F(RunStageTest, ARunRefusedByTheFolderLockLeavesRunJsonAlone) {
+  const fs::path run = dir_ / "run";
+  auto c = chain();
+  imscal::run_stages(c.stages, options(run));
+  const std::string record = read_text(run / "run.json");
+  // The lock as another imscal run holds it (flock conflicts across open file descriptions).
+  const int other_run = ::open((run / ".imscal-run.lock").c_str(), O_RDWR | O_CLOEXEC);
+  ASSERT_GE(other_run, 0);
+  ASSERT_EQ(::flock(other_run, LOCK_EX | LOCK_NB), 0);
+  write_text(dir_ / "other.yaml", "# another config\n");
+  RunOptions other = options(run, /*force=*/true);
+  other.config_file = dir_ / "other.yaml";
+  try {
+    imscal::run_stages(c.stages, other);
+    ADD_FAILURE() << "a second run in a locked folder was accepted";
+  } catch (const imscal::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("another imscal run is working in this folder"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(read_text(run / "run.json"), record);
+  ::close(other_run);
+  EXPECT_NO_THROW(imscal::run_stages(c.stages, options(run)));
 }
 
 // run.json is read through its reader (core/run_record.hpp): a damaged record is refused naming

@@ -9,6 +9,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "calib/robot_log.hpp"
@@ -67,7 +68,16 @@ TEST_F(VerifyCli, ZeroTableVerifiesUnchangedAndEvaluateAgrees) {
         "attained_uncompensated_1.csv", "attained_compensated_1.csv"}) {
     EXPECT_TRUE(fs::exists(s / f)) << f;
   }
-  const auto doc = nlohmann::json::parse(read(s / "verification.json"));
+  // Again without --force: refused before any work (exit 2), naming the existing output.
+  const std::string earlier = read(s / "verification.json");
+  EXPECT_EQ(run("verify --table " + table.string() + " --scenario seed-line --out " + out.string(),
+                dir_ / "again.log"),
+            2);
+  EXPECT_NE(read(dir_ / "again.log").find((s / "verification.json").string() + ": field '--out'"),
+            std::string::npos)
+      << read(dir_ / "again.log");
+  EXPECT_EQ(read(s / "verification.json"), earlier);
+  const auto doc = nlohmann::json::parse(earlier);
   ASSERT_EQ(doc["cases"].size(), 2u);
   const auto& before = doc["cases"][0];
   const auto& after = doc["cases"][1];
@@ -105,6 +115,39 @@ TEST_F(VerifyCli, ZeroTableVerifiesUnchangedAndEvaluateAgrees) {
                       (dir_ / "figures.json").string()),
           dir_ / "again.log"),
       2);
+}
+
+// Every regular file below `folder` (relative path -> content).
+std::map<std::string, std::string> files_below(const fs::path& folder) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(folder))
+    if (e.is_regular_file()) files[fs::relative(e.path(), folder).string()] = read(e.path());
+  return files;
+}
+
+// All or nothing: a rerun whose writes fail leaves every earlier output as it was and names the
+// target, never the staging copy. A file-size limit (RLIMIT_FSIZE, SIGXFSZ ignored: EFBIG as a
+// full disk's ENOSPC) of 8 KiB, below the size of the path files, stands in for a full disk; the
+// rerun draws other friction (--seed), so that every file it would write differs.
+TEST_F(VerifyCli, AFailingWriteLeavesTheEarlierOutputsAsTheyWere) {
+  const fs::path table = dir_ / "zero.json", out = dir_ / "out";
+  ident::write_parameters_json(table, zero_error_table("kr16"));
+  const std::string arguments = "verify --table " + table.string() +
+                                " --scenario seed-line --segments \"line -y\" --cycles 1 --out " +
+                                out.string();
+  ASSERT_EQ(run(arguments, dir_ / "verify.log"), 0) << read(dir_ / "verify.log");
+  const auto before = files_below(out);
+  ASSERT_GE(before.size(), 9u);  // scenario files, path files of one cycle before and after
+  const std::string limited = "sh -c 'trap \"\" XFSZ; ulimit -f 16; " + std::string(IMSCAL_BINARY) +
+                              " " + arguments + " --seed 7 --force; echo exit=$?' > " +
+                              (dir_ / "limited.log").string() + " 2>&1";
+  ASSERT_EQ(std::system(limited.c_str()), 0);
+  const std::string message = read(dir_ / "limited.log");
+  EXPECT_NE(message.find("exit=3"), std::string::npos) << message;
+  EXPECT_NE(message.find("File too large"), std::string::npos) << message;
+  EXPECT_NE(message.find((out / "seed-line").string()), std::string::npos) << message;
+  EXPECT_EQ(message.find(".imscal-staging-"), std::string::npos) << message;
+  EXPECT_EQ(files_below(out), before);  // no staging copy left either
 }
 
 TEST_F(VerifyCli, CompensateWritesOffsetsOrRefusesAnotherRobotsTable) {

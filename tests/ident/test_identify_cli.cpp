@@ -236,6 +236,28 @@ TEST_F(IdentifyCli, LatinOneSourceLineIsWrittenAsReplacementCharacter) {
             "d");  // U+FFFD
 }
 
+// A file name that is not UTF-8 (a legacy encoding): the outputs are written, the name recorded
+// with U+FFFD and a warning, instead of a JSON library error after all the work. The console
+// gives each joint's fit as the table is applied beside the cells' own, labelled as such.
+TEST_F(IdentifyCli, NonUtf8FileNameIsWrittenAndTheTablesFitIsPrinted) {
+  const std::filesystem::path latin = dir_ / "joint_errors_\xe9t\xe9.csv";
+  std::filesystem::copy_file(dir_ / "joint_errors.csv", latin);
+  ASSERT_EQ(imscal::test_support::run_imscal("identify --joint-errors '" + latin.string() +
+                                                 "' --config " + (dir_ / "ident.yaml").string() +
+                                                 " --out " + (dir_ / "out").string(),
+                                             dir_ / "log.txt"),
+            0)
+      << log_text();
+  EXPECT_NE(log_text().find("is not valid UTF-8; its invalid bytes are written as U+FFFD"),
+            std::string::npos)
+      << log_text();
+  const std::string report =
+      imscal::test_support::read_file_text(dir_ / "out" / "identification_report.json");
+  EXPECT_NE(report.find("joint_errors_\xef\xbf\xbdt\xef\xbf\xbd.csv"), std::string::npos);
+  EXPECT_NE(log_text().find("A1 table: held-out joint-error fit"), std::string::npos) << log_text();
+  EXPECT_NE(log_text().find("cell's own held-out fit"), std::string::npos) << log_text();
+}
+
 // Plausibility against the record: orders a short record cannot fit (every cell would fit from
 // no rows and correct nothing) and a payload far above the robot's rating are refused (exit 2),
 // naming the field, before any output.
