@@ -13,10 +13,8 @@
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
-#include "core/numeric_table.hpp"
 #include "core/units.hpp"
-#include "eval/iso9283_path.hpp"
-#include "eval/path_deviation.hpp"
+#include "eval/path_evaluation.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
@@ -34,75 +32,33 @@ struct EvaluateArgs {
   bool force = false;
 };
 
-eval::PoseSeries read_path(const std::string& file, double from_s, double to_s) {
-  const imscal::NumericTable t = imscal::read_numeric_table(file);
-  const char* names[] = {"t_s", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz"};
-  std::array<std::size_t, 8> col{};
-  for (int i = 0; i < 8; ++i) col[std::size_t(i)] = t.column(names[i]);
-  eval::PoseSeries out;
-  for (std::size_t r = 0; r < t.rows(); ++r) {
-    eval::PathPose p;
-    p.t_s = t.at(r, col[0]);
-    if (!out.empty() && !(p.t_s > out.back().t_s)) {
-      throw imscal::InputError(file, t.lines[r], "t_s", "time does not increase");
-    }
-    if (p.t_s < from_s || p.t_s > to_s) continue;
-    p.p_m = {t.at(r, col[1]), t.at(r, col[2]), t.at(r, col[3])};
-    p.q = Eigen::Quaterniond(t.at(r, col[4]), t.at(r, col[5]), t.at(r, col[6]), t.at(r, col[7]));
-    const double norm = p.q.norm();
-    if (std::abs(norm - 1.0) > 1e-6) {
-      throw imscal::InputError(file, t.lines[r], "qw",
-                               fmt::format("quaternion norm {} is not 1", norm));
-    }
-    p.q.normalize();
-    out.push_back(p);
-  }
-  if (out.size() < 2) {
-    throw imscal::InputError(file, t.header_line, "t_s",
-                             "fewer than two poses in the evaluated time range");
-  }
-  return out;
-}
-
 void run(const EvaluateArgs& args) {
   if (!args.out.empty() && !args.force && std::filesystem::exists(args.out)) {
     throw imscal::InputError(args.out, 0, "", "output exists; use --force to overwrite it");
   }
-  const eval::PoseSeries commanded = read_path(args.commanded, args.from_s, args.to_s);
+  const eval::PoseSeries commanded = eval::read_path_file(args.commanded, args.from_s, args.to_s);
   std::vector<eval::PoseSeries> attained;
   for (const auto& f : args.attained) {
-    attained.push_back(read_path(f, args.from_s - args.window_s, args.to_s + args.window_s));
-  }
-  double v_c = args.velocity_m_s;
-  if (!(v_c > 0.0)) {
-    for (std::size_t k = 1; k < commanded.size(); ++k) {
-      v_c = std::max(v_c, (commanded[k].p_m - commanded[k - 1].p_m).norm() /
-                              (commanded[k].t_s - commanded[k - 1].t_s));
-    }
+    attained.push_back(
+        eval::read_path_file(f, args.from_s - args.window_s, args.to_s + args.window_s));
   }
   eval::Iso9283Options options;
   options.calculation_points = args.points;
   options.time_window_s = args.window_s;
-  eval::Iso9283PathResult r;
+  eval::PathEvaluation e;
   try {
-    r = eval::iso9283_path(commanded, attained, v_c, options);
-  } catch (const std::invalid_argument& e) {
-    throw imscal::InputError(args.attained.front(), 0, "", e.what());
+    e = eval::evaluate_paths(commanded, attained, args.velocity_m_s, options);
+  } catch (const std::invalid_argument& error) {
+    throw imscal::InputError(args.attained.front(), 0, "", error.what());
   }
-  std::vector<eval::TimedPoint> desired;
-  for (const auto& p : commanded) desired.push_back({p.t_s, p.p_m});
-  double max_dev = 0.0;
+  const eval::Iso9283PathResult& r = e.iso;
+  const double v_c = e.commanded_speed_m_s;
+  const double max_dev = e.max_path_deviation_m;
   nlohmann::json per_cycle = nlohmann::json::array();
   for (std::size_t j = 0; j < attained.size(); ++j) {
-    std::vector<eval::TimedPoint> actual;
-    for (const auto& p : attained[j])
-      if (p.t_s >= commanded.front().t_s && p.t_s <= commanded.back().t_s)
-        actual.push_back({p.t_s, p.p_m});
-    const eval::PathDeviation d = eval::path_deviation(desired, actual, args.window_s);
-    max_dev = std::max(max_dev, d.max_m);
     per_cycle.push_back({{"file", args.attained[j]},
-                         {"max_path_deviation_mm", d.max_m * 1e3},
-                         {"rms_path_deviation_mm", d.rms_m * 1e3}});
+                         {"max_path_deviation_mm", e.deviation[j].max_m * 1e3},
+                         {"rms_path_deviation_mm", e.deviation[j].rms_m * 1e3}});
   }
   constexpr double deg = kDegPerRad;
   auto finite = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };

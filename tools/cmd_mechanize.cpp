@@ -29,6 +29,7 @@
 #include "ims/earth_model.hpp"
 #include "ims/imu_conversion.hpp"
 #include "ims/imu_file.hpp"
+#include "ims/mechanization_start.hpp"
 #include "ims/nav_trajectory_io.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
@@ -59,14 +60,7 @@ struct MechanizeArgs {
   bool force = false;
 };
 
-// Everything the mechanization starts from.
-struct Prepared {
-  ims::ImuSeries increments;  // from the first sample after initial.t_s
-  std::unique_ptr<ims::EarthModel> earth;
-  ims::NavState initial;
-  std::string attitude_source;
-  Eigen::Vector3d attitude_sigma_rad = Eigen::Vector3d::Zero();  // E, N, U; from the alignment
-};
+using Prepared = ims::MechanizationStart;
 
 // Three comma-separated finite numbers.
 Eigen::Vector3d parse_triple(const std::string& text, const std::string& option,
@@ -96,102 +90,23 @@ Eigen::Vector3d parse_triple(const std::string& text, const std::string& option,
   return values;
 }
 
-ims::Site choose_site(const MechanizeArgs& args, const ims::ImuSeries& series) {
+Prepared prepare(const MechanizeArgs& args) {
+  ims::MechanizationRequest request;
+  request.input = args.input;
+  if (!args.initial_attitude.empty()) {
+    request.initial_attitude_deg =
+        parse_triple(args.initial_attitude, "--initial-attitude", "ROLL,PITCH,HEADING (deg)");
+  }
+  request.align_s = args.align_s;
   if (!args.site.empty()) {
     const Eigen::Vector3d v = parse_triple(args.site, "--site", "LAT,LON,H (deg, deg, m)");
-    return ims::Site{v.x(), v.y(), v.z()};
+    request.site = ims::Site{v.x(), v.y(), v.z()};
   }
-  if (series.site) return *series.site;
-  throw imscal::InputError(args.input, 0, "site",
-                           "the file names no site; give --site LAT,LON,H (needed for the Earth "
-                           "rate and gravity)");
-}
-
-Prepared prepare(const MechanizeArgs& args) {
-  if (args.initial_attitude.empty() == !args.align_s.has_value()) {
-    throw imscal::InputError(kCommandLine, 0, "--initial-attitude/--align-s",
-                             "give exactly one of --initial-attitude ROLL,PITCH,HEADING_DEG and "
-                             "--align-s SECONDS");
-  }
-  Prepared p;
-  ims::ImuSeries series = ims::read_imu_file(args.input);
-  if (series.samples.size() < 2) {
-    throw imscal::InputError(args.input, 0, "", "fewer than two samples: nothing to mechanize");
-  }
-  if (series.quantity == ims::ImuQuantity::kRates) {
-    // The rectangle rule of ims/imu_conversion.hpp: errs by -(1/2) d(rate)/dt dt^2 per sample.
-    spdlog::warn(
-        "{} holds rates, not increments: converted by the rectangle rule, which is not "
-        "exact for a changing rate (ims/imu_conversion.hpp)",
-        args.input);
-    series = ims::rates_to_increments(series);
-  }
-  if (!args.sensor_errors.empty()) {
-    // Error correction on read: the unit's calibration (bias, scale factor, misalignment).
-    series = ims::correct(series, ims::load_sensor_error_model(args.sensor_errors));
-    spdlog::info("corrected {} with the sensor error model {}", args.input, args.sensor_errors);
-  }
-  try {
-    p.earth = std::make_unique<ims::EarthModel>(choose_site(args, series));
-  } catch (const std::invalid_argument& e) {
-    throw imscal::InputError(kCommandLine, 0, "--site", e.what());
-  }
-
-  const auto& samples = series.samples;
-  const double first_dt =
-      series.nominal_dt_s > 0.0 ? series.nominal_dt_s : samples[1].t_s - samples[0].t_s;
-  const double record_start = samples.front().t_s - first_dt;
-  std::size_t first_sample = 0;
-  p.initial.t_s = record_start;
-  if (!args.initial_attitude.empty()) {
-    const Eigen::Vector3d deg =
-        parse_triple(args.initial_attitude, "--initial-attitude", "ROLL,PITCH,HEADING (deg)");
-    // Heading is clockwise from North; the angle convention's yaw counter-clockwise.
-    p.initial.q_W_S = Eigen::Quaterniond(
-        ims::R_W_S_from_angles(deg.x() * kRadPerDeg, deg.y() * kRadPerDeg, -deg.z() * kRadPerDeg));
-    p.attitude_source = "command line";
-  } else {
-    if (!(*args.align_s > 0.0) || record_start + *args.align_s > samples.back().t_s) {
-      throw imscal::InputError(kCommandLine, 0, "--align-s",
-                               fmt::format("{} s is not inside the record ({} s long)",
-                                           *args.align_s, samples.back().t_s - record_start));
-    }
-    ims::CoarseAlignment alignment;
-    try {
-      alignment = ims::align_at_rest(
-          series, ims::samples_in_interval(series, record_start, *args.align_s), *p.earth);
-    } catch (const std::invalid_argument& e) {
-      throw imscal::InputError(kCommandLine, 0, "--align-s", e.what());
-    }
-    // The alignment holds at t_ref (a sample time in the middle of the interval); the
-    // trajectory starts there, at rest.
-    p.initial.t_s = alignment.t_ref_s;
-    p.initial.q_W_S = alignment.q_W_S;
-    const double level_sigma = std::max(alignment.sigma_roll_rad, alignment.sigma_pitch_rad);
-    p.attitude_sigma_rad = {level_sigma, level_sigma, alignment.sigma_heading_rad};
-    if (args.heading_deg) {
-      alignment.angles.heading_rad = *args.heading_deg * kRadPerDeg;
-      alignment.sigma_heading_rad = args.heading_sigma_deg * kRadPerDeg;
-      p.initial.q_W_S = Eigen::Quaterniond(ims::R_W_S_from_angles(
-          alignment.angles.roll_rad, alignment.angles.pitch_rad, -alignment.angles.heading_rad));
-      p.attitude_sigma_rad.z() = alignment.sigma_heading_rad;
-    }
-    while (first_sample < samples.size() && samples[first_sample].t_s <= alignment.t_ref_s) {
-      ++first_sample;
-    }
-    p.attitude_source = fmt::format(
-        "coarse alignment over the first {} s (roll {:.4f} +- {:.4f}, pitch {:.4f} +- {:.4f}, "
-        "heading {:.4f} +- {:.4f} deg{})",
-        *args.align_s, alignment.angles.roll_rad / kRadPerDeg,
-        alignment.sigma_roll_rad / kRadPerDeg, alignment.angles.pitch_rad / kRadPerDeg,
-        alignment.sigma_pitch_rad / kRadPerDeg, alignment.angles.heading_rad / kRadPerDeg,
-        alignment.sigma_heading_rad / kRadPerDeg,
-        args.heading_deg ? " from --heading-deg" : " by gyrocompassing");
-  }
-  p.increments = std::move(series);
-  p.increments.samples.erase(p.increments.samples.begin(),
-                             p.increments.samples.begin() + static_cast<long>(first_sample));
-  return p;
+  request.sensor_errors = args.sensor_errors;
+  request.heading_deg = args.heading_deg;
+  request.heading_sigma_deg = args.heading_sigma_deg;
+  request.origin = kCommandLine;
+  return ims::prepare_mechanization(request);
 }
 
 // Both outputs, refused before any work when they exist and --force is not given.
