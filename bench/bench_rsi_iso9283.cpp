@@ -1,4 +1,4 @@
-// The closed loop through the RSI server against `imscal verify`'s in-process loop, on the
+// The closed loop through the RSI and EGM servers against `imscal verify`'s in-process loop, on the
 // paper's line (seed-line) and the ISO 9283 set: the default table (identified from the
 // identification scenario's truth, as tests/eval/test_verification.cpp) is served with the
 // program's path loaded (online/path_follower.hpp: the preview and the model torque along it,
@@ -8,7 +8,8 @@
 // in process and through the sockets, on the true path over 3 friction cycles, and their
 // difference in percentage points (goal: within 0.5), with the path's clock started at the
 // motion (the server cannot know the path ahead at the start of the first motion) and with the
-// stream (the path recorded from the stream's first datagram).
+// stream (the path recorded from the stream's first datagram); and through the EGM server, which
+// plays the loaded path itself (online/egm_session.hpp: its clock is the stream's).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -17,10 +18,11 @@
 #include "eval/model_torque.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
+#include "online/controller_emulator.hpp"
+#include "online/egm_session.hpp"
 #include "online/path_follower.hpp"
-#include "online/rsi_controller_emulator.hpp"
 #include "sim/scenario.hpp"
-#include "tests/support/rsi_loopback.hpp"
+#include "tests/support/loopback_server.hpp"
 
 namespace {
 
@@ -41,12 +43,16 @@ const eval::IdentifiedTable& default_table() {
   return table;
 }
 
+enum class Served { kRsiClockAtMotion, kRsiClockWithStream, kEgm };
+
 // The offsets of `table` along `path` as the RSI server answers them (the path loaded, its clock
-// started at the motion or, with the path recorded from the stream's start, with the stream).
+// started at the motion or, with the path recorded from the stream's start, with the stream), or
+// as the EGM server does (the path, with the warm-up's rest first, played by the server).
+
 eval::CompensationRun through_sockets(const ident::ParameterTable& table,
                                       const sim::DesiredJointPath& path,
-                                      const eval::CompensationOptions& options,
-                                      bool clock_from_stream) {
+                                      const eval::CompensationOptions& options, Served served) {
+  const bool clock_from_stream = served != Served::kRsiClockAtMotion;
   online::LoadedPath loaded;
   loaded.cycle_s = path.cycle_s;
   std::vector<calib::JointVector> torque;
@@ -77,18 +83,29 @@ eval::CompensationRun through_sockets(const ident::ParameterTable& table,
       loaded.torque_nm.insert(loaded.torque_nm.begin(), warm_up, loaded.torque_nm.front());
     loaded.payload_kg.insert(loaded.payload_kg.begin(), warm_up, loaded.payload_kg.front());
   }
-  auto follower = std::make_unique<online::PathFollower>(loaded, path.cycle_s, ahead_s, follow);
-  online::RsiSessionOptions session;
-  session.cycle_s = path.cycle_s;
-  session.ipoc_per_cycle = 2;
-  test_support::RsiLoopbackServer server(table, options.precontrol, session, std::move(follower));
-  online::UdpSocket controller("127.0.0.1", 0);
-  online::RsiEmulatorOptions emulator;
+  std::unique_ptr<test_support::LoopbackServer> server;
+  online::EmulatorOptions emulator;
   emulator.cycle_s = path.cycle_s;
-  emulator.ipoc_per_cycle = 2;
-  const online::RsiEmulatorRun run =
-      online::emulate_rsi_controller(controller, server.peer(), setpoint, emulator);
-  server.finish();
+  if (served == Served::kEgm) {
+    online::EgmSessionOptions session;
+    session.cycle_s = path.cycle_s;
+    server = std::make_unique<test_support::LoopbackServer>(table, options.precontrol, session,
+                                                            loaded, ahead_s);
+    emulator.protocol = online::ControllerProtocol::kEgm;
+    emulator.ipoc_per_cycle = 1;
+  } else {
+    auto follower = std::make_unique<online::PathFollower>(loaded, path.cycle_s, ahead_s, follow);
+    online::RsiSessionOptions session;
+    session.cycle_s = path.cycle_s;
+    session.ipoc_per_cycle = 2;
+    server = std::make_unique<test_support::LoopbackServer>(table, options.precontrol, session,
+                                                            std::move(follower));
+    emulator.ipoc_per_cycle = 2;
+  }
+  online::UdpSocket controller("127.0.0.1", 0);
+  const online::EmulatorRun run =
+      online::emulate_controller(controller, server->peer(), setpoint, emulator);
+  server->finish();
   eval::CompensationRun out;
   for (std::size_t k = 0; k < path.samples.size(); ++k) {
     const auto& c = run.correction_rad[warm_up + k];
@@ -110,18 +127,20 @@ void compare(benchmark::State& state, const char* scenario_name) {
     return eval::reduction_percent(r.before.true_figures.max_path_deviation_m,
                                    r.after[0].true_figures.max_path_deviation_m);
   };
-  double in_process = 0.0, at_motion = 0.0, with_stream = 0.0;
+  double in_process = 0.0, at_motion = 0.0, with_stream = 0.0, egm = 0.0;
   for (auto _ : state) {
     in_process = reduction(eval::verify_scenario(scenario, tables, options));
-    for (const bool from_stream : {false, true}) {
-      options.compensation_runner = [from_stream](const ident::ParameterTable& table,
-                                                  const std::string&,
-                                                  const sim::DesiredJointPath& path,
-                                                  const eval::CompensationOptions& compensation) {
-        return through_sockets(table, path, compensation, from_stream);
+    for (const Served served :
+         {Served::kRsiClockAtMotion, Served::kRsiClockWithStream, Served::kEgm}) {
+      options.compensation_runner = [served](const ident::ParameterTable& table, const std::string&,
+                                             const sim::DesiredJointPath& path,
+                                             const eval::CompensationOptions& compensation) {
+        return through_sockets(table, path, compensation, served);
       };
-      (from_stream ? with_stream : at_motion) =
-          reduction(eval::verify_scenario(scenario, tables, options));
+      const double r = reduction(eval::verify_scenario(scenario, tables, options));
+      (served == Served::kEgm                  ? egm
+       : served == Served::kRsiClockWithStream ? with_stream
+                                               : at_motion) = r;
     }
   }
   state.counters["in_process_reduction_percent"] = in_process;
@@ -129,6 +148,8 @@ void compare(benchmark::State& state, const char* scenario_name) {
   state.counters["sockets_clock_with_stream_reduction_percent"] = with_stream;
   state.counters["at_motion_difference_pp"] = at_motion - in_process;
   state.counters["with_stream_difference_pp"] = with_stream - in_process;
+  state.counters["sockets_egm_reduction_percent"] = egm;
+  state.counters["egm_difference_pp"] = egm - in_process;
 }
 
 void BM_RsiSeedLineInProcessVsSockets(benchmark::State& state) {

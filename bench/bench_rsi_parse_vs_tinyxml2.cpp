@@ -17,7 +17,7 @@
 #include <cstdlib>
 #include <vector>
 
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
 #include "online/rsi_datagram.hpp"
 #include "tests/support/allocation_counter.hpp"
 

@@ -1,4 +1,4 @@
-// The RSI server (online/): 6 joints, order-32 ARX models (na = nb = 32, dead time 2) in a
+// The RSI and EGM servers (online/): 6 joints, order-32 ARX models (na = nb = 32, dead time 2) in a
 // 3 x 2 operating-point table with blending and backlash (bench_precontrol.cpp's table without
 // further inputs: the default identification's table takes a preview and the model torque,
 // which RSI does not feed, docs/decisions/0024), at the 4 ms RSI cycle (two model steps per
@@ -9,10 +9,13 @@
 //    percentile, maximum, and the heap allocations inside the calls (counted by replacing
 //    operator new). Goal: p99.9 < 50 us.
 //  - BM_RsiLockStepLoopback: 10^6 datagrams through loopback UDP in lock-step (the emulator of
-//    online/rsi_controller_emulator.hpp against the server loop in a thread): missed answers
+//    online/controller_emulator.hpp against the server loop in a thread): missed answers
 //    (goal 0) and the round trip.
 //  - BM_RsiPaced4ms: the controller's real pacing, one datagram every 4 ms for 30 s: the share of
 //    answers later than 1 ms after their datagram was sent, and the latency's percentiles.
+//  - BM_Egm*: the same three for ABB EGM (online/egm_session.hpp: protocol buffers, the server
+//    playing the path of the set-points above plus the correction); the allocation count
+//    excludes the first datagram, whose shape sizes the codec's reused messages.
 // The machine is shared: a preempted call shows in the maximum and, when frequent, in p99.9.
 // GCC 12 flags the malloc/free pair of the counting operator new (tests/support/
 // allocation_counter.hpp) at every inlined std::allocator use in this file (a false positive).
@@ -27,11 +30,12 @@
 #include <vector>
 
 #include "ident/precontrol.hpp"
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
+#include "online/egm_session.hpp"
 #include "online/rsi_session.hpp"
 #include "tests/support/allocation_counter.hpp"
 #include "tests/support/arx_systems.hpp"
-#include "tests/support/rsi_loopback.hpp"
+#include "tests/support/loopback_server.hpp"
 
 namespace {
 
@@ -126,35 +130,109 @@ void BM_RsiSessionDatagram(benchmark::State& state) {
 }
 BENCHMARK(BM_RsiSessionDatagram)->Unit(benchmark::kMillisecond)->Iterations(1);
 
-RsiEmulatorRun run_over_loopback(std::size_t datagrams, bool paced) {
-  RsiSessionOptions options;
+// The set-points of `datagrams` cycles as the path an EGM server plays.
+online::LoadedPath setpoint_path(std::size_t datagrams) {
+  online::LoadedPath path;
+  path.cycle_s = kCycle;
+  path.q_rad.resize(datagrams);
+  for (std::size_t k = 0; k < datagrams; ++k) path.q_rad[k] = setpoint(k);
+  return path;
+}
+
+void BM_EgmSessionDatagram(benchmark::State& state) {
+  constexpr std::size_t kDatagrams = 1000000;
+  EgmSessionOptions options;
   options.payload_kg = 8.0;
-  test_support::RsiLoopbackServer server(order_32_table(), keep_active(), options);
+  std::string why;
+  auto session = EgmSession::create(order_32_table(), "kr16", keep_active(), options,
+                                    setpoint_path(kDatagrams), 0.0, &why);
+  if (!session) {
+    state.SkipWithError(why.c_str());
+    return;
+  }
+  std::vector<double> ns(kDatagrams);
+  std::array<char, 1024> in{}, out{};
+  EgmCodec controller;
+  long allocations = 0, answered = 0;
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < kDatagrams; ++k) {
+      EgmRobotDatagram d;  // the robot at its target: the path's joints of the cycle
+      d.seqno = std::uint32_t(k + 1);
+      d.tm_ms = std::uint32_t(4 * k);
+      d.feedback_joints = d.planned_joints = kEgmAxes;
+      const std::array<double, kRsiAxes> q = setpoint(k);
+      for (int a = 0; a < kEgmAxes; ++a)
+        d.feedback_deg[std::size_t(a)] = d.planned_deg[std::size_t(a)] =
+            q[std::size_t(a)] * 180.0 / M_PI;
+      d.motors = EgmMotors::kOn;
+      const int n = controller.write_robot(d, in.data(), int(in.size()));
+      const long before = test_support::g_allocations.load(std::memory_order_relaxed);
+      const auto begin = std::chrono::steady_clock::now();
+      const int bytes = session->handle(std::string_view(in.data(), std::size_t(n)),
+                                        double(k) * kCycle, out.data(), int(out.size()));
+      const auto end = std::chrono::steady_clock::now();
+      if (k > 0)
+        allocations += test_support::g_allocations.load(std::memory_order_relaxed) - before;
+      answered += bytes > 0;
+      benchmark::DoNotOptimize(out);
+      ns[k] = std::chrono::duration<double, std::nano>(end - begin).count();
+    }
+  }
+  percentiles(state, ns, "ns");
+  state.counters["allocations"] = double(allocations);
+  state.counters["answered"] = double(answered);
+  state.counters["active_at_end"] = session->state() == ident::PrecontrolState::kActive;
+}
+BENCHMARK(BM_EgmSessionDatagram)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+EmulatorRun run_over_loopback(std::size_t datagrams, bool paced, ControllerProtocol protocol) {
+  std::unique_ptr<test_support::LoopbackServer> server;
+  if (protocol == ControllerProtocol::kEgm) {
+    EgmSessionOptions options;
+    options.payload_kg = 8.0;
+    server = std::make_unique<test_support::LoopbackServer>(order_32_table(), keep_active(),
+                                                            options, setpoint_path(datagrams), 0.0);
+  } else {
+    RsiSessionOptions options;
+    options.payload_kg = 8.0;
+    server =
+        std::make_unique<test_support::LoopbackServer>(order_32_table(), keep_active(), options);
+  }
   std::vector<std::array<double, kRsiAxes>> q(datagrams);
   for (std::size_t k = 0; k < datagrams; ++k) q[k] = setpoint(k);
   UdpSocket controller("127.0.0.1", 0);
-  RsiEmulatorOptions emulator;
+  EmulatorOptions emulator;
+  emulator.protocol = protocol;
+  if (protocol == ControllerProtocol::kEgm) emulator.ipoc_per_cycle = 1;
   emulator.paced = paced;
   emulator.answer_timeout_s = paced ? 0.004 : 0.5;  // paced: an answer after the cycle is missed
-  return emulate_rsi_controller(controller, server.peer(), q, emulator);
+  return emulate_controller(controller, server->peer(), q, emulator);
 }
 
-void BM_RsiLockStepLoopback(benchmark::State& state) {
+void lock_step_loopback(benchmark::State& state, ControllerProtocol protocol) {
   constexpr std::size_t kDatagrams = 1000000;
-  RsiEmulatorRun run;
-  for (auto _ : state) run = run_over_loopback(kDatagrams, false);
+  EmulatorRun run;
+  for (auto _ : state) run = run_over_loopback(kDatagrams, false, protocol);
   state.counters["datagrams"] = double(kDatagrams);
   state.counters["missed"] = double(run.missed);
   std::vector<double> us;
   for (double s : run.latency_s) us.push_back(s * 1e6);
   percentiles(state, us, "round_trip_us");
 }
+void BM_RsiLockStepLoopback(benchmark::State& state) {
+  lock_step_loopback(state, ControllerProtocol::kRsi);
+}
 BENCHMARK(BM_RsiLockStepLoopback)->Unit(benchmark::kSecond)->Iterations(1);
 
-void BM_RsiPaced4ms(benchmark::State& state) {
+void BM_EgmLockStepLoopback(benchmark::State& state) {
+  lock_step_loopback(state, ControllerProtocol::kEgm);
+}
+BENCHMARK(BM_EgmLockStepLoopback)->Unit(benchmark::kSecond)->Iterations(1);
+
+void paced_4ms(benchmark::State& state, ControllerProtocol protocol) {
   constexpr std::size_t kDatagrams = 7500;  // 30 s
-  RsiEmulatorRun run;
-  for (auto _ : state) run = run_over_loopback(kDatagrams, true);
+  EmulatorRun run;
+  for (auto _ : state) run = run_over_loopback(kDatagrams, true, protocol);
   std::vector<double> us;
   std::size_t late = 0;
   for (std::size_t k = 0; k < run.latency_s.size(); ++k) {
@@ -167,7 +245,15 @@ void BM_RsiPaced4ms(benchmark::State& state) {
   state.counters["later_than_1ms_percent"] = 100.0 * double(late) / double(kDatagrams);
   percentiles(state, us, "latency_us");
 }
+void BM_RsiPaced4ms(benchmark::State& state) {
+  paced_4ms(state, ControllerProtocol::kRsi);
+}
 BENCHMARK(BM_RsiPaced4ms)->Unit(benchmark::kSecond)->Iterations(1);
+
+void BM_EgmPaced4ms(benchmark::State& state) {
+  paced_4ms(state, ControllerProtocol::kEgm);
+}
+BENCHMARK(BM_EgmPaced4ms)->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace
 

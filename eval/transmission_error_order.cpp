@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "eval/verification.hpp"
+#include "ident/identification_config_record.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -24,8 +25,12 @@ constexpr double kMinGainPoints = 0.15;
 }  // namespace
 
 TransmissionErrorOrderSearch search_transmission_error_orders(
-    const ident::JointErrorLog& log, const ident::IdentificationConfig& config,
+    const ident::JointErrorLog& log, const ident::IdentificationConfig& given_config,
     const std::vector<double>& candidates, const ModelTorqueSource* torque_model) {
+  const ident::IdentificationConfig config =
+      given_config.resolved_cycle_s == log.cycle_s
+          ? given_config
+          : ident::resolve_for_record(given_config, log.robot, log.cycle_s, "the joint errors");
   if (!config.options.transmission_error_input)
     throw std::invalid_argument("order search: the config's models take no transmission error");
   if (candidates.empty()) throw std::invalid_argument("order search: no candidate harmonic");

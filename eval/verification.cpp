@@ -13,6 +13,7 @@
 #include "eval/ims_measured_path.hpp"
 #include "eval/iso9283_path.hpp"
 #include "eval/path_deviation.hpp"
+#include "ident/identification_config_record.hpp"
 #include "ident/identify_joints.hpp"
 #include "ims/earth_model.hpp"
 #include "sim/motion_planner.hpp"
@@ -330,9 +331,13 @@ ident::JointErrorLog with_model_torques(ident::JointErrorLog log, const ModelTor
 }  // namespace
 
 IdentifiedTable identify_table(const ident::JointErrorLog& log,
-                               const ident::IdentificationConfig& config,
+                               const ident::IdentificationConfig& given_config,
                                const std::string& source_file,
                                const ModelTorqueSource* torque_model) {
+  const ident::IdentificationConfig config =
+      given_config.resolved_cycle_s == log.cycle_s
+          ? given_config
+          : ident::resolve_for_record(given_config, log.robot, log.cycle_s, source_file);
   if (needs_model_torques(log, config, torque_model, "identify_table"))
     return identify_table(with_model_torques(log, *torque_model, config), config, source_file);
   if (config.max_speed_rad_s.size() != log.joint_count()) {

@@ -32,6 +32,7 @@
 #include "ims/psins_reader.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
+#include "online/egm_codec.hpp"
 #include "online/rsi_datagram.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/scenario.hpp"
@@ -75,6 +76,20 @@ inline void parse_rsi_datagram(std::string_view bytes) {
                            answer.data(), int(answer.size()));
 }
 
+// The EGM codec on raw bytes (it takes no file and throws nothing): a datagram read as the
+// controller's EgmRobot and, accepted, its measured joints written back as the answer, as the
+// server writes its targets; the same codec for every input, as the server keeps it.
+inline void parse_egm_datagram(std::string_view bytes) {
+  static online::EgmCodec codec;
+  online::EgmRobotDatagram datagram;
+  if (codec.parse_robot(bytes, &datagram) != online::EgmParseError::kNone) return;
+  std::array<double, online::kEgmAxes> joints_deg{};
+  for (int a = 0; a < online::kEgmAxes && a < datagram.feedback_joints; ++a)
+    joints_deg[std::size_t(a)] = datagram.feedback_deg[std::size_t(a)];
+  std::array<char, 1024> answer{};
+  codec.write_sensor(datagram.seqno, datagram.tm_ms, joints_deg, answer.data(), int(answer.size()));
+}
+
 // Reads `file` with the reader of `target` (the fuzz target's name without "fuzz_"); returns
 // quietly when the reader accepts or refuses the input with an InputError.
 inline void read_with(std::string_view target, const std::filesystem::path& file) {
@@ -116,6 +131,9 @@ inline void read_with(std::string_view target, const std::filesystem::path& file
     } else if (target == "rsi_datagram") {
       std::ifstream in(file, std::ios::binary);
       parse_rsi_datagram(std::string(std::istreambuf_iterator<char>(in), {}));
+    } else if (target == "egm_datagram") {
+      std::ifstream in(file, std::ios::binary);
+      parse_egm_datagram(std::string(std::istreambuf_iterator<char>(in), {}));
     } else if (target == "yaml_configs") {
       std::ifstream in(file, std::ios::binary);
       parse_yaml_configs(std::string(std::istreambuf_iterator<char>(in), {}));

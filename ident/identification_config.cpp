@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "core/units.hpp"
+#include "ident/identification_config_record.hpp"
 #include "ident/precontrol.hpp"
 
 namespace imscal::ident {
@@ -52,6 +53,35 @@ std::pair<int, int> range(const ConfigNode& node, int lowest, int highest) {
   return {int(v[0]), int(v[1])};
 }
 
+// `duration_key` [s] or `count_key`, not both: the duration (NaN when not given), its line kept.
+double duration_instead_of_count(const ConfigNode& parent, const std::string& parent_key,
+                                 const char* duration_key, const char* count_key,
+                                 IdentificationConfig& c) {
+  const auto node = parent.optional_child(duration_key);
+  if (!node) return ConfigDurations::kNone;
+  if (parent.has(count_key))
+    node->fail(fmt::format("give {} or {}, not both", duration_key, count_key));
+  const double seconds = node->as_double();
+  if (!(seconds >= 0.0 && seconds <= 3600.0)) node->fail("must be in [0, 3600] s");
+  c.key_lines[parent_key + "." + duration_key] = node->line();
+  return seconds;
+}
+
+// `robot:` and `cycle_s:`, the record the config is for.
+void load_record_keys(const ConfigNode& root, IdentificationConfig& c) {
+  c.file = root.file();
+  if (const auto robot = root.optional_child("robot")) {
+    c.robot = robot->as_string();
+    c.key_lines["robot"] = robot->line();
+  }
+  if (const auto cycle = root.optional_child("cycle_s")) {
+    c.counts_cycle_s = cycle->as_double();
+    if (!(c.counts_cycle_s > 0.0 && c.counts_cycle_s <= 1.0)) cycle->fail("must be in (0, 1] s");
+    c.key_lines["cycle_s"] = cycle->line();
+    c.resolved_cycle_s = c.counts_cycle_s;
+  }
+}
+
 }  // namespace
 
 CellGrid IdentificationConfig::joint_grid(std::size_t joint) const {
@@ -89,12 +119,13 @@ JointIdentificationOptions IdentificationConfig::joint_options(std::size_t joint
 }
 
 IdentificationConfig load_identification_config(const ConfigNode& root) {
-  root.require_only_keys({"imscal-identification-config", "joints", "cells", "model", "order",
-                          "validation", "stability_margin", "backlash"});
+  root.require_only_keys({"imscal-identification-config", "robot", "cycle_s", "joints", "cells",
+                          "model", "order", "validation", "stability_margin", "backlash"});
   if (root.child("imscal-identification-config").as_int() != 1)
     root.child("imscal-identification-config").fail("unknown config version; expected 1");
   IdentificationConfig c;
   auto& o = c.options;
+  load_record_keys(root, c);
 
   const ConfigNode joints = root.child("joints");
   joints.require_only_keys(
@@ -111,7 +142,9 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
 
   if (auto cells = root.optional_child("cells")) {
     cells->require_only_keys({"speed_fraction_bounds", "payload_fraction_bounds", "extra",
-                              "min_rows", "min_rms_speed_deg_s"});
+                              "min_rows", "min_estimation_s", "min_rms_speed_deg_s"});
+    c.durations.min_estimation_s =
+        duration_instead_of_count(*cells, "cells", "min_estimation_s", "min_rows", c);
     if (auto n = cells->optional_child("speed_fraction_bounds")) {
       c.speed_fraction_bounds = n->as_doubles();
       check_increasing(*n, c.speed_fraction_bounds);
@@ -148,11 +181,20 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
         cells->get_double("min_rms_speed_deg_s", o.min_rms_speed_rad_s / kRadPerDeg) * kRadPerDeg;
   }
   if (auto model = root.optional_child("model")) {
-    model->require_only_keys({"form", "preview_cycles", "model_torque", "direction",
+    model->require_only_keys({"form", "preview_cycles", "preview_s", "model_torque", "direction",
                               "direction_speed_scale_deg_s", "torque_sign",
-                              "torque_sign_scale_fraction", "input_taps", "torque_sign_taps",
-                              "transmission_error", "transmission_error_harmonic_per_motor_rev",
-                              "transmission_error_taps"});
+                              "torque_sign_scale_fraction", "input_taps", "input_history_s",
+                              "torque_sign_taps", "torque_sign_history_s", "transmission_error",
+                              "transmission_error_harmonic_per_motor_rev",
+                              "transmission_error_taps", "transmission_error_history_s"});
+    ConfigDurations& d = c.durations;
+    d.preview_s = duration_instead_of_count(*model, "model", "preview_s", "preview_cycles", c);
+    d.input_history_s =
+        duration_instead_of_count(*model, "model", "input_history_s", "input_taps", c);
+    d.torque_sign_history_s =
+        duration_instead_of_count(*model, "model", "torque_sign_history_s", "torque_sign_taps", c);
+    d.transmission_error_history_s = duration_instead_of_count(
+        *model, "model", "transmission_error_history_s", "transmission_error_taps", c);
     if (auto n = model->optional_child("form")) {
       try {
         o.form = arx_model_form_from_string(n->as_string());
@@ -163,8 +205,9 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
     o.preview_cycles = int(model->get_int("preview_cycles", o.preview_cycles));
     if (o.preview_cycles < 0 || o.preview_cycles > 32)
       model->child("preview_cycles").fail("must be in 0..32 cycles");
-    if (o.preview_cycles > 0 && o.form != ArxModelForm::kInverse)
-      model->child("preview_cycles").fail("a preview is used only by the inverse form");
+    if ((o.preview_cycles > 0 || d.preview_s > 0.0) && o.form != ArxModelForm::kInverse)
+      model->child(model->has("preview_s") ? "preview_s" : "preview_cycles")
+          .fail("a preview is used only by the inverse form");
     o.model_torque_input = model->get_bool("model_torque", o.model_torque_input);
     o.direction_input = model->get_bool("direction", o.direction_input);
     o.direction_speed_scale_rad_s = model->get_double("direction_speed_scale_deg_s",
@@ -238,6 +281,8 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
         n->fail("criterion must be aic, bic or validation");
     }
   }
+  // Durations in counts of the config's cycle (2 ms if it names none) until a record's is known.
+  apply_durations(c, c.resolved_cycle_s);
   // The exported table must load into the precontrol (ident/precontrol.hpp): a further input's
   // coefficients move behind the dead time when the model is written in the angle form, so
   // taps + largest dead time must fit the runtime's kMaxPrecontrolOrder per input.

@@ -4,6 +4,9 @@
 // names; everything is converted to SI on loading. Shipped default with every key explained:
 // datasets/identification/ident-default.yaml.
 #include <cstddef>
+#include <limits>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "core/config_node.hpp"
@@ -17,7 +20,30 @@ struct ExtraDimension {
   std::vector<double> bounds_si;  // the same for every joint
 };
 
+// The durations a config may state in seconds instead of cycles (NaN: given as a count, or not
+// at all), by key path: model.preview_s (preview_cycles), model.input_history_s (input_taps),
+// model.torque_sign_history_s (torque_sign_taps), model.transmission_error_history_s
+// (transmission_error_taps), cells.min_estimation_s (min_rows).
+struct ConfigDurations {
+  static constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  double preview_s = kNone;
+  double input_history_s = kNone;
+  double torque_sign_history_s = kNone;
+  double transmission_error_history_s = kNone;
+  double min_estimation_s = kNone;
+};
+
 struct IdentificationConfig {
+  std::string file;   // the config file (messages of refusals made against a record)
+  std::string robot;  // `robot:` the speeds, gear data and rating are of; empty: not named
+  // `cycle_s:` the cycle the config's counts (preview_cycles, *_taps, min_rows, the order grid,
+  // validation.max_lag) are in; NaN: not stated (counts are then taken in the record's cycle).
+  double counts_cycle_s = std::numeric_limits<double>::quiet_NaN();
+  ConfigDurations durations;
+  std::map<std::string, std::size_t> key_lines;  // line of robot, cycle_s and each duration key
+  // The record cycle the durations were last turned into counts for (ident/
+  // identification_config_record.hpp); at loading, cycle_s or 2 ms.
+  double resolved_cycle_s = 0.002;
   std::vector<double> max_speed_rad_s;  // per joint, in the joint order of the data
   // Per joint (motor revolutions per joint revolution), for the transmission-error inputs; empty
   // when the config gives none.

@@ -102,7 +102,23 @@ json cell_json(const CellIdentification& c, const CellFitFigures& figures) {
   return cell;
 }
 
-json joint_json(const JointIdentification& r, double seconds) {
+json estimate_json(const StructureEstimate& e) {
+  return {{"value", number_or_null(e.value)}, {"sigma", number_or_null(e.sigma)}};
+}
+
+json structure_json(const IdentifiedStructure& s) {
+  return {{"cells", s.cells},
+          {"compliance_rad_per_nm", estimate_json(s.compliance_rad_per_nm)},
+          {"nominal_compliance_rad_per_nm", number_or_null(s.nominal_compliance_rad_per_nm)},
+          {"stiffness_nm_per_rad", estimate_json(s.stiffness_nm_per_rad)},
+          {"direction_offset_rad", estimate_json(s.direction_offset_rad)},
+          {"transmission_error_harmonic_per_motor_rev",
+           number_or_null(s.transmission_error_harmonic_per_motor_rev)},
+          {"transmission_error_amplitude_rad", estimate_json(s.transmission_error_amplitude_rad)},
+          {"transmission_error_phase_rad", estimate_json(s.transmission_error_phase_rad)}};
+}
+
+json joint_json(const JointIdentification& r, double seconds, const IdentifiedStructure& s) {
   const auto& b = r.backlash;
   json cells = json::array();
   for (const auto& c : r.cells)
@@ -121,6 +137,7 @@ json joint_json(const JointIdentification& r, double seconds) {
             {"lag_samples", b.lag_samples},
             {"per_reversal_l_rad", b.per_reversal_rad},
             {"reason", b.reason}}},
+          {"structure", structure_json(s)},
           {"cells", cells}};
 }
 
@@ -190,6 +207,24 @@ ReportedBacklash backlash_of(const JsonField& f) {
   return b;
 }
 
+StructureEstimate estimate_of(const JsonField& f) {
+  return {f["value"].number_or_nan(), f["sigma"].number_or_nan()};
+}
+
+IdentifiedStructure structure_of(const JsonField& f) {
+  IdentifiedStructure s;
+  s.cells = f["cells"].count();
+  s.compliance_rad_per_nm = estimate_of(f["compliance_rad_per_nm"]);
+  s.nominal_compliance_rad_per_nm = f["nominal_compliance_rad_per_nm"].number_or_nan();
+  s.stiffness_nm_per_rad = estimate_of(f["stiffness_nm_per_rad"]);
+  s.direction_offset_rad = estimate_of(f["direction_offset_rad"]);
+  s.transmission_error_harmonic_per_motor_rev =
+      f["transmission_error_harmonic_per_motor_rev"].number_or_nan();
+  s.transmission_error_amplitude_rad = estimate_of(f["transmission_error_amplitude_rad"]);
+  s.transmission_error_phase_rad = estimate_of(f["transmission_error_phase_rad"]);
+  return s;
+}
+
 ReportedJoint joint_of(const JsonField& f) {
   ReportedJoint j;
   j.name = f["joint"].text();
@@ -197,6 +232,7 @@ ReportedJoint joint_of(const JsonField& f) {
   j.table_joint_error_fit_percent = f["table_joint_error_fit_percent"].number_or_nan();
   j.table_validation_rows = f["table_validation_rows"].count();
   j.backlash = backlash_of(f["backlash"]);
+  if (const auto structure = f.optional("structure")) j.structure = structure_of(*structure);
   const JsonField cells = f["cells"];
   for (std::size_t k = 0; k < cells.size(); ++k) j.cells.push_back(cell_of(cells[k]));
   return j;
@@ -241,7 +277,7 @@ json identification_report_json(const IdentificationReportHeader& header,
                                 const std::vector<JointOutcome>& outcomes) {
   json joints = json::array();
   for (const JointOutcome& outcome : outcomes)
-    joints.push_back(joint_json(outcome.result, outcome.seconds));
+    joints.push_back(joint_json(outcome.result, outcome.seconds, outcome.structure));
   return {{kVersionKey, 1},
           {"created_by", header.created_by},
           {"joint_errors", header.joint_errors},

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "ident/identified_structure.hpp"
 #include "ident/identify_joints.hpp"
 #include "ident/parameter_table.hpp"
 
@@ -79,6 +80,8 @@ struct ReportedJoint {
   double table_joint_error_fit_percent = 0.0;
   std::size_t table_validation_rows = 0;
   ReportedBacklash backlash;
+  // The drive structure the models imply, with 1σ (absent in reports written before it was).
+  std::optional<IdentifiedStructure> structure;
   std::vector<ReportedCell> cells;
 };
 

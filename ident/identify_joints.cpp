@@ -9,11 +9,33 @@
 
 #include "core/input_error.hpp"
 #include "core/version.hpp"
+#include "ident/identification_config_record.hpp"
 
 namespace imscal::ident {
+namespace {
 
-ParameterTable parameter_table_header(const JointErrorLog& log, const IdentificationConfig& config,
-                                      DataSource source) {
+IdentifiedStructure structure_beside_config(const JointIdentification& result,
+                                            const IdentificationConfig& config, std::size_t joint) {
+  IdentifiedStructure s = identified_structure(result, extra_inputs_of(config.options));
+  if (joint < config.gear_stiffness_nm_per_rad.size())
+    s.nominal_compliance_rad_per_nm = 1.0 / config.gear_stiffness_nm_per_rad[joint];
+  if (config.options.transmission_error_input)
+    s.transmission_error_harmonic_per_motor_rev = config.transmission_error_harmonic(joint);
+  return s;
+}
+
+// The config with its durations in counts of the log's cycle (ident/
+// identification_config_record.hpp), checked against the log.
+IdentificationConfig for_log(const IdentificationConfig& config, const JointErrorLog& log) {
+  if (config.resolved_cycle_s == log.cycle_s) return config;
+  return resolve_for_record(config, log.robot, log.cycle_s, "the joint errors");
+}
+
+}  // namespace
+
+ParameterTable parameter_table_header(const JointErrorLog& log,
+                                      const IdentificationConfig& given_config, DataSource source) {
+  const IdentificationConfig config = for_log(given_config, log);
   ParameterTable table;
   table.robot = log.robot;
   table.sample_time_s = log.cycle_s;
@@ -28,8 +50,9 @@ ParameterTable parameter_table_header(const JointErrorLog& log, const Identifica
 }
 
 std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
-                                          const IdentificationConfig& config, unsigned threads,
-                                          const JointDoneCallback& on_done) {
+                                          const IdentificationConfig& given_config,
+                                          unsigned threads, const JointDoneCallback& on_done) {
+  const IdentificationConfig config = for_log(given_config, log);
   const std::size_t joints = log.joint_count();
   std::vector<JointOutcome> outcomes(joints);
   std::vector<std::exception_ptr> errors(joints);
@@ -67,6 +90,8 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
       } catch (...) {
         errors[j] = std::current_exception();
       }
+      if (!errors[j])
+        outcomes[j].structure = structure_beside_config(outcomes[j].result, config, j);
       outcomes[j].seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const std::lock_guard lock(done_mutex);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "ident/identification_config.hpp"
+#include "ident/identified_structure.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/joint_identification.hpp"
 
@@ -18,6 +19,9 @@ struct JointOutcome {
   JointIdentification result;
   std::string failure;   // empty when identified; else why the joint got the neutral model
   double seconds = 0.0;  // wall time of this joint's identification
+  // The drive structure its models imply (compliance, friction, transmission error) with 1σ,
+  // beside the config's values.
+  IdentifiedStructure structure;
 };
 
 // threads: worker threads, 0 = the machine's hardware concurrency (at most one per joint).

@@ -6,26 +6,6 @@
 #include "core/units.hpp"
 
 namespace imscal::online {
-const char* to_string(RsiFault fault) {
-  switch (fault) {
-    case RsiFault::kMalformed:
-      return "malformed datagram";
-    case RsiFault::kLate:
-      return "late datagram";
-    case RsiFault::kLost:
-      return "lost datagrams";
-    case RsiFault::kDuplicated:
-      return "duplicated IPOC";
-    case RsiFault::kReordered:
-      return "reordered IPOC";
-    case RsiFault::kUnknownRobot:
-      return "unknown robot type";
-    case RsiFault::kOffPath:
-      return "set-point off the loaded path";
-  }
-  return "?";
-}
-
 std::unique_ptr<RsiSession> RsiSession::create(const ident::ParameterTable& table,
                                                const std::string& robot_name,
                                                ident::PrecontrolOptions precontrol,
@@ -55,31 +35,12 @@ std::unique_ptr<RsiSession> RsiSession::create(const ident::ParameterTable& tabl
   return session;
 }
 
-void RsiSession::record(std::uint64_t ipoc, RsiFault fault, int detail, double value) noexcept {
-  if (fault_count_ == kRsiFaultCapacity) {
-    fault_head_ = (fault_head_ + 1) % kRsiFaultCapacity;
-    --fault_count_;
-  }
-  faults_[std::size_t((fault_head_ + fault_count_) % kRsiFaultCapacity)] =
-      RsiFaultEvent{ipoc, fault, detail, value};
-  ++fault_count_;
-}
-
-int RsiSession::read_faults(RsiFaultEvent* out, int capacity) noexcept {
-  int n = 0;
-  for (; n < capacity && fault_count_ > 0; ++n, --fault_count_) {
-    out[n] = faults_[std::size_t(fault_head_)];
-    fault_head_ = (fault_head_ + 1) % kRsiFaultCapacity;
-  }
-  return n;
-}
-
 bool RsiSession::judge(const RsiRobotDatagram& d, double receive_time_s) noexcept {
   const std::uint64_t cycle = d.ipoc / options_.ipoc_per_cycle;
   in_order_ = !started_ || cycle > last_cycle_;
   if (!in_order_) {
     // Not for the precontrol (its counter and its state stay); faded at the next in-order one.
-    record(d.ipoc, cycle == last_cycle_ ? RsiFault::kDuplicated : RsiFault::kReordered, 0,
+    record(d.ipoc, cycle == last_cycle_ ? SessionFault::kDuplicated : SessionFault::kReordered, 0,
            double(last_cycle_ - cycle));
     pending_fault_ = true;
     return false;
@@ -87,18 +48,18 @@ bool RsiSession::judge(const RsiRobotDatagram& d, double receive_time_s) noexcep
   bool fade = pending_fault_;
   pending_fault_ = false;
   if (!options_.robot_type.empty() && d.type_name() != options_.robot_type) {
-    record(d.ipoc, RsiFault::kUnknownRobot, 0, 0.0);
+    record(d.ipoc, SessionFault::kUnknownRobot, 0, 0.0);
     fade = true;
   }
   if (started_) {
     const double gap_s = receive_time_s - last_receive_s_;
     if (options_.late_after_s > 0.0 && gap_s > options_.cycle_s + options_.late_after_s) {
-      record(d.ipoc, RsiFault::kLate, 0, gap_s);
+      record(d.ipoc, SessionFault::kLate, 0, gap_s);
       fade = true;
     }
     // The precontrol's own counter check fades out on a gap; it is logged here by kind too.
     if (cycle > last_cycle_ + 1)
-      record(d.ipoc, RsiFault::kLost, 0, double(cycle - last_cycle_ - 1));
+      record(d.ipoc, SessionFault::kLost, 0, double(cycle - last_cycle_ - 1));
   }
   advanced_ = started_ ? cycle - last_cycle_ : 1;
   started_ = true;
@@ -143,7 +104,7 @@ int RsiSession::handle(std::string_view datagram, double receive_time_s, char* a
                        int capacity) noexcept {
   const RsiParseError error = parse_rsi_robot_datagram(datagram, &datagram_);
   if (error != RsiParseError::kNone) {
-    record(0, RsiFault::kMalformed, int(error), 0.0);
+    record(0, SessionFault::kMalformed, int(error), 0.0);
     pending_fault_ = true;
     ++refused_;
     return 0;
@@ -157,7 +118,7 @@ int RsiSession::handle(std::string_view datagram, double receive_time_s, char* a
       q_rad[std::size_t(a)] = datagram_.setpoint_deg[std::size_t(a)] / kDegPerRad;
     PathSample input;
     if (!precontrol_input(q_rad, &input)) {
-      record(datagram_.ipoc, RsiFault::kOffPath, 0, 0.0);
+      record(datagram_.ipoc, SessionFault::kOffPath, 0, 0.0);
       fade = true;
     }
     if (fade) precontrol_.fault(cycle, 0.0);

@@ -3,7 +3,7 @@
 // (online/rsi_datagram.hpp), judge it (malformed, late, lost / duplicated / reordered IPOC,
 // unknown robot), step the precontrol (ident/precontrol.hpp) on the set-points ASPos, and write
 // the answer with the IPOC echoed. `imscal serve` puts it behind a UDP socket
-// (online/rsi_server.hpp); the bench and the tests call it directly too.
+// (online/udp_server.hpp); the bench and the tests call it directly too.
 //
 // Faults: what the session detects itself is reported to the precontrol as a caller fault
 // (Precontrol::fault: the corrections fade out over fade_out_s, never stepping above the rate
@@ -35,6 +35,7 @@
 
 #include "ident/parameter_table.hpp"
 #include "ident/precontrol.hpp"
+#include "online/datagram_session.hpp"
 #include "online/path_follower.hpp"
 #include "online/rsi_datagram.hpp"
 
@@ -52,26 +53,7 @@ struct RsiSessionOptions {
   double payload_kg = 0.0;    // the payload the precontrol's operating point uses
 };
 
-enum class RsiFault : std::uint8_t {
-  kMalformed,     // detail: the RsiParseError
-  kLate,          // value: the gap to the previous datagram [s]
-  kLost,          // value: cycles missing before this IPOC
-  kDuplicated,    // the IPOC of the previous datagram again
-  kReordered,     // an IPOC older than the previous one
-  kUnknownRobot,  // Rob's Type is not the expected one
-  kOffPath,       // the set-point is not on the loaded path at its time (online/path_follower)
-};
-const char* to_string(RsiFault fault);
-
-struct RsiFaultEvent {
-  std::uint64_t ipoc = 0;  // of the datagram (0 for a malformed one)
-  RsiFault fault = RsiFault::kMalformed;
-  int detail = 0;
-  double value = 0.0;
-};
-inline constexpr int kRsiFaultCapacity = 256;
-
-class RsiSession {
+class RsiSession final : public DatagramSession {
  public:
   // nullptr with the reason in *why when the precontrol refuses the table or the options are
   // inconsistent (cycle, IPOC step, sensor type). `path`: the program's desired path, which a
@@ -85,11 +67,9 @@ class RsiSession {
 
   // One received datagram at receive_time_s (any monotonic clock): the answer's length written
   // to `answer`, or 0 when the datagram is not answered (malformed).
-  int handle(std::string_view datagram, double receive_time_s, char* answer, int capacity) noexcept;
-
-  // Faults since the last call, oldest first (the ring keeps the newest kRsiFaultCapacity).
-  int read_faults(RsiFaultEvent* out, int capacity) noexcept;
-  ident::Precontrol& precontrol() noexcept { return precontrol_; }
+  int handle(std::string_view datagram, double receive_time_s, char* answer,
+             int capacity) noexcept override;
+  ident::Precontrol& precontrol() noexcept override { return precontrol_; }
   // The correction of the last answer [rad] (absolute, whichever the mode) and its state.
   const std::array<double, kRsiAxes>& correction_rad() const noexcept { return correction_rad_; }
   ident::PrecontrolState state() const noexcept { return state_; }
@@ -98,7 +78,6 @@ class RsiSession {
 
  private:
   RsiSession() = default;
-  void record(std::uint64_t ipoc, RsiFault fault, int detail, double value) noexcept;
   // The session's own judgement of a parsed datagram; true when the precontrol must fade out.
   bool judge(const RsiRobotDatagram& datagram, double receive_time_s) noexcept;
   void answer_values(const std::array<double, kRsiAxes>& offset_rad,
@@ -122,8 +101,6 @@ class RsiSession {
   std::array<double, kRsiAxes> correction_rad_{};
   std::array<double, kRsiAxes> sent_sum_deg_{};  // increment mode: what the controller summed
   ident::PrecontrolState state_ = ident::PrecontrolState::kInactive;
-  std::array<RsiFaultEvent, kRsiFaultCapacity> faults_{};
-  int fault_head_ = 0, fault_count_ = 0;
   std::uint64_t answered_ = 0, refused_ = 0;
 };
 

@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libceres-dev libsuitesparse-dev libgeographiclib-dev liborocos-kdl-dev liburdfdom-dev liburdfdom-headers-dev
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev libopencv-calib3d-dev libtinyxml2-dev
+  protobuf-compiler libprotobuf-dev
   gnuplot-nox python3 python3-numpy python3-dev pybind11-dev python3-pybind11 python3-pytest
   python3-matplotlib clang-format clang-tidy clang lld chromium
   snakemake slurm-wlm munge

@@ -24,6 +24,7 @@
 #include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
+#include "ident/identification_config_record.hpp"
 #include "ident/identification_report.hpp"
 #include "ident/identify_joints.hpp"
 #include "ident/joint_error_io.hpp"
@@ -51,8 +52,8 @@ struct IdentifyArgs {
 void attach_model_torques(ident::JointErrorLog& log, const ident::IdentificationConfig& config,
                           const IdentifyArgs& args) {
   if (!config.options.model_torque_input) return;
-  const imscal::eval::ModelTorqueSource model =
-      args.model_torque.source(log.robot, args.joint_errors, args.config, "model.model_torque");
+  const imscal::eval::ModelTorqueSource model = args.model_torque.source(
+      log.robot, args.joint_errors, args.config, "model.model_torque", log.cycle_s);
   spdlog::info("identify: model torques of {} along the {} path", model.robot.name,
                imscal::eval::torque_along_measured_path(config.options) ? "measured" : "desired");
   imscal::eval::attach_model_torques(log, model, config.options);
@@ -186,7 +187,11 @@ void run(const IdentifyArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   ident::JointErrorLog log = ident::read_joint_errors_csv(args.joint_errors);
   const imscal::ConfigNode config_node = imscal::ConfigNode::load_file(args.config);
-  ident::IdentificationConfig config = ident::load_identification_config(config_node);
+  std::vector<std::string> warnings;
+  ident::IdentificationConfig config =
+      ident::resolve_for_record(ident::load_identification_config(config_node), log.robot,
+                                log.cycle_s, args.joint_errors, &warnings);
+  for (const std::string& w : warnings) spdlog::warn("identify: {}", w);
   attach_model_torques(log, config, args);
   if (config.max_speed_rad_s.size() != log.joint_count())
     throw imscal::InputError(

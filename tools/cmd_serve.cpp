@@ -1,8 +1,9 @@
-// `imscal serve`: the precontrol (ident/precontrol.hpp) online behind KUKA RSI: binds a UDP port,
-// answers every controller datagram with the joint corrections of a parameter table, the IPOC
-// echoed (online/rsi_server.hpp, online/rsi_session.hpp), and logs every fault and supervisor
-// event. Runs until interrupted (SIGINT/SIGTERM) or, with --idle-timeout-s, until the controller
-// stops sending.
+// `imscal serve`: the precontrol (ident/precontrol.hpp) online behind KUKA RSI or ABB EGM: binds a
+// UDP port, answers every controller datagram (online/udp_server.hpp) with the joint corrections
+// of a parameter table, the IPOC echoed (RSI: online/rsi_session.hpp), or with the program's path
+// plus the corrections, the seqno echoed (EGM position guidance: online/egm_session.hpp), and
+// logs every fault and supervisor event. Runs until interrupted (SIGINT/SIGTERM) or, with
+// --idle-timeout-s, until the controller stops sending.
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -17,9 +18,10 @@
 #include "core/input_error.hpp"
 #include "eval/model_torque.hpp"
 #include "ident/parameter_table_io.hpp"
+#include "online/egm_session.hpp"
 #include "online/path_follower.hpp"
-#include "online/rsi_server.hpp"
 #include "online/rsi_session.hpp"
+#include "online/udp_server.hpp"
 #include "online/udp_socket.hpp"
 #include "tools/command_registry.hpp"
 #include "tools/model_torque_option.hpp"
@@ -35,10 +37,11 @@ extern "C" void request_stop(int) {
 }
 
 struct ServeArgs {
-  std::string table, bind = "0.0.0.0", mode = "absolute", path;
+  std::string protocol = "rsi", table, bind = "0.0.0.0", mode = "absolute", path;
   imscal::tools::ModelTorqueOption model_torque;  // for tables with the model-torque input
   int port = 0;
   online::RsiSessionOptions session;
+  online::EgmSessionOptions egm;
   double cycle_ms = 4.0, late_ms = 0.0, idle_timeout_s = 0.0;
   double offset_tolerance_rad = 0.0;
   double max_setpoint_speed_deg_s = 1000.0;
@@ -51,8 +54,7 @@ struct ServeArgs {
 // The robot program's desired path (a robot log: q_desired and payload per sample), with the
 // model torque along it when the table's models take it (eval/model_torque.hpp, as `imscal
 // compensate`), for a table with a preview or the model torque (decision 0024).
-std::unique_ptr<online::PathFollower> load_path(const ServeArgs& args,
-                                                const ident::ParameterTable& table) {
+online::LoadedPath load_path(const ServeArgs& args, const ident::ParameterTable& table) {
   const imscal::calib::RobotLog log = imscal::calib::read_robot_log_csv(
       args.path, table.robot, "the parameter table " + args.table);
   online::LoadedPath path;
@@ -81,12 +83,23 @@ std::unique_ptr<online::PathFollower> load_path(const ServeArgs& args,
       for (int j = 0; j < online::kPathJoints; ++j)
         path.torque_nm[k][std::size_t(j)] = torque[std::size_t(j)][k];
   }
+  return path;
+}
+
+// How far ahead of the set-point the precontrol is fed [s].
+double ahead_s(const ServeArgs& args, const ident::ParameterTable& table) {
+  return (table.preview_cycles + args.look_ahead_cycles) * table.sample_time_s;
+}
+
+// RSI: the path followed by the controller's IPOC.
+std::unique_ptr<online::PathFollower> follow_path(const ServeArgs& args,
+                                                  const ident::ParameterTable& table) {
+  online::LoadedPath path = load_path(args, table);
   try {
     online::PathFollowerOptions follow;
     follow.clock_from_first_datagram = args.path_clock == "stream";
-    return std::make_unique<online::PathFollower>(
-        std::move(path), args.cycle_ms * 1e-3,
-        (table.preview_cycles + args.look_ahead_cycles) * table.sample_time_s, follow);
+    return std::make_unique<online::PathFollower>(std::move(path), args.cycle_ms * 1e-3,
+                                                  ahead_s(args, table), follow);
   } catch (const std::invalid_argument& e) {
     throw imscal::InputError(args.path, 0, "cycle_s", e.what());
   }
@@ -110,16 +123,19 @@ void check_servable_without_path(const std::string& file, const ident::Parameter
   }
 }
 
-void log_events(online::RsiSession& session) {
-  std::array<online::RsiFaultEvent, 32> faults{};
+void log_events(online::DatagramSession& session, bool egm) {
+  std::array<online::SessionFaultEvent, 32> faults{};
+  const char* counter = egm ? "EGM: seqno" : "RSI: IPOC";
   for (int n; (n = session.read_faults(faults.data(), int(faults.size()))) > 0;) {
     for (int i = 0; i < n; ++i) {
-      const online::RsiFaultEvent& f = faults[std::size_t(i)];
-      if (f.fault == online::RsiFault::kMalformed) {
-        spdlog::warn("RSI: malformed datagram refused: {}",
-                     online::to_string(static_cast<online::RsiParseError>(f.detail)));
+      const online::SessionFaultEvent& f = faults[std::size_t(i)];
+      if (f.fault == online::SessionFault::kMalformed) {
+        spdlog::warn("{}: malformed datagram refused: {}", egm ? "EGM" : "RSI",
+                     egm ? online::to_string(static_cast<online::EgmParseError>(f.detail))
+                         : online::to_string(static_cast<online::RsiParseError>(f.detail)));
       } else {
-        spdlog::warn("RSI: IPOC {}: {} (value {})", f.ipoc, online::to_string(f.fault), f.value);
+        spdlog::warn("{} {}: {} (value {})", counter, f.counter, online::to_string(f.fault),
+                     f.value);
       }
     }
   }
@@ -134,27 +150,55 @@ void log_events(online::RsiSession& session) {
   }
 }
 
-void run(ServeArgs args) {
-  const ident::ParameterTable table = ident::read_parameters_json(args.table);
+ident::PrecontrolOptions precontrol_options(const ServeArgs& args) {
+  ident::PrecontrolOptions precontrol;
+  if (args.offset_tolerance_rad > 0.0)
+    precontrol.offset_tolerance_rad.fill(args.offset_tolerance_rad);
+  precontrol.max_input_speed_rad_s = args.max_setpoint_speed_deg_s * M_PI / 180.0;
+  return precontrol;
+}
+
+std::unique_ptr<online::DatagramSession> rsi_session(ServeArgs& args,
+                                                     const ident::ParameterTable& table) {
   std::unique_ptr<online::PathFollower> path;
   if (args.path.empty()) {
     check_servable_without_path(args.table, table);
   } else {
-    path = load_path(args, table);
+    path = follow_path(args, table);
   }
   args.session.mode = args.mode == "increment" ? online::RsiCorrectionMode::kIncrement
                                                : online::RsiCorrectionMode::kAbsolute;
   args.session.cycle_s = args.cycle_ms * 1e-3;
   args.session.late_after_s = args.late_ms * 1e-3;
-  ident::PrecontrolOptions precontrol;
-  if (args.offset_tolerance_rad > 0.0)
-    precontrol.offset_tolerance_rad.fill(args.offset_tolerance_rad);
-  precontrol.max_input_speed_rad_s = args.max_setpoint_speed_deg_s * M_PI / 180.0;
   std::string why;
-  const std::string& robot = table.robot;
-  std::unique_ptr<online::RsiSession> session =
-      online::RsiSession::create(table, robot, precontrol, args.session, &why, std::move(path));
+  auto session = online::RsiSession::create(table, table.robot, precontrol_options(args),
+                                            args.session, &why, std::move(path));
   if (!session) throw imscal::InputError(args.table, 0, "", "cannot serve this table: " + why);
+  return session;
+}
+
+// EGM position guidance: the server plays the program's path (docs/decisions/0033).
+std::unique_ptr<online::DatagramSession> egm_session(ServeArgs& args,
+                                                     const ident::ParameterTable& table) {
+  if (args.path.empty())
+    throw imscal::InputError("--path", 0, "",
+                             "EGM position guidance streams the program's desired path: give it "
+                             "(--path robot.csv)");
+  args.egm.cycle_s = args.cycle_ms * 1e-3;
+  args.egm.late_after_s = args.late_ms * 1e-3;
+  args.egm.payload_kg = args.session.payload_kg;
+  std::string why;
+  auto session = online::EgmSession::create(table, table.robot, precontrol_options(args), args.egm,
+                                            load_path(args, table), ahead_s(args, table), &why);
+  if (!session) throw imscal::InputError(args.path, 0, "", "cannot serve this path: " + why);
+  return session;
+}
+
+void run(ServeArgs args) {
+  const ident::ParameterTable table = ident::read_parameters_json(args.table);
+  const bool egm = args.protocol == "egm";
+  std::unique_ptr<online::DatagramSession> session =
+      egm ? egm_session(args, table) : rsi_session(args, table);
   try {
     (void)online::udp_peer(args.bind, 0);
   } catch (const std::invalid_argument& e) {
@@ -163,21 +207,28 @@ void run(ServeArgs args) {
   online::UdpSocket socket(args.bind, static_cast<std::uint16_t>(args.port));
   std::signal(SIGINT, request_stop);
   std::signal(SIGTERM, request_stop);
-  spdlog::info("serve: RSI on {}:{}, {} corrections, cycle {} ms, table {} ({})", args.bind,
-               socket.port(), args.mode, args.cycle_ms, args.table, robot);
-  online::RsiServerOptions options;
+  spdlog::info(
+      "serve: {} on {}:{}, {}, cycle {} ms, table {} ({})", egm ? "EGM" : "RSI", args.bind,
+      socket.port(),
+      egm ? std::string("position guidance along ") + args.path : args.mode + " corrections",
+      args.cycle_ms, args.table, table.robot);
+  online::UdpServerOptions options;
   options.idle_timeout_s = args.idle_timeout_s;
-  const online::RsiServerStats stats =
-      online::serve_rsi(socket, *session, g_stop, options, [&] { log_events(*session); });
-  log_events(*session);
+  const online::UdpServerStats stats =
+      online::serve_udp(socket, *session, g_stop, options, [&] { log_events(*session, egm); });
+  log_events(*session, egm);
   spdlog::info("serve: {} datagrams, {} answered, {} not answered", stats.datagrams, stats.answered,
                stats.not_answered);
 }
 
 imscal::tools::CommandRegistration registration{
-    "serve", "Serve the precontrol online to a KUKA controller over RSI (UDP, XML)",
+    "serve",
+    "Serve the precontrol online to a robot controller: KUKA RSI (UDP, XML) or ABB EGM (UDP, "
+    "protocol buffers)",
     [](CLI::App& sub) {
       auto args = std::make_shared<ServeArgs>();
+      sub.add_option("--protocol", args->protocol, "rsi (default) or egm")
+          ->check(CLI::IsMember({"rsi", "egm"}));
       sub.add_option("--table", args->table, "parameters.json (imscal identify)")->required();
       sub.add_option("--port", args->port, "UDP port the controller sends to")
           ->required()
@@ -186,8 +237,14 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--mode", args->mode, "AKorr as the RSI configuration sums it")
           ->check(CLI::IsMember({"absolute", "increment"}));
       sub.add_option("--path", args->path,
-                     "the program's desired path (robot.csv), followed by IPOC: needed by tables "
-                     "with a preview or the model torque");
+                     "the program's desired path (robot.csv): RSI follows it by IPOC (needed by "
+                     "tables with a preview or the model torque); EGM streams it (required)");
+      sub.add_option("--start-tolerance-rad", args->egm.start_tolerance_rad,
+                     "EGM: the robot is at the path's first pose within this, per joint")
+          ->check(CLI::PositiveNumber);
+      sub.add_option("--track-tolerance-rad", args->egm.track_tolerance_rad,
+                     "EGM: a measured joint farther from its target is a fault")
+          ->check(CLI::PositiveNumber);
       args->model_torque.add_to(sub);
       sub.add_option(
              "--look-ahead-cycles", args->look_ahead_cycles,

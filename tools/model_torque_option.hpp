@@ -19,10 +19,12 @@ struct ModelTorqueOption {
 
   // The rigid-body model for the data of `data_robot` (file `data_file`, for messages), or
   // InputError naming `needed_by` (file and field that asked for the torque) when --robot is
-  // missing, and the robot file when its robot is not the data's.
+  // missing, and the robot file when its robot is not the data's or (data_cycle_s > 0) its
+  // controller cycle is not the data's sample time [s].
   eval::ModelTorqueSource source(const std::string& data_robot, const std::string& data_file,
                                  const std::string& needed_by_file,
-                                 const std::string& needed_by_field) const;
+                                 const std::string& needed_by_field,
+                                 double data_cycle_s = 0.0) const;
 };
 
 }  // namespace imscal::tools

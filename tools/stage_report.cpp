@@ -18,6 +18,7 @@
 #include "tools/report_chain_sections.hpp"
 #include "tools/report_figures.hpp"
 #include "tools/report_gnuplot.hpp"
+#include "tools/report_structure_section.hpp"
 #include "tools/stage_chain.hpp"
 
 namespace imscal::tools {
@@ -164,6 +165,7 @@ std::string models_body(const ident::ParameterTable& table,
         table_fit_of(report, joint.name));
   }
   body += "</table>\n";
+  if (report) body += structure_table_html(*report);
   for (const auto& joint : table.joints) {
     const ident::CellGrid grid = joint.grid();
     body += fmt::format(

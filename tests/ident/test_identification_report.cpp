@@ -1,6 +1,7 @@
 // identification_report.json (ident/identification_report.hpp): an identification written is read
-// back with the same figures (cells, chosen orders, held-out fits, backlash, order search), and a
-// report with a missing or mistyped field is refused naming the file and the field.
+// back with the same figures (cells, chosen orders, held-out fits, backlash, order search, the
+// identified structure), and a report with a missing or mistyped field is refused naming the file
+// and the field.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -62,6 +63,10 @@ JointOutcome sample_joint() {
   filled.filled_from = 0;
   filled.reason = "0 estimation rows";
   r.cells = {identified, filled};
+  outcome.structure.cells = 1;
+  outcome.structure.compliance_rad_per_nm = {2.5e-6, 1e-7};
+  outcome.structure.nominal_compliance_rad_per_nm = 2.2e-6;
+  outcome.structure.transmission_error_phase_rad = {0.75, 0.125};
   return outcome;
 }
 
@@ -117,6 +122,13 @@ TEST_F(IdentificationReportTest, WhatIsWrittenIsReadBack) {
   EXPECT_EQ(j.cells[1].filled_from, 0);
   EXPECT_EQ(j.cells[1].reason, "0 estimation rows");
   EXPECT_FALSE(j.cells[1].validation.has_value());
+  ASSERT_TRUE(j.structure.has_value());
+  EXPECT_EQ(j.structure->cells, 1u);
+  EXPECT_EQ(j.structure->compliance_rad_per_nm.value, 2.5e-6);
+  EXPECT_EQ(j.structure->compliance_rad_per_nm.sigma, 1e-7);
+  EXPECT_EQ(j.structure->nominal_compliance_rad_per_nm, 2.2e-6);
+  EXPECT_EQ(j.structure->transmission_error_phase_rad.sigma, 0.125);
+  EXPECT_FALSE(j.structure->stiffness_nm_per_rad.identified());  // NaN written as null, read as NaN
 }
 
 TEST_F(IdentificationReportTest, RefusalsNameTheFileAndTheField) {

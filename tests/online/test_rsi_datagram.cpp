@@ -9,7 +9,7 @@
 #include <cmath>
 #include <string>
 
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
 
 namespace imscal::online {
 namespace {

@@ -10,14 +10,14 @@
 #include <filesystem>
 
 #include "eval/closed_loop.hpp"
+#include "online/controller_emulator.hpp"
 #include "online/path_follower.hpp"
-#include "online/rsi_controller_emulator.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
 #include "sim/scenario.hpp"
 #include "tests/support/lag_table.hpp"
-#include "tests/support/rsi_loopback.hpp"
+#include "tests/support/loopback_server.hpp"
 
 namespace imscal::online {
 namespace {
@@ -131,13 +131,13 @@ TEST(RsiPath, APreviewTableThroughSocketsGetsThePathAhead) {
   session.cycle_s = path.cycle_s;
   session.ipoc_per_cycle = 2;
   auto follower = std::make_unique<PathFollower>(loaded, path.cycle_s, 20 * 0.002);
-  test_support::RsiLoopbackServer server(preview_table(), precontrol, session, std::move(follower));
+  test_support::LoopbackServer server(preview_table(), precontrol, session, std::move(follower));
   UdpSocket controller("127.0.0.1", 0);
-  RsiEmulatorOptions emulator;
+  EmulatorOptions emulator;
   emulator.cycle_s = path.cycle_s;
   emulator.ipoc_per_cycle = 2;
   emulator.answer_timeout_s = 5.0;  // a stalled server thread (loaded machine) is not a miss
-  const RsiEmulatorRun run = emulate_rsi_controller(controller, server.peer(), setpoint, emulator);
+  const EmulatorRun run = emulate_controller(controller, server.peer(), setpoint, emulator);
   server.finish();
   EXPECT_EQ(run.missed, 0u);
   EXPECT_TRUE(server.faults().empty());
@@ -150,7 +150,7 @@ TEST(RsiPath, APreviewTableThroughSocketsGetsThePathAhead) {
     ++moving;
   ASSERT_LT(moving + 200, loaded.q_rad.size());
   // From 100 cycles after it (the model forgets the missed start by 0.5^100), the corrections
-  // equal the in-process ones within the written values' rounding (see test_rsi_loopback).
+  // equal the in-process ones within the written values' rounding (see test_interface_loopback).
   double largest = 0.0, largest_difference = 0.0;
   for (std::size_t k = moving + 100; k < path.samples.size(); ++k) {
     for (int j = 0; j < 6; ++j) {

@@ -14,7 +14,7 @@
 #include <cmath>
 #include <string>
 
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
 #include "tests/support/allocation_counter.hpp"
 #include "tests/support/lag_table.hpp"
 
@@ -73,7 +73,7 @@ TEST(RsiSession, HandlesDatagramsWithoutAllocating) {
   }
   EXPECT_EQ(test_support::g_allocations.load() - before, 0);
   EXPECT_GT(answered, 1900);
-  std::array<RsiFaultEvent, kRsiFaultCapacity> faults{};
+  std::array<SessionFaultEvent, kSessionFaultCapacity> faults{};
   EXPECT_GT(session->read_faults(faults.data(), int(faults.size())), 10);
 }
 

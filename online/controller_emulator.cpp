@@ -1,4 +1,4 @@
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
 
 #include <charconv>
 #include <chrono>
@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "core/units.hpp"
+#include "online/egm_codec.hpp"
 
 namespace imscal::online {
 namespace {
@@ -41,9 +42,10 @@ bool read_answer(std::string_view text, Answer* out) {
 
 class Emulator {
  public:
-  Emulator(UdpSocket& socket, const UdpPeer& server, const RsiEmulatorOptions& options,
-           std::size_t cycles)
-      : socket_(socket), server_(server), options_(options) {
+  Emulator(UdpSocket& socket, const UdpPeer& server, const EmulatorOptions& options,
+           const std::vector<std::array<double, kRsiAxes>>& setpoint_rad)
+      : socket_(socket), server_(server), options_(options), setpoint_rad_(setpoint_rad) {
+    const std::size_t cycles = setpoint_rad.size();
     run_.correction_rad.resize(cycles);
     run_.answered.assign(cycles, false);
     run_.latency_s.assign(cycles, 0.0);
@@ -53,19 +55,42 @@ class Emulator {
   void send(std::size_t k, const std::array<double, kRsiAxes>& q_rad, InjectedFault* fault) {
     std::array<double, kRsiAxes> q_deg{};
     for (int a = 0; a < kRsiAxes; ++a) q_deg[std::size_t(a)] = q_rad[std::size_t(a)] * kDegPerRad;
-    std::string_view type = options_.robot_type;
-    if (fault != nullptr && *fault == InjectedFault::kNaN)
-      q_deg[0] = std::numeric_limits<double>::quiet_NaN();
-    if (fault != nullptr && *fault == InjectedFault::kJump) q_deg[0] += options_.jump_deg;
-    if (fault != nullptr && *fault == InjectedFault::kUnknownRobot) type = "UNKNOWN";
-    const int n =
-        write_rsi_robot_datagram(type, q_deg, ipoc(k), buffer_.data(), int(buffer_.size()));
+    const InjectedFault kind = fault != nullptr ? *fault : InjectedFault::kDrop;
+    if (kind == InjectedFault::kNaN) q_deg[0] = std::numeric_limits<double>::quiet_NaN();
+    if (kind == InjectedFault::kJump) q_deg[0] += options_.jump_deg;
+    const bool unknown = kind == InjectedFault::kUnknownRobot;
+    const int n = options_.protocol == ControllerProtocol::kEgm
+                      ? write_egm(k, q_deg, unknown)
+                      : write_rsi_robot_datagram(unknown ? "UNKNOWN" : options_.robot_type, q_deg,
+                                                 ipoc(k), buffer_.data(), int(buffer_.size()));
     sent_at_[k] = Clock::now();
     if (n <= 0 || !socket_.send(buffer_.data(), n, server_))
       throw std::runtime_error("emulator: cannot send a datagram");
   }
 
+  // EGM: the robot's measured joints (a 7-axis robot when `unknown`), planned the same, motors on.
+  int write_egm(std::size_t k, const std::array<double, kRsiAxes>& q_deg, bool unknown) {
+    EgmRobotDatagram d;
+    d.seqno = std::uint32_t(ipoc(k));
+    d.tm_ms = std::uint32_t(std::llround(double(k) * options_.cycle_s * 1e3));
+    d.feedback_joints = unknown ? kEgmAxes + 1 : kEgmAxes;
+    d.planned_joints = kEgmAxes;
+    for (int a = 0; a < kEgmAxes; ++a) {
+      d.feedback_deg[std::size_t(a)] = q_deg[std::size_t(a)];
+      d.planned_deg[std::size_t(a)] = setpoint_rad_[k][std::size_t(a)] * kDegPerRad;
+    }
+    d.motors = EgmMotors::kOn;
+    return codec_.write_robot(d, buffer_.data(), int(buffer_.size()));
+  }
+
   void send_malformed(std::size_t k) {
+    if (options_.protocol == ControllerProtocol::kEgm) {
+      // A header field whose length runs past the datagram's end.
+      const std::string broken("\x0a\x10\x08\x01\x10", 5);
+      if (!socket_.send(broken.data(), int(broken.size()), server_))
+        throw std::runtime_error("emulator: cannot send a datagram");
+      return;
+    }
     const std::string broken = "<Rob Type=\"" + options_.robot_type + "\"><ASPos A1=\"1\"/><IPOC>" +
                                std::to_string(ipoc(k)) + "</IPC></Rob>";
     if (!socket_.send(broken.data(), int(broken.size()), server_))
@@ -85,13 +110,16 @@ class Emulator {
       if (n < 0) throw std::runtime_error("emulator: socket error");
       if (n == 0) return;
       Answer answer;
-      if (!read_answer(std::string_view(buffer_.data(), std::size_t(n)), &answer)) continue;
+      const std::string_view bytes(buffer_.data(), std::size_t(n));
+      if (!(options_.protocol == ControllerProtocol::kEgm ? read_egm_answer(bytes, &answer)
+                                                          : read_answer(bytes, &answer)))
+        continue;
       ++got;
       apply(answer);
     }
   }
 
-  RsiEmulatorRun finish() {
+  EmulatorRun finish() {
     // Cycles without an answer hold the correction the controller had.
     for (std::size_t k = 0; k < run_.correction_rad.size(); ++k) {
       if (!run_.answered[k]) run_.correction_rad[k] = k > 0 ? run_.correction_rad[k - 1] : held_;
@@ -104,6 +132,13 @@ class Emulator {
   }
 
  private:
+  bool read_egm_answer(std::string_view bytes, Answer* out) {
+    std::uint32_t seqno = 0;
+    if (!codec_.parse_sensor(bytes, &seqno, &out->value_deg)) return false;
+    out->ipoc = seqno;
+    return true;
+  }
+
   void apply(const Answer& answer) {
     if (answer.ipoc < options_.first_ipoc) return;
     const std::uint64_t offset = answer.ipoc - options_.first_ipoc;
@@ -112,7 +147,9 @@ class Emulator {
     if (k >= run_.answered.size() || run_.answered[k]) return;  // a second answer: discarded
     for (int a = 0; a < kRsiAxes; ++a) {
       const double v = answer.value_deg[std::size_t(a)] / kDegPerRad;
-      if (options_.mode == RsiCorrectionMode::kIncrement) {
+      if (options_.protocol == ControllerProtocol::kEgm) {
+        sum_rad_[std::size_t(a)] = v - setpoint_rad_[k][std::size_t(a)];  // target - path
+      } else if (options_.mode == RsiCorrectionMode::kIncrement) {
         sum_rad_[std::size_t(a)] += v;
       } else {
         sum_rad_[std::size_t(a)] = v;
@@ -125,8 +162,10 @@ class Emulator {
 
   UdpSocket& socket_;
   UdpPeer server_;
-  const RsiEmulatorOptions& options_;
-  RsiEmulatorRun run_;
+  const EmulatorOptions& options_;
+  const std::vector<std::array<double, kRsiAxes>>& setpoint_rad_;
+  EgmCodec codec_;
+  EmulatorRun run_;
   std::vector<Clock::time_point> sent_at_;
   std::array<double, kRsiAxes> sum_rad_{};
   std::array<double, kRsiAxes> held_{};
@@ -149,10 +188,10 @@ int write_rsi_robot_datagram(std::string_view robot_type, const std::array<doubl
   return n > 0 && n < capacity ? n : -1;
 }
 
-RsiEmulatorRun emulate_rsi_controller(UdpSocket& socket, const UdpPeer& server,
-                                      const std::vector<std::array<double, kRsiAxes>>& setpoint_rad,
-                                      const RsiEmulatorOptions& options) {
-  Emulator emulator(socket, server, options, setpoint_rad.size());
+EmulatorRun emulate_controller(UdpSocket& socket, const UdpPeer& server,
+                               const std::vector<std::array<double, kRsiAxes>>& setpoint_rad,
+                               const EmulatorOptions& options) {
+  Emulator emulator(socket, server, options, setpoint_rad);
   const Clock::time_point start = Clock::now();
   for (std::size_t k = 0; k < setpoint_rad.size(); ++k) {
     if (options.paced) {
@@ -184,7 +223,7 @@ RsiEmulatorRun emulate_rsi_controller(UdpSocket& socket, const UdpPeer& server,
     }
     emulator.collect(expected);
   }
-  RsiEmulatorRun run = emulator.finish();
+  EmulatorRun run = emulator.finish();
   for (std::size_t k = 0; k < run.answered.size(); ++k) {
     const auto found = options.faults.find(k);
     const bool dropped = found != options.faults.end() && found->second == InjectedFault::kDrop;

@@ -1,8 +1,10 @@
-// The RSI server through real sockets and real serialisation, against the in-process closed loop
-// (eval/closed_loop.hpp) as truth: the controller emulator (online/rsi_controller_emulator.hpp)
-// plays the seed-line program's set-points over loopback UDP in lock-step, the robot simulator
-// runs on q_d + the corrections it received, and the attained joints equal those of
-// eval::run_closed_loop with the same precontrol; every datagram is answered.
+// The RSI and EGM servers through real sockets and real serialisation, against the in-process
+// closed loop (eval/closed_loop.hpp) as truth: the controller emulator
+// (online/controller_emulator.hpp) plays the seed-line program over loopback UDP in lock-step
+// (RSI: its set-points; EGM: the robot following the targets of the server, which plays the same
+// program path), the robot simulator runs on q_d + the corrections it received, and the attained
+// joints equal those of eval::run_closed_loop with the same precontrol; every datagram is
+// answered.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,13 +13,13 @@
 #include <filesystem>
 
 #include "eval/closed_loop.hpp"
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
 #include "sim/scenario.hpp"
 #include "tests/support/lag_table.hpp"
-#include "tests/support/rsi_loopback.hpp"
+#include "tests/support/loopback_server.hpp"
 
 namespace imscal::online {
 namespace {
@@ -38,7 +40,10 @@ ident::PrecontrolOptions precontrol_options() {
   return o;
 }
 
-TEST(RsiLoopback, ClosedLoopThroughSocketsEqualsTheInProcessLoop) {
+class Loopback : public ::testing::TestWithParam<ControllerProtocol> {};
+
+TEST_P(Loopback, ClosedLoopThroughSocketsEqualsTheInProcessLoop) {
+  const bool egm = GetParam() == ControllerProtocol::kEgm;
   const sim::Scenario scenario =
       sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets/scenarios/seed-line.yaml");
   const calib::RobotDescription robot = sim::load_plant_robot(scenario);
@@ -60,27 +65,41 @@ TEST(RsiLoopback, ClosedLoopThroughSocketsEqualsTheInProcessLoop) {
       eval::run_closed_loop(path, lag_table(), "kr16", eval::simulator_plant(config), options);
 
   // Through the sockets: the same warm-up at the first set-point, then the path.
-  RsiSessionOptions session;
-  session.cycle_s = path.cycle_s;
-  session.ipoc_per_cycle = 2;
-  test_support::RsiLoopbackServer server(lag_table(), precontrol_options(), session);
   std::vector<std::array<double, kRsiAxes>> setpoint(kWarmUp + path.samples.size());
   for (std::size_t k = 0; k < setpoint.size(); ++k) {
     const Eigen::VectorXd& q = path.samples[k < kWarmUp ? 0 : k - kWarmUp].q_rad;
     for (int a = 0; a < kRsiAxes; ++a) setpoint[k][std::size_t(a)] = q[a];
   }
+  std::unique_ptr<test_support::LoopbackServer> owned;
+  if (egm) {
+    EgmSessionOptions session;
+    session.cycle_s = path.cycle_s;
+    LoadedPath played;
+    played.cycle_s = path.cycle_s;
+    played.q_rad = setpoint;
+    owned = std::make_unique<test_support::LoopbackServer>(lag_table(), precontrol_options(),
+                                                           session, std::move(played), 0.0);
+  } else {
+    RsiSessionOptions session;
+    session.cycle_s = path.cycle_s;
+    session.ipoc_per_cycle = 2;
+    owned =
+        std::make_unique<test_support::LoopbackServer>(lag_table(), precontrol_options(), session);
+  }
+  test_support::LoopbackServer& server = *owned;
   UdpSocket controller("127.0.0.1", 0);
-  RsiEmulatorOptions emulator;
+  EmulatorOptions emulator;
+  emulator.protocol = GetParam();
   emulator.cycle_s = path.cycle_s;
-  emulator.ipoc_per_cycle = 2;
+  emulator.ipoc_per_cycle = egm ? 1 : 2;
   emulator.answer_timeout_s = 5.0;  // a stalled server thread (loaded machine) is not a miss
-  const RsiEmulatorRun run = emulate_rsi_controller(controller, server.peer(), setpoint, emulator);
+  const EmulatorRun run = emulate_controller(controller, server.peer(), setpoint, emulator);
   server.finish();
   EXPECT_EQ(run.missed, 0u);
   EXPECT_EQ(server.stats().answered, setpoint.size());
 
-  // The corrections: the set-points travel with 6 decimals of a degree (8.7e-9 rad) and so do
-  // the answers; through this two-cycle model that is < 3e-8 rad.
+  // The corrections: RSI's set-points travel with 6 decimals of a degree (8.7e-9 rad) and so do
+  // the answers; through this two-cycle model that is < 3e-8 rad. EGM's travel as doubles.
   std::vector<calib::JointVector> offsets(path.samples.size());
   double largest_offset = 0.0, largest_difference = 0.0;
   for (std::size_t k = 0; k < path.samples.size(); ++k) {
@@ -112,6 +131,13 @@ TEST(RsiLoopback, ClosedLoopThroughSocketsEqualsTheInProcessLoop) {
       "%.3g rad (attained joints)\n",
       largest_offset, largest_difference, largest_gap);
 }
+
+INSTANTIATE_TEST_SUITE_P(Protocols, Loopback,
+                         ::testing::Values(ControllerProtocol::kRsi, ControllerProtocol::kEgm),
+                         [](const ::testing::TestParamInfo<ControllerProtocol>& info) {
+                           return std::string(info.param == ControllerProtocol::kEgm ? "Egm"
+                                                                                     : "Rsi");
+                         });
 
 }  // namespace
 }  // namespace imscal::online

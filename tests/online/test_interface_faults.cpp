@@ -1,6 +1,8 @@
-// Faults through the sockets: the controller emulator (online/rsi_controller_emulator.hpp) injects
-// each fault of the RSI stream into a 4 ms lock-step run (a dropped, duplicated, swapped,
-// malformed, NaN, jumping, late datagram, a wrong robot type), in absolute and increment mode.
+// Faults through the sockets: the controller emulator (online/controller_emulator.hpp) injects
+// each fault of the stream into a 4 ms lock-step run (a dropped, duplicated, swapped, malformed,
+// NaN, jumping, late datagram, a wrong robot), for KUKA RSI in absolute and increment mode and
+// for ABB EGM (position guidance: the server plays the same path, NaN and the jump are in the
+// measured joints).
 // Checked from the controller's side: the corrections fade out to exactly zero after each fault,
 // come back after it (equal to those of an undisturbed run), and the commanded correction never
 // steps by more than the rate limit per cycle; from the server's side: each fault is logged with
@@ -11,9 +13,9 @@
 #include <cmath>
 #include <set>
 
-#include "online/rsi_controller_emulator.hpp"
+#include "online/controller_emulator.hpp"
 #include "tests/support/lag_table.hpp"
-#include "tests/support/rsi_loopback.hpp"
+#include "tests/support/loopback_server.hpp"
 
 namespace imscal::online {
 namespace {
@@ -47,39 +49,62 @@ std::vector<std::array<double, kRsiAxes>> swinging_path(std::size_t cycles) {
 }
 
 struct FaultRun {
-  RsiEmulatorRun run;
-  std::vector<RsiFaultEvent> faults;
+  EmulatorRun run;
+  std::vector<SessionFaultEvent> faults;
   std::vector<ident::PrecontrolEvent> events;
 };
 
-FaultRun run_with(const std::map<std::size_t, InjectedFault>& faults, RsiCorrectionMode mode,
-                  std::size_t cycles) {
+struct Case {
+  ControllerProtocol protocol;
+  RsiCorrectionMode mode;
+};
+
+// The server of the case's protocol. Lock-step datagrams come every ~0.1 ms; the late one 0.6 s
+// late. A threshold far above any scheduling stall of a loaded (sanitizer) machine: no false late
+// datagram in the clean run.
+std::unique_ptr<test_support::LoopbackServer> server_for(const Case& c, std::size_t cycles) {
+  if (c.protocol == ControllerProtocol::kEgm) {
+    EgmSessionOptions session;
+    session.cycle_s = kCycle;
+    session.late_after_s = 0.3;
+    LoadedPath path;
+    path.cycle_s = kCycle;
+    path.q_rad = swinging_path(cycles);
+    return std::make_unique<test_support::LoopbackServer>(lag_table(), precontrol_options(),
+                                                          session, std::move(path), 0.0);
+  }
   RsiSessionOptions session;
-  session.mode = mode;
+  session.mode = c.mode;
   session.cycle_s = kCycle;
   session.robot_type = "KUKA";
-  // Lock-step datagrams come every ~0.1 ms; the late one 0.6 s late. A threshold far above any
-  // scheduling stall of a loaded (sanitizer) machine: no false late datagram in the clean run.
   session.late_after_s = 0.3;
-  test_support::RsiLoopbackServer server(lag_table(), precontrol_options(), session);
+  return std::make_unique<test_support::LoopbackServer>(lag_table(), precontrol_options(), session);
+}
+
+FaultRun run_with(const std::map<std::size_t, InjectedFault>& faults, const Case& c,
+                  std::size_t cycles) {
+  const std::unique_ptr<test_support::LoopbackServer> owned = server_for(c, cycles);
+  test_support::LoopbackServer& server = *owned;
   UdpSocket controller("127.0.0.1", 0);
-  RsiEmulatorOptions emulator;
-  emulator.mode = mode;
+  EmulatorOptions emulator;
+  emulator.protocol = c.protocol;
+  if (c.protocol == ControllerProtocol::kEgm) emulator.ipoc_per_cycle = 1;
+  emulator.mode = c.mode;
   emulator.cycle_s = kCycle;
   emulator.faults = faults;
   emulator.late_delay_s = 0.6;
   emulator.answer_timeout_s = 5.0;  // a stalled server thread is not a missed answer here
   FaultRun out;
-  out.run = emulate_rsi_controller(controller, server.peer(), swinging_path(cycles), emulator);
+  out.run = emulate_controller(controller, server.peer(), swinging_path(cycles), emulator);
   server.finish();
   out.faults = server.faults();
   out.events = server.events();
   return out;
 }
 
-class RsiFaults : public ::testing::TestWithParam<RsiCorrectionMode> {};
+class InterfaceFaults : public ::testing::TestWithParam<Case> {};
 
-TEST_P(RsiFaults, EachFaultFadesOutIsLoggedAndTheCorrectionComesBack) {
+TEST_P(InterfaceFaults, EachFaultFadesOutIsLoggedAndTheCorrectionComesBack) {
   const std::vector<InjectedFault> kinds{
       InjectedFault::kDrop,      InjectedFault::kDuplicate,   InjectedFault::kSwapWithNext,
       InjectedFault::kMalformed, InjectedFault::kNaN,         InjectedFault::kJump,
@@ -125,32 +150,49 @@ TEST_P(RsiFaults, EachFaultFadesOutIsLoggedAndTheCorrectionComesBack) {
   }
 
   // The server's log names every fault (the precontrol logs NaN and the jump itself).
-  std::set<RsiFault> logged;
-  for (const RsiFaultEvent& f : disturbed.faults) logged.insert(f.fault);
-  for (RsiFault f : {RsiFault::kMalformed, RsiFault::kLate, RsiFault::kLost, RsiFault::kDuplicated,
-                     RsiFault::kReordered, RsiFault::kUnknownRobot})
-    EXPECT_TRUE(logged.count(f)) << to_string(f);
+  // EGM: the server's own path feeds the precontrol; NaN and the jump are in the measured joints,
+  // which the session judges.
+  const bool egm = GetParam().protocol == ControllerProtocol::kEgm;
+  std::set<SessionFault> logged;
+  for (const SessionFaultEvent& f : disturbed.faults) logged.insert(f.fault);
+  std::vector<SessionFault> expected{SessionFault::kMalformed, SessionFault::kLate,
+                                     SessionFault::kLost,      SessionFault::kDuplicated,
+                                     SessionFault::kReordered, SessionFault::kUnknownRobot};
+  if (egm) expected.push_back(SessionFault::kBadFeedback);
+  for (SessionFault f : expected) EXPECT_TRUE(logged.count(f)) << to_string(f);
   std::set<ident::PrecontrolCause> causes;
   for (const ident::PrecontrolEvent& e : disturbed.events) causes.insert(e.cause);
-  for (ident::PrecontrolCause cause :
-       {ident::PrecontrolCause::kInvalidInput, ident::PrecontrolCause::kInputJump,
-        ident::PrecontrolCause::kLostCycles, ident::PrecontrolCause::kCallerFault})
+  std::vector<ident::PrecontrolCause> expected_causes{ident::PrecontrolCause::kLostCycles,
+                                                      ident::PrecontrolCause::kCallerFault};
+  if (!egm) {
+    expected_causes.push_back(ident::PrecontrolCause::kInvalidInput);
+    expected_causes.push_back(ident::PrecontrolCause::kInputJump);
+  }
+  for (ident::PrecontrolCause cause : expected_causes)
     EXPECT_TRUE(causes.count(cause)) << ident::to_string(cause);
   EXPECT_TRUE(clean.faults.empty());
 }
 
-TEST_P(RsiFaults, AnUnknownRobotIsNeverCorrected) {
+TEST_P(InterfaceFaults, AnUnknownRobotIsNeverCorrected) {
   std::map<std::size_t, InjectedFault> faults;
   for (std::size_t k = 0; k < 600; ++k) faults[k] = InjectedFault::kUnknownRobot;
   const FaultRun run = run_with(faults, GetParam(), 600);
   EXPECT_EQ(run.run.missed, 0u);
+  // RSI: exactly zero; EGM: the target minus the path, each through degrees (a few ulps).
   for (const auto& c : run.run.correction_rad)
-    for (double v : c) ASSERT_EQ(v, 0.0);
+    for (double v : c) ASSERT_NEAR(v, 0.0, 1e-15);
 }
 
-INSTANTIATE_TEST_SUITE_P(Modes, RsiFaults,
-                         ::testing::Values(RsiCorrectionMode::kAbsolute,
-                                           RsiCorrectionMode::kIncrement));
+INSTANTIATE_TEST_SUITE_P(
+    Protocols, InterfaceFaults,
+    ::testing::Values(Case{ControllerProtocol::kRsi, RsiCorrectionMode::kAbsolute},
+                      Case{ControllerProtocol::kRsi, RsiCorrectionMode::kIncrement},
+                      Case{ControllerProtocol::kEgm, RsiCorrectionMode::kAbsolute}),
+    [](const ::testing::TestParamInfo<Case>& info) {
+      if (info.param.protocol == ControllerProtocol::kEgm) return std::string("Egm");
+      return std::string(info.param.mode == RsiCorrectionMode::kAbsolute ? "RsiAbsolute"
+                                                                         : "RsiIncrement");
+    });
 
 }  // namespace
 }  // namespace imscal::online

@@ -1,17 +1,19 @@
-#include "online/rsi_server.hpp"
+#include "online/udp_server.hpp"
 
 #include <array>
 #include <chrono>
 
+#include "online/rsi_datagram.hpp"
+
 namespace imscal::online {
 
-RsiServerStats serve_rsi(UdpSocket& socket, RsiSession& session, const std::atomic<bool>& stop,
-                         const RsiServerOptions& options,
+UdpServerStats serve_udp(UdpSocket& socket, DatagramSession& session, const std::atomic<bool>& stop,
+                         const UdpServerOptions& options,
                          const std::function<void()>& after_answer) {
   using Clock = std::chrono::steady_clock;
   std::array<char, kRsiMaxDatagramBytes + 1> in{};
   std::array<char, 1024> out{};
-  RsiServerStats stats;
+  UdpServerStats stats;
   Clock::time_point last = Clock::now();
   const Clock::time_point origin = last;
   while (!stop.load(std::memory_order_relaxed)) {

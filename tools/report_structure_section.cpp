@@ -1,0 +1,57 @@
+#include "tools/report_structure_section.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "core/units.hpp"
+#include "tools/report_gnuplot.hpp"
+
+namespace imscal::tools {
+namespace {
+
+std::string number(double value) {
+  return std::isfinite(value) ? fmt::format("{:.3g}", value) : "n/a";
+}
+
+// "value ± σ" in the unit `scale` converts to.
+std::string with_sigma(const ident::StructureEstimate& e, double scale) {
+  if (!e.identified()) return "n/a";
+  return number(e.value * scale) + " &plusmn; " + number(e.sigma * scale);
+}
+
+std::string structure_row(const std::string& joint, const ident::IdentifiedStructure& s) {
+  constexpr double kMicro = 1e6, kKilo = 1e-3;
+  return fmt::format(
+      "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
+      "<td>{}</td><td>{}</td></tr>\n",
+      html_escape(joint), s.cells, with_sigma(s.compliance_rad_per_nm, kMicro),
+      number(s.nominal_compliance_rad_per_nm * kMicro), with_sigma(s.stiffness_nm_per_rad, kKilo),
+      with_sigma(s.direction_offset_rad, kArcsecPerRad),
+      number(s.transmission_error_harmonic_per_motor_rev),
+      with_sigma(s.transmission_error_amplitude_rad, kArcsecPerRad),
+      with_sigma(s.transmission_error_phase_rad, kDegPerRad));
+}
+
+}  // namespace
+
+std::string structure_table_html(const ident::IdentificationReport& report) {
+  std::string rows;
+  for (const ident::ReportedJoint& j : report.joints)
+    if (j.structure) rows += structure_row(j.name, *j.structure);
+  if (rows.empty()) return "";
+  return "<p>The drive structure the identified models imply, from their static gains "
+         "(ident/identified_structure.hpp), with 1&sigma; beside the values the identification "
+         "config gave: the compliance is the joint error per N m of model torque (the gear's and "
+         "the position loop's), the direction offset what the direction of motion adds as the "
+         "speed tends to zero, the transmission error the amplitude and phase of the config's "
+         "harmonic.</p>\n"
+         "<table>\n<tr><th>joint</th><th>cells</th><th>compliance [&micro;rad/(N m)]</th>"
+         "<th>config's 1/k [&micro;rad/(N m)]</th><th>stiffness [kN m/rad]</th>"
+         "<th>direction offset [&Prime;]</th>"
+         "<th>transmission error harmonic [per motor rev]</th><th>amplitude [&Prime;]</th>"
+         "<th>phase [&deg;]</th></tr>\n" +
+         rows + "</table>\n";
+}
+
+}  // namespace imscal::tools

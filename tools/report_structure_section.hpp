@@ -1,0 +1,14 @@
+#pragma once
+// The report's table of the drive structure the identified models imply (compliance, stiffness,
+// direction offset and friction level, transmission error) with 1σ beside the values the
+// identification config gave (identification_report.json, ident/identified_structure.hpp).
+#include <string>
+
+#include "ident/identification_report.hpp"
+
+namespace imscal::tools {
+
+// The HTML table, or an empty string when the report holds no structure.
+std::string structure_table_html(const ident::IdentificationReport& report);
+
+}  // namespace imscal::tools
