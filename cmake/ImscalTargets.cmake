@@ -43,6 +43,8 @@ function(imscal_folder_library name)
   file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   if(sources)
     add_library(${name} STATIC ${sources})
+    # Linked into the Python module (a shared object) as well as into the executables.
+    set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ${IMSCAL_PYTHON})
     imscal_precompile(${name} ${ARG_PRECOMPILE})
     target_include_directories(${name} PUBLIC ${imscal_include_dirs})
     target_link_libraries(${name} PUBLIC ${ARG_DEPENDS} PRIVATE imscal_build_options)

@@ -8,7 +8,8 @@ packages=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev libopencv-calib3d-dev libtinyxml2-dev
   protobuf-compiler libprotobuf-dev
-  gnuplot-nox python3 python3-numpy clang-format clang-tidy clang lld chromium
+  gnuplot-nox python3 python3-numpy python3-dev pybind11-dev python3-pybind11 python3-pytest
+  python3-matplotlib clang-format clang-tidy clang lld chromium
   snakemake slurm-wlm munge
 )
 missing=()

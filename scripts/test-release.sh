@@ -5,7 +5,7 @@
 # the ISO 9283 set, the two-session identification, the gap harness, `imscal run` through the
 # chain, the main job; under the sanitizers they run shortened and assert less), and the tests
 # that need Release speed (label `release`: the plant population, the workflows locally and
-# through a single-node Slurm). The figures the
+# through a single-node Slurm, and the Python module's pytest). The figures the
 # tests record are written to <build>/results.md (scripts/results.py), stamped with commit and
 # machine. $1: the build folder (default build-release).
 set -euo pipefail
