@@ -4,10 +4,15 @@
 // kinematic record as in tests/calib/frame_calibration_scenes.hpp), the navigation-grade IMS at
 // 1 kHz with its noise; the initial time offset by cross-correlation (also outside). Timed:
 // calibrate_frames (cutting, preintegration, initial values, two solves, covariance).
+// Beside it, the whole session as `imscal calibrate` runs it (calib::calibrate_session: rests,
+// clock offset, bundle, halves and segments, joint errors) on the shipped 70 s campaign
+// (datasets/campaign/), its files read once outside the timed loop.
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
 
+#include "calib/calibration_session.hpp"
+#include "calib/calibration_session_inputs.hpp"
 #include "calib/frame_calibration.hpp"
 #include "calib/robot_description.hpp"
 #include "calib/time_offset.hpp"
@@ -82,6 +87,24 @@ void BM_CalibrateTenMinutes1kHz(benchmark::State& state) {
   state.counters["converged"] = converged ? 1.0 : 0.0;
 }
 BENCHMARK(BM_CalibrateTenMinutes1kHz)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+void BM_CalibrateSessionCampaign(benchmark::State& state) {
+  const std::filesystem::path campaign =
+      std::filesystem::path(IMSCAL_SOURCE_DIR) / "datasets" / "campaign";
+  imscal::calib::SessionFiles files;
+  files.imu = (campaign / "imu.csv").string();
+  files.robot_log = (campaign / "robot.csv").string();
+  files.config = (campaign / "calibrate.yaml").string();
+  const imscal::calib::LoadedSession loaded = imscal::calib::read_session_inputs(files);
+  std::size_t rests = 0;
+  for (auto _ : state) {
+    const auto session = imscal::calib::calibrate_session(loaded.inputs, loaded.options);
+    rests = session.rests.rests.size();
+    benchmark::DoNotOptimize(session.frames.T_S_H);
+  }
+  state.counters["rests"] = static_cast<double>(rests);
+}
+BENCHMARK(BM_CalibrateSessionCampaign)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 }  // namespace
 

@@ -77,12 +77,40 @@ void parse_thresholds(const ConfigNode& node, MountingValidationOptions& v) {
       positive(node, "max_translation_sigma_mm", t.max_translation_sigma_m * 1e3) * 1e-3;
 }
 
+// priors: the bias sigmas (default: the sensor spec's) and the rest joint-angle priors.
+void parse_priors(const ConfigNode& p, PriorConfig& priors) {
+  p.require_only_keys({"gyro_bias_sigma_deg_per_h", "acc_bias_sigma_ug",
+                       "deflection_uncertainty_fraction", "joint_sigma_floor_urad"});
+  if (p.has("gyro_bias_sigma_deg_per_h"))
+    priors.gyro_bias_sigma_rad_s =
+        positive(p, "gyro_bias_sigma_deg_per_h", 1.0) * kRadPerDeg / 3600.0;
+  if (p.has("acc_bias_sigma_ug"))
+    priors.acc_bias_sigma_m_s2 =
+        positive(p, "acc_bias_sigma_ug", 1.0) * 1e-6 * kStandardGravity_m_s2;
+  priors.deflection_uncertainty_fraction =
+      non_negative(p, "deflection_uncertainty_fraction", priors.deflection_uncertainty_fraction);
+  priors.joint_sigma_floor_rad =
+      non_negative(p, "joint_sigma_floor_urad", priors.joint_sigma_floor_rad * 1e6) * 1e-6;
+}
+
+// heading_reference: {yaw_deg, sigma_deg}, both required.
+HeadingReference heading_reference(const ConfigNode& h) {
+  h.require_only_keys({"yaw_deg", "sigma_deg"});
+  HeadingReference reference;
+  reference.yaw_rad = h.child("yaw_deg").as_double() * kRadPerDeg;
+  const ConfigNode sigma = h.child("sigma_deg");
+  if (!(sigma.as_double() > 0.0)) sigma.fail("expected a number > 0 (the reference's 1-sigma)");
+  reference.sigma_rad = sigma.as_double() * kRadPerDeg;
+  reference.source = fmt::format("{} line {} heading_reference", h.file(), h.line());
+  return reference;
+}
+
 }  // namespace
 
 CalibrationConfig parse_calibration_config(const ConfigNode& root) {
   root.require_only_keys({"imscal-calibration-config", "sensor", "robot", "payload", "rests",
                           "time_offset", "bundle", "priors", "validation", "joint_errors",
-                          "first_rest_position_m", "unit_calibration"});
+                          "first_rest_position_m", "unit_calibration", "heading_reference"});
   const ConfigNode version = root.child("imscal-calibration-config");
   if (version.as_int() != 1) version.fail("unknown config version; expected 1");
   CalibrationConfig c;
@@ -140,24 +168,13 @@ CalibrationConfig parse_calibration_config(const ConfigNode& root) {
         b->get_bool("estimate_deflection_scale", o.estimate_deflection_scale);
     o.deflection_scale_sigma = positive(*b, "deflection_scale_sigma", o.deflection_scale_sigma);
   }
-  if (auto p = root.optional_child("priors")) {
-    p->require_only_keys({"gyro_bias_sigma_deg_per_h", "acc_bias_sigma_ug",
-                          "deflection_uncertainty_fraction", "joint_sigma_floor_urad"});
-    if (p->has("gyro_bias_sigma_deg_per_h"))
-      c.priors.gyro_bias_sigma_rad_s =
-          positive(*p, "gyro_bias_sigma_deg_per_h", 1.0) * kRadPerDeg / 3600.0;
-    if (p->has("acc_bias_sigma_ug"))
-      c.priors.acc_bias_sigma_m_s2 =
-          positive(*p, "acc_bias_sigma_ug", 1.0) * 1e-6 * kStandardGravity_m_s2;
-    c.priors.deflection_uncertainty_fraction = non_negative(
-        *p, "deflection_uncertainty_fraction", c.priors.deflection_uncertainty_fraction);
-    c.priors.joint_sigma_floor_rad =
-        non_negative(*p, "joint_sigma_floor_urad", c.priors.joint_sigma_floor_rad * 1e6) * 1e-6;
-  }
+  if (auto p = root.optional_child("priors")) parse_priors(*p, c.priors);
   if (auto v = root.optional_child("validation")) parse_thresholds(*v, c.validation);
   c.joint_errors = root.get_bool("joint_errors", c.joint_errors);
   if (auto p = root.optional_child("first_rest_position_m"))
     c.first_rest_position_W_m = p->as_vector3();
+  if (auto h = root.optional_child("heading_reference"))
+    c.heading_reference = heading_reference(*h);
   return c;
 }
 

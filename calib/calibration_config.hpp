@@ -22,6 +22,7 @@
 //   validation: {halves: true, segments: true, segment_rests: 5, ...thresholds}
 //   joint_errors: true
 //   first_rest_position_m: [0, 0, 0]              # sensor at rest 1 from the site point, ENU
+//   heading_reference: {yaw_deg: 30.0, sigma_deg: 0.01}  # surveyed yaw of T_W_R (optional)
 #include <Eigen/Core>
 #include <filesystem>
 #include <optional>
@@ -80,6 +81,9 @@ struct CalibrationConfig {
   // The sensor at the first rest relative to the site point, in W (ENU) [m]: only for the
   // gravity field (0.3 ug per metre of height); a tape-measure value is plenty.
   Eigen::Vector3d first_rest_position_W_m = Eigen::Vector3d::Zero();
+  // A surveyed heading of the robot base with its 1-sigma (calib/frame_calibration.hpp,
+  // HeadingReference): a prior on T_W_R's yaw; absent: the IMS alone (Earth rate).
+  std::optional<HeadingReference> heading_reference;
 };
 
 // InputError(file, line, key) for bad values; unknown keys refused.

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "calib/forward_kinematics.hpp"
 #include "core/input_error.hpp"
 
@@ -30,6 +32,7 @@ const ims::Site& checked_site(const FrameCalibrationInput& input, const std::str
                                  "rotations about two different axes)",
                                  input.rests.size()));
   }
+  check_heading_reference(input.heading_reference, input.known_frames, source);
   return input.site;
 }
 
@@ -110,6 +113,22 @@ void declare_parameter_layout(FrameBundle& b) {
 }
 
 }  // namespace
+
+void check_heading_reference(const std::optional<HeadingReference>& heading,
+                             const std::optional<KnownFrames>& known_frames,
+                             const std::string& source) {
+  if (!heading) return;
+  if (known_frames)
+    throw InputError(source, 0, "heading_reference",
+                     "a heading reference (" + heading->source + ") with the frames held at " +
+                         known_frames->source +
+                         ": the base's heading is that session's, not estimated here");
+  if (!(heading->sigma_rad > 0.0) || !std::isfinite(heading->sigma_rad) ||
+      !std::isfinite(heading->yaw_rad))
+    throw InputError(source, 0, "heading_reference",
+                     fmt::format("{}: expected a finite yaw and a sigma > 0, got {} +- {} rad",
+                                 heading->source, heading->yaw_rad, heading->sigma_rad));
+}
 
 Eigen::Matrix3d FrameUnknowns::R_W_R() const {
   return Eigen::Map<const Eigen::Quaterniond>(q_W_R).toRotationMatrix();

@@ -12,7 +12,8 @@
 //    motion residuals only use position differences, so it needs no residual of its own.
 //  - Residuals (calib/frame_residuals.hpp): rest means (6), motions (9, closed-form Brownian
 //    covariance with the gravity cross terms, calib/frame_noise.hpp), gyro rate in windows
-//    during motion (3 per window, for dt), joint-deviation priors. Scale factors enter only the
+//    during motion (3 per window, for dt), joint-deviation priors, and with a surveyed heading a
+//    prior on the base's yaw (HeadingReference). Scale factors enter only the
 //    rests (where 100 ppm of g is 1e-3 m/s^2); the motions take the sensor's scale as exact.
 //  - The rate windows carry dt alone (R_S_H, b_g from the previous solution; see RateResidual).
 //  - Two solves: the first with a guessed rate-window sigma (1e-3 rad/s); then the window
@@ -163,6 +164,7 @@ void add_motion_residuals(FrameBundle& b, FrameStage& stage,
 void set_up_deflection_scale(FrameBundle& b);
 void set_up_time_offset(FrameBundle& b);
 void add_known_frames(FrameBundle& b, ceres::Problem& problem);
+void add_heading_reference(FrameBundle& b, ceres::Problem& problem);
 void add_acc_bias_drift(FrameBundle& b, ceres::Problem& problem);
 void add_scale_factors(FrameBundle& b, ceres::Problem& problem);
 void add_deflection_scale(FrameBundle& b, ceres::Problem& problem);

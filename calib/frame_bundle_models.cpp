@@ -1,6 +1,6 @@
 // The optional models of the frame-and-bias bundle (calib/frame_bundle.hpp) other than the time
-// offset (calib/frame_bundle_time_offset.cpp): known frames, the accelerometer bias's drift,
-// scale factors and the deflection scales.
+// offset (calib/frame_bundle_time_offset.cpp): known frames, a heading reference, the
+// accelerometer bias's drift, scale factors and the deflection scales.
 #include <algorithm>
 #include <cmath>
 
@@ -19,7 +19,34 @@ struct BiasPriorResidual {
   }
 };
 
+// A surveyed heading of the base (HeadingReference): the yaw of R_W_R = Rz(yaw) Ry Rx,
+// atan2(R_10, R_00) of the unit quaternion q_W_R (x, y, z, w), minus the reference, wrapped to
+// (-pi, pi], over its sigma. Its derivative along a small rotation about W's up axis is 1.
+struct HeadingPriorResidual {
+  double yaw_rad = 0.0;
+  double inverse_sigma = 0.0;
+  template <typename T>
+  bool operator()(const T* q, T* residual) const {
+    const T r00 = T(1) - T(2) * (q[1] * q[1] + q[2] * q[2]);
+    const T r10 = T(2) * (q[0] * q[1] + q[3] * q[2]);
+    T difference = ceres::atan2(r10, r00) - T(yaw_rad);
+    if (difference > T(M_PI)) difference -= T(2 * M_PI);
+    if (difference <= T(-M_PI)) difference += T(2 * M_PI);
+    residual[0] = difference * T(inverse_sigma);
+    return true;
+  }
+};
+
 }  // namespace
+
+void add_heading_reference(FrameBundle& b, ceres::Problem& problem) {
+  const std::optional<HeadingReference>& reference = b.input.heading_reference;
+  if (!reference) return;
+  problem.AddResidualBlock(
+      new ceres::AutoDiffCostFunction<HeadingPriorResidual, 1, 4>(
+          new HeadingPriorResidual{reference->yaw_rad, 1.0 / reference->sigma_rad}),
+      nullptr, b.x.q_W_R);
+}
 
 void set_up_deflection_scale(FrameBundle& b) {
   DeflectionScaleModel& d = b.deflection;

@@ -14,6 +14,7 @@ void build_frame_stage(FrameBundle& b, FrameStage& stage, const ImuBiases& linea
   stage.motions = integrate_motions(*b.input.imu, b.rests, linearisation);
   add_frame_and_bias_blocks(b, problem);
   add_known_frames(b, problem);
+  add_heading_reference(b, problem);
   add_acc_bias_drift(b, problem);
   add_scale_factors(b, problem);
   add_deflection_scale(b, problem);

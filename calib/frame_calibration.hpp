@@ -121,6 +121,18 @@ struct KnownFrames {
   std::string source;  // e.g. the frames.json path, for messages
 };
 
+// A surveyed heading of the robot base (e.g. from a total station or the site's floor plan):
+// the yaw of T_W_R, R_W_R = Rz(yaw) Ry(pitch) Rx(roll), i.e. the base's x axis counterclockwise
+// from East about the vertical (frames.json's T_W_R.rpy_deg[2]) [rad], with its 1-sigma [rad].
+// The bundle adds it as a prior residual on R_W_R's yaw (not a held value): the covariance, the
+// mounting verdict and the report then carry both it and what the IMS sees through the Earth
+// rate (FrameCalibrationResult::heading).
+struct HeadingReference {
+  double yaw_rad = 0.0;
+  double sigma_rad = 0.0;  // > 0
+  std::string source;      // where it came from, for messages ("--heading-reference", a file)
+};
+
 struct FrameCalibrationInput {
   const ims::ImuSeries* imu = nullptr;  // increments (ImuQuantity::kIncrements), IMS clock
   ims::Site site;
@@ -136,6 +148,8 @@ struct FrameCalibrationInput {
   Eigen::Vector3d first_rest_position_W_m = Eigen::Vector3d::Zero();
   // Set: the frames are held at these values (KnownFrames above), not estimated.
   std::optional<KnownFrames> known_frames;
+  // Set: a prior on the base's yaw (refused with known_frames, which hold R_W_R).
+  std::optional<HeadingReference> heading_reference;
 };
 
 struct FrameCalibrationOptions {
@@ -202,6 +216,20 @@ struct PoseResidual {
   bool outlier = false;
 };
 
+// The heading of the robot base (yaw of T_W_R, see HeadingReference) as the bundle found it,
+// and from the IMS alone (gyrocompassing through the Earth rate): without a reference both are
+// the same; with one, the IMS-only figures are the posterior's with the reference's information
+// taken out again (1 / sigma_ims^2 = 1 / sigma^2 - 1 / sigma_ref^2, the estimate likewise; exact
+// for a linear problem, checked against a solve without the reference in
+// tests/calib/test_heading_reference.cpp) [rad].
+struct HeadingEstimate {
+  double yaw_rad = 0.0;
+  double sigma_rad = 0.0;
+  double ims_only_yaw_rad = 0.0;
+  double ims_only_sigma_rad = 0.0;  // infinite when the IMS alone does not see the heading
+  std::optional<HeadingReference> reference;
+};
+
 struct FrameCalibrationResult {
   Eigen::Isometry3d T_R_W = Eigen::Isometry3d::Identity();  // W origin: see convention above
   Eigen::Isometry3d T_S_H = Eigen::Isometry3d::Identity();
@@ -233,6 +261,8 @@ struct FrameCalibrationResult {
   Eigen::VectorXd parameter_values;  // the estimates in that order [SI; rotations: rotation vector]
   Eigen::MatrixXd covariance;
   Eigen::MatrixXd correlation;
+  // From the covariance's R_W_R.up; unset when the covariance failed or the frames were held.
+  std::optional<HeadingEstimate> heading;
   bool covariance_rank_deficient = false;  // pseudo-inverse used; see weak_directions
   std::vector<EstimatedVector> estimates;  // the same in reporting units with 1-sigma
   std::vector<WeakDirection> weak_directions;
@@ -269,6 +299,13 @@ struct FrameCalibrationResult {
 // rotation about one axis), naming the missing directions.
 FrameCalibrationResult calibrate_frames(const FrameCalibrationInput& input,
                                         const FrameCalibrationOptions& options = {});
+
+// Throws InputError (source, field heading_reference) for a reference with held frames (they hold
+// R_W_R) or without a finite yaw and a sigma > 0; calibrate_frames checks it, callers may check
+// before long work.
+void check_heading_reference(const std::optional<HeadingReference>& heading,
+                             const std::optional<KnownFrames>& known_frames,
+                             const std::string& source);
 
 // A known T_R_W (e.g. simulation truth with W's origin at the site) moved to this file's
 // convention: W's origin at the sensor's position at the first rest pose, given the true T_S_H

@@ -1,10 +1,13 @@
 // The result of the solved frame-and-bias bundle (calib/frame_bundle.hpp): the estimates with
-// their covariance in reporting units, the weak directions, and the residuals per rest and motion
-// with the outliers. Blocks are found through the bundle's parameter layout by name.
+// their covariance in reporting units, the weak directions, the base's heading (with and without
+// a heading reference), and the residuals per rest and motion with the outliers. Blocks are
+// found through the bundle's parameter layout by name.
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <tuple>
 
 #include "calib/forward_kinematics.hpp"
@@ -194,6 +197,43 @@ void report_weak_directions(const FrameBundle& b, const FrameCovariance& cov,
   });
 }
 
+double wrapped_rad(double angle_rad) {
+  return std::remainder(angle_rad, 2.0 * std::numbers::pi);
+}
+
+// The base's heading from the covariance's R_W_R.up; with a reference, the IMS alone's figures
+// by taking the reference's information out again (HeadingEstimate).
+void report_heading(const FrameBundle& b, const FrameCovariance& cov,
+                    FrameCalibrationResult& result) {
+  if (!cov.computed || b.frames_known) return;
+  HeadingEstimate h;
+  const Eigen::Matrix3d R_W_R = b.x.R_W_R();
+  h.yaw_rad = std::atan2(R_W_R(1, 0), R_W_R(0, 0));  // R_W_R = Rz(yaw) Ry(pitch) Rx(roll)
+  const int up = b.layout.index("R_W_R", "up");
+  h.sigma_rad = std::sqrt(std::max(0.0, cov.covariance(up, up)));
+  h.ims_only_yaw_rad = h.yaw_rad;
+  h.ims_only_sigma_rad = h.sigma_rad;
+  h.reference = b.input.heading_reference;
+  if (h.reference) {
+    const double reference_information = 1.0 / (h.reference->sigma_rad * h.reference->sigma_rad);
+    const double ims_information = 1.0 / (h.sigma_rad * h.sigma_rad) - reference_information;
+    if (ims_information > 0.0) {
+      h.ims_only_sigma_rad = 1.0 / std::sqrt(ims_information);
+      h.ims_only_yaw_rad =
+          wrapped_rad(h.yaw_rad + reference_information / ims_information *
+                                      wrapped_rad(h.yaw_rad - h.reference->yaw_rad));
+    } else {
+      h.ims_only_sigma_rad = std::numeric_limits<double>::infinity();
+    }
+    // The heading is the reference's (with the IMS): no weak direction; the mounting report's
+    // heading check gives both figures (calib/mounting_validation.hpp).
+    std::erase_if(result.weak_directions, [](const WeakDirection& w) {
+      return w.description.rfind("heading of R in W", 0) == 0;
+    });
+  }
+  result.heading = h;
+}
+
 void report_rest_residuals(const FrameBundle& b, const FrameStage& stage,
                            FrameCalibrationResult& result) {
   const FrameUnknowns& x = b.x;
@@ -261,6 +301,7 @@ FrameCalibrationResult report_frame_bundle(const FrameBundle& b, const FrameStag
     report_drive_estimates(b, cov, result);
   }
   report_weak_directions(b, cov, result);
+  report_heading(b, cov, result);
   report_rest_residuals(b, final_stage, result);
   report_motion_residuals(b, final_stage, result);
   return result;

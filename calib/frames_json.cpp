@@ -174,6 +174,22 @@ const json& conventions_and_units() {
   return kept;
 }
 
+// With a heading reference: the base's heading with it, the reference, and the IMS alone's.
+json heading_json(const HeadingEstimate& h) {
+  const HeadingReference& reference = *h.reference;
+  return {
+      {"yaw_deg", h.yaw_rad / kRadPerDeg},
+      {"sigma_deg", h.sigma_rad / kRadPerDeg},
+      {"reference",
+       {{"yaw_deg", reference.yaw_rad / kRadPerDeg},
+        {"sigma_deg", reference.sigma_rad / kRadPerDeg},
+        {"source", reference.source}}},
+      {"ims_only",
+       {{"yaw_deg", h.ims_only_yaw_rad / kRadPerDeg},
+        {"sigma_deg", std::isfinite(h.ims_only_sigma_rad) ? json(h.ims_only_sigma_rad / kRadPerDeg)
+                                                          : json(nullptr)}}}};
+}
+
 }  // namespace
 
 json frames_json(const FrameCalibrationResult& result, const FramesJsonContext& context) {
@@ -181,32 +197,36 @@ json frames_json(const FrameCalibrationResult& result, const FramesJsonContext& 
   for (const auto& e : result.estimates) estimates.push_back(estimate_json(e));
   json weak = json::array();
   for (const auto& w : result.weak_directions) weak.push_back(weak_json(w));
-  return {{"imscal-frames", 1},
-          {"created_by", context.created_by},
-          {"robot", context.robot},
-          {"frames_from", context.frames_from},
-          {"conventions", conventions_and_units()["conventions"]},
-          {"units", conventions_and_units()["units"]},
-          {"T_R_W", pose_json(result.T_R_W)},
-          {"T_S_H", pose_json(result.T_S_H)},
-          {"gyro_bias_deg_per_h", vector_json(result.biases.gyro_rad_s, 3600.0 / kRadPerDeg)},
-          {"acc_bias_ug", vector_json(result.biases.acc_m_s2, 1e6 / kStandardGravity_m_s2)},
-          {"time_offset_ms", result.time_offset_s * 1e3},
-          {"gyro_scale_factor_ppm", vector_json(result.gyro_scale_factor, 1e6)},
-          {"acc_scale_factor_ppm", vector_json(result.acc_scale_factor, 1e6)},
-          {"estimates", estimates},
-          {"parameter_names", result.parameter_names},
-          {"covariance_si", matrix_json(result.covariance)},
-          {"correlation", matrix_json(result.correlation)},
-          {"covariance_rank_deficient", result.covariance_rank_deficient},
-          {"weak_directions", weak},
-          {"solver", solver_json(result)},
-          {"initial_values", initial_values_json(result, context)},
-          {"rests",
-           {{"used", context.rests_used},
-            {"rejected", context.rests_rejected},
-            {"trimmed", context.rests_trimmed}}},
-          {"inputs", context.inputs}};
+  json out = {{"imscal-frames", 1},
+              {"created_by", context.created_by},
+              {"robot", context.robot},
+              {"frames_from", context.frames_from},
+              {"conventions", conventions_and_units()["conventions"]},
+              {"units", conventions_and_units()["units"]},
+              {"T_R_W", pose_json(result.T_R_W)},
+              {"T_S_H", pose_json(result.T_S_H)},
+              {"gyro_bias_deg_per_h", vector_json(result.biases.gyro_rad_s, 3600.0 / kRadPerDeg)},
+              {"acc_bias_ug", vector_json(result.biases.acc_m_s2, 1e6 / kStandardGravity_m_s2)},
+              {"time_offset_ms", result.time_offset_s * 1e3},
+              {"gyro_scale_factor_ppm", vector_json(result.gyro_scale_factor, 1e6)},
+              {"acc_scale_factor_ppm", vector_json(result.acc_scale_factor, 1e6)},
+              {"estimates", estimates},
+              {"parameter_names", result.parameter_names},
+              {"covariance_si", matrix_json(result.covariance)},
+              {"correlation", matrix_json(result.correlation)},
+              {"covariance_rank_deficient", result.covariance_rank_deficient},
+              {"weak_directions", weak},
+              {"solver", solver_json(result)},
+              {"initial_values", initial_values_json(result, context)},
+              {"rests",
+               {{"used", context.rests_used},
+                {"rejected", context.rests_rejected},
+                {"trimmed", context.rests_trimmed}}},
+              {"inputs", context.inputs}};
+  // Only with a reference: without one the heading is R_W_R.up's (weak_directions).
+  if (result.heading && result.heading->reference)
+    out["heading_of_base"] = heading_json(*result.heading);
+  return out;
 }
 
 SessionFrames read_frames_json(const std::filesystem::path& file, const std::string& robot_name) {

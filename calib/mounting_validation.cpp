@@ -151,6 +151,34 @@ std::vector<std::pair<std::size_t, std::size_t>> rest_segments(std::size_t rest_
   return out;
 }
 
+std::optional<MountingCheck> heading_reference_check(const FrameCalibrationResult& result,
+                                                     const MountingThresholds& t) {
+  if (!result.heading || !result.heading->reference) return std::nullopt;
+  const HeadingEstimate& h = *result.heading;
+  const HeadingReference& reference = *h.reference;
+  const double difference =
+      std::remainder(h.ims_only_yaw_rad - reference.yaw_rad, 2.0 * std::numbers::pi);
+  const double combined = std::hypot(h.ims_only_sigma_rad, reference.sigma_rad);
+  const double normalised = std::abs(difference) / combined;
+  MountingCheck check;
+  check.name = "heading_reference";
+  check.level = normalised > t.repeat_fail_sigma   ? Verdict::kFail
+                : normalised > t.repeat_warn_sigma ? Verdict::kWarn
+                                                   : Verdict::kPass;
+  check.message = fmt::format(
+      "base heading (yaw of T_W_R) {:.4f} +- {:.4f} deg with the reference {:.4f} +- {:.4f} deg "
+      "({}); the IMS alone (Earth rate) gives {:.4f} +- {:.4f} deg, {:.4f} deg = {:.1f} combined "
+      "sigma from the reference{}",
+      h.yaw_rad / kRadPerDeg, h.sigma_rad / kRadPerDeg, reference.yaw_rad / kRadPerDeg,
+      reference.sigma_rad / kRadPerDeg, reference.source, h.ims_only_yaw_rad / kRadPerDeg,
+      h.ims_only_sigma_rad / kRadPerDeg, difference / kRadPerDeg, normalised,
+      check.level == Verdict::kPass
+          ? ""
+          : ": check the reference (its value, its sign: counterclockwise from East) and that the "
+            "base did not turn");
+  return check;
+}
+
 MountingValidation assess_mounting(const FrameCalibrationResult& combined,
                                    std::vector<SessionPart> halves,
                                    std::vector<SessionPart> segments, const MountingThresholds& t) {
@@ -288,6 +316,8 @@ MountingValidation assess_mounting(const FrameCalibrationResult& combined,
                       failed));
     }
   }
+
+  if (auto heading = heading_reference_check(combined, t)) v.checks.push_back(*heading);
 
   for (const auto& c : v.checks) {
     v.verdict = std::max(v.verdict, c.level);

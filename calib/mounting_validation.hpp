@@ -7,6 +7,7 @@
 //  - a slipped mount: T_S_H calibrated on consecutive segments of rests (windows of k rests);
 //    neighbouring segments that differ beyond n combined sigma AND beyond a floor in deg/mm mean
 //    "the mount slipped between rest i and rest j";
+//  - with a surveyed heading of the base: the IMS's own heading against it;
 //  - a verdict pass / warn / fail with the reasons in plain words.
 //
 // Differences of T_S_H are taken in the bundle's tangent space: rotation as the small angle of
@@ -127,6 +128,12 @@ struct MountingValidation {
 std::vector<std::pair<std::size_t, std::size_t>> rest_segments(std::size_t rest_count,
                                                                std::size_t per_segment,
                                                                std::size_t min_rests = 3);
+
+// With a heading reference (FrameCalibrationResult::heading): the IMS alone's heading against the
+// reference, beyond repeat_warn_sigma / repeat_fail_sigma of their combined sigma a warn / fail
+// (a wrong reference, a wrong sign convention, or a base that turned); none without a reference.
+std::optional<MountingCheck> heading_reference_check(const FrameCalibrationResult& result,
+                                                     const MountingThresholds& thresholds);
 
 // Pure assessment (no solving) of a combined result and parts already calibrated.
 MountingValidation assess_mounting(const FrameCalibrationResult& combined,

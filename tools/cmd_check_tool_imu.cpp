@@ -1,222 +1,35 @@
-// `imscal check-tool-imu`: reads a tool-mounted IMU record (sensor rates + robot tool pose),
-// prints every defect found (NaN rows, time steps, robot quaternions, gyro rails, scale/unit,
-// time offset, lost motion, quaternion convention, axis misalignment) and the rotation
-// calibration (R_T_S, gyro bias and scale, time offset, 1 sigma). The calibration (this
-// record's own, or with --calibration-from another record's, with this run's clock offset and
-// standstill bias) is applied to the gyro: every motion segment whose rotation the gyro lost by
-// 5 deg or more is listed, and the orientation error against the robot's poses is printed from
-// the start and restarted after each lost span (--no-restart: from the start only). With
+// `imscal check-tool-imu` (calib/tool_imu_check_session.hpp): reads a tool-mounted IMU record
+// (sensor rates + robot tool pose), prints every defect found (NaN rows, time steps, robot
+// quaternions, gyro rails, scale/unit, time offset, lost motion, quaternion convention, axis
+// misalignment) and the rotation calibration (R_T_S, gyro bias and scale, time offset, 1 sigma).
+// The calibration (this record's own, or with --calibration-from another record's, with this run's
+// clock offset and standstill bias) is applied to the gyro: every motion segment whose rotation the
+// gyro lost by 5 deg or more is listed, and the orientation error against the robot's poses is
+// printed from the start and restarted after each lost span (--no-restart: from the start only).
+// With
 // --xsens, the AHRS's own error beside it, or the reason its record is refused as a reference.
 // --out writes all of it as JSON (atomically). A record the calibration cannot use ends with
 // an InputError (exit 2), before any output is written.
-#include <fmt/format.h>
-
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <iostream>
 #include <memory>
-#include <nlohmann/json.hpp>
-#include <optional>
 #include <string>
 
-#include "calib/attitude_filter.hpp"
-#include "calib/orientation_error.hpp"
-#include "calib/orientation_losses.hpp"
-#include "calib/rotation_calibration.hpp"
-#include "calib/tool_imu_record.hpp"
+#include "calib/tool_imu_check_session.hpp"
 #include "core/atomic_file.hpp"
-#include "core/input_error.hpp"
 #include "core/json_output.hpp"
-#include "core/units.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
 
-using imscal::kDegPerRad;
-
-using namespace imscal::calib;
-
 struct Args {
-  std::string imu;
-  std::string xsens;
-  std::string calibration_from;
+  imscal::calib::ToolImuCheckSessionOptions session;
   std::string out;
-  bool no_restart = false;
 };
 
-nlohmann::json vector_json(const Eigen::Vector3d& v, double scale = 1.0) {
-  return {v.x() * scale, v.y() * scale, v.z() * scale};
-}
-
-nlohmann::json calibration_json(const RotationCalibration& c) {
-  nlohmann::json j;
-  j["q_T_S_wxyz"] = {c.q_T_S.w(), c.q_T_S.x(), c.q_T_S.y(), c.q_T_S.z()};
-  j["rotation_angle_deg"] = Eigen::AngleAxisd(c.q_T_S).angle() * kDegPerRad;
-  j["sigma_rotation_deg"] = vector_json(c.sigma_rotation_rad, kDegPerRad);
-  j["gyro_bias_deg_s_as_labelled"] = vector_json(c.gyro_bias_rad_s, kDegPerRad);
-  j["sigma_gyro_bias_deg_s"] = vector_json(c.sigma_bias_rad_s, kDegPerRad);
-  j["gyro_scale"] = vector_json(c.gyro_scale);
-  j["sigma_gyro_scale"] = vector_json(c.sigma_scale);
-  j["time_offset_s"] = c.time_offset_s;
-  j["sigma_time_offset_s"] = c.sigma_time_offset_s;
-  j["sigma_method"] = c.sigma_from_bootstrap ? "moving-block bootstrap" : "covariance";
-  j["bootstrap_replicates"] = c.bootstrap_replicates;
-  j["covariance_sigma_rotation_deg"] = vector_json(c.covariance_sigma_rotation_rad, kDegPerRad);
-  j["covariance_sigma_time_offset_s"] = c.covariance_sigma_time_offset_s;
-  j["covariance_ok"] = c.covariance_ok;
-  j["window_count"] = c.window_count;
-  j["rms_residual_deg"] = c.rms_residual_rad * kDegPerRad;
-  j["solver"] = c.summary;
-  return j;
-}
-
-void print_calibration(const std::string& title, const RotationCalibration& c) {
-  std::cout << fmt::format(
-      "{}: R_T_S angle {:.3f} deg (1 sigma {:.3f} {:.3f} {:.3f} deg, {}), time offset {:.4f} +- "
-      "{:.4f} s,\n  gyro bias {:.4g} {:.4g} {:.4g} deg/s (as labelled), scale {:.5g} {:.5g} "
-      "{:.5g}, window residual RMS {:.3f} deg over {} windows\n",
-      title, Eigen::AngleAxisd(c.q_T_S).angle() * kDegPerRad, c.sigma_rotation_rad.x() * kDegPerRad,
-      c.sigma_rotation_rad.y() * kDegPerRad, c.sigma_rotation_rad.z() * kDegPerRad,
-      c.sigma_from_bootstrap ? "block bootstrap" : "covariance", c.time_offset_s,
-      c.sigma_time_offset_s, c.gyro_bias_rad_s.x() * kDegPerRad, c.gyro_bias_rad_s.y() * kDegPerRad,
-      c.gyro_bias_rad_s.z() * kDegPerRad, c.gyro_scale.x(), c.gyro_scale.y(), c.gyro_scale.z(),
-      c.rms_residual_rad * kDegPerRad, c.window_count);
-}
-
-nlohmann::json error_json(const OrientationErrorStats& e) {
-  return {{"rms_deg", e.rms_rad * kDegPerRad},
-          {"max_deg", e.max_rad * kDegPerRad},
-          {"final_deg", e.final_rad * kDegPerRad},
-          {"samples", e.sample_count}};
-}
-
-nlohmann::json segment_json(const SegmentRotation& s) {
-  return {{"begin_s", s.begin_s},
-          {"end_s", s.end_s},
-          {"first_line", s.first_line},
-          {"last_line", s.last_line},
-          {"robot_angle_deg", s.robot_angle_rad * kDegPerRad},
-          {"gyro_angle_deg", s.gyro_angle_rad * kDegPerRad},
-          {"difference_deg", s.difference_rad * kDegPerRad},
-          {"loss_deg", s.loss_rad * kDegPerRad},
-          {"axis_tilt_deg", s.axis_tilt_rad * kDegPerRad}};
-}
-
-// The findings of the record's checks, printed and as JSON.
-void report_findings(const ToolImuAnalysis& analysis, nlohmann::json& report) {
-  report["findings"] = nlohmann::json::array();
-  for (const auto& f : analysis.findings) {
-    std::cout << fmt::format("[{}{}] {}\n    {}\n", to_string(f.kind), f.is_defect ? "" : " (ok)",
-                             f.where, f.message);
-    report["findings"].push_back({{"kind", to_string(f.kind)},
-                                  {"where", f.where},
-                                  {"size", f.size},
-                                  {"unit", f.unit},
-                                  {"defect", f.is_defect},
-                                  {"message", f.message}});
-  }
-}
-
-// The calibrated gyro's rotation per motion segment against the robot's, every loss listed, and
-// the orientation error from the start and restarted after each loss.
-nlohmann::json report_orientation(const ToolImuRecord& record, const ToolImuAnalysis& analysis,
-                                  const RotationCalibration& applied, const std::string& source,
-                                  bool restart) {
-  const OrientationLossCheck check = find_orientation_losses(record, applied);
-  std::cout << fmt::format(
-      "rotation lost per motion segment (calibrated gyro against the robot, calibration from "
-      "{}): {} segments judged, {} with a loss of 5 deg or more\n",
-      source, check.segments.size(), check.losses.size());
-  nlohmann::json out;
-  out["calibration_source"] = source;
-  out["segments_judged"] = check.segments.size();
-  out["segments"] = nlohmann::json::array();
-  for (const auto& segment : check.segments) out["segments"].push_back(segment_json(segment));
-  out["losses"] = nlohmann::json::array();
-  for (const auto& loss : check.losses) {
-    std::cout << fmt::format(
-        "  [orientation_loss] lines {}-{}, sensor time {:.2f}-{:.2f} s: the robot turned {:.1f} "
-        "deg, the gyro {:.1f} deg; {:.1f} deg of rotation about the turn's axis lost (or added), "
-        "{:.1f} deg across it\n",
-        loss.first_line, loss.last_line, loss.begin_s, loss.end_s,
-        loss.robot_angle_rad * kDegPerRad, loss.gyro_angle_rad * kDegPerRad,
-        loss.loss_rad * kDegPerRad, loss.axis_tilt_rad * kDegPerRad);
-    out["losses"].push_back(segment_json(loss));
-  }
-  const auto spans =
-      restart ? lost_spans(analysis, check) : std::vector<std::pair<double, double>>{};
-  const RestartedOrientationError error = orientation_error_with_restarts(record, applied, spans);
-  std::cout << fmt::format(
-      "orientation error of the calibrated gyro against the robot: from the start RMS {:.3f} deg, "
-      "max {:.3f} deg over {} samples\n",
-      error.from_start.rms_rad * kDegPerRad, error.from_start.max_rad * kDegPerRad,
-      error.from_start.sample_count);
-  out["from_start"] = error_json(error.from_start);
-  if (restart) {
-    std::cout << fmt::format(
-        "  restarted from the robot's pose after each of {} lost spans (the spans left out): RMS "
-        "{:.3f} deg, max {:.3f} deg over {} of the {} samples\n",
-        spans.size(), error.with_restarts.rms_rad * kDegPerRad,
-        error.with_restarts.max_rad * kDegPerRad, error.with_restarts.sample_count,
-        error.from_start.sample_count);
-    out["with_restarts"] = error_json(error.with_restarts);
-    out["restart_times_s"] = error.restart_times_s;
-  }
-  return out;
-}
-
-// The AHRS's own orientation error, or the reason it is refused as a reference (its rates do
-// not follow the robot's; the IMU's results stand without it).
-nlohmann::json report_ahrs(const ToolImuRecord& ahrs) {
-  try {
-    const AhrsAlignment alignment = align_ahrs_to_robot(ahrs);
-    const OrientationErrorStats error =
-        orientation_error(ahrs, alignment.time_offset_s, alignment.t_s, alignment.q_B_T);
-    std::cout << fmt::format(
-        "AHRS {} (alignment to tool and base fitted on this same record): RMS {:.3f} deg, max "
-        "{:.3f} deg over {} samples\n",
-        ahrs.file, error.rms_rad * kDegPerRad, error.max_rad * kDegPerRad, error.sample_count);
-    nlohmann::json out = error_json(error);
-    out["file"] = ahrs.file;
-    out["refused"] = false;
-    out["time_offset_s"] = alignment.time_offset_s;
-    return out;
-  } catch (const imscal::InputError& e) {
-    std::cout << fmt::format("AHRS {} REFUSED as a reference: {}\n", ahrs.file, e.what());
-    return {{"file", ahrs.file}, {"refused", true}, {"reason", e.what()}};
-  }
-}
-
 void run(const Args& args) {
-  nlohmann::json report;
-  const ToolImuRecord record = read_tool_imu_record(args.imu);
-  // An unreadable AHRS file is bad input (exit 2) before any work; one that reads but does not
-  // follow the robot is refused as a reference below, beside the IMU's results.
-  std::optional<ToolImuRecord> ahrs;
-  if (!args.xsens.empty()) ahrs = read_tool_imu_record(args.xsens);
-  const ToolImuAnalysis analysis = check_tool_imu_record(record);
-  std::cout << fmt::format("{}: {} rows\n", record.file, record.t_s.size());
-  report["file"] = record.file;
-  report["rows"] = record.t_s.size();
-  report_findings(analysis, report);
-  const RotationCalibration own = calibrate_rotation(record, analysis);
-  print_calibration("rotation calibration on this record", own);
-  report["calibration"] = calibration_json(own);
-
-  RotationCalibration applied = own;
-  std::string source = record.file + " (this record)";
-  if (!args.calibration_from.empty()) {
-    const ToolImuRecord other = read_tool_imu_record(args.calibration_from);
-    applied = calibrate_rotation(other, check_tool_imu_record(other));
-    print_calibration("calibration from " + other.file, applied);
-    report["calibration_from"] = calibration_json(applied);
-    source = other.file;
-    // This run's own clock offset and standstill bias (what a user has at run time).
-    applied.time_offset_s = analysis.time_offset_s;
-    gyro_bias_at_rest(record, applied.time_offset_s, 0.01, applied.gyro_bias_rad_s, 3.0);
-  }
-  report["orientation"] = report_orientation(record, analysis, applied, source, !args.no_restart);
-  if (ahrs) report["ahrs_orientation_error"] = report_ahrs(*ahrs);
+  const nlohmann::json report = imscal::calib::check_tool_imu_session(
+      args.session, [](const std::string& text) { std::cout << text; });
   if (!args.out.empty())
     imscal::write_file_atomically(args.out, imscal::json_text(report, 2, args.out));
 }
@@ -226,13 +39,14 @@ imscal::tools::CommandRegistration registration{
     "Report the defects of a tool-mounted IMU record and calibrate its rotation part",
     [](CLI::App& sub) {
       auto args = std::make_shared<Args>();
-      sub.add_option("--imu", args->imu, "Sensor CSV (t_s, gyro_*_dps, acc_*_g, robot_*)")
+      sub.add_option("--imu", args->session.imu, "Sensor CSV (t_s, gyro_*_dps, acc_*_g, robot_*)")
           ->required();
-      sub.add_option("--xsens", args->xsens, "AHRS CSV (sens_q0..3, robot_*) of the same path");
-      sub.add_option("--calibration-from", args->calibration_from,
+      sub.add_option("--xsens", args->session.xsens,
+                     "AHRS CSV (sens_q0..3, robot_*) of the same path");
+      sub.add_option("--calibration-from", args->session.calibration_from,
                      "Calibrate on this sensor CSV and apply it to --imu");
       sub.add_option("--out", args->out, "JSON report (written atomically)");
-      sub.add_flag("--no-restart", args->no_restart,
+      sub.add_flag("--no-restart", args->session.no_restart,
                    "Do not restart the orientation from the robot's pose after a lost span");
       sub.callback([args] { run(*args); });
     }};

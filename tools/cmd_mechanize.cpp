@@ -1,198 +1,30 @@
-// `imscal mechanize`: strapdown mechanization of a raw IMS record (ims/strapdown.hpp) into the
-// trajectory of the sensor frame S in W, written as DIR/trajectory.csv and DIR/trajectory.tum
-// (ims/nav_trajectory_io.hpp).
+// `imscal mechanize`: strapdown mechanization of a raw IMS record (ims/mechanize_session.hpp)
+// into the trajectory of the sensor frame S in W, written as DIR/trajectory.csv and
+// DIR/trajectory.tum (ims/nav_trajectory_io.hpp), both or neither.
 //
 // The initial attitude comes either from the command line (--initial-attitude, angles as in
 // ims/coarse_alignment.hpp) or from a coarse alignment over the first seconds of the record,
 // which must then be at rest (--align-s). Position and velocity start at zero.
-//
-// The work is in three stages, prepare -> mechanize -> write, so that a later stage (e.g.
-// zero-velocity smoothing, which also yields 1-sigma columns) slots in between the last two.
-#include <fmt/format.h>
-#include <spdlog/spdlog.h>
-
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <optional>
-#include <sstream>
-#include <string>
-#include <vector>
 
-#include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/output_folder.hpp"
-#include "core/units.hpp"
-#include "ims/coarse_alignment.hpp"
-#include "ims/earth_model.hpp"
-#include "ims/imu_conversion.hpp"
-#include "ims/imu_file.hpp"
+#include "ims/mechanize_session.hpp"
 #include "ims/nav_trajectory_io.hpp"
-#include "ims/sensor_error_model.hpp"
-#include "ims/sensor_spec.hpp"
-#include "ims/strapdown.hpp"
-#include "ims/zupt_smoother.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
 
-using imscal::kRadPerDeg;
-
 namespace fs = std::filesystem;
 namespace ims = imscal::ims;
-constexpr const char* kCommandLine = "<command line>";
 
 struct MechanizeArgs {
-  std::string input;
+  ims::MechanizeSessionOptions session;
   std::string out_dir;
-  std::string initial_attitude;  // "ROLL,PITCH,HEADING" [deg]
-  std::optional<double> align_s;
-  std::string site;
-  std::string smooth_spec;    // sensor spec YAML: zero-velocity smoothing (ims/zupt_smoother.hpp)
-  std::string sensor_errors;  // sensor error model YAML applied on read (ims/sensor_error_model)
-  // Heading from an external reference, replacing the gyrocompassed one: a few seconds of
-  // gyrocompassing give degrees (sigma ~ gyro noise / horizontal Earth rate).
-  std::optional<double> heading_deg;
-  double heading_sigma_deg = 0.001;
   bool force = false;
 };
-
-// Everything the mechanization starts from.
-struct Prepared {
-  ims::ImuSeries increments;  // from the first sample after initial.t_s
-  std::unique_ptr<ims::EarthModel> earth;
-  ims::NavState initial;
-  std::string attitude_source;
-  Eigen::Vector3d attitude_sigma_rad = Eigen::Vector3d::Zero();  // E, N, U; from the alignment
-};
-
-// Three comma-separated finite numbers.
-Eigen::Vector3d parse_triple(const std::string& text, const std::string& option,
-                             const std::string& expected) {
-  Eigen::Vector3d values;
-  std::istringstream in(text);
-  for (int i = 0; i < 3; ++i) {
-    std::string token;
-    const bool last = i == 2;
-    if (!std::getline(in, token, last ? '\n' : ',')) {
-      throw imscal::InputError(kCommandLine, 0, option,
-                               fmt::format("expected {}, got '{}'", expected, text));
-    }
-    try {
-      std::size_t used = 0;
-      values[i] = std::stod(token, &used);
-      if (used != token.size() || !std::isfinite(values[i])) throw std::invalid_argument(token);
-    } catch (const std::exception&) {
-      throw imscal::InputError(kCommandLine, 0, option,
-                               fmt::format("'{}' is not a number (expected {})", token, expected));
-    }
-  }
-  if (in.peek() != std::char_traits<char>::eof()) {
-    throw imscal::InputError(kCommandLine, 0, option,
-                             fmt::format("expected {}, got '{}'", expected, text));
-  }
-  return values;
-}
-
-ims::Site choose_site(const MechanizeArgs& args, const ims::ImuSeries& series) {
-  if (!args.site.empty()) {
-    const Eigen::Vector3d v = parse_triple(args.site, "--site", "LAT,LON,H (deg, deg, m)");
-    return ims::Site{v.x(), v.y(), v.z()};
-  }
-  if (series.site) return *series.site;
-  throw imscal::InputError(args.input, 0, "site",
-                           "the file names no site; give --site LAT,LON,H (needed for the Earth "
-                           "rate and gravity)");
-}
-
-Prepared prepare(const MechanizeArgs& args) {
-  if (args.initial_attitude.empty() == !args.align_s.has_value()) {
-    throw imscal::InputError(kCommandLine, 0, "--initial-attitude/--align-s",
-                             "give exactly one of --initial-attitude ROLL,PITCH,HEADING_DEG and "
-                             "--align-s SECONDS");
-  }
-  Prepared p;
-  ims::ImuSeries series = ims::read_imu_file(args.input);
-  if (series.samples.size() < 2) {
-    throw imscal::InputError(args.input, 0, "", "fewer than two samples: nothing to mechanize");
-  }
-  if (series.quantity == ims::ImuQuantity::kRates) {
-    // The rectangle rule of ims/imu_conversion.hpp: errs by -(1/2) d(rate)/dt dt^2 per sample.
-    spdlog::warn(
-        "{} holds rates, not increments: converted by the rectangle rule, which is not "
-        "exact for a changing rate (ims/imu_conversion.hpp)",
-        args.input);
-    series = ims::rates_to_increments(series);
-  }
-  if (!args.sensor_errors.empty()) {
-    // Error correction on read: the unit's calibration (bias, scale factor, misalignment).
-    series = ims::correct(series, ims::load_sensor_error_model(args.sensor_errors));
-    spdlog::info("corrected {} with the sensor error model {}", args.input, args.sensor_errors);
-  }
-  try {
-    p.earth = std::make_unique<ims::EarthModel>(choose_site(args, series));
-  } catch (const std::invalid_argument& e) {
-    throw imscal::InputError(kCommandLine, 0, "--site", e.what());
-  }
-
-  const auto& samples = series.samples;
-  const double first_dt =
-      series.nominal_dt_s > 0.0 ? series.nominal_dt_s : samples[1].t_s - samples[0].t_s;
-  const double record_start = samples.front().t_s - first_dt;
-  std::size_t first_sample = 0;
-  p.initial.t_s = record_start;
-  if (!args.initial_attitude.empty()) {
-    const Eigen::Vector3d deg =
-        parse_triple(args.initial_attitude, "--initial-attitude", "ROLL,PITCH,HEADING (deg)");
-    // Heading is clockwise from North; the angle convention's yaw counter-clockwise.
-    p.initial.q_W_S = Eigen::Quaterniond(
-        ims::R_W_S_from_angles(deg.x() * kRadPerDeg, deg.y() * kRadPerDeg, -deg.z() * kRadPerDeg));
-    p.attitude_source = "command line";
-  } else {
-    if (!(*args.align_s > 0.0) || record_start + *args.align_s > samples.back().t_s) {
-      throw imscal::InputError(kCommandLine, 0, "--align-s",
-                               fmt::format("{} s is not inside the record ({} s long)",
-                                           *args.align_s, samples.back().t_s - record_start));
-    }
-    ims::CoarseAlignment alignment;
-    try {
-      alignment = ims::align_at_rest(
-          series, ims::samples_in_interval(series, record_start, *args.align_s), *p.earth);
-    } catch (const std::invalid_argument& e) {
-      throw imscal::InputError(kCommandLine, 0, "--align-s", e.what());
-    }
-    // The alignment holds at t_ref (a sample time in the middle of the interval); the
-    // trajectory starts there, at rest.
-    p.initial.t_s = alignment.t_ref_s;
-    p.initial.q_W_S = alignment.q_W_S;
-    const double level_sigma = std::max(alignment.sigma_roll_rad, alignment.sigma_pitch_rad);
-    p.attitude_sigma_rad = {level_sigma, level_sigma, alignment.sigma_heading_rad};
-    if (args.heading_deg) {
-      alignment.angles.heading_rad = *args.heading_deg * kRadPerDeg;
-      alignment.sigma_heading_rad = args.heading_sigma_deg * kRadPerDeg;
-      p.initial.q_W_S = Eigen::Quaterniond(ims::R_W_S_from_angles(
-          alignment.angles.roll_rad, alignment.angles.pitch_rad, -alignment.angles.heading_rad));
-      p.attitude_sigma_rad.z() = alignment.sigma_heading_rad;
-    }
-    while (first_sample < samples.size() && samples[first_sample].t_s <= alignment.t_ref_s) {
-      ++first_sample;
-    }
-    p.attitude_source = fmt::format(
-        "coarse alignment over the first {} s (roll {:.4f} +- {:.4f}, pitch {:.4f} +- {:.4f}, "
-        "heading {:.4f} +- {:.4f} deg{})",
-        *args.align_s, alignment.angles.roll_rad / kRadPerDeg,
-        alignment.sigma_roll_rad / kRadPerDeg, alignment.angles.pitch_rad / kRadPerDeg,
-        alignment.sigma_pitch_rad / kRadPerDeg, alignment.angles.heading_rad / kRadPerDeg,
-        alignment.sigma_heading_rad / kRadPerDeg,
-        args.heading_deg ? " from --heading-deg" : " by gyrocompassing");
-  }
-  p.increments = std::move(series);
-  p.increments.samples.erase(p.increments.samples.begin(),
-                             p.increments.samples.begin() + static_cast<long>(first_sample));
-  return p;
-}
 
 // Both outputs, refused before any work when they exist and --force is not given.
 struct Outputs {
@@ -206,7 +38,7 @@ Outputs check_outputs(const MechanizeArgs& args) {
   if (!args.force) {
     for (const fs::path& f : {o.csv, o.tum}) {
       if (fs::exists(f)) {
-        throw imscal::InputError(kCommandLine, 0, "--out",
+        throw imscal::InputError("<command line>", 0, "--out",
                                  f.string() + " exists; give --force to overwrite it");
       }
     }
@@ -214,75 +46,21 @@ Outputs check_outputs(const MechanizeArgs& args) {
   return o;
 }
 
-void write_outputs(const Outputs& o, const std::vector<ims::NavState>& states,
-                   const std::vector<ims::NavSigma>* sigmas, bool force) {
+void run(const MechanizeArgs& args) {
+  const Outputs o = check_outputs(args);
+  const ims::MechanizedTrajectory trajectory = ims::mechanize_session(args.session);
   // Both or neither: staged together and published together.
   const fs::path dir = o.csv.parent_path().empty() ? fs::path(".") : o.csv.parent_path();
   imscal::OutputFolder folder(dir, {o.csv.filename(), o.tum.filename()},
-                              force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
-  ims::write_trajectory_csv(folder.staged(o.csv.filename()), states, sigmas,
+                              args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse);
+  ims::write_trajectory_csv(folder.staged(o.csv.filename()), trajectory.states,
+                            trajectory.sigmas ? &*trajectory.sigmas : nullptr,
                             imscal::Overwrite::kAllow);
-  ims::write_trajectory_tum(folder.staged(o.tum.filename()), states, imscal::Overwrite::kAllow);
+  ims::write_trajectory_tum(folder.staged(o.tum.filename()), trajectory.states,
+                            imscal::Overwrite::kAllow);
   folder.commit();
-}
-
-// --smooth: zero-velocity-aided smoothing instead of the plain mechanization; starts at rest
-// with the alignment's attitude sigma, zero velocity and the position that defines the origin.
-void smooth(const MechanizeArgs& args, const Outputs& outputs, const Prepared& p) {
-  if (!args.align_s) {
-    throw imscal::InputError(kCommandLine, 0, "--smooth",
-                             "needs --align-s (the initial attitude and its 1-sigma)");
-  }
-  const ims::SensorSpec spec = ims::load_sensor_spec(args.smooth_spec);
-  const ims::ZuptOptions options = ims::zupt_options_from_spec(spec);
-  // Levelling at rest cannot tell tilt from a horizontal accelerometer bias: the tilt sigma is
-  // at least the turn-on bias over g, whatever the noise of the alignment says.
-  Eigen::Vector3d attitude_sigma = p.attitude_sigma_rad;
-  const double bias_tilt_rad = spec.acc.turn_on_bias_sigma / p.earth->normal_gravity_magnitude();
-  for (int i = 0; i < 2; ++i) attitude_sigma[i] = std::hypot(attitude_sigma[i], bias_tilt_rad);
-  ims::NavSigma initial_sigma;
-  initial_sigma << attitude_sigma, Eigen::Vector3d::Constant(options.zero_velocity_sigma_m_s),
-      Eigen::Vector3d::Zero();
-  const ims::ZuptSmootherResult result =
-      ims::smooth_with_zupt(p.increments, *p.earth, p.initial, initial_sigma, options);
-  std::vector<ims::NavState> states;
-  std::vector<ims::NavSigma> sigmas;
-  for (const ims::SmoothedState& s : result.states) {
-    states.push_back(s.state);
-    sigmas.push_back(s.sigma);
-  }
-  write_outputs(outputs, states, &sigmas, args.force);
-  const auto& zv = result.summary.zero_velocity;
-  const auto& zr = result.summary.zero_angular_rate;
-  std::cout << fmt::format(
-      "smoothed {} samples; {} rests; zero-velocity updates {} (gated {}, mean NIS {:.2f}), "
-      "zero-rate updates {} (gated {}, mean NIS {:.2f}); final position sigma [{:.3e}, {:.3e}, "
-      "{:.3e}] m\ninitial attitude: {}\nwritten: {}\nwritten: {}\n",
-      states.size(), result.summary.rest_intervals.size(), zv.accepted, zv.rejected, zv.mean_nis,
-      zr.accepted, zr.rejected, zr.mean_nis, sigmas.back()[6], sigmas.back()[7], sigmas.back()[8],
-      p.attitude_source, outputs.csv.string(), outputs.tum.string());
-}
-
-void run(const MechanizeArgs& args) {
-  const Outputs outputs = check_outputs(args);
-  const Prepared p = prepare(args);
-  if (!args.smooth_spec.empty()) return smooth(args, outputs, p);
-  std::vector<ims::NavState> states;
-  try {
-    states = ims::mechanize(p.increments, *p.earth, p.initial);
-  } catch (const std::invalid_argument& e) {
-    throw imscal::InputError(args.input, 0, "", e.what());
-  }
-  write_outputs(outputs, states, nullptr, args.force);
-
-  const ims::NavState& last = states.back();
-  std::cout << fmt::format(
-      "mechanized {} samples ({:.3f} s) from {}\ninitial attitude: {}\nfinal position "
-      "[{:.6f}, {:.6f}, {:.6f}] m, velocity [{:.6f}, {:.6f}, {:.6f}] m/s (W = ENU)\nwritten: "
-      "{}\nwritten: {}\n",
-      p.increments.samples.size(), last.t_s - p.initial.t_s, args.input, p.attitude_source,
-      last.p_W.x(), last.p_W.y(), last.p_W.z(), last.v_W.x(), last.v_W.y(), last.v_W.z(),
-      outputs.csv.string(), outputs.tum.string());
+  std::cout << trajectory.summary << "written: " << o.csv.string()
+            << "\nwritten: " << o.tum.string() << "\n";
 }
 
 imscal::tools::CommandRegistration registration{
@@ -290,27 +68,28 @@ imscal::tools::CommandRegistration registration{
     "Strapdown mechanization of an IMS record into a trajectory (trajectory.csv, .tum)",
     [](CLI::App& sub) {
       auto args = std::make_shared<MechanizeArgs>();
-      sub.add_option("--input", args->input, "Raw IMS file (.csv, .imsb, .imu PSINS)")->required();
+      sub.add_option("--input", args->session.input, "Raw IMS file (.csv, .imsb, .imu PSINS)")
+          ->required();
       sub.add_option("--out", args->out_dir, "Output folder (created if missing)")->required();
       auto* attitude = sub.add_option(
-          "--initial-attitude", args->initial_attitude,
+          "--initial-attitude", args->session.initial_attitude,
           "ROLL,PITCH,HEADING in deg (heading clockwise from North, ims/coarse_alignment.hpp)");
-      auto* align = sub.add_option("--align-s", args->align_s,
+      auto* align = sub.add_option("--align-s", args->session.align_s,
                                    "Coarse alignment over the first SECONDS of the record (at "
                                    "rest); the trajectory starts in its middle");
       attitude->excludes(align);
-      sub.add_option("--site", args->site,
+      sub.add_option("--site", args->session.site,
                      "LAT,LON,H (deg, deg, m, WGS84) if the file names no site or to override it");
-      sub.add_option("--smooth", args->smooth_spec,
+      sub.add_option("--smooth", args->session.smooth_spec,
                      "Sensor spec YAML: zero-velocity-aided smoothing with 1-sigma columns "
                      "(needs --align-s)");
-      sub.add_option("--sensor-errors", args->sensor_errors,
+      sub.add_option("--sensor-errors", args->session.sensor_errors,
                      "Sensor error model YAML (bias, scale factor, misalignment) to correct the "
                      "raw data with on read (datasets/FORMAT.md)");
-      sub.add_option("--heading-deg", args->heading_deg,
+      sub.add_option("--heading-deg", args->session.heading_deg,
                      "Initial heading from an external reference (deg clockwise from North of "
                      "the sensor's +Y axis), replacing gyrocompassing; with --align-s");
-      sub.add_option("--heading-sigma-deg", args->heading_sigma_deg,
+      sub.add_option("--heading-sigma-deg", args->session.heading_sigma_deg,
                      "1-sigma of --heading-deg (deg)")
           ->capture_default_str();
       sub.add_flag("--force", args->force, "Overwrite existing outputs");

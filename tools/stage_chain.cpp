@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <charconv>
 #include <stdexcept>
 
 #include "tools/stage_subcommand.hpp"
@@ -116,22 +115,6 @@ std::unique_ptr<Stage> make_identify_stage(const RunConfig& config) {
     }
     return arguments;
   };
-  // `imscal identify` logs "joint A2 (2/6): ..." when it starts a joint.
-  spec.progress_of_line = [](const std::string& line) -> std::optional<double> {
-    // Parsed by hand: std::regex trips GCC 12's -Wmaybe-uninitialized under the sanitizers.
-    const auto at = line.find("joint ");
-    if (at == std::string::npos) return std::nullopt;
-    const auto open = line.find('(', at), slash = line.find('/', open),
-               close = line.find(')', slash);
-    if (open == std::string::npos || slash == std::string::npos || close == std::string::npos)
-      return std::nullopt;
-    int done = 0, of = 0;
-    const char* text = line.data();
-    if (std::from_chars(text + open + 1, text + slash, done).ec != std::errc() ||
-        std::from_chars(text + slash + 1, text + close, of).ec != std::errc() || of < 1)
-      return std::nullopt;
-    return (done - 1.0) / of;
-  };
   spec.success_message = "parameter tables written";
   return std::make_unique<SubcommandStage>(std::move(spec));
 }
@@ -160,14 +143,6 @@ std::unique_ptr<Stage> make_verify_stage(const RunConfig& config) {
     args.push_back("--out");
     args.push_back(out.string());
     return args;
-  };
-  // `imscal verify` logs "verify: <scenario> (...)" as it starts each scenario.
-  const double scenarios = double(config.verify->scenarios.size());
-  spec.progress_of_line = [scenarios,
-                           count = 0.0](const std::string& line) mutable -> std::optional<double> {
-    if (line.find("verify: ") == std::string::npos || line.find(" cycles x ") == std::string::npos)
-      return std::nullopt;
-    return count++ / scenarios;
   };
   spec.success_message = "ISO 9283 before/after written";
   return std::make_unique<SubcommandStage>(std::move(spec));

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/input_error.hpp"
+#include "core/progress_channel.hpp"
 #include "core/subprocess.hpp"
 
 namespace imscal::tools {
@@ -42,7 +43,12 @@ StageOutcome SubcommandStage::run(StageWorkspace& workspace) {
   SubprocessOptions options;
   options.timeout_s = spec_.timeout_s;
   const std::string tag = spec_.stage_name;
+  request_progress_lines_from_children();
   options.on_line = [&](std::string_view line) {
+    if (const std::optional<ProgressReport> report = parse_progress_line(line)) {
+      workspace.progress(report->fraction);
+      return;
+    }
     spdlog::debug("{}| {}", tag, line);
     const std::string text(line);
     if (const auto at = text.find("[error] "); at != std::string::npos)

@@ -1,10 +1,10 @@
 #pragma once
 // A stage that runs one imscal subcommand (the same binary, as a child process, so that the stage
 // writes exactly what the subcommand writes) into the stage's staging folder. The stages of the
-// chain (calibrate, identify, verify, diagnose) differ only in their arguments, inputs and
-// progress lines; the child's log goes to run.log, and its exit codes map to the run's:
-// 2 bad input (InputError, nothing committed), 1 a failed check (outputs committed, the chain
-// stops), anything else a failure.
+// chain (calibrate, identify, verify, diagnose) differ only in their arguments and inputs; the
+// child reports its progress through core/progress_channel.hpp; the child's log goes to run.log,
+// and its exit codes map to the run's: 2 bad input (InputError, nothing committed), 1 a failed
+// check (outputs committed, the chain stops), anything else a failure.
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -24,7 +24,8 @@ struct SubcommandSpec {
                                          const std::filesystem::path& out)>
       arguments;
   std::function<StageInputs()> inputs;
-  // The stage's progress in [0, 1] that a log line of the child tells, if any (empty: none).
+  // For a subcommand that does not report through the progress channel: the stage's progress in
+  // [0, 1] that a log line of the child tells, if any (empty: none).
   std::function<std::optional<double>(const std::string& line)> progress_of_line;
   std::string success_message;  // the stage's one-line result when the child ends with 0
 };

@@ -1,5 +1,5 @@
 # The plant-population study on a workflow engine: one job per plant and step of the lab's chain
-# (`imscal population --step`, tools/cmd_population.cpp), then the summary of the range.
+# (`imscal population --step`, eval/population_study.hpp), then the summary of the range.
 #   snakemake -s workflows/population.smk --configfile workflows/config/population.yaml \
 #     --profile workflows/profiles/local        (all cores of this machine)
 #   ... --profile workflows/profiles/slurm      (each job through sbatch)

@@ -9,7 +9,9 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
+#include "core/progress_channel.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "tests/ident/joint_simulation.hpp"
@@ -177,6 +179,29 @@ TEST_F(IdentifyCli, JointThatCannotBeIdentifiedGetsTheNeutralModel) {
 
 // A log in which no joint moved: a table of neutral models corrects nothing, so identify fails
 // the check (exit 1), names the reason per joint and writes none of its outputs.
+// The progress channel (core/progress_channel.hpp): with the variable set, as `imscal run` sets
+// it for its stages, each finished joint is one progress line, the last at 1; without it, none.
+TEST_F(IdentifyCli, ReportsEachJointThroughTheProgressChannelWhenAsked) {
+  ASSERT_EQ(identify(), 0) << log_text();
+  EXPECT_EQ(log_text().find("imscal-progress"), std::string::npos) << log_text();
+  ::setenv(imscal::kProgressChannelVariable, "1", 1);
+  const int code = identify("--force");
+  ::unsetenv(imscal::kProgressChannelVariable);
+  ASSERT_EQ(code, 0) << log_text();
+  std::vector<double> fractions;
+  std::istringstream lines(log_text());
+  for (std::string line; std::getline(lines, line);)
+    if (const auto report = imscal::parse_progress_line(line)) {
+      EXPECT_EQ(report->stage, "joints");
+      fractions.push_back(report->fraction);
+    }
+  // The start (0) and one line per joint: 0, 1/2, 1.
+  ASSERT_EQ(fractions.size(), 3u) << log_text();
+  EXPECT_EQ(fractions.front(), 0.0);
+  EXPECT_DOUBLE_EQ(fractions[1], 0.5);
+  EXPECT_EQ(fractions.back(), 1.0);
+}
+
 TEST_F(IdentifyCli, NoJointIdentifiedIsAFailedCheckWithoutOutput) {
   ident::JointErrorLog log = ident::read_joint_errors_csv(dir_ / "joint_errors.csv");
   for (std::size_t j = 0; j < log.joint_count(); ++j) {

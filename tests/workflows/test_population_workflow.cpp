@@ -1,6 +1,6 @@
 // workflows/population.smk run by Snakemake on this machine (the local profile, 2 cores): three
 // plants (seeds 1000-1002, 1 cycle per verification), one job per plant and step. Truth: the same
-// plants run by `imscal population` in one process (tools/cmd_population.cpp runs the same steps
+// plants run by `imscal population` in one process (eval/population_study.hpp runs the same steps
 // in a loop); every figure of every row must agree. A rerun has nothing to do.
 // Release only (CI's Release stage): ~2 min for the two runs there, 5-10x under the sanitizers.
 #include <gtest/gtest.h>

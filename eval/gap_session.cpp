@@ -1,0 +1,79 @@
+#include "eval/gap_session.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include "calib/robot_description.hpp"
+#include "core/input_error.hpp"
+#include "core/payload_plausibility.hpp"
+#include "ident/joint_error_io.hpp"
+#include "ident/parameter_table_io.hpp"
+
+namespace imscal::eval {
+
+namespace {
+
+// The sim's joint errors from the second joint_errors.csv, row by row with the real ones.
+std::vector<std::vector<double>> sim_log_joint_errors(const GapSessionOptions& args,
+                                                      const ident::JointErrorLog& real) {
+  const ident::JointErrorLog sim = ident::read_joint_errors_csv(args.sim_joint_errors);
+  if (sim.joint_names != real.joint_names || sim.sample_count() != real.sample_count())
+    throw InputError(args.sim_joint_errors, sim.first_data_line, "",
+                     fmt::format("{} samples of joints {}; the real joint errors have {} "
+                                 "samples of joints {} (they must match row by row)",
+                                 sim.sample_count(), fmt::join(sim.joint_names, ","),
+                                 real.sample_count(), fmt::join(real.joint_names, ",")));
+  for (std::size_t k = 0; k < sim.sample_count(); ++k)
+    if (std::abs(sim.time_s[k] - real.time_s[k]) > 0.25 * real.cycle_s)
+      throw InputError(
+          args.sim_joint_errors, sim.first_data_line + k, "t_s",
+          fmt::format("{} s where the real joint errors have {} s", sim.time_s[k], real.time_s[k]));
+  return measured_joint_errors(sim);
+}
+
+}  // namespace
+
+GapSession diagnose_gap_session(const GapSessionOptions& args) {
+  const ident::JointErrorLog real = ident::read_joint_errors_csv(args.joint_errors);
+  const calib::RobotDescription robot = calib::load_robot_description(args.robot);
+  if (robot.name != real.robot)
+    throw InputError(args.joint_errors, 2, "robot",
+                     fmt::format("'{}', but the robot file {} describes '{}'", real.robot,
+                                 args.robot, robot.name));
+  check_payload_series(
+      real.payload_kg, real.time_s, robot.nominal_payload_kg,
+      {args.joint_errors, 0, "payload_kg", fmt::format("robot {} ({})", robot.name, robot.source)});
+  std::vector<std::vector<double>> sim_errors;
+  std::optional<ident::ParameterTable> table;
+  if (!args.table.empty()) {
+    table = ident::read_parameters_json(args.table);
+    if (table->sample_time_s != real.cycle_s)
+      throw InputError(args.table, 0, "sample_time_s",
+                       fmt::format("{} s, but {} has cycle_s {} s", table->sample_time_s,
+                                   args.joint_errors, real.cycle_s));
+    try {
+      sim_errors = predict_table_joint_errors(*table, real);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(args.table, 0, "joints", e.what());
+    }
+  } else {
+    sim_errors = sim_log_joint_errors(args, real);
+  }
+  GapSession session;
+  try {
+    session.signals = make_gap_signals(real, sim_errors, robot, table ? &*table : nullptr);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(args.robot, 0, "joints", e.what());
+  }
+  spdlog::info("diagnose: {} samples, {} joints, gap RMS to be analysed",
+               session.signals.sample_count(), session.signals.joint_count());
+  session.diagnosis = diagnose_gap(session.signals);
+  return session;
+}
+
+}  // namespace imscal::eval

@@ -1,0 +1,235 @@
+#include "eval/identification_session.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "core/atomic_file.hpp"
+#include "core/config_node.hpp"
+#include "core/input_error.hpp"
+#include "core/json_output.hpp"
+#include "core/payload_plausibility.hpp"
+#include "eval/transmission_error_order.hpp"
+#include "eval/verification.hpp"
+#include "ident/identification_config_record.hpp"
+#include "ident/parameter_table_io.hpp"
+
+namespace imscal::eval {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The model torques of the log's path (eval/model_torque.hpp), when the config's models take
+// them.
+void attach_session_model_torques(ident::JointErrorLog& log,
+                                  const ident::IdentificationConfig& config,
+                                  const IdentificationSessionOptions& options) {
+  if (!config.options.model_torque_input) return;
+  if (!options.model_torque)
+    throw InputError(options.config, 0, "model.model_torque", "no rigid-body model given");
+  const ModelTorqueSource model = options.model_torque(
+      log.robot, options.joint_errors, options.config, "model.model_torque", log.cycle_s);
+  spdlog::info("identify: model torques of {} along the {} path", model.robot.name,
+               torque_along_measured_path(config.options) ? "measured" : "desired");
+  attach_model_torques(log, model, config.options);
+}
+
+// `--search-transmission-error-order`: each joint's harmonic found from the data replaces the
+// config's (eval/transmission_error_order.hpp); the search for the report.
+ident::OrderSearchReport search_orders(const ident::JointErrorLog& log,
+                                       const std::string& config_file,
+                                       ident::IdentificationConfig& config) {
+  if (!config.options.transmission_error_input)
+    throw InputError(config_file, 0, "model.transmission_error",
+                     "--search-transmission-error-order needs the transmission-error "
+                     "inputs (model.transmission_error: true)");
+  spdlog::info("identify: searching the transmission error's order per motor revolution");
+  const TransmissionErrorOrderSearch search =
+      search_transmission_error_orders(log, config, default_order_candidates());
+  ident::OrderSearchReport report;
+  report.candidates_per_motor_rev = search.candidates;
+  for (std::size_t j = 0; j < search.chosen_harmonic.size(); ++j) {
+    spdlog::info("identify: {}: {}", log.joint_names[j], describe_order_search(search, j));
+    std::vector<double> fits;
+    for (const auto& per_candidate : search.fit_percent) fits.push_back(per_candidate[j]);
+    report.joints.push_back({log.joint_names[j], search.prior_harmonic[j], search.best_harmonic[j],
+                             search.gain_points[j], search.chosen_harmonic[j], fits});
+  }
+  config = with_searched_orders(std::move(config), search);
+  return report;
+}
+
+// The order sweep's longest model must leave rows to fit it: a segment needs more samples than
+// the longest lag plus the coefficients, or every cell fits from no rows and corrects nothing.
+void check_orders_fit_record(const ident::JointErrorLog& log,
+                             const ident::IdentificationConfig& config,
+                             const ConfigNode& config_node, const std::string& file,
+                             const std::string& log_file) {
+  const auto& grid = config.options.grid;
+  const std::size_t longest_lag =
+      std::size_t(std::max(grid.na_max, grid.nb_max + grid.dead_time_max));
+  const std::size_t coefficients = std::size_t(grid.na_max + grid.nb_max);
+  std::size_t longest_segment = 0;
+  for (const auto& [begin, end] : log.segments())
+    longest_segment = std::max(longest_segment, end - begin);
+  if (longest_segment > longest_lag + coefficients) return;
+  const auto order = config_node.optional_child("order");
+  throw InputError(
+      file, order ? order->line() : 0, "order",
+      fmt::format("the largest model (na {}, nb {}, dead time {}) needs more than {} samples in "
+                  "one segment; the longest segment of {} has {}",
+                  grid.na_max, grid.nb_max, grid.dead_time_max, longest_lag + coefficients,
+                  log_file, longest_segment));
+}
+
+// A table in which no joint was identified corrects nothing: why, or empty when one was.
+std::string no_joint_identified(const std::vector<ident::JointOutcome>& outcomes,
+                                const ident::JointErrorLog& log, const std::string& log_file) {
+  std::string reasons;
+  for (std::size_t j = 0; j < outcomes.size(); ++j) {
+    if (outcomes[j].failure.empty()) return "";
+    reasons += fmt::format("{}joint {}: {}", reasons.empty() ? "" : "; ", log.joint_names[j],
+                           outcomes[j].failure);
+  }
+  return fmt::format("{}: no joint could be identified, the table would correct nothing ({})",
+                     log_file, reasons);
+}
+
+// An inverse-form table does not predict the joint error from q_d (the gap diagnosis's "sim"):
+// the paper's forward error model from the same data is written beside it.
+std::optional<ident::ParameterTable> forward_table_of(const ident::JointErrorLog& log,
+                                                      const ident::IdentificationConfig& config,
+                                                      const ident::ParameterTable& table) {
+  if (config.options.form != ident::ArxModelForm::kInverse) return std::nullopt;
+  spdlog::info("identify: the forward error model (paper form) for the gap diagnosis");
+  const ident::IdentificationConfig forward = paper_form(config);
+  ident::ParameterTable forward_table = ident::parameter_table_header(log, forward, table.source);
+  for (auto& outcome : ident::identify_joints(log, forward))
+    forward_table.joints.push_back(std::move(outcome.result.parameters));
+  return forward_table;
+}
+
+}  // namespace
+
+PreparedIdentification prepare_identification(const IdentificationSessionOptions& options) {
+  PreparedIdentification p;
+  p.start = std::chrono::steady_clock::now();
+  p.options = options;
+  p.log = ident::read_joint_errors_csv(options.joint_errors);
+  const ConfigNode config_node = ConfigNode::load_file(options.config);
+  std::vector<std::string> warnings;
+  p.config = ident::resolve_for_record(ident::load_identification_config(config_node), p.log.robot,
+                                       p.log.cycle_s, options.joint_errors, &warnings);
+  for (const std::string& w : warnings) spdlog::warn("identify: {}", w);
+  attach_session_model_torques(p.log, p.config, options);
+  if (p.config.max_speed_rad_s.size() != p.log.joint_count())
+    throw InputError(
+        options.config, config_node.child("joints").child("max_speed_deg_s").line(),
+        "joints.max_speed_deg_s",
+        fmt::format("{} maximum speeds, but {} has {} joints ({})", p.config.max_speed_rad_s.size(),
+                    options.joint_errors, p.log.joint_count(), fmt::join(p.log.joint_names, ", ")));
+  // The log's payload against the rating of the config (the payload cells are fractions of it).
+  check_payload_series(
+      p.log.payload_kg, p.log.time_s, p.config.nominal_payload_kg,
+      {options.joint_errors, 0, "payload_kg",
+       fmt::format("robot {} ({}: joints.nominal_payload_kg)", p.log.robot, options.config)});
+  check_orders_fit_record(p.log, p.config, config_node, options.config, options.joint_errors);
+  return p;
+}
+
+std::vector<fs::path> identification_output_names(const ident::IdentificationConfig& config) {
+  std::vector<fs::path> names = {"identification_report.json", "parameters.csv", "parameters.json"};
+  if (config.options.form == ident::ArxModelForm::kInverse)
+    names.emplace_back("forward_parameters.json");
+  return names;
+}
+
+IdentificationResult identify_session(PreparedIdentification p,
+                                      const IdentificationProgress& progress) {
+  const ident::JointErrorLog& log = p.log;
+  const std::string& file = p.options.joint_errors;
+  std::optional<ident::OrderSearchReport> order_search;
+  if (p.options.search_order) order_search = search_orders(log, p.options.config, p.config);
+  const auto segments = log.segments();
+  IdentificationResult r;
+  r.joint_names = log.joint_names;
+  r.table = ident::parameter_table_header(
+      log, p.config, {file, ident::file_sha256_hex(file), log.sample_count(), log.source});
+  spdlog::info("identify: {} joints, {} samples in {} segments, cycle {} s", log.joint_count(),
+               log.sample_count(), segments.size(), log.cycle_s);
+  spdlog::info("identify: per joint {} cells, order sweep na {}..{} nb {}..{} d {}..{}",
+               p.config.joint_grid(0).cell_count(), p.config.options.grid.na_min,
+               p.config.options.grid.na_max, p.config.options.grid.nb_min,
+               p.config.options.grid.nb_max, p.config.options.grid.dead_time_min,
+               p.config.options.grid.dead_time_max);
+  if (progress) progress("joints", 0.0);
+  r.outcomes = ident::identify_joints(log, p.config, 0, [&](std::size_t joint, std::size_t done) {
+    spdlog::info("joint {} ({}/{}) done", log.joint_names[joint], done, log.joint_count());
+    if (progress) progress("joints", double(done) / double(log.joint_count()));
+  });
+  for (const ident::JointOutcome& outcome : r.outcomes)
+    r.table.joints.push_back(outcome.result.parameters);
+  r.no_joint_identified = no_joint_identified(r.outcomes, log, file);
+  if (!r.no_joint_identified.empty()) return r;
+  const ident::IdentificationReportHeader header{
+      r.table.created_by,
+      file,
+      r.table.source.sha256,
+      p.options.config,
+      log.sample_count(),
+      segments.size(),
+      log.cycle_s,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - p.start).count(),
+      order_search};
+  r.report = ident::identification_report_json(header, r.outcomes);
+  r.forward_table = forward_table_of(log, p.config, r.table);
+  return r;
+}
+
+std::string joint_summary_text(const ident::JointOutcome& outcome, const std::string& name) {
+  const ident::JointIdentification& r = outcome.result;
+  if (!outcome.failure.empty()) {
+    // No cell of this joint could be identified (e.g. it did not move): the other joints'
+    // models are still good, so this joint has the neutral model (zero correction) and the
+    // table says why, instead of the whole run failing.
+    spdlog::warn("joint {}: not identified, its table holds the neutral model (no correction): {}",
+                 name, outcome.failure);
+  }
+  int identified = 0;
+  for (const auto& c : r.cells) identified += c.status == ident::CellStatus::kIdentified;
+  spdlog::info("joint {}: {}/{} cells identified, backlash l = {:.3g} ± {:.2g} rad, {:.2f} s", name,
+               identified, r.cells.size(), r.parameters.backlash_l_rad,
+               r.parameters.backlash_l_sigma_rad, outcome.seconds);
+  // A cell's figures judge its own model on its own held-out runs (each restarted from the
+  // measured output); the table line judges what the precontrol applies: every cell blended.
+  std::string text;
+  for (const auto& c : r.cells) {
+    const ident::CellFitFigures& f = r.parameters.cells[std::size_t(c.cell)].figures;
+    text += fmt::format(
+        "{:>4} cell {:>2} {:<40} {:<10} {:>14} cell's own held-out fit: angle {:>7.2f} %, "
+        "joint error {:>7.2f} %\n",
+        name, c.cell, c.label, ident::to_string(c.status),
+        c.sweep ? ident::to_string(c.sweep->chosen) : "-", f.simulation_fit_percent,
+        f.joint_error_fit_percent);
+  }
+  text += fmt::format(
+      "{:>4} table: held-out joint-error fit {:>7.2f} % over {} rows (all {} cells blended as "
+      "the precontrol applies them)\n",
+      name, r.table_fit.joint_error_fit_percent, r.table_fit.rows, r.cells.size());
+  return text;
+}
+
+void write_identification(const OutputFolder& folder, const IdentificationResult& result) {
+  const fs::path report_path = folder.folder() / "identification_report.json";
+  write_file_atomically(folder.staged("identification_report.json"),
+                        json_text(result.report, 1, report_path.string()));
+  if (result.forward_table)
+    ident::write_parameters_json(folder.staged("forward_parameters.json"), *result.forward_table);
+  ident::write_parameters_csv(folder.staged("parameters.csv"), result.table);
+  ident::write_parameters_json(folder.staged("parameters.json"), result.table);
+}
+
+}  // namespace imscal::eval

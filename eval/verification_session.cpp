@@ -1,0 +1,160 @@
+#include "eval/verification_session.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <optional>
+#include <stdexcept>
+
+#include "core/config_node.hpp"
+#include "core/input_error.hpp"
+#include "core/output_folder.hpp"
+#include "core/payload_plausibility.hpp"
+#include "eval/transmission_error_order.hpp"
+#include "ident/identification_config.hpp"
+#include "ident/joint_error_io.hpp"
+#include "ident/parameter_table_io.hpp"
+
+namespace imscal::eval {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The joint errors the tables are identified from, and the file that names them in messages.
+struct JointErrorSource {
+  std::optional<ident::JointErrorLog> log;
+  std::string file;
+};
+
+// From a file, or the simulator's truth of a scenario (written to OUT/joint_errors_truth.csv).
+JointErrorSource joint_error_source(const VerificationSessionOptions& options, const fs::path& out,
+                                    Overwrite overwrite) {
+  JointErrorSource source;
+  if (!options.joint_errors.empty()) {
+    source.log = ident::read_joint_errors_csv(options.joint_errors);
+    source.file = options.joint_errors;
+  } else if (!options.identify_scenario.empty()) {
+    spdlog::info("verify: simulating {} for the truth joint errors", options.identify_scenario);
+    source.log = simulate_truth_joint_errors(
+        sim::load_scenario(sim::resolve_scenario(options.identify_scenario)));
+    create_output_folder(out);
+    source.file = (out / "joint_errors_truth.csv").string();
+    ident::write_joint_errors_csv(source.file, *source.log, overwrite);
+  }
+  return source;
+}
+
+// The identification config, its payload rating checked against the log's payload.
+ident::IdentificationConfig checked_config(const VerificationSessionOptions& options,
+                                           const JointErrorSource& source) {
+  const std::string config_file =
+      options.ident_config.empty()
+          ? (sim::resolve_scenario("identification").parent_path().parent_path() /
+             "identification/ident-default.yaml")
+                .string()
+          : options.ident_config;
+  ident::IdentificationConfig config =
+      ident::load_identification_config(ConfigNode::load_file(config_file));
+  check_payload_series(
+      source.log->payload_kg, source.log->time_s, config.nominal_payload_kg,
+      {source.file, 0, "payload_kg",
+       fmt::format("robot {} ({}: joints.nominal_payload_kg)", source.log->robot, config_file)});
+  return config;
+}
+
+// Replaces the config's harmonic per joint by the one the identification record fits best.
+void search_orders(const ident::JointErrorLog& log, const ModelTorqueSource& torque_model,
+                   ident::IdentificationConfig& config) {
+  spdlog::info("verify: searching the transmission error's order per motor revolution");
+  const TransmissionErrorOrderSearch search =
+      search_transmission_error_orders(log, config, default_order_candidates(), &torque_model);
+  for (std::size_t j = 0; j < search.chosen_harmonic.size(); ++j)
+    spdlog::info("verify: {}: {}", log.joint_names[j], describe_order_search(search, j));
+  config = with_searched_orders(std::move(config), search);
+}
+
+// The compensated table (from the file or identified) and the ablation tables.
+std::vector<NamedTable> session_tables(const VerificationSessionOptions& options,
+                                       const JointErrorSource& source,
+                                       const std::optional<ident::IdentificationConfig>& config,
+                                       const ModelTorqueSource& torque_model, const fs::path& out,
+                                       Overwrite overwrite) {
+  std::vector<NamedTable> tables;
+  if (!options.table.empty()) {
+    tables.push_back({"compensated", ident::read_parameters_json(options.table)});
+  } else {
+    spdlog::info("verify: identifying the table from {}", source.file);
+    const IdentifiedTable t = identify_table(*source.log, *config, source.file, &torque_model);
+    for (const auto& f : t.failed_joints) spdlog::warn("verify: not identified: {}", f);
+    ident::write_parameters_json(out / "parameters.json", t.table, overwrite);
+    tables.push_back({"compensated", t.table});
+  }
+  if (source.log && options.ablation) {
+    for (const auto& [label, cfg] : ablation_configs(*config)) {
+      spdlog::info("verify: ablation table '{}'", label);
+      const IdentifiedTable t = identify_table(*source.log, cfg, source.file, &torque_model);
+      for (const auto& f : t.failed_joints)
+        spdlog::warn("verify: {}: not identified: {}", label, f);
+      tables.push_back({label, t.table});
+    }
+  }
+  return tables;
+}
+
+// The tables of the session: the joint errors' robot checked against the scenarios' nominal
+// robot, whose rigid-body model (never the plant's) serves the multi-input tables.
+std::vector<NamedTable> prepare_tables(const VerificationSessionOptions& options,
+                                       const fs::path& out, Overwrite overwrite) {
+  const JointErrorSource source = joint_error_source(options, out, overwrite);
+  if (options.table.empty() && !source.log)
+    throw InputError("", 0, "--table", "give --table, --joint-errors or --identify-scenario");
+  const ModelTorqueSource torque_model = scenario_model_torque(sim::load_scenario(
+      sim::resolve_scenario(options.identify_scenario.empty() ? options.scenarios.front()
+                                                              : options.identify_scenario)));
+  if (source.log && source.log->robot != torque_model.robot.name)
+    throw InputError(source.file, 0, "robot",
+                     fmt::format("the joint errors are of robot '{}', the scenarios' "
+                                 "nominal robot is '{}'",
+                                 source.log->robot, torque_model.robot.name));
+  std::optional<ident::IdentificationConfig> config;
+  if (source.log) config = checked_config(options, source);
+  if (options.search_order) {
+    if (!config || !config->options.transmission_error_input)
+      throw InputError(options.ident_config, 0, "--search-transmission-error-order",
+                       "needs joint errors and a config with the transmission error");
+    search_orders(*source.log, torque_model, *config);
+  }
+  return session_tables(options, source, config, torque_model, out, overwrite);
+}
+
+}  // namespace
+
+void verify_session(const VerificationSessionOptions& options, const fs::path& out,
+                    Overwrite overwrite, const ScenarioVerified& on_scenario,
+                    const VerificationSessionProgress& progress) {
+  if (progress) progress("tables", 0.0);
+  const std::vector<NamedTable> tables = prepare_tables(options, out, overwrite);
+  const VerificationRecord record{options.verification.seed,
+                                  options.verification.compensation.look_ahead_cycles,
+                                  options.verification.compensation.inversion_iterations,
+                                  options.table, options.verification.measure_with_ims};
+  for (std::size_t i = 0; i < options.scenarios.size(); ++i) {
+    const sim::Scenario scenario = sim::load_scenario(sim::resolve_scenario(options.scenarios[i]));
+    spdlog::info("verify: {} ({} cycles x {} runs)", scenario.name, options.verification.cycles,
+                 tables.size() + 1);
+    if (progress) progress(scenario.name, double(i) / double(options.scenarios.size()));
+    VerificationResult r;
+    try {
+      r = verify_scenario(scenario, tables, options.verification);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(scenario.file.string(), 0, "", e.what());
+    }
+    const fs::path dir = out / scenario.name;
+    const std::string text = write_verification_files(dir, r, record, overwrite);
+    if (on_scenario) on_scenario(dir, text);
+  }
+  if (progress) progress("done", 1.0);
+}
+
+}  // namespace imscal::eval
