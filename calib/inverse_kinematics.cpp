@@ -8,104 +8,28 @@
 #include <stdexcept>
 
 #include "calib/forward_kinematics.hpp"
-#include "calib/jacobian.hpp"
+#include "calib/ik_geometry.hpp"
+#include "calib/ik_refinement.hpp"
 
 namespace imscal::calib {
 namespace {
+
+using ik_geometry::angle_about;
+using ik_geometry::cross2;
+using ik_geometry::distance_to_line;
+using ik_geometry::nearest_point_to_lines;
+using ik_geometry::rotate2;
+using ik_geometry::rotation_about;
+using ik_geometry::wrap_to_pi;
 
 // Structure checks: how far the model may depart from the ideal class for the closed form to
 // be a good start for Newton (a few mrad / mm converge in a handful of steps).
 constexpr double kStructureAngleTolerance = 1e-2;     // rad
 constexpr double kStructureDistanceTolerance = 5e-3;  // m
 
-Eigen::Matrix3d rotation_about(const Eigen::Vector3d& axis, double angle) {
-  return Eigen::AngleAxisd(angle, axis).toRotationMatrix();
-}
-
-// Paden-Kahan subproblem 1: the angle that turns u into v about the unit axis w.
-double angle_about(const Eigen::Vector3d& w, const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
-  const Eigen::Vector3d u_perp = u - w.dot(u) * w;
-  const Eigen::Vector3d v_perp = v - w.dot(v) * w;
-  return std::atan2(w.dot(u_perp.cross(v_perp)), u_perp.dot(v_perp));
-}
-
-double wrap_to_pi(double angle) {
-  return std::remainder(angle, 2.0 * M_PI);
-}
-
-// Point nearest (least squares) to the lines {p_i + t w_i}.
-Eigen::Vector3d nearest_point_to_lines(const std::vector<Eigen::Vector3d>& points,
-                                       const std::vector<Eigen::Vector3d>& directions) {
-  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Matrix3d projector =
-        Eigen::Matrix3d::Identity() - directions[i] * directions[i].transpose();
-    a += projector;
-    b += projector * points[i];
-  }
-  return a.ldlt().solve(b);
-}
-
-double distance_to_line(const Eigen::Vector3d& x, const Eigen::Vector3d& p,
-                        const Eigen::Vector3d& w) {
-  return (x - p - w.dot(x - p) * w).norm();
-}
-
-double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  return a.x() * b.y() - a.y() * b.x();
-}
-
-Eigen::Vector2d rotate2(const Eigen::Vector2d& v, double angle) {
-  const double c = std::cos(angle);
-  const double s = std::sin(angle);
-  return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
-}
-
-// Orientation error as a rotation vector in R: R_error = R_target * R^T.
-Eigen::Vector3d rotation_error(const Eigen::Matrix3d& R_target, const Eigen::Matrix3d& R) {
-  const Eigen::AngleAxisd error(R_target * R.transpose());
-  return error.angle() * error.axis();
-}
-
 }  // namespace
 
-std::string to_string(const ArmConfiguration& c) {
-  return fmt::format("{}/{}/{}", c.shoulder_front ? "front" : "back", c.elbow_up ? "up" : "down",
-                     c.wrist_flip ? "flip" : "noflip");
-}
-
-const char* to_string(IkStatus status) {
-  switch (status) {
-    case IkStatus::kOk:
-      return "ok";
-    case IkStatus::kUnreachable:
-      return "unreachable";
-    case IkStatus::kShoulderSingular:
-      return "shoulder singular";
-    case IkStatus::kElbowSingular:
-      return "elbow singular";
-    case IkStatus::kWristSingular:
-      return "wrist singular";
-    case IkStatus::kOutsideJointLimits:
-      return "outside joint limits";
-    case IkStatus::kNotConverged:
-      return "not converged";
-  }
-  return "?";
-}
-
-std::vector<ArmConfiguration> InverseKinematics::all_configurations() {
-  std::vector<ArmConfiguration> out;
-  for (bool front : {true, false}) {
-    for (bool up : {true, false}) {
-      for (bool flip : {false, true}) out.push_back({front, up, flip});
-    }
-  }
-  return out;
-}
-
-InverseKinematics::InverseKinematics(const KinematicModel& model) : model_(model) {
+InverseKinematics::InverseKinematics(const KinematicModel& model) : IkSolver(model) {
   const ChainPoses<double> zero = chain_poses<double>(model_, JointVector::Zero().eval());
   for (int i = 0; i < kJointCount; ++i) {
     axis_[i] = zero.T_R_axis[i].linear().col(2);
@@ -214,27 +138,6 @@ SingularityMeasures InverseKinematics::singularity_measures(const JointVector& q
   m.elbow = std::abs(std::sin(elbow_bend(q(2))));
   m.wrist = std::abs(signed_wrist_measure(q(4)));
   return m;
-}
-
-std::vector<IkResult> InverseKinematics::solve_all(const Eigen::Isometry3d& T_R_H,
-                                                   const IkOptions& options) const {
-  std::vector<IkResult> out;
-  for (const ArmConfiguration& c : all_configurations()) out.push_back(solve(T_R_H, c, options));
-  return out;
-}
-
-IkResult InverseKinematics::solve_nearest(const Eigen::Isometry3d& T_R_H,
-                                          const JointVector& q_reference, IkOptions options) const {
-  if (!options.q_near) options.q_near = q_reference;
-  ArmConfiguration configuration = configuration_of(q_reference);
-  IkResult own = solve(T_R_H, configuration, options);
-  configuration.wrist_flip = !configuration.wrist_flip;
-  IkResult flipped = solve(T_R_H, configuration, options);
-  if (!flipped.ok()) return own;
-  if (!own.ok()) return flipped;
-  const double own_distance = (own.q - q_reference).cwiseAbs().maxCoeff();
-  const double flipped_distance = (flipped.q - q_reference).cwiseAbs().maxCoeff();
-  return flipped_distance < own_distance ? flipped : own;
 }
 
 IkResult InverseKinematics::solve(const Eigen::Isometry3d& T_R_H,
@@ -352,7 +255,7 @@ IkResult InverseKinematics::solve(const Eigen::Isometry3d& T_R_H,
 
   for (int i = 0; i < kJointCount; ++i) q(i) = wrap_to_pi(q(i));
   result.q = q;
-  refine(T_R_H, options, result);
+  refine_ik(model_, T_R_H, options, result);
   if (result.position_error_m > options.position_tolerance_m ||
       result.orientation_error_rad > options.orientation_tolerance_rad) {
     return fail(IkStatus::kNotConverged,
@@ -377,83 +280,12 @@ IkResult InverseKinematics::solve(const Eigen::Isometry3d& T_R_H,
                   "Newton refinement went over to the " + to_string(reached) + " configuration");
     }
   }
-  if (!fit_limits(options, result.q) && options.enforce_joint_limits) {
-    std::string outside;
-    for (int i = 0; i < kJointCount; ++i) {
-      if (result.q(i) < model_.lower_limit_rad(i) || result.q(i) > model_.upper_limit_rad(i)) {
-        outside += fmt::format(" q{}={:.6f} rad not in [{:.6f}, {:.6f}]", i + 1, result.q(i),
-                               model_.lower_limit_rad(i), model_.upper_limit_rad(i));
-      }
-    }
-    return fail(IkStatus::kOutsideJointLimits, "outside joint limits:" + outside);
+  if (!fit_joint_limits(model_, options, result.q) && options.enforce_joint_limits) {
+    return fail(IkStatus::kOutsideJointLimits,
+                "outside joint limits:" + describe_joints_outside_limits(model_, result.q));
   }
   result.status = IkStatus::kOk;
   return result;
-}
-
-void InverseKinematics::refine(const Eigen::Isometry3d& T_R_H, const IkOptions& options,
-                               IkResult& result) const {
-  auto errors = [&](const JointVector& q, Eigen::Matrix<double, 6, 1>& e) {
-    const Eigen::Isometry3d pose = forward_kinematics<double>(model_, q);
-    e.head<3>() = T_R_H.translation() - pose.translation();
-    e.tail<3>() = rotation_error(T_R_H.linear(), pose.linear());
-  };
-  Eigen::Matrix<double, 6, 1> e;
-  errors(result.q, e);
-  int iteration = 0;
-  while (iteration < options.max_newton_iterations &&
-         (e.head<3>().norm() > options.position_tolerance_m ||
-          e.tail<3>().norm() > options.orientation_tolerance_rad)) {
-    const Jacobian jacobian = geometric_jacobian(model_, result.q);
-    JointVector step = jacobian.partialPivLu().solve(e);
-    // Limit the step so that a poor start cannot jump to another solution branch.
-    constexpr double kMaxStep = 0.3;  // rad
-    if (!step.allFinite()) break;
-    if (step.norm() > kMaxStep) step *= kMaxStep / step.norm();
-    ++iteration;
-    // Backtracking: halve the step until the error shrinks; if even a tiny step does not
-    // help, rounding level (or a singular start) is reached.
-    bool improved = false;
-    for (int halving = 0; halving < 20 && !improved; ++halving, step *= 0.5) {
-      const JointVector candidate = result.q + step;
-      Eigen::Matrix<double, 6, 1> candidate_error;
-      errors(candidate, candidate_error);
-      if (candidate_error.norm() < e.norm()) {
-        result.q = candidate;
-        e = candidate_error;
-        improved = true;
-      }
-    }
-    if (!improved) break;
-  }
-  result.newton_iterations = iteration;
-  result.position_error_m = e.head<3>().norm();
-  result.orientation_error_rad = e.tail<3>().norm();
-}
-
-bool InverseKinematics::fit_limits(const IkOptions& options, JointVector& q) const {
-  bool all_inside = true;
-  for (int i = 0; i < kJointCount; ++i) {
-    const double reference = options.q_near ? (*options.q_near)(i) : 0.0;
-    double best = q(i);
-    bool found = false;
-    for (int turns = -3; turns <= 3; ++turns) {
-      const double candidate = q(i) + 2.0 * M_PI * turns;
-      if (candidate < model_.lower_limit_rad(i) || candidate > model_.upper_limit_rad(i)) {
-        continue;
-      }
-      if (!found || std::abs(candidate - reference) < std::abs(best - reference)) {
-        best = candidate;
-        found = true;
-      }
-    }
-    if (found) {
-      q(i) = best;
-    } else {
-      all_inside = false;
-    }
-  }
-  return all_inside;
 }
 
 }  // namespace imscal::calib

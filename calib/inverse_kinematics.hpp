@@ -21,8 +21,9 @@
 // - wrist_flip: the signed wrist bend (angle from axis 4 to axis 6 about axis 5) is negative
 //   (for the KR 16 description: q5 < 0).
 //
-// Failures are reported, never thrown: IkResult::status says what went wrong and
-// IkResult::reason says it in words with the numbers (distances in m, angles in rad).
+// Types, failures and the common calls: calib/ik_solver.hpp. Failures are reported, never thrown:
+// IkResult::status says what went wrong and IkResult::reason says it in words with the numbers
+// (distances in m, angles in rad).
 // - kUnreachable: the wrist centre is out of reach of the arm (too far, too close, or inside
 //   the cylinder of the lateral offset about axis 1).
 // - kShoulderSingular / kElbowSingular / kWristSingular: the pose lies within
@@ -34,87 +35,26 @@
 // The constructor throws std::invalid_argument if the model is not of the class above.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <optional>
+#include <array>
 #include <string>
 #include <vector>
 
+#include "calib/ik_solver.hpp"
 #include "calib/robot_description.hpp"
 
 namespace imscal::calib {
 
-struct ArmConfiguration {
-  bool shoulder_front = true;
-  bool elbow_up = true;
-  bool wrist_flip = false;
-  bool operator==(const ArmConfiguration&) const = default;
-};
-std::string to_string(const ArmConfiguration& configuration);  // "front/up/noflip"
-
-enum class IkStatus {
-  kOk,
-  kUnreachable,
-  kShoulderSingular,
-  kElbowSingular,
-  kWristSingular,
-  kOutsideJointLimits,
-  kNotConverged,
-};
-const char* to_string(IkStatus status);
-
-struct IkOptions {
-  // Distance to a singularity below which solve() refuses: shoulder [m] (wrist centre from the
-  // singular cylinder about axis 1), elbow and wrist [sine of the bend angle].
-  double singularity_tolerance = 1e-6;
-  int max_newton_iterations = 20;
-  double position_tolerance_m = 1e-12;       // flange position error after refinement
-  double orientation_tolerance_rad = 1e-12;  // flange rotation error after refinement
-  bool enforce_joint_limits = true;
-  // Among the 2*pi-equivalents of each angle within the limits, take the one nearest to this
-  // (default: nearest to 0).
-  std::optional<JointVector> q_near;
-};
-
-struct IkResult {
-  IkStatus status = IkStatus::kNotConverged;
-  std::string reason;  // empty when ok
-  JointVector q = JointVector::Zero();
-  ArmConfiguration configuration;
-  double position_error_m = 0.0;       // |p_H(q) - p_target| after refinement
-  double orientation_error_rad = 0.0;  // angle of R_H(q)^T R_target after refinement
-  int newton_iterations = 0;
-  bool ok() const { return status == IkStatus::kOk; }
-};
-
-// Distances to the three singularities at q (same units as IkOptions::singularity_tolerance).
-struct SingularityMeasures {
-  double shoulder_m = 0.0;
-  double elbow = 0.0;  // |sin| of the elbow bend from the stretched arm
-  double wrist = 0.0;  // |sin| of the wrist bend
-};
-
-class InverseKinematics {
+class InverseKinematics : public IkSolver {
  public:
   explicit InverseKinematics(const KinematicModel& model);
 
   // The solution of the given configuration for the flange pose T_R_H.
   IkResult solve(const Eigen::Isometry3d& T_R_H, const ArmConfiguration& configuration,
-                 const IkOptions& options = {}) const;
-  // The solution nearest (largest joint difference) to a reference reading, e.g. the robot's
-  // own encoders: of q_reference's arm configuration with either wrist branch. Near the wrist
-  // singularity (wrist bend ~ 0) a pose error of microradians can put the pose's wrist bend on
-  // the other side of zero; the reference's own branch is then A4 and A6 turned by ~pi, the
-  // other branch the physical solution. options.q_near defaults to q_reference.
-  IkResult solve_nearest(const Eigen::Isometry3d& T_R_H, const JointVector& q_reference,
-                         IkOptions options = {}) const;
-  // All 8 configurations, in the order of all_configurations(); each with its own status.
-  std::vector<IkResult> solve_all(const Eigen::Isometry3d& T_R_H,
-                                  const IkOptions& options = {}) const;
+                 const IkOptions& options = {}) const override;
+  ArmConfiguration configuration_of(const JointVector& q) const override;
+  SingularityMeasures singularity_measures(const JointVector& q) const override;
+  const char* structure() const override { return "spherical wrist"; }
 
-  ArmConfiguration configuration_of(const JointVector& q) const;
-  SingularityMeasures singularity_measures(const JointVector& q) const;
-
-  static std::vector<ArmConfiguration> all_configurations();
-  const KinematicModel& model() const { return model_; }
   // Wrist centre in the flange frame H [m].
   const Eigen::Vector3d& wrist_centre_H() const { return wrist_centre_H_; }
 
@@ -126,10 +66,7 @@ class InverseKinematics {
   double elbow_bend(double q3) const;
   double signed_wrist_measure(double q5) const;
   Eigen::Vector2d in_plane(const Eigen::Vector3d& point_R) const;
-  void refine(const Eigen::Isometry3d& T_R_H, const IkOptions& options, IkResult& result) const;
-  bool fit_limits(const IkOptions& options, JointVector& q) const;
 
-  KinematicModel model_;
   std::array<Eigen::Vector3d, kJointCount> axis_;   // joint axes at q = 0, in R
   std::array<Eigen::Vector3d, kJointCount> point_;  // a point on each axis at q = 0, in R
   Eigen::Matrix3d R_R_H_zero_;                      // flange orientation at q = 0

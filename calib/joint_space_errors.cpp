@@ -6,9 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "calib/forward_kinematics.hpp"
-#include "calib/inverse_kinematics.hpp"
+#include "calib/ik_solver.hpp"
 #include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
 #include "ims/earth_model.hpp"
@@ -72,7 +73,8 @@ JointSpaceErrors joint_errors_along(const std::vector<ims::SmoothedState>& traje
   JointSpaceErrors out;
   out.robot = log.robot_name;
   out.cycle_s = log.cycle_s;
-  const InverseKinematics ik(kinematics);
+  const std::unique_ptr<IkSolver> solver = make_inverse_kinematics(kinematics);
+  const IkSolver& ik = *solver;
   for (const RobotLogSample& sample : log.samples) {
     Eigen::Isometry3d T_W_S;
     if (!interpolate_sensor_pose(trajectory, sample.t_s + frames.time_offset_s, T_W_S)) {

@@ -11,7 +11,8 @@
 //              repeatability; calib/revisited_poses.hpp): the smoother cannot observe position;
 //   T_R_H(t)   = T_R_W W_T_S(t + dt) T_S_H at every robot sample (t robot clock, t + dt IMS clock;
 //              the smoothed poses interpolated between IMS samples: linear position, slerp);
-//   q_measured inverse kinematics (calib/inverse_kinematics.hpp) in the configuration of the
+//   q_measured inverse kinematics (calib/ik_solver.hpp, the arm's class) in the configuration of
+//   the
 //              robot's own reading at that sample, the 2*pi branch nearest to it;
 //   dq         = q_desired - q_measured per joint (the robot's internal reading beside it),
 //              with the 1-sigma the smoother's own sigmas give it (position and attitude of

@@ -10,12 +10,13 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "calib/forward_kinematics.hpp"
-#include "calib/inverse_kinematics.hpp"
+#include "calib/ik_solver.hpp"
 #include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
 #include "core/units.hpp"
@@ -64,7 +65,10 @@ struct JointState {
 class Planner {
  public:
   Planner(const calib::RobotDescription& robot, const MotionProgram& program)
-      : robot_(robot), program_(program), ik_(robot.kinematics), cycle_(robot.controller_cycle_s) {}
+      : robot_(robot),
+        program_(program),
+        ik_(calib::make_inverse_kinematics(robot.kinematics)),
+        cycle_(robot.controller_cycle_s) {}
 
   DesiredJointPath run();
 
@@ -100,7 +104,7 @@ class Planner {
 
   const calib::RobotDescription& robot_;
   const MotionProgram& program_;
-  calib::InverseKinematics ik_;
+  std::unique_ptr<calib::IkSolver> ik_;  // of the arm's class
   double cycle_;
   DesiredJointPath path_;
   JointVector q_;  // current joints (end of the last segment)
@@ -167,7 +171,7 @@ void Planner::plan_rest(const ProgramStep& step) {
 JointVector Planner::solve_pose(const ProgramStep& step, const Eigen::Isometry3d& pose) const {
   calib::IkOptions options;
   options.q_near = q_;
-  const std::vector<calib::IkResult> all = ik_.solve_all(pose, options);
+  const std::vector<calib::IkResult> all = ik_->solve_all(pose, options);
   const calib::IkResult* best = nullptr;
   double best_change = std::numeric_limits<double>::infinity();
   for (const auto& r : all) {
@@ -179,10 +183,10 @@ JointVector Planner::solve_pose(const ProgramStep& step, const Eigen::Isometry3d
     }
   }
   if (best == nullptr) {
-    const auto current = ik_.configuration_of(q_);
+    const auto current = ik_->configuration_of(q_);
     std::string reason;
     for (std::size_t i = 0; i < all.size(); ++i) {
-      if (calib::InverseKinematics::all_configurations()[i] == current) {
+      if (calib::IkSolver::all_configurations()[i] == current) {
         reason = all[i].status == calib::IkStatus::kOutsideJointLimits
                      ? "outside joint limits:" + describe_outside_limits(all[i].q)
                      : std::string(calib::to_string(all[i].status)) + ": " + all[i].reason;
@@ -345,7 +349,7 @@ std::vector<JointState> Planner::sample_cartesian(const ProgramStep& step,
     m.acceleration.tail<3>() = path.R0 * path.rotation_vector * (s.acceleration / length);
 
     options.q_near = q_prev;
-    const calib::IkResult ik = ik_.solve(m.pose, ik_.configuration_of(q_prev), options);
+    const calib::IkResult ik = ik_->solve(m.pose, ik_->configuration_of(q_prev), options);
     if (ik.status == calib::IkStatus::kOutsideJointLimits) {
       fail(step, fmt::format("at {:.3f} s ({:.1f} mm along the path):{}", t, s.position * 1e3,
                              describe_outside_limits(ik.q)));

@@ -13,12 +13,12 @@
 //   v_max_i from the robot file, a_max_i and j_max_i from the program.
 // - LIN / CIRC: the flange origin follows the line/arc with a profile along the arc length
 //   (path velocity, acceleration, jerk); orientation constant or slerp (R0 exp(sigma theta k),
-//   sigma = s / L). Joints by IK at every sample (configuration and 2 pi branch of the previous
-//   sample), joint rates from the Cartesian twist, q_dot = J^-1 [v; w], and accelerations
-//   q_ddot = J^-1 ([a; w_dot] - J_dot q_dot), J_dot q_dot in closed form
-//   (jacobian_rate_times_joint_rate): exact up to rounding, no finite differences.
-//   Joint limits: a LIN/CIRC move whose programmed timing would take a joint beyond its
-//   acceleration limit (or, jerk_limited, its jerk limit per cycle; both from the program) by
+//   sigma = s / L). Joints by IK (the solver of the arm's class, calib/ik_solver.hpp) at every
+//   sample (configuration and 2 pi branch of the previous sample), joint rates from the Cartesian
+//   twist, q_dot = J^-1 [v; w], and accelerations q_ddot = J^-1 ([a; w_dot] - J_dot q_dot), J_dot
+//   q_dot in closed form (jacobian_rate_times_joint_rate): exact up to rounding, no finite
+//   differences. Joint limits: a LIN/CIRC move whose programmed timing would take a joint beyond
+//   its acceleration limit (or, jerk_limited, its jerk limit per cycle; both from the program) by
 //   more than kJointLimitTolerance is slowed, as a controller does: same path and orientation
 //   law, a slower profile (sim/cartesian_timing.hpp: longer ramps where they suffice, a lower
 //   path speed where not). Logged (info) and recorded in PathSegment::timing (programmed and
@@ -36,7 +36,8 @@
 namespace imscal::sim {
 
 // Singularity margin for Cartesian moves (IkOptions::singularity_tolerance): 10 mm of the wrist
-// centre from axis 1, |sin| 0.01 (0.57 deg) of the elbow and wrist bends. Closer, the joint rates
+// centre (UR class: wrist point) from the shoulder singularity, |sin| 0.01 (0.57 deg) of the
+// elbow and wrist bends. Closer, the joint rates
 // of a constant path speed grow like 1 / distance and the IK branch is ill-defined.
 inline constexpr double kSingularityTolerance = 0.01;
 
