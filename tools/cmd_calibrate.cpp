@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -110,7 +111,14 @@ void run(const CalibrateArgs& args) {
   { OutputFolder check(args.out, outputs, overwrite); }
 
   Progress progress;
-  const ProgressCallback channel = progress_channel();
+  // The session may come back to a step (the rests are refined after the clock offset): the
+  // share reported never goes back.
+  double reported = 0.0;
+  const ProgressCallback channel = [&reported, to_parent = progress_channel()](
+                                       const std::string& stage, double fraction) {
+    reported = std::max(reported, fraction);
+    to_parent(stage, reported);
+  };
   progress.update("read", 0.0);
   const calib::LoadedSession loaded = calib::read_session_inputs(args.files);
   const calib::SessionResult session = calib::calibrate_session(
