@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 
+#include "calib/ik_refinement.hpp"
 #include "calib/inverse_kinematics.hpp"
 #include "calib/ur_inverse_kinematics.hpp"
 
@@ -49,6 +50,45 @@ std::vector<IkResult> IkSolver::solve_all(const Eigen::Isometry3d& T_R_H,
   std::vector<IkResult> out;
   for (const ArmConfiguration& c : all_configurations()) out.push_back(solve(T_R_H, c, options));
   return out;
+}
+
+void IkSolver::finish_refined(bool ideal, const ArmConfiguration& configuration,
+                              const IkOptions& options, IkResult& result) const {
+  auto fail = [&](IkStatus status, std::string reason) {
+    result.status = status;
+    result.reason = std::move(reason);
+  };
+  if (result.position_error_m > options.position_tolerance_m ||
+      result.orientation_error_rad > options.orientation_tolerance_rad) {
+    return fail(IkStatus::kNotConverged,
+                fmt::format("Newton refinement stopped at {:.3g} m, {:.3g} rad after {} steps",
+                            result.position_error_m, result.orientation_error_rad,
+                            result.newton_iterations));
+  }
+  if (!ideal) {
+    const SingularityMeasures measures = singularity_measures(result.q);
+    const double tolerance = options.singularity_tolerance;
+    if (measures.shoulder_m < tolerance) {
+      return fail(IkStatus::kShoulderSingular, "refined solution at the shoulder singularity");
+    }
+    if (measures.elbow < tolerance) {
+      return fail(IkStatus::kElbowSingular, "refined solution at the elbow singularity");
+    }
+    if (measures.wrist < tolerance) {
+      return fail(IkStatus::kWristSingular, "refined solution at the wrist singularity");
+    }
+    const ArmConfiguration reached = configuration_of(result.q);
+    if (!(reached == configuration)) {
+      return fail(IkStatus::kNotConverged,
+                  "Newton refinement went over to the " + to_string(reached) + " configuration");
+    }
+  }
+  if (!fit_joint_limits(model_, options, result.q) && options.enforce_joint_limits) {
+    return fail(IkStatus::kOutsideJointLimits,
+                "outside joint limits:" + describe_joints_outside_limits(model_, result.q));
+  }
+  result.status = IkStatus::kOk;
+  result.reason.clear();
 }
 
 IkResult IkSolver::solve_nearest(const Eigen::Isometry3d& T_R_H, const JointVector& q_reference,

@@ -98,6 +98,12 @@ class IkSolver {
 
  protected:
   explicit IkSolver(const KinematicModel& model) : model_(model) {}
+  // After the Newton refinement (calib/ik_refinement.hpp), for every solver: converged; for an arm
+  // that is not of the ideal structure (whose closed form checked its singularities before),
+  // away from a singularity and still on the requested configuration; within the joint limits.
+  // Sets result.status and result.reason.
+  void finish_refined(bool ideal, const ArmConfiguration& configuration, const IkOptions& options,
+                      IkResult& result) const;
   KinematicModel model_;
 };
 

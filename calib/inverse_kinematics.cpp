@@ -256,35 +256,7 @@ IkResult InverseKinematics::solve(const Eigen::Isometry3d& T_R_H,
   for (int i = 0; i < kJointCount; ++i) q(i) = wrap_to_pi(q(i));
   result.q = q;
   refine_ik(model_, T_R_H, options, result);
-  if (result.position_error_m > options.position_tolerance_m ||
-      result.orientation_error_rad > options.orientation_tolerance_rad) {
-    return fail(IkStatus::kNotConverged,
-                fmt::format("Newton refinement stopped at {:.3g} m, {:.3g} rad after {} steps",
-                            result.position_error_m, result.orientation_error_rad,
-                            result.newton_iterations));
-  }
-  if (!ideal_) {
-    const SingularityMeasures measures = singularity_measures(result.q);
-    if (measures.shoulder_m < tolerance) {
-      return fail(IkStatus::kShoulderSingular, "refined solution at the shoulder singularity");
-    }
-    if (measures.elbow < tolerance) {
-      return fail(IkStatus::kElbowSingular, "refined solution at the elbow singularity");
-    }
-    if (measures.wrist < tolerance) {
-      return fail(IkStatus::kWristSingular, "refined solution at the wrist singularity");
-    }
-    const ArmConfiguration reached = configuration_of(result.q);
-    if (!(reached == configuration)) {
-      return fail(IkStatus::kNotConverged,
-                  "Newton refinement went over to the " + to_string(reached) + " configuration");
-    }
-  }
-  if (!fit_joint_limits(model_, options, result.q) && options.enforce_joint_limits) {
-    return fail(IkStatus::kOutsideJointLimits,
-                "outside joint limits:" + describe_joints_outside_limits(model_, result.q));
-  }
-  result.status = IkStatus::kOk;
+  finish_refined(ideal_, configuration, options, result);
   return result;
 }
 

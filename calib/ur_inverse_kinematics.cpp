@@ -161,7 +161,7 @@ IkResult UrInverseKinematics::solve(const Eigen::Isometry3d& T_R_H,
   for (int i = 0; i < kJointCount; ++i) q(i) = wrap_to_pi(q(i));
   result.q = q;
   refine_ik(model_, T_R_H, options, result);
-  finish(configuration, options, result);
+  finish_refined(ideal_, configuration, options, result);
   return result;
 }
 
@@ -267,45 +267,6 @@ bool UrInverseKinematics::solve_joints_2_3_4(const Eigen::Isometry3d& T_R_H,
   q(2) = joint3_sign_ * theta3;
   q(3) = joint4_sign_ * (theta_sum - theta2 - theta3);
   return true;
-}
-
-void UrInverseKinematics::finish(const ArmConfiguration& configuration, const IkOptions& options,
-                                 IkResult& result) const {
-  auto fail = [&](IkStatus status, std::string reason) {
-    result.status = status;
-    result.reason = std::move(reason);
-  };
-  if (result.position_error_m > options.position_tolerance_m ||
-      result.orientation_error_rad > options.orientation_tolerance_rad) {
-    return fail(IkStatus::kNotConverged,
-                fmt::format("Newton refinement stopped at {:.3g} m, {:.3g} rad after {} steps",
-                            result.position_error_m, result.orientation_error_rad,
-                            result.newton_iterations));
-  }
-  if (!ideal_) {
-    const SingularityMeasures measures = singularity_measures(result.q);
-    const double tolerance = options.singularity_tolerance;
-    if (measures.shoulder_m < tolerance) {
-      return fail(IkStatus::kShoulderSingular, "refined solution at the shoulder singularity");
-    }
-    if (measures.elbow < tolerance) {
-      return fail(IkStatus::kElbowSingular, "refined solution at the elbow singularity");
-    }
-    if (measures.wrist < tolerance) {
-      return fail(IkStatus::kWristSingular, "refined solution at the wrist singularity");
-    }
-    const ArmConfiguration reached = configuration_of(result.q);
-    if (!(reached == configuration)) {
-      return fail(IkStatus::kNotConverged,
-                  "Newton refinement went over to the " + to_string(reached) + " configuration");
-    }
-  }
-  if (!fit_joint_limits(model_, options, result.q) && options.enforce_joint_limits) {
-    return fail(IkStatus::kOutsideJointLimits,
-                "outside joint limits:" + describe_joints_outside_limits(model_, result.q));
-  }
-  result.status = IkStatus::kOk;
-  result.reason.clear();
 }
 
 }  // namespace imscal::calib

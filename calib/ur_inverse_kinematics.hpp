@@ -74,9 +74,6 @@ class UrInverseKinematics : public IkSolver {
                         double tolerance, JointVector& q, IkResult& result) const;
   bool solve_joints_2_3_4(const Eigen::Isometry3d& T_R_H, const ArmConfiguration& configuration,
                           double tolerance, JointVector& q, IkResult& result) const;
-  // After refinement: convergence, singularity and branch of a non-ideal arm, joint limits.
-  void finish(const ArmConfiguration& configuration, const IkOptions& options,
-              IkResult& result) const;
 
   std::array<Eigen::Vector3d, kJointCount> axis_;   // joint axes at q = 0, in R
   std::array<Eigen::Vector3d, kJointCount> point_;  // a point on each axis at q = 0, in R
