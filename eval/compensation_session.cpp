@@ -66,20 +66,6 @@ void check_log_payload(const CompensationSessionOptions& args, const ident::Para
   check_payload_series(payload, t, rated_kg, {args.robot_log, 0, "payload_kg", rating_of});
 }
 
-const char* state_name(ident::PrecontrolState s) {
-  switch (s) {
-    case ident::PrecontrolState::kActive:
-      return "active";
-    case ident::PrecontrolState::kFadingOut:
-      return "fading_out";
-    case ident::PrecontrolState::kInactive:
-      return "inactive";
-    case ident::PrecontrolState::kEngaging:
-      return "engaging";
-  }
-  return "?";
-}
-
 // The offsets file's header: what made it and its columns.
 std::string offsets_header(const CompensationSessionOptions& args, const calib::RobotLog& log) {
   std::ostringstream csv;
@@ -109,7 +95,7 @@ std::string run_cycle(ident::Precontrol& precontrol, const calib::RobotLog& log,
                      : precontrol.cycle(q, log.samples[ahead].payload_kg, tau, cycle);
   summary.active_cycles += out.state == ident::PrecontrolState::kActive;
   std::string row =
-      fmt::format("{},{},{}", s.t_s, state_name(out.state), out.outside_table ? 1 : 0);
+      fmt::format("{},{},{}", s.t_s, ident::to_string(out.state), out.outside_table ? 1 : 0);
   for (double o : out.offset_rad) row += fmt::format(",{}", o);
   row += "\n";
   std::array<ident::PrecontrolEvent, ident::kPrecontrolEventCapacity> events{};

@@ -28,6 +28,20 @@ double default_if_zero(double value, double fallback) {
 
 }  // namespace
 
+const char* to_string(PrecontrolState state) {
+  switch (state) {
+    case PrecontrolState::kActive:
+      return "active";
+    case PrecontrolState::kFadingOut:
+      return "fading_out";
+    case PrecontrolState::kInactive:
+      return "inactive";
+    case PrecontrolState::kEngaging:
+      return "engaging";
+  }
+  return "?";
+}
+
 const char* to_string(PrecontrolCause cause) {
   switch (cause) {
     case PrecontrolCause::kNone:

@@ -110,6 +110,8 @@ enum class PrecontrolCause : std::uint8_t {
   kEngaged,        // the offset is fully faded in
 };
 const char* to_string(PrecontrolCause cause);
+// "active", "fading_out", "inactive", "engaging" (the offsets file's `state` column).
+const char* to_string(PrecontrolState state);
 
 struct PrecontrolEvent {
   std::uint64_t cycle = 0;

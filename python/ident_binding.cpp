@@ -62,20 +62,6 @@ py::dict identify(const std::string& joint_errors, const std::string& config_fil
                   "joint_error_fit_percent"_a = fit_percent, "failures"_a = failures);
 }
 
-const char* state_name(ident::PrecontrolState s) {
-  switch (s) {
-    case ident::PrecontrolState::kActive:
-      return "active";
-    case ident::PrecontrolState::kFadingOut:
-      return "fading_out";
-    case ident::PrecontrolState::kInactive:
-      return "inactive";
-    case ident::PrecontrolState::kEngaging:
-      return "engaging";
-  }
-  return "?";
-}
-
 // The precontrol with its table; one call of step() per controller cycle.
 class PythonPrecontrol {
  public:
@@ -103,7 +89,7 @@ class PythonPrecontrol {
                  double payload_kg, std::uint64_t cycle) {
     const ident::PrecontrolOutput out = precontrol_->cycle(q_desired_rad, payload_kg, cycle);
     py::array_t<double> offset(ident::kPrecontrolJoints, out.offset_rad.data());
-    return py::make_tuple(offset, state_name(out.state), out.outside_table);
+    return py::make_tuple(offset, ident::to_string(out.state), out.outside_table);
   }
 
   py::list events() {
