@@ -48,11 +48,26 @@ class DatagramSession {
 
   // Faults since the last call, oldest first (the ring keeps the newest kSessionFaultCapacity).
   int read_faults(SessionFaultEvent* out, int capacity) noexcept;
+  // Datagrams answered, and not answered (malformed, nothing to answer, no room for the answer).
+  std::uint64_t answered() const noexcept { return answered_; }
+  std::uint64_t refused() const noexcept { return refused_; }
 
  protected:
   void record(std::uint64_t counter, SessionFault fault, int detail, double value) noexcept;
+  // A datagram left unanswered: 0, the length handle() returns for it.
+  int refuse_datagram() noexcept {
+    ++refused_;
+    return 0;
+  }
+  // The answer's length as the protocol's writer gave it (<= 0: it could not be written).
+  int counted_answer(int bytes) noexcept {
+    if (bytes <= 0) return refuse_datagram();
+    ++answered_;
+    return bytes;
+  }
 
  private:
+  std::uint64_t answered_ = 0, refused_ = 0;
   std::array<SessionFaultEvent, kSessionFaultCapacity> faults_{};
   int fault_head_ = 0, fault_count_ = 0;
 };

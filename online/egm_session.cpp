@@ -153,8 +153,7 @@ int EgmSession::handle(std::string_view datagram, double receive_time_s, char* a
   if (error != EgmParseError::kNone) {
     record(0, SessionFault::kMalformed, int(error), 0.0);
     pending_fault_ = true;
-    ++refused_;
-    return 0;
+    return refuse_datagram();
   }
   const bool fade = judge(datagram_, receive_time_s);
   std::array<double, kEgmAxes> joints_deg = target_deg_;
@@ -168,18 +167,9 @@ int EgmSession::handle(std::string_view datagram, double receive_time_s, char* a
       joints_deg[std::size_t(a)] =
           (path_.q_rad[k][std::size_t(a)] + correction_rad_[std::size_t(a)]) * kDegPerRad;
   }
-  if (!has_target_) {  // nothing to hold the robot at yet
-    ++refused_;
-    return 0;
-  }
-  const int bytes =
-      codec_.write_sensor(datagram_.seqno, datagram_.tm_ms, joints_deg, answer, capacity);
-  if (bytes <= 0) {
-    ++refused_;
-    return 0;
-  }
-  ++answered_;
-  return bytes;
+  if (!has_target_) return refuse_datagram();  // nothing to hold the robot at yet
+  return counted_answer(
+      codec_.write_sensor(datagram_.seqno, datagram_.tm_ms, joints_deg, answer, capacity));
 }
 
 }  // namespace imscal::online

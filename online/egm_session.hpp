@@ -66,8 +66,6 @@ class EgmSession final : public DatagramSession {
   const std::array<double, kEgmAxes>& correction_rad() const noexcept { return correction_rad_; }
   ident::PrecontrolState state() const noexcept { return state_; }
   bool following() const noexcept { return following_; }
-  std::uint64_t answered() const noexcept { return answered_; }
-  std::uint64_t refused() const noexcept { return refused_; }
 
  private:
   EgmSession() = default;
@@ -94,7 +92,6 @@ class EgmSession final : public DatagramSession {
   std::array<double, kEgmAxes> target_deg_{};  // the last in-order answer's joints
   std::array<double, kEgmAxes> correction_rad_{};
   ident::PrecontrolState state_ = ident::PrecontrolState::kInactive;
-  std::uint64_t answered_ = 0, refused_ = 0;
 };
 
 }  // namespace imscal::online

@@ -106,8 +106,7 @@ int RsiSession::handle(std::string_view datagram, double receive_time_s, char* a
   if (error != RsiParseError::kNone) {
     record(0, SessionFault::kMalformed, int(error), 0.0);
     pending_fault_ = true;
-    ++refused_;
-    return 0;
+    return refuse_datagram();
   }
   const std::uint64_t cycle = datagram_.ipoc / options_.ipoc_per_cycle;
   bool fade = judge(datagram_, receive_time_s);
@@ -133,14 +132,8 @@ int RsiSession::handle(std::string_view datagram, double receive_time_s, char* a
     for (int a = 0; a < kRsiAxes; ++a)
       values_deg[std::size_t(a)] = correction_rad_[std::size_t(a)] * kDegPerRad;
   }  // increment mode out of order: zero increments
-  const int bytes =
-      write_rsi_answer(options_.sensor_type, values_deg, datagram_.ipoc, answer, capacity);
-  if (bytes <= 0) {
-    ++refused_;
-    return 0;
-  }
-  ++answered_;
-  return bytes;
+  return counted_answer(
+      write_rsi_answer(options_.sensor_type, values_deg, datagram_.ipoc, answer, capacity));
 }
 
 }  // namespace imscal::online

@@ -73,8 +73,6 @@ class RsiSession final : public DatagramSession {
   // The correction of the last answer [rad] (absolute, whichever the mode) and its state.
   const std::array<double, kRsiAxes>& correction_rad() const noexcept { return correction_rad_; }
   ident::PrecontrolState state() const noexcept { return state_; }
-  std::uint64_t answered() const noexcept { return answered_; }
-  std::uint64_t refused() const noexcept { return refused_; }
 
  private:
   RsiSession() = default;
@@ -101,7 +99,6 @@ class RsiSession final : public DatagramSession {
   std::array<double, kRsiAxes> correction_rad_{};
   std::array<double, kRsiAxes> sent_sum_deg_{};  // increment mode: what the controller summed
   ident::PrecontrolState state_ = ident::PrecontrolState::kInactive;
-  std::uint64_t answered_ = 0, refused_ = 0;
 };
 
 }  // namespace imscal::online
