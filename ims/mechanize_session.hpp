@@ -4,8 +4,8 @@
 // or from a coarse alignment over its first seconds at rest (ims/coarse_alignment.hpp), then the
 // strapdown mechanization (ims/strapdown.hpp) or, with a sensor spec, the zero-velocity-aided
 // smoother with 1-sigma columns (ims/zupt_smoother.hpp): the trajectory of the sensor frame S in
-// W (ENU), position and velocity starting at zero. Bad options are InputErrors naming the
-// command line's option.
+// W (ENU), position and velocity starting at zero (its start: ims/mechanization_start.hpp). Bad
+// options are InputErrors naming the command line's option.
 #include <optional>
 #include <string>
 #include <vector>
