@@ -11,6 +11,11 @@
 
 namespace imscal::calib::ik_geometry {
 
+// How far a model may depart from a solver's ideal structure for its closed form to be a good
+// start for Newton (a few mrad / mm converge in a handful of steps).
+inline constexpr double kStructureAngleTolerance = 1e-2;     // rad
+inline constexpr double kStructureDistanceTolerance = 5e-3;  // m
+
 inline Eigen::Matrix3d rotation_about(const Eigen::Vector3d& axis, double angle) {
   return Eigen::AngleAxisd(angle, axis).toRotationMatrix();
 }

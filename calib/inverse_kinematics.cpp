@@ -22,10 +22,8 @@ using ik_geometry::rotate2;
 using ik_geometry::rotation_about;
 using ik_geometry::wrap_to_pi;
 
-// Structure checks: how far the model may depart from the ideal class for the closed form to
-// be a good start for Newton (a few mrad / mm converge in a handful of steps).
-constexpr double kStructureAngleTolerance = 1e-2;     // rad
-constexpr double kStructureDistanceTolerance = 5e-3;  // m
+using ik_geometry::kStructureAngleTolerance;
+using ik_geometry::kStructureDistanceTolerance;
 
 }  // namespace
 
