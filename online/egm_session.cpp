@@ -6,15 +6,6 @@
 #include "core/units.hpp"
 
 namespace imscal::online {
-namespace {
-
-// n when x is n whole samples of spacing (within 1e-6 of a sample), else -1.
-long whole_samples(double x_s, double spacing_s) {
-  const double n = x_s / spacing_s;
-  return std::abs(n - std::round(n)) < 1e-6 && n >= 0.0 ? std::lround(n) : -1;
-}
-
-}  // namespace
 
 std::unique_ptr<EgmSession> EgmSession::create(const ident::ParameterTable& table,
                                                const std::string& robot_name,

@@ -38,6 +38,10 @@ struct LoadedPath {
   std::vector<double> payload_kg;                          // per sample (or empty: 0)
 };
 
+// n when x_s is n whole samples of spacing_s (within 1e-6 of a sample), else -1: a controller
+// cycle or a preview that the path's samples must divide.
+long whole_samples(double x_s, double spacing_s);
+
 struct PathFollowerOptions {
   double rest_tolerance_rad = 1e-4;        // "at the start pose"
   double track_tolerance_rad = 0.02;       // a set-point farther from the path is off it
