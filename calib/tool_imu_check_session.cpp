@@ -22,6 +22,12 @@ nlohmann::json vector_json(const Eigen::Vector3d& v, double scale = 1.0) {
   return {v.x() * scale, v.y() * scale, v.z() * scale};
 }
 
+const char* sigma_method(const RotationCalibration& c) {
+  if (!c.sigma_from_bootstrap) return "covariance";
+  return c.sigma_resampling == SigmaResampling::kMotionSegments ? "motion-segment bootstrap"
+                                                                : "moving-block bootstrap";
+}
+
 nlohmann::json calibration_json(const RotationCalibration& c) {
   nlohmann::json j;
   j["q_T_S_wxyz"] = {c.q_T_S.w(), c.q_T_S.x(), c.q_T_S.y(), c.q_T_S.z()};
@@ -31,10 +37,13 @@ nlohmann::json calibration_json(const RotationCalibration& c) {
   j["sigma_gyro_bias_deg_s"] = vector_json(c.sigma_bias_rad_s, kDegPerRad);
   j["gyro_scale"] = vector_json(c.gyro_scale);
   j["sigma_gyro_scale"] = vector_json(c.sigma_scale);
+  j["gyro_cross_coupling"] = vector_json(c.gyro_cross_coupling);
+  j["sigma_gyro_cross_coupling"] = vector_json(c.sigma_cross_coupling);
   j["time_offset_s"] = c.time_offset_s;
   j["sigma_time_offset_s"] = c.sigma_time_offset_s;
-  j["sigma_method"] = c.sigma_from_bootstrap ? "moving-block bootstrap" : "covariance";
+  j["sigma_method"] = sigma_method(c);
   j["bootstrap_replicates"] = c.bootstrap_replicates;
+  j["bootstrap_segments"] = c.bootstrap_unit_count;
   j["covariance_sigma_rotation_deg"] = vector_json(c.covariance_sigma_rotation_rad, kDegPerRad);
   j["covariance_sigma_time_offset_s"] = c.covariance_sigma_time_offset_s;
   j["covariance_ok"] = c.covariance_ok;
@@ -49,13 +58,14 @@ void print_calibration(const std::string& title, const RotationCalibration& c,
   print(fmt::format(
       "{}: R_T_S angle {:.3f} deg (1 sigma {:.3f} {:.3f} {:.3f} deg, {}), time offset {:.4f} +- "
       "{:.4f} s,\n  gyro bias {:.4g} {:.4g} {:.4g} deg/s (as labelled), scale {:.5g} {:.5g} "
-      "{:.5g}, window residual RMS {:.3f} deg over {} windows\n",
+      "{:.5g}, cross-coupling {:.3g} {:.3g} {:.3g}, window residual RMS {:.3f} deg over {} "
+      "windows\n",
       title, Eigen::AngleAxisd(c.q_T_S).angle() * kDegPerRad, c.sigma_rotation_rad.x() * kDegPerRad,
-      c.sigma_rotation_rad.y() * kDegPerRad, c.sigma_rotation_rad.z() * kDegPerRad,
-      c.sigma_from_bootstrap ? "block bootstrap" : "covariance", c.time_offset_s,
-      c.sigma_time_offset_s, c.gyro_bias_rad_s.x() * kDegPerRad, c.gyro_bias_rad_s.y() * kDegPerRad,
-      c.gyro_bias_rad_s.z() * kDegPerRad, c.gyro_scale.x(), c.gyro_scale.y(), c.gyro_scale.z(),
-      c.rms_residual_rad * kDegPerRad, c.window_count));
+      c.sigma_rotation_rad.y() * kDegPerRad, c.sigma_rotation_rad.z() * kDegPerRad, sigma_method(c),
+      c.time_offset_s, c.sigma_time_offset_s, c.gyro_bias_rad_s.x() * kDegPerRad,
+      c.gyro_bias_rad_s.y() * kDegPerRad, c.gyro_bias_rad_s.z() * kDegPerRad, c.gyro_scale.x(),
+      c.gyro_scale.y(), c.gyro_scale.z(), c.gyro_cross_coupling.x(), c.gyro_cross_coupling.y(),
+      c.gyro_cross_coupling.z(), c.rms_residual_rad * kDegPerRad, c.window_count));
 }
 
 nlohmann::json error_json(const OrientationErrorStats& e) {
