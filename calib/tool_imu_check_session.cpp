@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -69,10 +70,16 @@ void print_calibration(const std::string& title, const RotationCalibration& c,
 }
 
 nlohmann::json error_json(const OrientationErrorStats& e) {
-  return {{"rms_deg", e.rms_rad * kDegPerRad},
-          {"max_deg", e.max_rad * kDegPerRad},
-          {"final_deg", e.final_rad * kDegPerRad},
-          {"samples", e.sample_count}};
+  return {{"rms_deg", e.rms_rad * kDegPerRad},     {"median_deg", e.median_rad * kDegPerRad},
+          {"p90_deg", e.p90_rad * kDegPerRad},     {"max_deg", e.max_rad * kDegPerRad},
+          {"final_deg", e.final_rad * kDegPerRad}, {"samples", e.sample_count}};
+}
+
+std::string error_text(const OrientationErrorStats& e) {
+  return fmt::format(
+      "median {:.2f} deg, 90th percentile {:.2f} deg, RMS {:.2f} deg, max {:.2f} deg",
+      e.median_rad * kDegPerRad, e.p90_rad * kDegPerRad, e.rms_rad * kDegPerRad,
+      e.max_rad * kDegPerRad);
 }
 
 nlohmann::json segment_json(const SegmentRotation& s) {
@@ -133,17 +140,15 @@ nlohmann::json report_orientation(const ToolImuRecord& record, const ToolImuAnal
       restart ? lost_spans(analysis, check) : std::vector<std::pair<double, double>>{};
   const RestartedOrientationError error = orientation_error_with_restarts(record, applied, spans);
   print(fmt::format(
-      "orientation error of the calibrated gyro against the robot: from the start RMS {:.3f} deg, "
-      "max {:.3f} deg over {} samples\n",
-      error.from_start.rms_rad * kDegPerRad, error.from_start.max_rad * kDegPerRad,
-      error.from_start.sample_count));
+      "orientation error of the calibrated gyro against the robot: from the start {} over {} "
+      "samples\n",
+      error_text(error.from_start), error.from_start.sample_count));
   out["from_start"] = error_json(error.from_start);
   if (restart) {
     print(fmt::format(
-        "  restarted from the robot's pose after each of {} lost spans (the spans left out): RMS "
-        "{:.3f} deg, max {:.3f} deg over {} of the {} samples\n",
-        spans.size(), error.with_restarts.rms_rad * kDegPerRad,
-        error.with_restarts.max_rad * kDegPerRad, error.with_restarts.sample_count,
+        "  restarted from the robot's pose after each of {} lost spans (the spans left out): {} "
+        "over {} of the {} samples\n",
+        spans.size(), error_text(error.with_restarts), error.with_restarts.sample_count,
         error.from_start.sample_count));
     out["with_restarts"] = error_json(error.with_restarts);
     out["restart_times_s"] = error.restart_times_s;
@@ -159,9 +164,8 @@ nlohmann::json report_ahrs(const ToolImuRecord& ahrs, const TextSink& print) {
     const OrientationErrorStats error =
         orientation_error(ahrs, alignment.time_offset_s, alignment.t_s, alignment.q_B_T);
     print(fmt::format(
-        "AHRS {} (alignment to tool and base fitted on this same record): RMS {:.3f} deg, max "
-        "{:.3f} deg over {} samples\n",
-        ahrs.file, error.rms_rad * kDegPerRad, error.max_rad * kDegPerRad, error.sample_count));
+        "AHRS {} (alignment to tool and base fitted on this same record): {} over {} samples\n",
+        ahrs.file, error_text(error), error.sample_count));
     nlohmann::json out = error_json(error);
     out["file"] = ahrs.file;
     out["refused"] = false;
