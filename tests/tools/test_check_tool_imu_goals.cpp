@@ -11,12 +11,14 @@
 // one is shipped, so that the figures are not those of a fit to the evaluated record itself; the
 // MPU6050 has one record only and uses its own. The same records with their own calibration (the
 // command without --calibration-from) are run too: no crash, 90th percentile within 8 deg.
+// The README's table of these figures is checked against the command's report.
 // Truth: the robot controller's reported tool orientation (as in test_real_abb_mems.cpp).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -62,6 +64,25 @@ bool sanitized() {
   return std::getenv("IMSCAL_SANITIZED") != nullptr;
 }
 
+// The README's row for `file` (its figures: median, 90th percentile, max, losses), or empty.
+std::vector<double> readme_row(const std::string& file) {
+  std::istringstream readme(read_file_text(fs::path(IMSCAL_SOURCE_DIR) / "README.md"));
+  std::string line;
+  while (std::getline(readme, line)) {
+    const auto start = line.find_first_not_of(' ');
+    if (start == std::string::npos || line.compare(start, file.size() + 4, "| `" + file + "`") != 0)
+      continue;
+    std::vector<std::string> cells;
+    std::istringstream fields(line.substr(start + 1));
+    std::string cell;
+    while (std::getline(fields, cell, '|')) cells.push_back(cell);
+    std::vector<double> figures;
+    for (std::size_t i = 2; i < cells.size() && i < 6; ++i) figures.push_back(std::stod(cells[i]));
+    return figures;
+  }
+  return {};
+}
+
 class CheckToolImuGoals : public imscal::test_support::ScratchDirTest {
  protected:
   // Runs the command on `record` (with its other record's calibration unless `own`) and returns
@@ -96,6 +117,13 @@ TEST_F(CheckToolImuGoals, EveryShippedRecordMeetsTheGoals) {
     // The goals themselves (measured: medians 0.58-2.94 deg, 90th percentiles 2.36-4.52 deg).
     EXPECT_LE(median, 4.0);
     EXPECT_LE(p90, 8.0);
+    // The README quotes these figures (rounded to 0.01 deg): they are the command's.
+    const std::vector<double> quoted = readme_row(record.file);
+    ASSERT_EQ(quoted.size(), 4u) << "README.md has no row for " << record.file;
+    EXPECT_NEAR(quoted[0], median, 0.005);
+    EXPECT_NEAR(quoted[1], p90, 0.005);
+    EXPECT_NEAR(quoted[2], error.at("max_deg").get<double>(), 0.005);
+    EXPECT_EQ(quoted[3], static_cast<double>(orientation.at("losses").size()));
     // The list of losses is the judged segments losing 5 deg or more, none left out.
     std::size_t at_least_5 = 0;
     for (const auto& segment : orientation.at("segments")) {
