@@ -140,7 +140,8 @@ TEST_P(RealAbbMems, CalibrateOnOneSequenceTrackTheOther) {
           .cwiseSqrt();
   fmt::print(
       "{}: R_T_S from the two sequences differ by {:.3f} deg, about T x, y, z {} deg; combined 1 "
-      "sigma {} deg (motion-segment bootstrap, at least the covariance), {} deg (covariance of independent "
+      "sigma {} deg (motion-segment bootstrap, at least the covariance), {} deg (covariance of "
+      "independent "
       "windows)\n",
       sensor, rotation_difference * kDegPerRad, v3(difference, kDegPerRad),
       v3(combined_sigma, kDegPerRad), v3(covariance_sigma, kDegPerRad));
