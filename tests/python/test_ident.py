@@ -87,13 +87,29 @@ def test_identify_finds_the_lag(identified):
     assert min(identified["joint_error_fit_percent"]) > 95.0
 
 
+def offsets_columns(file):
+    """The columns of an offsets.csv of `imscal compensate` by name, as text."""
+    rows = [l for l in file.read_text().splitlines() if not l.startswith("#")]
+    return {name: column for name, column in zip(rows[0].split(","),
+                                                 zip(*(r.split(",") for r in rows[1:])))}
+
+
+def assert_steps_as_written(offsets, states, expected):
+    """Offsets (N, 6) and states equal to those of an offsets.csv: it holds the shortest decimal
+    of each double, so equal."""
+    offsets = np.array(offsets)
+    for j in range(6):
+        np.testing.assert_array_equal(offsets[:, j],
+                                      np.array(expected[f"offset_A{j + 1}_rad"], dtype=float))
+    assert states == list(expected["state"])
+    return offsets
+
+
 def test_precontrol_steps_as_the_command_line(files, identified, cli):
     folder, q_d, _ = files
     cli("compensate", "--table", folder / "cli" / "parameters.json", "--robot-log",
         folder / "robot.csv", "--out", folder / "offsets.csv")
-    rows = [l for l in (folder / "offsets.csv").read_text().splitlines() if not l.startswith("#")]
-    expected = {name: column for name, column in zip(rows[0].split(","),
-                                                     zip(*(r.split(",") for r in rows[1:])))}
+    expected = offsets_columns(folder / "offsets.csv")
     precontrol = imscal.Precontrol(str(folder / "cli" / "parameters.json"))
     assert precontrol.preview_cycles == 0  # the paper's forward form
     offsets, states = [], []
@@ -102,12 +118,7 @@ def test_precontrol_steps_as_the_command_line(files, identified, cli):
         offset, state, _ = precontrol.step(q_d[k], 5.0, round(k * CYCLE_S / CYCLE_S))
         offsets.append(offset)
         states.append(state)
-    offsets = np.array(offsets)
-    # offsets.csv holds the shortest decimal of each double: equal.
-    for j in range(6):
-        np.testing.assert_array_equal(offsets[:, j],
-                                      np.array(expected[f"offset_A{j + 1}_rad"], dtype=float))
-    assert states == list(expected["state"])
+    offsets = assert_steps_as_written(offsets, states, expected)
     # The precontrol's offset is the model's joint error: after the engagement (0.2 s settle,
     # 0.2 s fade-in) it follows q_d - q_m of the data to the model's fit (10 % of the peak).
     _, q_d, q_m = files
@@ -234,10 +245,7 @@ def test_precontrol_with_the_model_torque_steps_as_the_command_line(files, torqu
             "--robot", robot, "--out", folder / "cli_torque")
     cli("compensate", "--table", table, "--robot-log", folder / "robot.csv", "--robot", robot,
         "--out", folder / "offsets_torque.csv")
-    rows = [l for l in (folder / "offsets_torque.csv").read_text().splitlines()
-            if not l.startswith("#")]
-    expected = {name: column for name, column in zip(rows[0].split(","),
-                                                     zip(*(r.split(",") for r in rows[1:])))}
+    expected = offsets_columns(folder / "offsets_torque.csv")
     precontrol = imscal.Precontrol(str(table))
     assert precontrol.needs_model_torque
     preview = precontrol.preview_cycles
@@ -252,11 +260,7 @@ def test_precontrol_with_the_model_torque_steps_as_the_command_line(files, torqu
         offset, state, _ = precontrol.step(q_d[ahead], 5.0, k, model_torque_nm=torque[ahead])
         offsets.append(offset)
         states.append(state)
-    offsets = np.array(offsets)
-    for j in range(6):
-        np.testing.assert_array_equal(offsets[:, j],
-                                      np.array(expected[f"offset_A{j + 1}_rad"], dtype=float))
-    assert states == list(expected["state"])
+    assert_steps_as_written(offsets, states, expected)
     assert "active" in states
     # Without the torques such a table deactivates (the supervisor's missing-torque event).
     bare = imscal.Precontrol(str(table))
