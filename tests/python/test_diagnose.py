@@ -20,7 +20,7 @@ def columns(*kinds):
 def records(tmp_path_factory, repo, cli):
     """"real": the lagging joints of test_ident with and without the encoders' block; "sim": a
     model that predicts no joint error (q_measured = q_desired). Each diagnosed by the command
-    line."""
+    line and by Python."""
     folder = tmp_path_factory.mktemp("diagnose")
     t, q_d, q_m = joint_motion()
     write_csv(folder / "real.csv", HEADER, columns("desired", "measured", "internal"), t,
@@ -34,17 +34,17 @@ def records(tmp_path_factory, repo, cli):
     for name in ["real", "real_one_sensor"]:
         done = cli("diagnose", "--joint-errors", folder / f"{name}.csv", "--sim-joint-errors",
                    folder / "sim.csv", "--robot", robot, "--out", folder / name)
+        python = imscal.diagnose(str(folder / f"{name}.csv"), str(robot),
+                                 sim_joint_errors=str(folder / "sim.csv"))
         reports[name] = (json.loads((folder / name / "report.json").read_text()),
-                         (folder / name / "report.txt").read_text(), done)
+                         (folder / name / "report.txt").read_text(), done, python)
     return folder, robot, reports
 
 
 @pytest.mark.parametrize("name", ["real", "real_one_sensor"])
 def test_diagnose_matches_the_command_line(records, name):
-    folder, robot, reports = records
-    python = imscal.diagnose(str(folder / f"{name}.csv"), str(robot),
-                             sim_joint_errors=str(folder / "sim.csv"))
-    report, text, done = reports[name]
+    _, _, reports = records
+    report, text, done, python = reports[name]
     # The same session on the same files: report.json and report.txt equal, the verdict printed.
     assert python["report"] == report
     assert python["text"] == text
@@ -52,11 +52,10 @@ def test_diagnose_matches_the_command_line(records, name):
 
 
 def test_the_gap_is_the_joint_error_with_or_without_the_internal_block(records):
-    folder, robot, _ = records
+    _, _, reports = records
     _, q_d, q_m = joint_motion()
     for name in ["real", "real_one_sensor"]:
-        python = imscal.diagnose(str(folder / f"{name}.csv"), str(robot),
-                                 sim_joint_errors=str(folder / "sim.csv"))
+        python = reports[name][3]
         # Independent truth: the sim predicts no error, so the gap is q_desired - q_measured of
         # the generated data (the files hold the shortest repr of each double: exact).
         np.testing.assert_array_equal(python["gap_rad"], q_d - q_m)
