@@ -80,6 +80,12 @@ def test_without_the_internal_block_the_parts_that_do_not_read_it_agree(records)
     assert len(same) >= 18  # time offset, resonance, compliance on the 6 joints, and the chain's
     for key in same:
         assert b[key] == a[key], key
+    # The command says what it does without the block, naming the file and the columns.
+    done = reports["real_one_sensor"][2]
+    warning = [l for l in (done.stdout + done.stderr).splitlines() if "q_internal" in l]
+    assert len(warning) == 1 and "real_one_sensor.csv" in warning[0]
+    assert "transmission error is not tried" in warning[0]
+    assert not any("q_internal" in l for l in reports["real"][2].stdout.splitlines())
     # The transmission error needs the motor angle: tried with the block only.
     assert any(k[0] == "transmission_error" for k in a)
     assert not any(k[0] == "transmission_error" for k in b)
