@@ -5,6 +5,7 @@
 // another robot.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "calib/robot_description.hpp"
@@ -16,16 +17,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The config's per-joint numbers against the robot's.
-void expect_robot_numbers(const fs::path& robot_file, const fs::path& config_file) {
+// The config's per-joint numbers against the robot's; returns the config.
+ident::IdentificationConfig expect_robot_numbers(const fs::path& robot_file,
+                                                 const fs::path& config_file) {
   const calib::RobotDescription robot = calib::load_robot_description(robot_file);
   const ident::IdentificationConfig config =
       ident::load_identification_config(ConfigNode::load_file(config_file));
-  ASSERT_EQ(config.gear_ratio.size(), robot.joints.size());
-  ASSERT_EQ(config.gear_stiffness_nm_per_rad.size(), robot.joints.size());
-  ASSERT_EQ(config.max_speed_rad_s.size(), robot.joints.size());
+  EXPECT_EQ(config.gear_ratio.size(), robot.joints.size());
+  EXPECT_EQ(config.gear_stiffness_nm_per_rad.size(), robot.joints.size());
+  EXPECT_EQ(config.max_speed_rad_s.size(), robot.joints.size());
   EXPECT_EQ(config.nominal_payload_kg, robot.nominal_payload_kg);
-  for (std::size_t j = 0; j < robot.joints.size(); ++j) {
+  const std::size_t joints =
+      std::min({config.gear_ratio.size(), config.max_speed_rad_s.size(),
+                config.gear_stiffness_nm_per_rad.size(), robot.joints.size()});
+  for (std::size_t j = 0; j < joints; ++j) {
     const auto& drive = robot.joints[j].drive;
     // Ratios and stiffnesses are written with the same digits in both files: equal exactly.
     EXPECT_EQ(config.gear_ratio[j], drive.gear_ratio) << robot.joints[j].name;
@@ -35,14 +40,13 @@ void expect_robot_numbers(const fs::path& robot_file, const fs::path& config_fil
     EXPECT_NEAR(config.max_speed_rad_s[j], robot.joints[j].max_velocity_rad_s, 0.5 * M_PI / 180.0)
         << robot.joints[j].name;
   }
+  return config;
 }
 
 TEST(IdentConfigMatchesRobot, DefaultConfigHasTheKr16sDriveNumbers) {
   const fs::path root(IMSCAL_SOURCE_DIR);
-  expect_robot_numbers(root / "datasets/robots/kr16.yaml",
-                       root / "datasets/identification/ident-default.yaml");
-  const ident::IdentificationConfig config = ident::load_identification_config(
-      ConfigNode::load_file(root / "datasets/identification/ident-default.yaml"));
+  const ident::IdentificationConfig config = expect_robot_numbers(
+      root / "datasets/robots/kr16.yaml", root / "datasets/identification/ident-default.yaml");
   // The default takes the pair, with its phase from the deflected gear.
   EXPECT_TRUE(config.options.transmission_error_input);
   EXPECT_DOUBLE_EQ(config.joint_options(1).transmission_error_rad_per_rad, 160.0);
@@ -54,10 +58,8 @@ TEST(IdentConfigMatchesRobot, DefaultConfigHasTheKr16sDriveNumbers) {
 // no transmission-error input) but the speeds and payload.
 TEST(IdentConfigMatchesRobot, Ur10eConfigHasTheUr10esDriveNumbers) {
   const fs::path root(IMSCAL_SOURCE_DIR);
-  expect_robot_numbers(root / "datasets/robots/ur10e.urdf",
-                       root / "datasets/identification/ident-ur10e.yaml");
-  const ident::IdentificationConfig config = ident::load_identification_config(
-      ConfigNode::load_file(root / "datasets/identification/ident-ur10e.yaml"));
+  const ident::IdentificationConfig config = expect_robot_numbers(
+      root / "datasets/robots/ur10e.urdf", root / "datasets/identification/ident-ur10e.yaml");
   // Strain-wave gears: twice per wave-generator (motor) revolution, ratio 101.
   EXPECT_DOUBLE_EQ(config.joint_options(1).transmission_error_rad_per_rad, 2.0 * 101.0);
   const calib::RobotDescription robot =
