@@ -62,12 +62,18 @@ void check_options(const ImuSeries& imu, const ZuptOptions& o) {
 struct Epoch {
   std::size_t last_sample = 0;  // sample index ending the interval (k - 1, k]; unused for k = 0
   double t_s = 0.0;
-  ErrorMatrix transition;                               // from k - 1 to k
-  ErrorMatrix predicted_cov;                            // at k before the updates
-  ErrorMatrix filtered_cov;                             // at k after the updates
   ErrorVector correction = ErrorVector::Zero();         // error estimate fed back at k
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();  // estimates after the updates at k
   Eigen::Vector3d acc_bias = Eigen::Vector3d::Zero();
+};
+
+// The matrices of instant k, which only the backward pass needs: kept apart from Epoch so that
+// they are released before the smoothed states are built (5.4 kB per instant, more than the
+// states of its samples).
+struct EpochCovariances {
+  ErrorMatrix transition;     // from k - 1 to k
+  ErrorMatrix predicted_cov;  // at k before the updates
+  ErrorMatrix filtered_cov;   // at k after the updates
 };
 
 struct UpdateTally {
@@ -147,10 +153,9 @@ RestDetectorOptions rest_options_of(const ZuptOptions& o) {
   return r;
 }
 
-Epoch initial_epoch(const NavState& initial, const Eigen::Matrix<double, 9, 1>& initial_sigma,
-                    const ZuptOptions& options) {
-  Epoch first;
-  first.t_s = initial.t_s;
+EpochCovariances initial_covariances(const Eigen::Matrix<double, 9, 1>& initial_sigma,
+                                     const ZuptOptions& options) {
+  EpochCovariances first;
   first.filtered_cov.setZero();
   first.filtered_cov.diagonal().head<9>() = initial_sigma.cwiseAbs2();
   first.filtered_cov.diagonal().segment<3>(kGyroBias).setConstant(
@@ -159,6 +164,12 @@ Epoch initial_epoch(const NavState& initial, const Eigen::Matrix<double, 9, 1>& 
       options.initial_acc_bias_sigma_m_s2 * options.initial_acc_bias_sigma_m_s2);
   first.predicted_cov = first.filtered_cov;
   first.transition.setIdentity();
+  return first;
+}
+
+Epoch initial_epoch(const NavState& initial, const ZuptOptions& options) {
+  Epoch first;
+  first.t_s = initial.t_s;
   first.gyro_bias = options.initial_gyro_bias_rad_s;
   first.acc_bias = options.initial_acc_bias_m_s2;
   return first;
@@ -174,22 +185,24 @@ struct SmoothedErrors {
 
 // Rauch-Tung-Striebel on the error state. With the estimates fed back, the filtered error is
 // zero after every update and so is its prediction: x_s(k) = C_k x_s^before(k + 1).
-SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs) {
+SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs,
+                                 const std::vector<EpochCovariances>& covariances) {
   const std::size_t last = epochs.size() - 1;
   SmoothedErrors s;
   s.after.resize(epochs.size());
   s.before.resize(epochs.size());
   s.variance.resize(epochs.size());
   s.after[last].setZero();
-  ErrorMatrix smoothed_cov = epochs[last].filtered_cov;
+  ErrorMatrix smoothed_cov = covariances[last].filtered_cov;
   s.variance[last] = smoothed_cov.diagonal();
   s.before[last] = epochs[last].correction;
   for (std::size_t k = last; k-- > 0;) {
-    const Epoch& next = epochs[k + 1];
+    const EpochCovariances& next = covariances[k + 1];
     const ErrorMatrix C =
-        smoother_gain(epochs[k].filtered_cov, next.transition, next.predicted_cov);
+        smoother_gain(covariances[k].filtered_cov, next.transition, next.predicted_cov);
     s.after[k] = C * s.before[k + 1];
-    smoothed_cov = epochs[k].filtered_cov + C * (smoothed_cov - next.predicted_cov) * C.transpose();
+    smoothed_cov =
+        covariances[k].filtered_cov + C * (smoothed_cov - next.predicted_cov) * C.transpose();
     smoothed_cov = 0.5 * (smoothed_cov + smoothed_cov.transpose());
     s.variance[k] = smoothed_cov.diagonal().cwiseMax(0.0);
     s.before[k] = s.after[k] + epochs[k].correction;
@@ -300,8 +313,11 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
   // ---- forward pass ----
   std::vector<NavState> nominal(n);  // per sample, mechanised from the last fed-back state
   std::vector<Epoch> epochs;
+  std::vector<EpochCovariances> covariances;
   epochs.reserve(epoch_count + 1);
-  epochs.push_back(initial_epoch(initial, initial_sigma, options));
+  covariances.reserve(epoch_count + 1);
+  epochs.push_back(initial_epoch(initial, options));
+  covariances.push_back(initial_covariances(initial_sigma, options));
   Strapdown strapdown(earth, initial);
   ErrorLinearisation point;
   point.earth_rate_W = earth.earth_rate_W();
@@ -323,6 +339,7 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
     const std::size_t begin = (k - 1) * samples_per_epoch;
     const std::size_t end = std::min(n, begin + samples_per_epoch);
     const Epoch& previous = epochs.back();
+    const ErrorMatrix& previous_filtered_cov = covariances.back().filtered_cov;
     Eigen::Matrix3d sum_R = Eigen::Matrix3d::Zero();
     Eigen::Vector3d sum_dv_W = Eigen::Vector3d::Zero();
     Eigen::Vector3d sum_raw_dtheta = Eigen::Vector3d::Zero();
@@ -350,13 +367,14 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
     Epoch epoch;
     epoch.last_sample = end - 1;
     epoch.t_s = strapdown.state().t_s;
-    epoch.transition = model.transition;
-    epoch.predicted_cov = model.transition * previous.filtered_cov * model.transition.transpose() +
-                          model.noise_covariance;
-    epoch.predicted_cov = 0.5 * (epoch.predicted_cov + epoch.predicted_cov.transpose());
+    EpochCovariances cov;
+    cov.transition = model.transition;
+    cov.predicted_cov = model.transition * previous_filtered_cov * model.transition.transpose() +
+                        model.noise_covariance;
+    cov.predicted_cov = 0.5 * (cov.predicted_cov + cov.predicted_cov.transpose());
     epoch.gyro_bias = previous.gyro_bias;
     epoch.acc_bias = previous.acc_bias;
-    ErrorMatrix P = epoch.predicted_cov;
+    ErrorMatrix P = cov.predicted_cov;
     ErrorVector x = ErrorVector::Zero();
     if (epoch_zero_velocity[k]) {
       const NavState& state = strapdown.state();
@@ -414,16 +432,18 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
       rest_sum_R.setZero();
       rest_time = 0.0;
     }
-    epoch.filtered_cov = P;
+    cov.filtered_cov = P;
     epoch.correction = x;
     epochs.push_back(std::move(epoch));
+    covariances.push_back(std::move(cov));
   }
   result.summary.zero_velocity = zupt_tally.statistics();
   result.summary.zero_angular_rate = zaru_tally.statistics();
   result.summary.velocity_aid = aid_tally.statistics();
   result.summary.propagation_steps = epoch_count;
 
-  const SmoothedErrors smoothed = rts_backward_pass(epochs);
+  const SmoothedErrors smoothed = rts_backward_pass(epochs, covariances);
+  std::vector<EpochCovariances>().swap(covariances);  // released before the states are built
   result.states = apply_smoothed_errors(nominal, epochs, smoothed);
   result.biases.resize(epochs.size());
   for (std::size_t k = 0; k < epochs.size(); ++k) {
