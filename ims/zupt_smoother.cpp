@@ -210,21 +210,38 @@ SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs,
   return s;
 }
 
+// The sample's increment without the biases estimated at the instant before its interval.
+ImuSample bias_corrected(const ImuSeries& imu, std::size_t i, const Epoch& previous) {
+  const double dt = sample_interval(imu, i);
+  ImuSample corrected = imu.samples[i];
+  corrected.gyro -= previous.gyro_bias * dt;
+  corrected.acc -= previous.acc_bias * dt;
+  return corrected;
+}
+
 // The nominal state of every sample corrected by the smoothed error, interpolated linearly in
-// time between the propagation instants that enclose the sample.
-std::vector<SmoothedState> apply_smoothed_errors(const std::vector<NavState>& nominal,
+// time between the propagation instants that enclose the sample. The nominal states are
+// mechanised again from the strapdown kept at each interval's start (the same steps as the
+// forward pass, so the same states), instead of being kept per sample through the forward pass.
+std::vector<SmoothedState> apply_smoothed_errors(const ImuSeries& imu,
+                                                 const std::vector<Strapdown>& interval_start,
                                                  const std::vector<Epoch>& epochs,
                                                  const SmoothedErrors& smoothed) {
-  std::vector<SmoothedState> states(nominal.size());
+  std::vector<SmoothedState> states;
+  states.reserve(imu.samples.size() + 1);  // room for a caller's initial state, without a copy
+  states.resize(imu.samples.size());
   std::size_t i = 0;
   for (std::size_t k = 1; k < epochs.size(); ++k) {
     const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
+    Strapdown strapdown = interval_start[k - 1];
     for (; i <= epochs[k].last_sample; ++i) {
-      const double alpha = (nominal[i].t_s - t0) / (t1 - t0);
+      strapdown.step(bias_corrected(imu, i, epochs[k - 1]));
+      const NavState& nominal = strapdown.state();
+      const double alpha = (nominal.t_s - t0) / (t1 - t0);
       const ErrorVector e = (1.0 - alpha) * smoothed.after[k - 1] + alpha * smoothed.before[k];
       const ErrorVector var =
           (1.0 - alpha) * smoothed.variance[k - 1] + alpha * smoothed.variance[k];
-      states[i].state = apply_error(nominal[i], e);
+      states[i].state = apply_error(nominal, e);
       states[i].sigma = var.head<9>().cwiseSqrt();
     }
   }
@@ -311,7 +328,10 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
   const std::vector<bool> epoch_zero_velocity = rest_interior(options.zero_velocity_edge_margin_s);
 
   // ---- forward pass ----
-  std::vector<NavState> nominal(n);  // per sample, mechanised from the last fed-back state
+  // The strapdown at each interval's start (after the last feedback): the nominal states are
+  // mechanised again from it after the backward pass (apply_smoothed_errors).
+  std::vector<Strapdown> interval_start;
+  interval_start.reserve(epoch_count);
   std::vector<Epoch> epochs;
   std::vector<EpochCovariances> covariances;
   epochs.reserve(epoch_count + 1);
@@ -344,19 +364,17 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
     Eigen::Vector3d sum_dv_W = Eigen::Vector3d::Zero();
     Eigen::Vector3d sum_raw_dtheta = Eigen::Vector3d::Zero();
     const double t_begin = strapdown.state().t_s;
+    interval_start.push_back(strapdown);
     for (std::size_t i = begin; i < end; ++i) {
       const ImuSample& raw = imu.samples[i];
       const double dt = sample_interval(imu, i);
-      ImuSample corrected = raw;
-      corrected.gyro -= previous.gyro_bias * dt;
-      corrected.acc -= previous.acc_bias * dt;
+      const ImuSample corrected = bias_corrected(imu, i, previous);
       const Eigen::Matrix3d R_before = strapdown.state().q_W_S.toRotationMatrix();
       strapdown.step(corrected);
       const Eigen::Matrix3d R_mid = 0.5 * (R_before + strapdown.state().q_W_S.toRotationMatrix());
       sum_R += R_mid * dt;
       sum_dv_W += R_mid * corrected.acc;
       sum_raw_dtheta += raw.gyro;
-      nominal[i] = strapdown.state();
     }
     const double interval = strapdown.state().t_s - t_begin;
     point.mean_R_W_S = sum_R / interval;
@@ -444,7 +462,7 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
 
   const SmoothedErrors smoothed = rts_backward_pass(epochs, covariances);
   std::vector<EpochCovariances>().swap(covariances);  // released before the states are built
-  result.states = apply_smoothed_errors(nominal, epochs, smoothed);
+  result.states = apply_smoothed_errors(imu, interval_start, epochs, smoothed);
   result.biases.resize(epochs.size());
   for (std::size_t k = 0; k < epochs.size(); ++k) {
     SmoothedBias& b = result.biases[k];
