@@ -16,7 +16,9 @@
 #include "calib/forward_kinematics.hpp"
 #include "calib/jacobian.hpp"
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 #include "eval/gap_candidates.hpp"
+#include "eval/gap_nominal_plant.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table.hpp"
 #include "sim/motion_planner.hpp"
@@ -38,6 +40,9 @@ struct WithheldEffect {
   // factor, "sim" the robot file's value (coulomb: the Coulomb friction torque); transmission: the
   // error's harmonic per motor revolution (another order than the first).
   double scale = 0.0;
+  // > 0: the effect's size, not drawn from the seed: transmission error amplitude [arcsec],
+  // payload mass added [kg].
+  double size = 0.0;
 };
 
 inline EffectKind expected_kind(const std::string& name) {
@@ -147,6 +152,8 @@ struct GapWorld {
     // The identified error model's operating-point grid ("operating_point" cases): per joint one
     // speed dimension; cells beyond the identified speed are filled, not identified.
     std::optional<ident::ParameterTable> table;
+    // The nominal model whose simulation is "sim" (eval/gap_nominal_plant.hpp).
+    NominalPlant nominal;
   };
 
   // Errors of the IMS chain injected into q_measured: the flange pose the chain would measure
@@ -259,6 +266,7 @@ struct GapWorld {
       if (e.name == "transmission") {
         re.transmission_error = real_changed = true;
         re.transmission_error_shape.amplitude_rad *= 2.0 * size(rng);  // 28..52 arcsec
+        if (e.size > 0.0) re.transmission_error_shape.amplitude_rad = e.size * kRadPerArcsec;
         if (e.scale > 0.0) re.transmission_error_shape.harmonic_per_motor_rev = e.scale;
       }
       if (e.name == "coulomb" && e.scale > 0.0) {
@@ -269,11 +277,13 @@ struct GapWorld {
       }
       if (e.name == "elastic") se.elastic_gear = se.gear_damping = false, sim_changed = true;
       if (e.name == "payload") {
-        for (auto& p : real_path.payloads) p.body.mass_kg += 4.0 * size(rng);
+        const double added_kg = 4.0 * size(rng);
+        for (auto& p : real_path.payloads) p.body.mass_kg += e.size > 0.0 ? e.size : added_kg;
         real_changed = true;
       }
     }
     Case c;
+    c.nominal = {sim_config, path};
     const sim::PlantLog real_plant =
         real_changed ? sim::simulate_plant(real_config, real_path, path.cycle_s) : base_log;
     const sim::PlantLog sim_plant =

@@ -53,7 +53,7 @@ Score score_case(const test::GapWorld& world, const HarnessCase& hc,
   const auto c = world.make_case(hc.effects, hc.seed);
   const GapSignals signals =
       make_gap_signals(c.real, c.sim_joint_error_rad, world.robot, c.table ? &*c.table : nullptr);
-  const Diagnosis d = diagnose_gap(signals);
+  const Diagnosis d = diagnose_gap(signals, DiagnosisOptions{}, &c.nominal);
   Score s;
   for (const auto& e : hc.effects)
     s.name +=
@@ -123,9 +123,9 @@ Score score_case(const test::GapWorld& world, const HarnessCase& hc,
   ++confusion[row][col];
   fmt::print(
       "{:<32} top {:<34} first {:d} joint {:d}  shrinkage predicted {:6.1f} % true {:6.1f} %"
-      "  gap {:.3g} rad  all found {:d}\n  {}\n",
+      "  gap {:.3g} rad  all found {:d}  re-simulated {:d} ({} runs)\n  {}\n",
       s.name, s.top, s.ranked_first, s.joint_located, s.predicted, s.truth, d.heldout_rms_rad,
-      s.all_found, d.verdict);
+      s.all_found, d.refinement.applied, d.refinement.simulations, d.verdict);
   return s;
 }
 

@@ -1,0 +1,192 @@
+#include "eval/gap_refinement.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/parallel_tasks.hpp"
+#include "eval/gap_bounds.hpp"
+
+namespace imscal::eval {
+namespace {
+
+using Signal = std::vector<std::vector<double>>;  // [joint][sample]
+
+constexpr int kMaxGaussNewtonSteps = 4;
+constexpr double kConvergedFractionOfStep = 0.01;
+constexpr double kLowestOrder = 0.5, kHighestOrder = 8.0, kOrderStep = 0.5;
+
+struct Problem {
+  const GapSignals& s;
+  const NominalPlant& plant;
+  const std::vector<bool>& training;
+  const std::vector<std::size_t>& heldout;
+  std::vector<NominalParameter> parameters;
+  std::vector<Eigen::MatrixXd> others;  // the other members' linear columns, joined
+  std::vector<LevelBound> bounds;       // theirs, indexed into `others`
+  Signal q_nominal;
+  int simulations = 0;
+
+  Eigen::Index size() const {
+    Eigen::Index n = 0;
+    for (const auto& p : parameters) n += p.size();
+    return n;
+  }
+};
+
+// The modelled gap m(p) of the file's head.
+Signal modelled_gap(const Problem& x, const Eigen::VectorXd& p) {
+  Signal q = simulate_links(x.plant, x.parameters, p);
+  for (std::size_t j = 0; j < q.size(); ++j)
+    for (std::size_t k = 0; k < q[j].size(); ++k) q[j][k] = x.q_nominal[j][k] - q[j][k];
+  return q;
+}
+
+struct Evaluated {
+  Signal residual;
+  double training_energy = 0.0, heldout_energy = 0.0;
+};
+
+// The gap less m, less the other members fitted to what m leaves (within their bounds).
+Evaluated evaluate(const Problem& x, const Signal& m) {
+  Evaluated e{x.s.gap_rad};
+  for (std::size_t j = 0; j < m.size(); ++j)
+    for (std::size_t k = 0; k < m[j].size(); ++k) e.residual[j][k] -= m[j][k];
+  if (!x.others.empty()) {
+    LinearFit fit = fit_joint_columns(x.others, e.residual, x.training);
+    apply_level_bounds(x.others, e.residual, x.training, x.bounds, fit);
+    const Signal prediction = predict_joint_columns(x.others, fit.parameters);
+    for (std::size_t j = 0; j < prediction.size(); ++j)
+      for (std::size_t k = 0; k < prediction[j].size(); ++k) e.residual[j][k] -= prediction[j][k];
+  }
+  for (const auto& r : e.residual)
+    for (std::size_t k = 0; k < r.size(); ++k)
+      (x.training[k] ? e.training_energy : e.heldout_energy) += r[k] * r[k];
+  return e;
+}
+
+// The order per motor revolution of a transmission error on `joint` whose raw ripple best fits
+// `residual` (the gap less the other members) on the training rows.
+double search_order(const Problem& x, std::size_t joint, const std::vector<double>& residual) {
+  const std::size_t n = x.s.sample_count();
+  double best_order = 1.0, best_rms = -1.0;
+  for (double h = kLowestOrder; h <= kHighestOrder + 1e-9; h += kOrderStep) {
+    Eigen::MatrixXd columns(Eigen::Index(n), 2);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double angle = h * x.s.gear_ratio[joint] * x.s.q_internal_rad[joint][k];
+      columns(Eigen::Index(k), 0) = std::sin(angle);
+      columns(Eigen::Index(k), 1) = std::cos(angle);
+    }
+    const double rms = fit_columns(columns, residual, x.training).rms;
+    if (best_rms < 0.0 || rms < best_rms) best_rms = rms, best_order = h;
+  }
+  return best_order;
+}
+
+// One Gauss-Newton step at p (modelled gap m): the parameters' change, the others' coefficients
+// fitted beside it.
+Eigen::VectorXd gauss_newton_step(Problem& x, const Eigen::VectorXd& p, const Signal& m) {
+  const Eigen::Index np = p.size();
+  const Eigen::VectorXd step = nominal_steps(x.plant, x.parameters, p);
+  std::vector<Signal> moved(static_cast<std::size_t>(np));
+  run_parallel_tasks(std::size_t(np), [&](std::size_t i) {
+    Eigen::VectorXd q = p;
+    q[Eigen::Index(i)] += step[Eigen::Index(i)];
+    moved[i] = modelled_gap(x, q);
+  });
+  x.simulations += int(np);
+  const std::size_t n = x.s.sample_count();
+  std::vector<Eigen::MatrixXd> jacobian(m.size(), Eigen::MatrixXd(Eigen::Index(n), np));
+  for (std::size_t j = 0; j < m.size(); ++j)
+    for (Eigen::Index i = 0; i < np; ++i)
+      for (std::size_t k = 0; k < n; ++k)
+        jacobian[j](Eigen::Index(k), i) = (moved[std::size_t(i)][j][k] - m[j][k]) / step[i];
+  const std::vector<Eigen::MatrixXd> columns =
+      x.others.empty() ? jacobian : join_columns(jacobian, x.others, n);
+  std::vector<LevelBound> bounds = x.bounds;
+  for (LevelBound& b : bounds) b.first += np;
+  Signal target = x.s.gap_rad;
+  for (std::size_t j = 0; j < m.size(); ++j)
+    for (std::size_t k = 0; k < n; ++k) target[j][k] -= m[j][k];
+  LinearFit fit = fit_joint_columns(columns, target, x.training);
+  apply_level_bounds(columns, target, x.training, bounds, fit);
+  return fit.parameters.head(np);
+}
+
+// The members split: those with a parameter of the nominal model, the others' columns and bounds.
+void split_members(Problem& x, const std::vector<CandidateFit>& members, NominalRefinement& out) {
+  const std::size_t n = x.s.sample_count();
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    const CandidateFit& f = members[i];
+    bool repeated = false;
+    for (const NominalParameter& p : x.parameters)
+      repeated |= p.kind == f.kind && (p.joint == f.joint || f.spans_joints);
+    if (!repeated && has_nominal_parameter(x.plant, f.kind, f.joint)) {
+      x.parameters.push_back({f.kind, f.joint, 1.0});
+      out.members.push_back(i);
+      continue;
+    }
+    Eigen::Index offset = 0;
+    for (const Eigen::MatrixXd& c : x.others) offset = std::max(offset, c.cols());
+    if (f.bound.count > 0) {
+      LevelBound b = f.bound;
+      b.first += offset;
+      x.bounds.push_back(std::move(b));
+    }
+    x.others = x.others.empty() ? f.columns : join_columns(x.others, f.columns, n);
+  }
+}
+
+}  // namespace
+
+NominalRefinement refine_on_nominal_plant(const GapSignals& s, const NominalPlant& plant,
+                                          const std::vector<CandidateFit>& members,
+                                          const std::vector<bool>& training,
+                                          const std::vector<std::size_t>& heldout,
+                                          double linear_heldout_energy) {
+  NominalRefinement out;
+  if (s.sample_count() != plant.path.samples.size() || s.q_internal_rad.empty()) return out;
+  Problem x{s, plant, training, heldout, {}, {}, {}, {}, 0};
+  split_members(x, members, out);
+  if (x.parameters.empty()) return out;
+  x.q_nominal = simulate_links(plant, {}, Eigen::VectorXd());
+  x.simulations = 1;
+  const Signal zero(s.joint_count(), std::vector<double>(s.sample_count(), 0.0));
+  Evaluated current = evaluate(x, zero);
+  for (NominalParameter& p : x.parameters)
+    if (p.kind == EffectKind::kTransmissionError)
+      p.harmonic_per_motor_rev = search_order(x, p.joint, current.residual[p.joint]);
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(x.size());
+  Signal m = zero;
+  for (int it = 0; it < kMaxGaussNewtonSteps; ++it) {
+    const Eigen::VectorXd delta = gauss_newton_step(x, p, m);
+    const Eigen::VectorXd step = nominal_steps(plant, x.parameters, p);
+    bool accepted = false;
+    for (double fraction : {1.0, 0.5}) {
+      const Eigen::VectorXd trial = physical_parameters(plant, x.parameters, p + fraction * delta);
+      Signal m_trial = modelled_gap(x, trial);
+      ++x.simulations;
+      Evaluated e = evaluate(x, m_trial);
+      if (e.training_energy >= current.training_energy) continue;
+      p = trial, m = std::move(m_trial), current = std::move(e), accepted = true;
+      break;
+    }
+    if (!accepted || (delta.cwiseAbs().array() < kConvergedFractionOfStep * step.array()).all())
+      break;
+  }
+  double e0 = 0.0;
+  for (const auto& g : s.gap_rad)
+    for (std::size_t k : heldout) e0 += g[k] * g[k];
+  out.heldout_energy = current.heldout_energy;
+  out.shrinkage_percent = e0 > 0.0 ? 100.0 * (1.0 - std::sqrt(current.heldout_energy / e0)) : 0.0;
+  out.applied = current.heldout_energy < linear_heldout_energy;
+  out.simulations = x.simulations;
+  Eigen::Index i = 0;
+  for (const NominalParameter& parameter : x.parameters) {
+    out.changes.push_back(
+        describe_nominal_change(plant, parameter, p.segment(i, parameter.size())));
+    i += parameter.size();
+  }
+  return out;
+}
+
+}  // namespace imscal::eval
