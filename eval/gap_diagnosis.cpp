@@ -225,9 +225,11 @@ void refine_joint_model(const GapSignals& s, const NominalPlant& nominal,
   out.heldout_rms_modelled_rad =
       std::sqrt(out.refinement.heldout_energy / double(std::max<std::size_t>(heldout.size(), 1)));
   for (std::size_t i = 0; i < out.refinement.members.size(); ++i) {
-    CandidateFit& f = out.combination[out.refinement.members[i]].fit;
-    f.shape = "the nominal model re-simulated";
-    f.size_text = out.refinement.changes[i];
+    CombinationStep& step = out.combination[out.refinement.members[i]];
+    step.fit.kind = out.refinement.kinds[i];
+    step.fit.shape = "the nominal model re-simulated";
+    step.fit.size_text = out.refinement.changes[i];
+    step.label = candidate_label(s, step.fit);
   }
 }
 
@@ -268,7 +270,8 @@ double block_bootstrap_p_value(const std::vector<double>& d, std::size_t block, 
   return (1.0 + not_positive) / (1.0 + resamples);
 }
 
-Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o, const NominalPlant* nominal) {
+Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o,
+                       const NominalPlant* nominal) {
   Diagnosis out;
   out.where = analyse_gap(s);
   const std::vector<bool> training = training_rows(s, o.block_s);

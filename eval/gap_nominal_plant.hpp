@@ -63,10 +63,11 @@ std::vector<std::vector<double>> simulate_links(const NominalPlant& plant,
 
 // A joint model refined on the nominal model (eval/gap_refinement.hpp).
 struct NominalRefinement {
-  bool applied = false;            // its held-out residual is below the linear model's
-  double shrinkage_percent = 0.0;  // held-out, all joints, of the refined model
-  double heldout_energy = 0.0;     // of its residual [rad²]
+  bool applied = false;              // its held-out residual is below the linear model's
+  double shrinkage_percent = 0.0;    // held-out, all joints, of the refined model
+  double heldout_energy = 0.0;       // of its residual [rad²]
   std::vector<std::size_t> members;  // the members refined (indices into the joint model)
+  std::vector<EffectKind> kinds;     // the effect each stands for, in the same order
   std::vector<std::string> changes;  // their parameters in words, in the same order
   int simulations = 0;               // runs of the nominal model it took
 };

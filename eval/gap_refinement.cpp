@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/parallel_tasks.hpp"
 #include "eval/gap_bounds.hpp"
@@ -13,7 +14,6 @@ using Signal = std::vector<std::vector<double>>;  // [joint][sample]
 
 constexpr int kMaxGaussNewtonSteps = 4;
 constexpr double kConvergedFractionOfStep = 0.01;
-constexpr double kLowestOrder = 0.5, kHighestOrder = 8.0, kOrderStep = 0.5;
 
 struct Problem {
   const GapSignals& s;
@@ -64,27 +64,14 @@ Evaluated evaluate(const Problem& x, const Signal& m) {
   return e;
 }
 
-// The order per motor revolution of a transmission error on `joint` whose raw ripple best fits
-// `residual` (the gap less the other members) on the training rows.
-double search_order(const Problem& x, std::size_t joint, const std::vector<double>& residual) {
-  const std::size_t n = x.s.sample_count();
-  double best_order = 1.0, best_rms = -1.0;
-  for (double h = kLowestOrder; h <= kHighestOrder + 1e-9; h += kOrderStep) {
-    Eigen::MatrixXd columns(Eigen::Index(n), 2);
-    for (std::size_t k = 0; k < n; ++k) {
-      const double angle = h * x.s.gear_ratio[joint] * x.s.q_internal_rad[joint][k];
-      columns(Eigen::Index(k), 0) = std::sin(angle);
-      columns(Eigen::Index(k), 1) = std::cos(angle);
-    }
-    const double rms = fit_columns(columns, residual, x.training).rms;
-    if (best_rms < 0.0 || rms < best_rms) best_rms = rms, best_order = h;
-  }
-  return best_order;
-}
-
 // One Gauss-Newton step at p (modelled gap m): the parameters' change, the others' coefficients
-// fitted beside it.
-Eigen::VectorXd gauss_newton_step(Problem& x, const Eigen::VectorXd& p, const Signal& m) {
+// fitted beside it, and the linearised model's residual RMS on the training rows.
+struct Step {
+  Eigen::VectorXd delta;
+  double rms = 0.0;
+};
+
+Step gauss_newton_step(Problem& x, const Eigen::VectorXd& p, const Signal& m) {
   const Eigen::Index np = p.size();
   const Eigen::VectorXd step = nominal_steps(x.plant, x.parameters, p);
   std::vector<Signal> moved(static_cast<std::size_t>(np));
@@ -109,7 +96,56 @@ Eigen::VectorXd gauss_newton_step(Problem& x, const Eigen::VectorXd& p, const Si
     for (std::size_t k = 0; k < n; ++k) target[j][k] -= m[j][k];
   LinearFit fit = fit_joint_columns(columns, target, x.training);
   apply_level_bounds(columns, target, x.training, bounds, fit);
-  return fit.parameters.head(np);
+  return {fit.parameters.head(np), fit.rms};
+}
+
+// The effects of a joint's drive that the nominal model has as parameters, one of which a member
+// may stand for: the linear candidates confuse them (a Coulomb friction raised looks like a play
+// on a joint whose torque and velocity change sign together), the simulated ones less.
+constexpr EffectKind kDriveEffects[] = {EffectKind::kCoulombFriction, EffectKind::kBacklash,
+                                        EffectKind::kTransmissionError};
+
+// How many of the orders the raw ripple fits best are tried by simulation: the link's response
+// to a high order is filtered and delayed by the loop, so the raw ripple's best is not always it.
+constexpr std::size_t kOrdersSimulated = 3;
+
+// What the drive member i may stand for: each drive effect of its joint that no other member
+// holds, a transmission error at the orders whose raw ripple best fits the member's residual.
+std::vector<NominalParameter> drive_alternatives(const Problem& x, std::size_t i,
+                                                 const Signal& residual) {
+  const std::size_t joint = x.parameters[i].joint;
+  std::vector<NominalParameter> out;
+  for (EffectKind kind : kDriveEffects) {
+    bool present = false;
+    for (std::size_t k = 0; k < x.parameters.size(); ++k)
+      present |= k != i && x.parameters[k].kind == kind && x.parameters[k].joint == joint;
+    if (present || !has_nominal_parameter(x.plant, kind, joint)) continue;
+    if (kind != EffectKind::kTransmissionError) {
+      out.push_back({kind, joint, 1.0});
+      continue;
+    }
+    const std::vector<double> orders =
+        transmission_orders_by_fit(x.s, joint, residual[joint], x.training);
+    for (std::size_t o = 0; o < std::min(kOrdersSimulated, orders.size()); ++o)
+      out.push_back({kind, joint, orders[o]});
+  }
+  return out;
+}
+
+// Each drive member replaced by the alternative whose linearised fit (the first Gauss-Newton
+// step, at the nominal model) leaves the least training residual.
+void choose_drive_effects(Problem& x, const Signal& zero, const Signal& residual) {
+  for (std::size_t i = 0; i < x.parameters.size(); ++i) {
+    if (x.parameters[i].kind == EffectKind::kPayloadMismatch) continue;
+    double best = std::numeric_limits<double>::infinity();
+    NominalParameter chosen = x.parameters[i];
+    for (const NominalParameter& alternative : drive_alternatives(x, i, residual)) {
+      x.parameters[i] = alternative;
+      const double rms = gauss_newton_step(x, Eigen::VectorXd::Zero(x.size()), zero).rms;
+      if (rms < best) best = rms, chosen = alternative;
+    }
+    x.parameters[i] = chosen;
+  }
 }
 
 // The members split: those with a parameter of the nominal model, the others' columns and bounds.
@@ -152,13 +188,11 @@ NominalRefinement refine_on_nominal_plant(const GapSignals& s, const NominalPlan
   x.simulations = 1;
   const Signal zero(s.joint_count(), std::vector<double>(s.sample_count(), 0.0));
   Evaluated current = evaluate(x, zero);
-  for (NominalParameter& p : x.parameters)
-    if (p.kind == EffectKind::kTransmissionError)
-      p.harmonic_per_motor_rev = search_order(x, p.joint, current.residual[p.joint]);
+  choose_drive_effects(x, zero, current.residual);
   Eigen::VectorXd p = Eigen::VectorXd::Zero(x.size());
   Signal m = zero;
   for (int it = 0; it < kMaxGaussNewtonSteps; ++it) {
-    const Eigen::VectorXd delta = gauss_newton_step(x, p, m);
+    const Eigen::VectorXd delta = gauss_newton_step(x, p, m).delta;
     const Eigen::VectorXd step = nominal_steps(plant, x.parameters, p);
     bool accepted = false;
     for (double fraction : {1.0, 0.5}) {
@@ -182,6 +216,7 @@ NominalRefinement refine_on_nominal_plant(const GapSignals& s, const NominalPlan
   out.simulations = x.simulations;
   Eigen::Index i = 0;
   for (const NominalParameter& parameter : x.parameters) {
+    out.kinds.push_back(parameter.kind);
     out.changes.push_back(
         describe_nominal_change(plant, parameter, p.segment(i, parameter.size())));
     i += parameter.size();

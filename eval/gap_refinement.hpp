@@ -10,10 +10,13 @@
 // p starts at 0 (the nominal model), so the first step is the linearised fit; a step that does not
 // lower the training residual is halved once, then the search stops; at most 4 steps, fewer when a
 // step moves every parameter by less than 1 % of its difference step; every size within its
-// physical bound. A transmission error's order h per motor revolution is searched first (0.5 to 8
-// in steps of 0.5) by the raw ripple [sin, cos](h N q_internal) fitted to its joint's gap less the
-// other members, on the training rows. The refined model is applied when its held-out residual is
-// below the linear model's; the predicted shrinkage is then the refined model's held-out one.
+// physical bound. Before that, a member that is an effect of a joint's drive (Coulomb friction,
+// backlash, transmission error) stands for whichever of them on its joint the linearised fit
+// explains best on the training rows (the linear candidates confuse them); a transmission error is
+// tried at the 3 orders h per motor revolution (of 0.5 to 8 in steps of 0.5) whose raw ripple
+// [sin, cos](h N q_internal) best fits its joint's gap less the other members. The refined model
+// is applied when its held-out residual is below the linear model's; the predicted shrinkage is
+// then the refined model's held-out one.
 #include <cstddef>
 #include <vector>
 
