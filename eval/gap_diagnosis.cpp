@@ -226,7 +226,7 @@ void refine_joint_model(const GapSignals& s, const NominalPlant& nominal,
       std::sqrt(out.refinement.heldout_energy / double(std::max<std::size_t>(heldout.size(), 1)));
   for (std::size_t i = 0; i < out.refinement.members.size(); ++i) {
     CombinationStep& step = out.combination[out.refinement.members[i]];
-    step.fit.kind = out.refinement.kinds[i];
+    step.fit.kind = out.refinement.parameters[i].kind;
     step.fit.shape = "the nominal model re-simulated";
     step.fit.size_text = out.refinement.changes[i];
     step.label = candidate_label(s, step.fit);

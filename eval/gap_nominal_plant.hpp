@@ -63,13 +63,14 @@ std::vector<std::vector<double>> simulate_links(const NominalPlant& plant,
 
 // A joint model refined on the nominal model (eval/gap_refinement.hpp).
 struct NominalRefinement {
-  bool applied = false;              // its held-out residual is below the linear model's
-  double shrinkage_percent = 0.0;    // held-out, all joints, of the refined model
-  double heldout_energy = 0.0;       // of its residual [rad²]
-  std::vector<std::size_t> members;  // the members refined (indices into the joint model)
-  std::vector<EffectKind> kinds;     // the effect each stands for, in the same order
-  std::vector<std::string> changes;  // their parameters in words, in the same order
-  int simulations = 0;               // runs of the nominal model it took
+  bool applied = false;                      // its held-out residual is below the linear model's
+  double shrinkage_percent = 0.0;            // held-out, all joints, of the refined model
+  double heldout_energy = 0.0;               // of its residual [rad²]
+  std::vector<std::size_t> members;          // the members refined (indices into the joint model)
+  std::vector<NominalParameter> parameters;  // what each stands for, in the same order
+  std::vector<Eigen::VectorXd> values;       // its change p (the units of the file's head)
+  std::vector<std::string> changes;          // in words
+  int simulations = 0;                       // runs of the nominal model it took
 };
 
 // The parameters in words, e.g. "A3 Coulomb friction 20.1 N m (nominal 40.2 N m)".

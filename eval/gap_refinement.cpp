@@ -216,7 +216,8 @@ NominalRefinement refine_on_nominal_plant(const GapSignals& s, const NominalPlan
   out.simulations = x.simulations;
   Eigen::Index i = 0;
   for (const NominalParameter& parameter : x.parameters) {
-    out.kinds.push_back(parameter.kind);
+    out.parameters.push_back(parameter);
+    out.values.push_back(p.segment(i, parameter.size()));
     out.changes.push_back(
         describe_nominal_change(plant, parameter, p.segment(i, parameter.size())));
     i += parameter.size();
