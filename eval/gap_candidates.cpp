@@ -95,13 +95,21 @@ EffectKind effect_kind_from_index(int index) {
   return static_cast<EffectKind>(index);
 }
 
+// The fewest periods a searched order's ripple must complete over the joint's motion.
+constexpr double kMinRipplePeriods = 10.0;
+
 std::vector<double> transmission_orders_by_fit(const GapSignals& s, std::size_t joint,
                                                const std::vector<double>& gap,
                                                const std::vector<bool>& use) {
   const std::size_t n = s.sample_count();
+  const auto [lowest, highest] =
+      std::minmax_element(s.q_internal_rad[joint].begin(), s.q_internal_rad[joint].end());
+  const double motor_range_rad = n > 0 ? s.gear_ratio[joint] * (*highest - *lowest) : 0.0;
   std::vector<std::pair<double, double>> scored;  // (rms, order)
-  for (int twice = 1; twice <= 16; ++twice) {
+  for (int twice = 2; twice <= 16; ++twice) {
     const double h = 0.5 * twice;
+    // A ripple of fewer periods over the motion is a slow drift to the data, not an order.
+    if (h * motor_range_rad < kMinRipplePeriods * 2.0 * M_PI) continue;
     Eigen::MatrixXd columns(Eigen::Index(n), 2);
     for (std::size_t k = 0; k < n; ++k) {
       const double angle = h * s.gear_ratio[joint] * s.q_internal_rad[joint][k];

@@ -13,7 +13,7 @@
 // physical bound. Before that, a member that is an effect of a joint's drive (Coulomb friction,
 // backlash, transmission error) stands for whichever of them on its joint the linearised fit
 // explains best on the training rows (the linear candidates confuse them); a transmission error is
-// tried at the 3 orders h per motor revolution (of 0.5 to 8 in steps of 0.5) whose raw ripple
+// tried at the 3 orders h per motor revolution (of 1 to 8 in steps of 0.5) whose raw ripple
 // [sin, cos](h N q_internal) best fits its joint's gap less the other members. The refined model
 // is applied when its held-out residual is below the linear model's; the predicted shrinkage is
 // then the refined model's held-out one.
