@@ -18,6 +18,7 @@
 #include "calib/robot_description.hpp"
 #include "core/units.hpp"
 #include "eval/gap_candidates.hpp"
+#include "eval/gap_diagnosis.hpp"
 #include "eval/gap_nominal_plant.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table.hpp"
@@ -396,5 +397,20 @@ struct GapWorld {
     return c;
   }
 };
+
+// The held-out shrinkage the true effects give (the sim re-run with them on leaves only the noise
+// of the real data) [%]: the truth a predicted shrinkage is scored against.
+inline double true_heldout_shrinkage_percent(const GapWorld::Case& c, const GapSignals& signals) {
+  const std::vector<bool> training = training_rows(signals, DiagnosisOptions{}.block_s);
+  double e_gap = 0.0, e_noise = 0.0;
+  for (std::size_t j = 0; j < signals.joint_count(); ++j)
+    for (std::size_t k = 0; k < signals.sample_count(); ++k) {
+      if (training[k]) continue;
+      const double noise = c.real.q_measured_rad[j][k] - c.real_noise_free.q_measured_rad[j][k];
+      e_gap += signals.gap_rad[j][k] * signals.gap_rad[j][k];
+      e_noise += noise * noise;
+    }
+  return 100.0 * (1.0 - std::sqrt(e_noise / e_gap));
+}
 
 }  // namespace imscal::eval::test

@@ -25,21 +25,11 @@ Refined diagnose(const test::GapWorld& world, const test::WithheldEffect& effect
                  std::uint64_t seed) {
   const auto c = world.make_case({effect}, seed);
   const GapSignals s = make_gap_signals(c.real, c.sim_joint_error_rad, world.robot);
-  Refined r{diagnose_gap(s, DiagnosisOptions{}, &c.nominal)};
-  const std::vector<bool> training = training_rows(s, DiagnosisOptions{}.block_s);
-  double e_gap = 0.0, e_noise = 0.0;
-  for (std::size_t j = 0; j < s.joint_count(); ++j)
-    for (std::size_t k = 0; k < s.sample_count(); ++k) {
-      if (training[k]) continue;
-      const double noise = c.real.q_measured_rad[j][k] - c.real_noise_free.q_measured_rad[j][k];
-      e_gap += s.gap_rad[j][k] * s.gap_rad[j][k];
-      e_noise += noise * noise;
-    }
-  r.truth_percent = 100.0 * (1.0 - std::sqrt(e_noise / e_gap));
-  return r;
+  return {diagnose_gap(s, DiagnosisOptions{}, &c.nominal),
+          test::true_heldout_shrinkage_percent(c, s)};
 }
 
-// The refined member standing for `kind` on `joint` (nullptr: none).
+// The refined member standing for `kind` on `joint` (parameters.size(): none).
 std::size_t find_member(const NominalRefinement& r, EffectKind kind, std::size_t joint) {
   for (std::size_t i = 0; i < r.parameters.size(); ++i)
     if (r.parameters[i].kind == kind && r.parameters[i].joint == joint) return i;
