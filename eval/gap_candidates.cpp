@@ -95,8 +95,37 @@ EffectKind effect_kind_from_index(int index) {
   return static_cast<EffectKind>(index);
 }
 
+// The fewest periods a searched order's ripple must complete over the joint's motion.
+constexpr double kMinRipplePeriods = 10.0;
+
+std::vector<double> transmission_orders_by_fit(const GapSignals& s, std::size_t joint,
+                                               const std::vector<double>& gap,
+                                               const std::vector<bool>& use) {
+  const std::size_t n = s.sample_count();
+  const auto [lowest, highest] =
+      std::minmax_element(s.q_internal_rad[joint].begin(), s.q_internal_rad[joint].end());
+  const double motor_range_rad = n > 0 ? s.gear_ratio[joint] * (*highest - *lowest) : 0.0;
+  std::vector<std::pair<double, double>> scored;  // (rms, order)
+  for (int twice = 2; twice <= 16; ++twice) {
+    const double h = 0.5 * twice;
+    // A ripple of fewer periods over the motion is a slow drift to the data, not an order.
+    if (h * motor_range_rad < kMinRipplePeriods * 2.0 * M_PI) continue;
+    Eigen::MatrixXd columns(Eigen::Index(n), 2);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double angle = h * s.gear_ratio[joint] * s.q_internal_rad[joint][k];
+      columns(Eigen::Index(k), 0) = std::sin(angle);
+      columns(Eigen::Index(k), 1) = std::cos(angle);
+    }
+    scored.emplace_back(fit_columns(columns, gap, use).rms, h);
+  }
+  std::sort(scored.begin(), scored.end());
+  std::vector<double> orders;
+  for (const auto& [rms, h] : scored) orders.push_back(h);
+  return orders;
+}
+
 std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& s,
-                                             std::size_t joint) {
+                                             std::size_t joint, const std::vector<bool>* training) {
   const Eigen::Index n = Eigen::Index(s.sample_count());
   const std::size_t nj = s.joint_count();
   const Column qd = to_column(s.qd_desired_rad_s[joint]);
@@ -267,8 +296,13 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
         }
         return std::pair{cols, names};
       };
-      for (int h = 1; h <= 3; ++h) {
-        const Column phase = double(h) * n_gear * q;
+      std::vector<double> orders = {1.0, 2.0, 3.0};
+      if (training)  // two further orders from the search on the training rows
+        for (double h : transmission_orders_by_fit(s, joint, s.gap_rad[joint], *training))
+          if (orders.size() < 5 && std::find(orders.begin(), orders.end(), h) == orders.end())
+            orders.push_back(h);
+      for (double h : orders) {
+        const Column phase = h * n_gear * q;
         const Column sn = phase.array().sin().matrix(), cs = phase.array().cos().matrix();
         out.push_back(local(fmt::format("harmonic {} of the motor angle", h), {sn, cs},
                             {"sin_rad", "cos_rad"}));
@@ -746,7 +780,7 @@ bool acts_through_dynamics(EffectKind kind) {
 
 std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, std::size_t joint,
                                           const std::vector<bool>& training) {
-  const std::vector<CandidateShape> shapes = candidate_shapes(kind, s, joint);
+  const std::vector<CandidateShape> shapes = candidate_shapes(kind, s, joint, &training);
   if (shapes.empty()) return std::nullopt;
   // The shape is chosen by the 2-fold validation inside the training rows
   // (eval/gap_validation.hpp). Of shapes within 1 % of the best validation error, the one with the

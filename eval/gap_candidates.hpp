@@ -26,7 +26,8 @@
 //                   [L_100ms,0..5 u], [L_100ms,0..3 u], [L_30ms,0..5 u] or [HP_30/100/300ms u]
 //   compliance      u = tau_d (inverse dynamics on q_d): deflection tau/k; [u], [G, u - G] (gravity
 //                   and motion parts apart), [u, L_30ms,0..1 u] or [u, L_30ms,0..5 u]
-//   transmission    s, c = sin/cos(h N q_internal), h = 1..3 per motor revolution: raw, through
+//   transmission    s, c = sin/cos(h N q_internal), h = 1..3 per motor revolution and the two
+//                   orders of 1..8 whose raw ripple best fits the training rows: raw, through
 //                   L_3ms (x3, x4), L_10ms or L_30ms (x4), or with the ripple torque tau_d s,
 //                   tau_d c (the gear's virtual work on the motor) through L_100ms x3 beside
 //                   L_10ms x3 or L_3ms + L_30ms x3 of s, c: below the loop's bandwidth the link
@@ -113,8 +114,20 @@ struct LevelBound {
 // The shapes of a candidate on a joint (empty when the candidate does not apply, e.g. the
 // operating point without a table). The columns are computed from the whole record (filters run
 // across training and held-out rows alike: they are known signals).
+// `training`: the rows a transmission error's further orders are searched on (below); null: the
+// orders 1 to 3 only.
 std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& signals,
-                                             std::size_t joint);
+                                             std::size_t joint,
+                                             const std::vector<bool>* training = nullptr);
+
+// The orders h per motor revolution of a transmission error on `joint`, 1 to 8 in steps of 0.5,
+// best first by the residual RMS of the raw ripple [sin, cos](h N q_internal) fitted to `gap` on
+// the rows `use` (an order search: a gear's error has orders other than the first few). Only
+// orders whose ripple completes at least 10 periods over the joint's range of motion: fewer are a
+// slow drift to the data (an order 0.5 on a slow A2 displaced its zero offset).
+std::vector<double> transmission_orders_by_fit(const GapSignals& signals, std::size_t joint,
+                                               const std::vector<double>& gap,
+                                               const std::vector<bool>& use);
 
 // The backlash shape of a joint whose gear torque never changes sign on the data: the link rests
 // on one flank and the play is a constant offset of half its width, indistinguishable there from

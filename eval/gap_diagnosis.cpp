@@ -9,6 +9,7 @@
 #include <random>
 
 #include "core/parallel_tasks.hpp"
+#include "eval/gap_refinement.hpp"
 #include "eval/gap_selection.hpp"
 #include "eval/gap_verdict.hpp"
 
@@ -210,6 +211,28 @@ std::vector<CandidateResult> fit_every_candidate(const GapSignals& s, const Diag
   return out;
 }
 
+// The joint model refined on the nominal model's simulator; applied when it predicts the held-out
+// gap better.
+void refine_joint_model(const GapSignals& s, const NominalPlant& nominal,
+                        const std::vector<bool>& training, const std::vector<std::size_t>& heldout,
+                        double linear_heldout_energy, Diagnosis& out) {
+  std::vector<CandidateFit> members;
+  for (const CombinationStep& step : out.combination) members.push_back(step.fit);
+  out.refinement =
+      refine_on_nominal_plant(s, nominal, members, training, heldout, linear_heldout_energy);
+  if (!out.refinement.applied) return;
+  out.combination.back().shrinkage_percent = out.refinement.shrinkage_percent;
+  out.heldout_rms_modelled_rad =
+      std::sqrt(out.refinement.heldout_energy / double(std::max<std::size_t>(heldout.size(), 1)));
+  for (std::size_t i = 0; i < out.refinement.members.size(); ++i) {
+    CombinationStep& step = out.combination[out.refinement.members[i]];
+    step.fit.kind = out.refinement.parameters[i].kind;
+    step.fit.shape = "the nominal model re-simulated";
+    step.fit.size_text = out.refinement.changes[i];
+    step.label = candidate_label(s, step.fit);
+  }
+}
+
 }  // namespace
 
 std::string candidate_label(const GapSignals& s, const CandidateFit& fit) {
@@ -247,7 +270,8 @@ double block_bootstrap_p_value(const std::vector<double>& d, std::size_t block, 
   return (1.0 + not_positive) / (1.0 + resamples);
 }
 
-Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
+Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o,
+                       const NominalPlant* nominal) {
   Diagnosis out;
   out.where = analyse_gap(s);
   const std::vector<bool> training = training_rows(s, o.block_s);
@@ -290,6 +314,7 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o) {
         select_joint_model(s, o, out.candidates, training, rows.heldout, block, seed);
     out.combination = model.steps;
     out.heldout_rms_modelled_rad = std::sqrt(std::max(model.heldout_energy, 0.0) / m);
+    if (nominal) refine_joint_model(s, *nominal, training, rows.heldout, model.heldout_energy, out);
   }
 
   find_per_joint(s, o, rows.heldout, out);

@@ -28,6 +28,7 @@
 #include "eval/gap_candidates.hpp"
 #include "eval/gap_joint_significance.hpp"
 #include "eval/gap_model_error.hpp"
+#include "eval/gap_nominal_plant.hpp"
 
 namespace imscal::eval {
 
@@ -88,6 +89,10 @@ struct Diagnosis {
   double heldout_rms_modelled_rad = 0.0;     // after the joint model
   std::vector<CandidateResult> candidates;   // sorted by held-out shrinkage, best first
   std::vector<CombinationStep> combination;  // the joint model's members
+  // The joint model refined on the nominal model's simulator (eval/gap_refinement.hpp; only with
+  // one). When applied, the last step's shrinkage and heldout_rms_modelled_rad are the refined
+  // model's and its members' size_text the re-simulated parameters.
+  NominalRefinement refinement;
   // Candidates the data cannot tell apart (members index `candidates`; groups in ranking order,
   // the group of the first candidate first when it has one).
   std::vector<AmbiguityGroup> ambiguity_groups;
@@ -107,7 +112,10 @@ std::vector<bool> training_rows(const GapSignals& signals, double block_s);
 double block_bootstrap_p_value(const std::vector<double>& d, std::size_t block, int resamples,
                                std::uint64_t seed);
 
-Diagnosis diagnose_gap(const GapSignals& signals, const DiagnosisOptions& options = {});
+// `nominal`: the simulator of the nominal model that predicted the "sim" joint errors, on the same
+// samples; the joint model is then refined on it (eval/gap_refinement.hpp). Null: linear only.
+Diagnosis diagnose_gap(const GapSignals& signals, const DiagnosisOptions& options = {},
+                       const NominalPlant* nominal = nullptr);
 
 std::string candidate_label(const GapSignals& signals, const CandidateFit& fit);
 

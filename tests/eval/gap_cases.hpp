@@ -16,7 +16,10 @@
 #include "calib/forward_kinematics.hpp"
 #include "calib/jacobian.hpp"
 #include "calib/robot_description.hpp"
+#include "core/units.hpp"
 #include "eval/gap_candidates.hpp"
+#include "eval/gap_diagnosis.hpp"
+#include "eval/gap_nominal_plant.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table.hpp"
 #include "sim/motion_planner.hpp"
@@ -38,6 +41,9 @@ struct WithheldEffect {
   // factor, "sim" the robot file's value (coulomb: the Coulomb friction torque); transmission: the
   // error's harmonic per motor revolution (another order than the first).
   double scale = 0.0;
+  // > 0: the effect's size, not drawn from the seed: transmission error amplitude [arcsec],
+  // payload mass added [kg].
+  double size = 0.0;
 };
 
 inline EffectKind expected_kind(const std::string& name) {
@@ -147,6 +153,8 @@ struct GapWorld {
     // The identified error model's operating-point grid ("operating_point" cases): per joint one
     // speed dimension; cells beyond the identified speed are filled, not identified.
     std::optional<ident::ParameterTable> table;
+    // The nominal model whose simulation is "sim" (eval/gap_nominal_plant.hpp).
+    NominalPlant nominal;
   };
 
   // Errors of the IMS chain injected into q_measured: the flange pose the chain would measure
@@ -259,6 +267,7 @@ struct GapWorld {
       if (e.name == "transmission") {
         re.transmission_error = real_changed = true;
         re.transmission_error_shape.amplitude_rad *= 2.0 * size(rng);  // 28..52 arcsec
+        if (e.size > 0.0) re.transmission_error_shape.amplitude_rad = e.size * kRadPerArcsec;
         if (e.scale > 0.0) re.transmission_error_shape.harmonic_per_motor_rev = e.scale;
       }
       if (e.name == "coulomb" && e.scale > 0.0) {
@@ -269,11 +278,13 @@ struct GapWorld {
       }
       if (e.name == "elastic") se.elastic_gear = se.gear_damping = false, sim_changed = true;
       if (e.name == "payload") {
-        for (auto& p : real_path.payloads) p.body.mass_kg += 4.0 * size(rng);
+        const double added_kg = 4.0 * size(rng);
+        for (auto& p : real_path.payloads) p.body.mass_kg += e.size > 0.0 ? e.size : added_kg;
         real_changed = true;
       }
     }
     Case c;
+    c.nominal = {sim_config, path};
     const sim::PlantLog real_plant =
         real_changed ? sim::simulate_plant(real_config, real_path, path.cycle_s) : base_log;
     const sim::PlantLog sim_plant =
@@ -386,5 +397,20 @@ struct GapWorld {
     return c;
   }
 };
+
+// The held-out shrinkage the true effects give (the sim re-run with them on leaves only the noise
+// of the real data) [%]: the truth a predicted shrinkage is scored against.
+inline double true_heldout_shrinkage_percent(const GapWorld::Case& c, const GapSignals& signals) {
+  const std::vector<bool> training = training_rows(signals, DiagnosisOptions{}.block_s);
+  double e_gap = 0.0, e_noise = 0.0;
+  for (std::size_t j = 0; j < signals.joint_count(); ++j)
+    for (std::size_t k = 0; k < signals.sample_count(); ++k) {
+      if (training[k]) continue;
+      const double noise = c.real.q_measured_rad[j][k] - c.real_noise_free.q_measured_rad[j][k];
+      e_gap += signals.gap_rad[j][k] * signals.gap_rad[j][k];
+      e_noise += noise * noise;
+    }
+  return 100.0 * (1.0 - std::sqrt(e_noise / e_gap));
+}
 
 }  // namespace imscal::eval::test

@@ -15,6 +15,7 @@
 // IMSCAL_SANITIZED a subset of the cases runs (each case is one plant simulation of ~8.5 s of
 // motion).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -53,7 +54,9 @@ Score score_case(const test::GapWorld& world, const HarnessCase& hc,
   const auto c = world.make_case(hc.effects, hc.seed);
   const GapSignals signals =
       make_gap_signals(c.real, c.sim_joint_error_rad, world.robot, c.table ? &*c.table : nullptr);
-  const Diagnosis d = diagnose_gap(signals);
+  // The joint model refined on the simulator of the nominal model, as the lab has it
+  // (eval/gap_refinement.hpp); linear only under the sanitizers (~10 more plant runs a case).
+  const Diagnosis d = diagnose_gap(signals, DiagnosisOptions{}, sanitized() ? nullptr : &c.nominal);
   Score s;
   for (const auto& e : hc.effects)
     s.name +=
@@ -106,17 +109,7 @@ Score score_case(const test::GapWorld& world, const HarnessCase& hc,
     }
   }
   s.effects = hc.effects.size();
-  // Truth: the sim re-run with the true effects on leaves only the noise of the real data.
-  const std::vector<bool> training = training_rows(signals, DiagnosisOptions{}.block_s);
-  double e_gap = 0.0, e_noise = 0.0;
-  for (std::size_t j = 0; j < signals.joint_count(); ++j)
-    for (std::size_t k = 0; k < signals.sample_count(); ++k) {
-      if (training[k]) continue;
-      const double noise = c.real.q_measured_rad[j][k] - c.real_noise_free.q_measured_rad[j][k];
-      e_gap += signals.gap_rad[j][k] * signals.gap_rad[j][k];
-      e_noise += noise * noise;
-    }
-  s.truth = 100.0 * (1.0 - std::sqrt(e_noise / e_gap));
+  s.truth = test::true_heldout_shrinkage_percent(c, signals);
   const std::string row = hc.effects.empty() ? "control" : hc.effects.front().name;
   // The confusion matrix counts the top candidate (the first of its group).
   const std::string col = d.significant_gap ? to_string(d.candidates.front().fit.kind) : "none";
@@ -126,6 +119,11 @@ Score score_case(const test::GapWorld& world, const HarnessCase& hc,
       "  gap {:.3g} rad  all found {:d}\n  {}\n",
       s.name, s.top, s.ranked_first, s.joint_located, s.predicted, s.truth, d.heldout_rms_rad,
       s.all_found, d.verdict);
+  std::vector<std::string> members;
+  for (const CombinationStep& step : d.combination) members.push_back(step.label);
+  fmt::print("  model: {}; re-simulated {:d} ({} runs, {:.1f} %): {}\n", fmt::join(members, " + "),
+             d.refinement.applied, d.refinement.simulations, d.refinement.shrinkage_percent,
+             fmt::join(d.refinement.changes, "; "));
   return s;
 }
 
@@ -241,9 +239,9 @@ TEST(GapHarness, WithheldEffectsAreFoundLocatedAndSized) {
   // The goals, all met and asserted: ranked first >= 90 % (the withheld effect first or
   // in the leading ambiguity group, which must stay small: at most 3 members, measured at most 2),
   // joint located >= 90 %, false alarms <= 10 % of the controls, predicted shrinkage within
-  // ±20 pp of the true one >= 90 % (measured 47/52; the misses: transmission error on A1 and A2,
-  // whose response through the loop and the wrist modes the Laguerre bases follow only in part,
-  // backlash on A2 and the payload, ~21 pp under the truth each).
+  // ±20 pp of the true one >= 90 % (measured 52/52 with the joint model refined on the nominal
+  // model; linear only 49/52, the transmission errors of A1 and A2 and the payload ~21 pp under the
+  // truth: the Laguerre bases follow their response through the loop only in part).
   test_support::record_figure("ranked_first_percent", pct(first, effect_cases));
   test_support::record_figure("joint_located_percent", pct(located, effect_cases));
   test_support::record_figure("shrinkage_within_20pp_percent", pct(within, effect_cases));
@@ -303,12 +301,47 @@ TEST(GapHarness, ResizedAndSimultaneousEffectsAreAllFound) {
       pct(multi_found, multi));
   test_support::record_figure("resized_within_20pp_percent", pct(resized_within, resized));
   test_support::record_figure("multi_effect_all_found_percent", pct(multi_found, multi));
-  // At the measured level (8/10 and 2/6 with the joint model; the greedy combination: 5/10 and
-  // 3/6): a fall shows here. The goal of every effect found in >= 80 % is met; shrinkage within
-  // ±20 pp in >= 85 % is not: the resized effects are found but under-predicted by the
-  // candidates' shapes.
+  // At the measured level (8/10 and 5/6 with the joint model refined on the nominal model; 8/10
+  // and 2/6 linear only): a fall shows here. The miss: a transmission error of order 2 on A1 that
+  // no member of the joint model stands for (an A4 backlash and an A1 time offset do), so no
+  // re-simulation of it is tried.
   EXPECT_GE(pct(multi_found, multi), 80.0);
-  EXPECT_GE(pct(resized_within, resized), 100.0 / 3.0 - 1e-9);
+  EXPECT_GE(pct(resized_within, resized), 500.0 / 6.0 - 1e-9);
+}
+
+// Resized effects of other sizes, orders and joints than the cases above (Release only): Coulomb
+// friction x0.6..x2 on other joints, transmission errors of orders 1.5..4 and other amplitudes,
+// payloads of 2 and 8 kg added. Scored as the resized effects above.
+TEST(GapHarness, ResizedEffectsOfOtherSizesAreSized) {
+  if (sanitized()) GTEST_SKIP() << "Release-only figures";
+  const test::GapWorld world;
+  const std::vector<HarnessCase> cases = {
+      {{{"coulomb", 1, 1.3}}, 90},
+      {{{"coulomb", 3, 0.7}}, 91},
+      {{{"coulomb", 5, 2.0}}, 92},
+      {{{"coulomb", 0, 0.6}}, 93},
+      {{{"transmission", 1, 1.5, 30.0}}, 94},
+      {{{"transmission", 3, 2.5}}, 95},
+      {{{"transmission", 4, 4.0, 45.0}}, 96},
+      {{{"transmission", 5, 2.0, 15.0}}, 97},
+      {{{"payload", 0, 0.0, 2.0}}, 98},
+      {{{"payload", 0, 0.0, 8.0}}, 99},
+  };
+  std::map<std::string, std::map<std::string, int>> confusion;
+  int within = 0, first = 0;
+  for (const auto& hc : cases) {
+    const Score s = score_case(world, hc, confusion);
+    within += std::abs(s.predicted - s.truth) <= 20.0;
+    first += s.ranked_first;
+  }
+  const double n = double(cases.size());
+  fmt::print(
+      "\nresized effects of other sizes: ranked first {}/{}, shrinkage within ±20 pp {}/{}\n",
+      first, cases.size(), within, cases.size());
+  test_support::record_figure("resized_heldout_within_20pp_percent", 100.0 * within / n);
+  // The goal (>= 85 % within ±20 pp); measured 10/10, ranked first 8/10 (the Coulomb
+  // friction of A1 and A2 raised or lowered ranks a backlash first; the re-simulation finds it).
+  EXPECT_GE(100.0 * within / n, 85.0);
 }
 
 }  // namespace
