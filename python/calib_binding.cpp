@@ -1,8 +1,8 @@
-// imscal.read_robot_log: the controller's log of a run (calib/robot_log.hpp, FORMAT.md §2).
+// imscal.read_robot_log: the controller's log of a run (robot/robot_log.hpp, FORMAT.md §2).
 #include <string>
 
-#include "calib/robot_log.hpp"
 #include "python/bindings.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::python {
 namespace {

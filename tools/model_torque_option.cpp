@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::tools {
 

@@ -13,12 +13,12 @@
 
 #include <Eigen/Geometry>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/jacobian.hpp"
-#include "calib/robot_description.hpp"
 #include "eval/gap_candidates.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/jacobian.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
