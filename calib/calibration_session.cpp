@@ -21,6 +21,7 @@ RestPoseOptions rest_pose_options(const CalibrationConfig& config) {
   RestPoseOptions options;
   options.min_duration_s = config.rests.min_duration_s;
   options.edge_trim_s = config.rests.trim_s;
+  options.detector_threshold_sigmas = config.rests.detector_threshold_sigmas;
   options.max_joint_spread_rad = config.rests.max_joint_spread_rad;
   options.settle_tolerance_rad = config.rests.settle_tolerance_rad;
   options.deflection.model_uncertainty_fraction = config.priors.deflection_uncertainty_fraction;

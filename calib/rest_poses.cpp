@@ -13,10 +13,12 @@
 namespace imscal::calib {
 namespace {
 
-// The rest detector's options from the data sheet, as the zero-velocity smoother fills them.
-ims::RestDetectorOptions detector_options(const ims::SensorSpec& spec) {
+// The rest detector's options from the data sheet, as the zero-velocity smoother fills them,
+// with the configured threshold.
+ims::RestDetectorOptions detector_options(const ims::SensorSpec& spec, double threshold_sigmas) {
   const ims::ZuptOptions zupt = ims::zupt_options_from_spec(spec);
   ims::RestDetectorOptions r = zupt.rest;
+  r.threshold_sigmas = threshold_sigmas;
   r.gyro_noise_density_rad_per_sqrt_s = zupt.gyro_noise_density_rad_per_sqrt_s;
   r.gyro_quantization_lsb_rad = zupt.gyro_quantization_lsb_rad;
   r.acc_noise_density_m_s_per_sqrt_s = zupt.acc_noise_density_m_s_per_sqrt_s;
@@ -63,7 +65,8 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
 
   RestPoseResult result;
   const ims::EarthModel earth(input.site);
-  result.detection = ims::detect_rest(*input.imu, earth, detector_options(input.sensor));
+  result.detection = ims::detect_rest(
+      *input.imu, earth, detector_options(input.sensor, options.detector_threshold_sigmas));
 
   for (const ims::RestInterval& interval : result.detection.intervals) {
     const double begin = interval.begin_s + options.edge_trim_s;

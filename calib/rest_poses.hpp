@@ -40,7 +40,9 @@ namespace imscal::calib {
 
 struct RestPoseOptions {
   double min_duration_s = 2.0;  // detected rests shorter than this are not used
-  double edge_trim_s = 0.5;     // taken off both ends of every rest
+  // The IMS rest detector's threshold in noise standard deviations (ims/rest_detector.hpp).
+  double detector_threshold_sigmas = 5.0;
+  double edge_trim_s = 0.5;  // taken off both ends of every rest
   // Largest spread (max - min) of a joint's internal reading over a rest [rad]. A still robot's
   // encoders move by a few counts at most (1e-5 rad = 2 arcsec), but after a move the joint
   // controllers may still creep towards their target through friction for seconds (up to

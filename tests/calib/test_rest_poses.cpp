@@ -167,6 +167,26 @@ TEST(RestPoses, RefusesRestsWhereTheRobotMoves) {
   EXPECT_LT(result.rests.size(), right.rests.size());
 }
 
+TEST(RestPoses, DetectorThresholdReachesTheDetector) {
+  const SimRun& run = seed_line();
+  // The IMS-only detection, in samples at rest, against the program's rests and moves: at the
+  // default 5 sigma the moves are not at rest; at 1e5 sigma every block passes the noise test
+  // (a move's rate, ~0.1-1 rad/s, is below 1e5 sigma of the navigation-grade gyro's window mean)
+  // and more samples are called rest. The count must grow strictly: the option is used.
+  RestPoseOptions strict = options_of(run);
+  RestPoseOptions loose = options_of(run);
+  loose.detector_threshold_sigmas = 1e5;
+  const auto count = [](const RestPoseResult& r) {
+    std::size_t n = 0;
+    for (bool at_rest : r.detection.at_rest) n += at_rest ? 1 : 0;
+    return n;
+  };
+  const double dt = run.sim.imu_clock_offset_s;
+  const std::size_t n_strict = count(find_rest_poses(input_of(run, dt), strict));
+  const std::size_t n_loose = count(find_rest_poses(input_of(run, dt), loose));
+  EXPECT_GT(n_loose, n_strict);
+}
+
 TEST(RestPoses, JointSeriesAndInitialTimeOffset) {
   const SimRun& run = seed_line();
   const RobotJointSeries series = robot_joint_series(run.log);
