@@ -17,9 +17,9 @@
 #include "calib/calibration_session.hpp"
 #include "calib/calibration_session_inputs.hpp"
 #include "calib/frame_calibration.hpp"
-#include "calib/robot_description.hpp"
 #include "calib/time_offset.hpp"
 #include "core/subprocess.hpp"
+#include "robot/robot_description.hpp"
 #include "tests/calib/frame_calibration_scenes.hpp"
 
 namespace {

@@ -14,7 +14,7 @@
 #include "bench/hand_eye_comparison.hpp"
 #include "bench/opencv_hand_eye.hpp"
 #include "calib/hand_eye.hpp"
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 
 namespace {
 

@@ -8,11 +8,11 @@
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainiksolverpos_lma.hpp>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/inverse_kinematics.hpp"
-#include "calib/jacobian.hpp"
-#include "calib/robot_description.hpp"
-#include "calib/ur_inverse_kinematics.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/inverse_kinematics.hpp"
+#include "robot/jacobian.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/ur_inverse_kinematics.hpp"
 #include "sim/kdl_chain.hpp"
 
 namespace {

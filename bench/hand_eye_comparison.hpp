@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/robot_description.hpp"
 #include "ims/so3.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::bench {
 

@@ -21,11 +21,11 @@
 #include "calib/joint_space_errors.hpp"
 #include "calib/mounting_validation.hpp"
 #include "calib/rest_poses.hpp"
-#include "calib/robot_description.hpp"
-#include "calib/robot_log.hpp"
 #include "calib/time_offset.hpp"
 #include "ims/imu_data.hpp"
 #include "ims/sensor_spec.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::calib {
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/jacobian.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/jacobian.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -21,9 +21,9 @@
 #include <Eigen/Geometry>
 #include <vector>
 
-#include "calib/robot_description.hpp"
-#include "calib/robot_log.hpp"
 #include "ims/smoother_aids.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::calib {
 

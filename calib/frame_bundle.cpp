@@ -6,8 +6,8 @@
 
 #include <cmath>
 
-#include "calib/forward_kinematics.hpp"
 #include "core/input_error.hpp"
+#include "robot/forward_kinematics.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -2,10 +2,10 @@
 // joint deviations at the rests with their priors, the rest means and the motions between them.
 #include <cmath>
 
-#include "calib/forward_kinematics.hpp"
 #include "calib/frame_bundle.hpp"
 #include "calib/frame_noise.hpp"
-#include "calib/jacobian.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/jacobian.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -6,10 +6,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "calib/forward_kinematics.hpp"
 #include "calib/frame_bundle.hpp"
-#include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/jacobian.hpp"
 
 namespace imscal::calib {
 namespace {

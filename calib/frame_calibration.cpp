@@ -6,8 +6,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "calib/forward_kinematics.hpp"
 #include "calib/frame_bundle.hpp"
+#include "robot/forward_kinematics.hpp"
 
 namespace imscal::calib {
 

@@ -41,9 +41,9 @@
 #include <vector>
 
 #include "calib/imu_preintegration.hpp"
-#include "calib/robot_description.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/imu_data.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

@@ -10,10 +10,10 @@
 #include <numbers>
 #include <tuple>
 
-#include "calib/forward_kinematics.hpp"
 #include "calib/frame_bundle.hpp"
 #include "calib/frame_covariance.hpp"
 #include "core/units.hpp"
+#include "robot/forward_kinematics.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "calib/forward_kinematics.hpp"
 #include "core/input_error.hpp"
 #include "ims/coarse_alignment.hpp"
+#include "robot/forward_kinematics.hpp"
 
 namespace imscal::calib {
 

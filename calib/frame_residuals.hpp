@@ -15,10 +15,10 @@
 #include <array>
 #include <vector>
 
-#include "calib/forward_kinematics.hpp"
 #include "calib/imu_preintegration.hpp"
-#include "calib/robot_description.hpp"
 #include "ims/so3.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

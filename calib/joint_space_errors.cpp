@@ -8,11 +8,11 @@
 #include <limits>
 #include <memory>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/ik_solver.hpp"
-#include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
 #include "ims/earth_model.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/ik_solver.hpp"
+#include "robot/jacobian.hpp"
 
 namespace imscal::calib {
 

@@ -11,7 +11,7 @@
 //              repeatability; calib/revisited_poses.hpp): the smoother cannot observe position;
 //   T_R_H(t)   = T_R_W W_T_S(t + dt) T_S_H at every robot sample (t robot clock, t + dt IMS clock;
 //              the smoothed poses interpolated between IMS samples: linear position, slerp);
-//   q_measured inverse kinematics (calib/ik_solver.hpp, the arm's class) in the configuration of
+//   q_measured inverse kinematics (robot/ik_solver.hpp, the arm's class) in the configuration of
 //   the
 //              robot's own reading at that sample, the 2*pi branch nearest to it;
 //   dq         = q_desired - q_measured per joint (the robot's internal reading beside it),
@@ -32,11 +32,11 @@
 #include "calib/frame_calibration.hpp"
 #include "calib/imu_preintegration.hpp"
 #include "calib/revisited_poses.hpp"
-#include "calib/robot_description.hpp"
-#include "calib/robot_log.hpp"
 #include "ims/imu_data.hpp"
 #include "ims/zupt_options.hpp"
 #include "ims/zupt_smoother.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::calib {
 

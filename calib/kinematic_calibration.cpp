@@ -10,7 +10,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "calib/forward_kinematics.hpp"
+#include "robot/forward_kinematics.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "calib/tracker_poses.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "calib/kinematic_calibration.hpp"
-#include "calib/robot_description.hpp"
 #include "calib/tracker_pose_limits.hpp"
 #include "calib/tracker_poses.hpp"
 #include "core/input_error.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

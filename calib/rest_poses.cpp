@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/zupt_options.hpp"
+#include "robot/jacobian.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -28,13 +28,13 @@
 
 #include "calib/frame_calibration.hpp"
 #include "calib/rest_stillness.hpp"
-#include "calib/robot_description.hpp"
-#include "calib/robot_log.hpp"
 #include "calib/static_deflection.hpp"
 #include "calib/time_offset.hpp"
 #include "ims/imu_data.hpp"
 #include "ims/rest_detector.hpp"
 #include "ims/sensor_spec.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::calib {
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <optional>
 
-#include "calib/forward_kinematics.hpp"
 #include "calib/joint_space_errors.hpp"
+#include "robot/forward_kinematics.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -32,9 +32,9 @@
 
 #include <Eigen/Geometry>
 
-#include "calib/robot_description.hpp"
-#include "calib/robot_log.hpp"
 #include "ims/zupt_smoother.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::calib {
 

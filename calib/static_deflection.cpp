@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "calib/forward_kinematics.hpp"
+#include "robot/forward_kinematics.hpp"
 
 namespace imscal::calib {
 namespace {

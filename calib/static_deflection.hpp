@@ -20,8 +20,8 @@
 #include <Eigen/Core>
 #include <array>
 
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

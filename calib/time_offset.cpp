@@ -6,9 +6,9 @@
 #include <cmath>
 #include <limits>
 
-#include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
 #include "core/parallel_tasks.hpp"
+#include "robot/jacobian.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "ims/imu_data.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

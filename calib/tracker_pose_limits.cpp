@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "calib/robot_log.hpp"
 #include "core/joint_limit_plausibility.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::calib {
 

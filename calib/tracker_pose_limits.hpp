@@ -3,8 +3,8 @@
 // (core/joint_limit_plausibility.hpp).
 #include <cstddef>
 
-#include "calib/robot_description.hpp"
 #include "calib/tracker_poses.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

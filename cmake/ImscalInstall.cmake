@@ -1,9 +1,9 @@
 # `cmake --install <build> --prefix P`: the headers (P/include/imscal, the repository's layout),
 # the static libraries (P/lib), the command line (P/bin), the shipped robots (P/share/imscal) and
 # the CMake package (P/lib/cmake/imscal) with the imported targets imscal::core, imscal::ims,
-# imscal::calib, imscal::ident, imscal::sim, imscal::eval and imscal::online. A project uses them with
-# find_package(imscal) and target_link_libraries(app PRIVATE imscal::calib); see
-# examples/find_package/.
+# imscal::robot, imscal::calib, imscal::ident, imscal::sim, imscal::eval and imscal::online. A
+# project uses them with find_package(imscal) and target_link_libraries(app PRIVATE imscal::robot);
+# see examples/find_package/.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -13,7 +13,7 @@ install(TARGETS ${imscal_libraries} imscal_build_options EXPORT imscalTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION include/imscal)
 install(TARGETS imscal RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-foreach(folder core ims calib ident sim eval online)
+foreach(folder core ims robot calib ident sim eval online)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${folder}/ DESTINATION include/imscal/${folder}
           FILES_MATCHING PATTERN "*.hpp")
 endforeach()

@@ -35,10 +35,10 @@
 #include <string>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "eval/model_torque.hpp"
 #include "ident/parameter_table.hpp"
 #include "ident/precontrol.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 #include "sim/plant_config.hpp"
 #include "sim/plant_simulator.hpp"

@@ -9,12 +9,12 @@
 #include <sstream>
 #include <vector>
 
-#include "calib/robot_description.hpp"
-#include "calib/robot_log.hpp"
 #include "core/input_error.hpp"
 #include "core/payload_plausibility.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "ident/precontrol.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::eval {
 

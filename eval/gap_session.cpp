@@ -9,12 +9,12 @@
 #include <optional>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
 #include "core/payload_plausibility.hpp"
 #include "eval/joint_error_limits.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::eval {
 

@@ -8,12 +8,12 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/jacobian.hpp"
 #include "core/units.hpp"
 #include "ident/arx_model.hpp"
 #include "ident/cell_blending.hpp"
 #include "ident/operating_point.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/jacobian.hpp"
 #include "sim/rigid_body_dynamics.hpp"
 
 namespace imscal::eval {

@@ -17,9 +17,9 @@
 #include <utility>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::eval {
 

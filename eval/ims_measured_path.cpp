@@ -4,10 +4,10 @@
 #include <random>
 
 #include "calib/joint_space_errors.hpp"
-#include "calib/robot_log.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
 #include "ims/zupt_options.hpp"
+#include "robot/robot_log.hpp"
 #include "sim/simulation.hpp"
 
 namespace imscal::eval {

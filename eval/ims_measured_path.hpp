@@ -10,8 +10,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "ims/zupt_smoother.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 #include "sim/plant_simulator.hpp"
 #include "sim/scenario.hpp"

@@ -4,8 +4,8 @@
 
 #include <vector>
 
-#include "calib/robot_log.hpp"
 #include "core/joint_limit_plausibility.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::eval {
 

@@ -4,8 +4,8 @@
 #include <cstddef>
 #include <string>
 
-#include "calib/robot_description.hpp"
 #include "ident/joint_error_io.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::eval {
 

@@ -21,9 +21,9 @@
 #include <utility>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/joint_identification.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 
 namespace imscal::eval {

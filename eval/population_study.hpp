@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::eval {
 

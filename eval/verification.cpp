@@ -9,13 +9,13 @@
 #include <stdexcept>
 #include <utility>
 
-#include "calib/forward_kinematics.hpp"
 #include "eval/ims_measured_path.hpp"
 #include "eval/iso9283_path.hpp"
 #include "eval/path_deviation.hpp"
 #include "ident/identification_config_record.hpp"
 #include "ident/identify_joints.hpp"
 #include "ims/earth_model.hpp"
+#include "robot/forward_kinematics.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 

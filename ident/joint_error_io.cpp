@@ -202,7 +202,7 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
       throw InputError(file, line, "t_s",
                        fmt::format("time {} s does not increase (previous sample {} s)", row[0],
                                    log.time_s.back()));
-    // The robot log's rule (calib/robot_log.hpp): a step under half a cycle is jitter no
+    // The robot log's rule (robot/robot_log.hpp): a step under half a cycle is jitter no
     // real-time controller produces, so `identify` and `compensate` refuse the same logs.
     if (!log.time_s.empty() && row[0] - log.time_s.back() < 0.5 * log.cycle_s)
       throw InputError(file, line, "t_s",

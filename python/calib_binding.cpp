@@ -1,4 +1,4 @@
-// imscal.read_robot_log and imscal.calibrate: the controller's log of a run (calib/robot_log.hpp,
+// imscal.read_robot_log and imscal.calibrate: the controller's log of a run (robot/robot_log.hpp,
 // FORMAT.md §2) and the calibration session of `imscal calibrate`
 // (calib/calibration_session.hpp).
 #include <string>
@@ -8,9 +8,9 @@
 #include "calib/calibration_session_inputs.hpp"
 #include "calib/calibration_session_json.hpp"
 #include "calib/calibration_session_summary.hpp"
-#include "calib/robot_log.hpp"
 #include "core/json_output.hpp"
 #include "python/bindings.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::python {
 namespace {

@@ -9,7 +9,6 @@
 #include <utility>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "core/units.hpp"
@@ -19,6 +18,7 @@
 #include "ident/parameter_table_io.hpp"
 #include "ident/precontrol.hpp"
 #include "python/bindings.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::python {
 namespace {

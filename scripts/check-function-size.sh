@@ -14,7 +14,7 @@ exceptions=scripts/function-size-exceptions.txt
 config="{CheckOptions: [{key: readability-function-size.LineThreshold, value: $lines}]}"
 found=$(mktemp)
 trap 'rm -f "$found"' EXIT
-git ls-files 'core/*.cpp' 'ims/*.cpp' 'calib/*.cpp' 'ident/*.cpp' 'sim/*.cpp' 'eval/*.cpp' \
+git ls-files 'core/*.cpp' 'ims/*.cpp' 'robot/*.cpp' 'calib/*.cpp' 'ident/*.cpp' 'sim/*.cpp' 'eval/*.cpp' \
   'tools/*.cpp' 'online/*.cpp' |
   xargs -P "$(nproc)" -n 4 clang-tidy -p "$build" --quiet --checks='-*,readability-function-size' \
     --config="$config" 2>/dev/null |

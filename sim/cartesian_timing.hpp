@@ -29,7 +29,7 @@
 #include <optional>
 #include <vector>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 #include "sim/motion_profile.hpp"
 

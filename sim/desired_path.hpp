@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/motion_profile.hpp"
 
 namespace imscal::sim {

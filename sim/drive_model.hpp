@@ -26,7 +26,7 @@
 // dz^-1(tau_g / k) (backlash taken up on the side of the torque; centred at zero torque).
 #include <vector>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/plant_config.hpp"
 
 namespace imscal::sim {

@@ -9,7 +9,7 @@
 // Anti-windup by conditional integration: while the torque is saturated, I does not grow in the
 // direction that drives it further into the limit. The drive's velocity estimate qd_m is taken
 // as exact at the sampling instant (no encoder quantisation).
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::sim {
 

@@ -1,18 +1,18 @@
 #pragma once
 // A KDL::Chain built from our robot description, with the link inertias, for the simulator's
 // rigid-body dynamics (KDL's recursive Newton-Euler, ChainDynParam) and as a test oracle for our
-// kinematics. calib/ does not depend on KDL; only sim/ does.
+// kinematics. robot/ and calib/ do not depend on KDL; only sim/ does.
 //
 // Segments, base to tip: "base" (fixed, T_R_0), "<joint name>" x 6 (revolute; tip = DH link
 // frame i, carrying link i's inertia), "flange" (fixed, T_6_H, carrying the tool body and the
 // payload, transformed into H), and, with end_at_tool, "tool" (fixed, massless, T_H_T).
 // So the chain's end frame is the flange H (or the tool frame T) and its root is R: KDL's forward
-// kinematics gives T_R_H, its Jacobian the twist of H in R (see calib/jacobian.hpp).
+// kinematics gives T_R_H, its Jacobian the twist of H in R (see robot/jacobian.hpp).
 // Joint positions are our q [rad] (offsets are in the segment frames, not in KDL joints).
 #include <kdl/chain.hpp>
 #include <optional>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::sim {
 

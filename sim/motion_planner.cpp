@@ -15,11 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/ik_solver.hpp"
-#include "calib/jacobian.hpp"
 #include "core/input_error.hpp"
 #include "core/units.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/ik_solver.hpp"
+#include "robot/jacobian.hpp"
 #include "sim/cartesian_timing.hpp"
 #include "sim/motion_profile.hpp"
 

@@ -13,7 +13,7 @@
 //   v_max_i from the robot file, a_max_i and j_max_i from the program.
 // - LIN / CIRC: the flange origin follows the line/arc with a profile along the arc length
 //   (path velocity, acceleration, jerk); orientation constant or slerp (R0 exp(sigma theta k),
-//   sigma = s / L). Joints by IK (the solver of the arm's class, calib/ik_solver.hpp) at every
+//   sigma = s / L). Joints by IK (the solver of the arm's class, robot/ik_solver.hpp) at every
 //   sample (configuration and 2 pi branch of the previous sample), joint rates from the Cartesian
 //   twist, q_dot = J^-1 [v; w], and accelerations q_ddot = J^-1 ([a; w_dot] - J_dot q_dot), J_dot
 //   q_dot in closed form (jacobian_rate_times_joint_rate): exact up to rounding, no finite
@@ -29,7 +29,7 @@
 //   max velocity, or the IK solution jumps (change of configuration).
 #include <Eigen/Core>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 #include "sim/motion_program.hpp"
 
@@ -43,7 +43,7 @@ inline constexpr double kSingularityTolerance = 0.01;
 
 DesiredJointPath plan_motion(const calib::RobotDescription& robot, const MotionProgram& program);
 
-// J_dot(q, q_dot) * q_dot for the geometric Jacobian of calib/jacobian.hpp (flange origin
+// J_dot(q, q_dot) * q_dot for the geometric Jacobian of robot/jacobian.hpp (flange origin
 // velocity and angular velocity in R): the velocity-product term of the flange acceleration,
 // [a; w_dot] = J q_ddot + J_dot q_dot.
 Eigen::Matrix<double, 6, 1> jacobian_rate_times_joint_rate(const calib::KinematicModel& model,

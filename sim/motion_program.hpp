@@ -56,7 +56,7 @@
 #include <string>
 #include <vector>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 #include "sim/motion_profile.hpp"
 

@@ -19,8 +19,8 @@
 #include <array>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal {
 class ConfigNode;

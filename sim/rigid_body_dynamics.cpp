@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "calib/forward_kinematics.hpp"
+#include "robot/forward_kinematics.hpp"
 #include "sim/kdl_chain.hpp"
 
 namespace imscal::sim {

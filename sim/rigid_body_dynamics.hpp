@@ -2,7 +2,7 @@
 // Rigid-body dynamics of the arm, the mounted tool (the IMS) and the current payload through
 // Orocos KDL: M(q) from ChainDynParam::JntToMass, the bias C(q, qd) qd + G(q) from one recursive
 // Newton-Euler pass with qdd = 0. Link-side joint coordinates [rad], torques [N m].
-// The potential energy is computed separately from our own forward kinematics (calib/), so the
+// The potential energy is computed separately from our own forward kinematics (robot/), so the
 // energy check of the simulator does not rely on KDL alone.
 //
 // References (docs/references.md): [KDL], [Featherstone2008] (recursive Newton-Euler, mass matrix).
@@ -13,7 +13,7 @@
 #include <memory>
 #include <optional>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::sim {
 

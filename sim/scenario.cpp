@@ -8,11 +8,11 @@
 #include <string>
 #include <string_view>
 
-#include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
 #include "core/path_checks.hpp"
 #include "core/payload_plausibility.hpp"
 #include "core/units.hpp"
+#include "robot/robot_description.hpp"
 
 #ifndef IMSCAL_DATASETS_DIR
 #define IMSCAL_DATASETS_DIR ""

@@ -15,9 +15,9 @@
 #include <optional>
 #include <string>
 
-#include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "ims/earth_model.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/plant_config.hpp"
 
 namespace imscal::sim {

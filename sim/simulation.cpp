@@ -3,11 +3,11 @@
 #include <cmath>
 #include <random>
 
-#include "calib/forward_kinematics.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/imu_noise.hpp"
 #include "ims/imu_synthesis.hpp"
 #include "ims/spline_trajectory.hpp"
+#include "robot/forward_kinematics.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"

@@ -8,12 +8,12 @@
 #include <random>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "ims/imu_data.hpp"
 #include "ims/imu_noise.hpp"
 #include "ims/nav_state.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/sensor_spec.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 #include "sim/plant_simulator.hpp"
 #include "sim/scenario.hpp"

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "calib/robot_log.hpp"
 #include "core/atomic_file.hpp"
+#include "robot/robot_log.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulation.hpp"
 

@@ -11,7 +11,6 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -20,10 +19,8 @@
 
 #include "calib/calibration_session.hpp"
 #include "calib/calibration_session_inputs.hpp"
-#include "calib/calibration_session_json.hpp"
-#include "calib/calibration_session_summary.hpp"
-#include "core/atomic_file.hpp"
-#include "core/json_output.hpp"
+#include "calib/calibration_session_outputs.hpp"
+#include "calib/calibration_session_progress.hpp"
 #include "core/output_folder.hpp"
 #include "core/progress.hpp"
 #include "core/progress_channel.hpp"
@@ -67,14 +64,7 @@ ident::JointErrorLog joint_error_log(const calib::JointSpaceErrors& e, const cal
 void write_outputs(const CalibrateArgs& args, OutputFolder& folder,
                    const calib::LoadedSession& loaded, const calib::SessionResult& session) {
   const calib::SessionFiles& f = args.files;
-  const calib::SessionJson json = calib::session_json(f, loaded, session);
-  write_file_atomically(folder.staged("frames.json"),
-                        json_text(json.frames, 1, (folder.folder() / "frames.json").string()));
-  write_file_atomically(
-      folder.staged("mounting_report.json"),
-      json_text(json.mounting_report, 1, (folder.folder() / "mounting_report.json").string()));
-  write_file_atomically(folder.staged("summary.txt"),
-                        calib::session_summary_text({f.imu, f.robot_log, f.frames}, session));
+  calib::stage_session_outputs(folder, f, loaded, session);
   if (session.joint_errors)
     ident::write_joint_errors_csv(
         folder.staged("joint_errors.csv"),
@@ -84,54 +74,30 @@ void write_outputs(const CalibrateArgs& args, OutputFolder& folder,
   folder.commit();
 }
 
-// The share of the whole command done when a step of the session is `fraction` through (the
-// bundle and the mounting validation it is followed by take about half of the work).
-double overall_fraction(const std::string& stage, double fraction) {
-  struct Span {
-    const char* stage;
-    double begin, end;
-  };
-  static constexpr Span kSpans[] = {{"rests", 0.1, 0.15},
-                                    {"time offset", 0.15, 0.2},
-                                    {"bundle", 0.2, 0.7},
-                                    {"joint errors", 0.7, 0.95}};
-  for (const Span& s : kSpans)
-    if (stage == s.stage) return s.begin + fraction * (s.end - s.begin);
-  return 0.1;
-}
-
 void run(const CalibrateArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   // Refuse existing outputs before any work (exit 2 through InputError); the config decides
   // whether joint_errors.csv is written.
-  std::vector<fs::path> outputs = {"frames.json", "mounting_report.json", "summary.txt"};
-  if (args.files.config.empty() || calib::load_calibration_config(args.files.config).joint_errors)
-    outputs.push_back("joint_errors.csv");
+  const std::vector<fs::path> outputs = calib::session_output_names(args.files);
   const Overwrite overwrite = args.force ? Overwrite::kAllow : Overwrite::kRefuse;
   { OutputFolder check(args.out, outputs, overwrite); }
 
   Progress progress;
-  // The session may come back to a step (the rests are refined after the clock offset): the
-  // share reported never goes back.
-  double reported = 0.0;
-  const ProgressCallback channel = [&reported, to_parent = progress_channel()](
-                                       const std::string& stage, double fraction) {
-    reported = std::max(reported, fraction);
-    to_parent(stage, reported);
-  };
+  // The whole command's share for `imscal run` (one copy: it keeps the highest share reported).
+  const calib::SessionProgress share = calib::command_share_progress(progress_channel());
   progress.update("read", 0.0);
   const calib::LoadedSession loaded = calib::read_session_inputs(args.files);
   const calib::SessionResult session = calib::calibrate_session(
       loaded.inputs, loaded.options, [&](const std::string& stage, double fraction) {
         progress.update(stage, fraction);
-        channel(stage, overall_fraction(stage, fraction));
+        share(stage, fraction);
       });
   progress.update("write", 0.0);
-  channel("write", 0.95);
+  share("write", 0.0);
   OutputFolder folder(args.out, outputs, overwrite);
   write_outputs(args, folder, loaded, session);
   progress.finish();
-  channel("write", 1.0);
+  share("write", 1.0);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const calib::MountingValidation& validation = session.validation;

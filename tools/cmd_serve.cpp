@@ -14,7 +14,6 @@
 #include <memory>
 #include <stdexcept>
 
-#include "calib/robot_log.hpp"
 #include "core/input_error.hpp"
 #include "eval/model_torque.hpp"
 #include "ident/parameter_table_io.hpp"
@@ -23,6 +22,7 @@
 #include "online/rsi_session.hpp"
 #include "online/udp_server.hpp"
 #include "online/udp_socket.hpp"
+#include "robot/robot_log.hpp"
 #include "tools/command_registry.hpp"
 #include "tools/model_torque_option.hpp"
 

@@ -5,11 +5,11 @@
 
 #include <algorithm>
 
-#include "calib/robot_log.hpp"
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "ims/imu_file.hpp"
+#include "robot/robot_log.hpp"
 
 namespace imscal::tools {
 

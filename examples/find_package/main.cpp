@@ -4,9 +4,9 @@
 #include <cstdlib>
 #include <exception>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 
 int main(int argc, char** argv) {
   if (argc != 8) {

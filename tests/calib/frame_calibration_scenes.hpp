@@ -14,7 +14,6 @@
 #include <random>
 #include <vector>
 
-#include "calib/forward_kinematics.hpp"
 #include "calib/frame_calibration.hpp"
 #include "calib/time_offset.hpp"
 #include "ims/earth_model.hpp"
@@ -22,6 +21,7 @@
 #include "ims/imu_synthesis.hpp"
 #include "ims/sensor_spec.hpp"
 #include "ims/spline_trajectory.hpp"
+#include "robot/forward_kinematics.hpp"
 
 namespace imscal::test_support {
 

@@ -50,7 +50,6 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "core/sha256.hpp"
 #include "eval/verification.hpp"
@@ -58,6 +57,7 @@
 #include "ident/joint_error_io.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/sensor_error_model.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/scenario.hpp"
 #include "tests/support/frames_json.hpp"
 #include "tests/support/record_figure.hpp"

@@ -11,8 +11,8 @@
 #include <filesystem>
 
 #include "calib/encoder_motion.hpp"
-#include "calib/forward_kinematics.hpp"
-#include "calib/robot_description.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 namespace {

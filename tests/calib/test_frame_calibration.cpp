@@ -18,10 +18,10 @@
 #include <thread>
 
 #include "calib/frame_calibration.hpp"
-#include "calib/robot_description.hpp"
 #include "calib/time_offset.hpp"
 #include "core/units.hpp"
 #include "ims/so3.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/scenario.hpp"

@@ -10,8 +10,8 @@
 
 #include "calib/frame_calibration.hpp"
 #include "calib/hand_eye.hpp"
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
+#include "robot/robot_description.hpp"
 #include "tests/calib/frame_calibration_scenes.hpp"
 
 namespace imscal::calib {

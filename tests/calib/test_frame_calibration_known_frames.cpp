@@ -18,10 +18,10 @@
 #include <filesystem>
 
 #include "calib/frame_calibration.hpp"
-#include "calib/robot_description.hpp"
 #include "calib/time_offset.hpp"
 #include "core/input_error.hpp"
 #include "core/units.hpp"
+#include "robot/robot_description.hpp"
 #include "tests/calib/frame_calibration_scenes.hpp"
 
 namespace imscal::calib {

@@ -19,10 +19,10 @@
 
 #include "bench/hand_eye_comparison.hpp"
 #include "bench/opencv_hand_eye.hpp"
-#include "calib/forward_kinematics.hpp"
 #include "calib/hand_eye.hpp"
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 
 using imscal::bench::frame_error;
 using imscal::bench::HandEyeScenario;

@@ -14,9 +14,9 @@
 
 #include "calib/calibration_config.hpp"
 #include "calib/frame_calibration.hpp"
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
 #include "ims/sensor_spec.hpp"
+#include "robot/robot_description.hpp"
 #include "tests/calib/frame_calibration_scenes.hpp"
 
 namespace imscal::calib {

@@ -22,10 +22,8 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "calib/forward_kinematics.hpp"
 #include "calib/joint_space_errors.hpp"
 #include "calib/rest_poses.hpp"
-#include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "ims/imu_noise.hpp"
@@ -33,6 +31,8 @@
 #include "ims/sensor_error_model.hpp"
 #include "ims/spline_trajectory.hpp"
 #include "ims/zupt_options.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulation.hpp"
 #include "sim/simulation_output.hpp"

@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "calib/forward_kinematics.hpp"
 #include "calib/kinematic_calibration.hpp"
 #include "calib/tracker_poses.hpp"
-#include "calib/urdf_robot.hpp"
 #include "core/input_error.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/urdf_robot.hpp"
 #include "tests/support/record_figure.hpp"
 #include "tests/support/scratch_dir.hpp"
 

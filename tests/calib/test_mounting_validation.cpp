@@ -15,10 +15,10 @@
 
 #include "calib/calibration_config.hpp"
 #include "calib/mounting_validation.hpp"
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
 #include "ims/sensor_spec.hpp"
 #include "ims/so3.hpp"
+#include "robot/robot_description.hpp"
 #include "tests/calib/frame_calibration_scenes.hpp"
 
 namespace imscal::calib {

@@ -16,9 +16,9 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "calib/forward_kinematics.hpp"
 #include "calib/revisited_poses.hpp"
-#include "calib/robot_description.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -13,9 +13,9 @@
 #include <kdl/chaindynparam.hpp>
 #include <random>
 
-#include "calib/robot_description.hpp"
 #include "calib/static_deflection.hpp"
 #include "ims/earth_model.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/drive_model.hpp"
 #include "sim/kdl_chain.hpp"
 #include "sim/motion_planner.hpp"

@@ -13,12 +13,12 @@
 #include <random>
 #include <string>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/robot_description.hpp"
 #include "calib/time_offset.hpp"
 #include "core/input_error.hpp"
 #include "ims/imu_data.hpp"
 #include "ims/so3.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 
 using imscal::calib::JointVector;
 using imscal::calib::RateMagnitudeSeries;

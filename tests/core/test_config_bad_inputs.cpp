@@ -25,8 +25,6 @@
 #include <vector>
 
 #include "calib/calibration_config.hpp"
-#include "calib/robot_description.hpp"
-#include "calib/robot_log.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "core/input_file.hpp"
@@ -35,6 +33,8 @@
 #include "ident/parameter_table_io.hpp"
 #include "ims/imu_file.hpp"
 #include "ims/psins_reader.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/robot_log.hpp"
 #include "sim/scenario.hpp"
 #include "tests/support/scratch_dir.hpp"
 #include "tests/tools/run_campaign.hpp"

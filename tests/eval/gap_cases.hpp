@@ -13,15 +13,15 @@
 
 #include <Eigen/Geometry>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/jacobian.hpp"
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
 #include "eval/gap_candidates.hpp"
 #include "eval/gap_diagnosis.hpp"
 #include "eval/gap_nominal_plant.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/jacobian.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"

@@ -10,11 +10,11 @@
 #include <numbers>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "eval/gap_candidates.hpp"
 #include "eval/gap_diagnosis.hpp"
 #include "eval/gap_signals.hpp"
 #include "ident/joint_error_io.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::eval {
 namespace {

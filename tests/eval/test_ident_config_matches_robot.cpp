@@ -8,9 +8,9 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "ident/identification_config.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal {
 namespace {

@@ -7,9 +7,9 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "calib/forward_kinematics.hpp"
 #include "eval/ims_measured_path.hpp"
 #include "eval/verification.hpp"
+#include "robot/forward_kinematics.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"

@@ -15,9 +15,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "eval/model_torque.hpp"
 #include "eval/verification.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/scenario.hpp"

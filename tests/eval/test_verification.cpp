@@ -15,10 +15,10 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "calib/forward_kinematics.hpp"
 #include "eval/path_deviation.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config.hpp"
+#include "robot/forward_kinematics.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "tests/support/record_figure.hpp"

@@ -12,8 +12,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "calib/robot_log.hpp"
 #include "ident/parameter_table_io.hpp"
+#include "robot/robot_log.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/scenario.hpp"

@@ -14,8 +14,8 @@ endfunction()
 file(REMOVE_RECURSE ${WORK_DIR})
 set(prefix ${WORK_DIR}/prefix)
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
-foreach(installed include/imscal/calib/forward_kinematics.hpp include/imscal/core/version.hpp
-                  lib/libimscal_calib.a lib/cmake/imscal/imscalConfig.cmake
+foreach(installed include/imscal/robot/forward_kinematics.hpp include/imscal/core/version.hpp
+                  lib/libimscal_calib.a lib/libimscal_robot.a lib/cmake/imscal/imscalConfig.cmake
                   lib/cmake/imscal/imscalTargets.cmake share/imscal/robots/kr16.urdf)
   if(NOT EXISTS ${prefix}/${installed})
     message(FATAL_ERROR "not installed: ${installed}")

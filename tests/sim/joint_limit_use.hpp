@@ -6,7 +6,7 @@
 #include <cmath>
 #include <optional>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 
 namespace imscal::sim {

@@ -9,9 +9,9 @@
 #include <string>
 #include <utility>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 #include "sim/motion_program.hpp"
 

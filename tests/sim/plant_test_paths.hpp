@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 
 namespace imscal::sim::test {

@@ -11,10 +11,10 @@
 #include <cmath>
 #include <string>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "core/units.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/cartesian_timing.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_profile.hpp"

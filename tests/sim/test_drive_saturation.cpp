@@ -14,7 +14,7 @@
 #include <filesystem>
 #include <string>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"

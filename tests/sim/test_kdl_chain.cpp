@@ -13,9 +13,9 @@
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <random>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/kdl_chain.hpp"
 
 using imscal::calib::JointVector;

@@ -8,9 +8,9 @@
 #include <sstream>
 #include <string>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/scenario.hpp"
 #include "tests/support/scratch_dir.hpp"
 

@@ -8,9 +8,9 @@
 #include <cstdio>
 #include <string>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 

@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "calib/forward_kinematics.hpp"
+#include "robot/forward_kinematics.hpp"
 #include "sim/plant_config.hpp"
 #include "sim/plant_simulator.hpp"
 #include "sim/rigid_body_dynamics.hpp"

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <set>
 
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/drive_model.hpp"
 #include "sim/plant_population.hpp"
 #include "sim/scenario.hpp"

@@ -14,9 +14,9 @@
 #include <map>
 #include <string>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/jacobian.hpp"
-#include "calib/robot_description.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/jacobian.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "tests/sim/joint_limit_use.hpp"

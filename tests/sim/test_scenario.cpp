@@ -7,8 +7,8 @@
 #include <cmath>
 #include <fstream>
 
-#include "calib/robot_description.hpp"
 #include "core/input_error.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "tests/support/scratch_dir.hpp"

@@ -9,13 +9,13 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/robot_description.hpp"
-#include "calib/robot_log.hpp"
 #include "core/numeric_table.hpp"
 #include "ims/earth_model.hpp"
 #include "ims/imu_file.hpp"
 #include "ims/nav_trajectory_io.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/robot_log.hpp"
 #include "tests/support/frames_json.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"

@@ -15,8 +15,8 @@
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <random>
 
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/kdl_chain.hpp"
 
 namespace imscal::sim {

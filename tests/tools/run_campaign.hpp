@@ -12,8 +12,8 @@
 #include <sstream>
 #include <string>
 
-#include "calib/robot_log.hpp"
 #include "ident/joint_error_io.hpp"
+#include "robot/robot_log.hpp"
 #include "tests/ident/joint_simulation.hpp"
 #include "tests/support/run_imscal.hpp"
 

@@ -10,10 +10,10 @@
 #include <cmath>
 #include <thread>
 
-#include "calib/robot_log.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "online/controller_emulator.hpp"
 #include "online/egm_codec.hpp"
+#include "robot/robot_log.hpp"
 #include "tests/support/lag_table.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"

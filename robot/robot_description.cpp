@@ -1,14 +1,14 @@
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 
 #include <fmt/format.h>
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
-#include "calib/urdf_robot.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "core/units.hpp"
+#include "robot/urdf_robot.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -1,4 +1,4 @@
-#include "calib/inverse_kinematics.hpp"
+#include "robot/inverse_kinematics.hpp"
 
 #include <fmt/format.h>
 
@@ -7,9 +7,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/ik_geometry.hpp"
-#include "calib/ik_refinement.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/ik_geometry.hpp"
+#include "robot/ik_refinement.hpp"
 
 namespace imscal::calib {
 namespace {

@@ -1,6 +1,6 @@
 #pragma once
-// Small geometric helpers of the closed-form inverse kinematics (calib/inverse_kinematics.cpp,
-// calib/ur_inverse_kinematics.cpp). Angles in rad.
+// Small geometric helpers of the closed-form inverse kinematics (robot/inverse_kinematics.cpp,
+// robot/ur_inverse_kinematics.cpp). Angles in rad.
 //
 // References (docs/references.md): [Paden1985] for subproblem 1.
 #include <Eigen/Core>

@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "calib/robot_description.hpp"
 #include "core/atomic_file.hpp"
 #include "core/joint_limit_plausibility.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/inverse_kinematics.hpp"
-#include "calib/robot_description.hpp"
-#include "calib/urdf_robot.hpp"
 #include "core/input_error.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/inverse_kinematics.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/urdf_robot.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal::calib {

@@ -12,10 +12,10 @@
 #include <kdl/chainjnttojacsolver.hpp>
 #include <random>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/jacobian.hpp"
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/jacobian.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/kdl_chain.hpp"
 
 using imscal::kRadPerDeg;

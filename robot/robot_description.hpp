@@ -110,7 +110,7 @@ struct RobotDescription {
 };
 
 // Reads and validates a robot description; any problem -> InputError(file, line, key, why).
-// A file ending in `.urdf` is read as a URDF (calib/urdf_robot.hpp) with its optional side file.
+// A file ending in `.urdf` is read as a URDF (robot/urdf_robot.hpp) with its optional side file.
 RobotDescription load_robot_description(const std::filesystem::path& file);
 // The same from a parsed YAML root (lets tests feed text through ConfigNode::load_string).
 RobotDescription parse_robot_description(const ConfigNode& root);

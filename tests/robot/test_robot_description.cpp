@@ -8,10 +8,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "calib/robot_description.hpp"
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "core/units.hpp"
+#include "robot/robot_description.hpp"
 
 using imscal::ConfigNode;
 using imscal::InputError;

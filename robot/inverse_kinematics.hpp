@@ -21,7 +21,7 @@
 // - wrist_flip: the signed wrist bend (angle from axis 4 to axis 6 about axis 5) is negative
 //   (for the KR 16 description: q5 < 0).
 //
-// Types, failures and the common calls: calib/ik_solver.hpp. Failures are reported, never thrown:
+// Types, failures and the common calls: robot/ik_solver.hpp. Failures are reported, never thrown:
 // IkResult::status says what went wrong and IkResult::reason says it in words with the numbers
 // (distances in m, angles in rad).
 // - kUnreachable: the wrist centre is out of reach of the arm (too far, too close, or inside
@@ -39,8 +39,8 @@
 #include <string>
 #include <vector>
 
-#include "calib/ik_solver.hpp"
-#include "calib/robot_description.hpp"
+#include "robot/ik_solver.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

@@ -1,4 +1,4 @@
-// Inverse kinematics of the UR class (calib/ur_inverse_kinematics.hpp) on the UR10 and UR10e
+// Inverse kinematics of the UR class (robot/ur_inverse_kinematics.hpp) on the UR10 and UR10e
 // URDFs: round trips q -> T_R_H(q) -> IK -> q over all 8 configurations, agreement with KDL's
 // numeric ChainIkSolverPos_LMA built straight from the URDF's joints (not from our DH model),
 // every failure status at a pose built to cause it, Newton on a calibrated (non-ideal) arm, and
@@ -13,11 +13,11 @@
 #include <kdl/chainiksolverpos_lma.hpp>
 #include <random>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/inverse_kinematics.hpp"
-#include "calib/robot_description.hpp"
-#include "calib/ur_inverse_kinematics.hpp"
-#include "calib/urdf_robot.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/inverse_kinematics.hpp"
+#include "robot/robot_description.hpp"
+#include "robot/ur_inverse_kinematics.hpp"
+#include "robot/urdf_robot.hpp"
 #include "sim/kdl_chain.hpp"
 
 namespace imscal::calib {

@@ -8,7 +8,7 @@
 #include <array>
 #include <cmath>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

@@ -1,4 +1,4 @@
-#include "calib/robot_log.hpp"
+#include "robot/robot_log.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

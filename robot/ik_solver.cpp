@@ -1,12 +1,12 @@
-#include "calib/ik_solver.hpp"
+#include "robot/ik_solver.hpp"
 
 #include <fmt/format.h>
 
 #include <stdexcept>
 
-#include "calib/ik_refinement.hpp"
-#include "calib/inverse_kinematics.hpp"
-#include "calib/ur_inverse_kinematics.hpp"
+#include "robot/ik_refinement.hpp"
+#include "robot/inverse_kinematics.hpp"
+#include "robot/ur_inverse_kinematics.hpp"
 
 namespace imscal::calib {
 

@@ -8,10 +8,10 @@
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <random>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/inverse_kinematics.hpp"
-#include "calib/robot_description.hpp"
 #include "core/units.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/inverse_kinematics.hpp"
+#include "robot/robot_description.hpp"
 #include "sim/kdl_chain.hpp"
 
 using imscal::calib::ArmConfiguration;

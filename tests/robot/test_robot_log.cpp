@@ -1,7 +1,7 @@
 // robot.csv: exact round trip, degrees converted, and every bad log in
 // tests/data/bad_inputs/robot/ (made by make_cases.py there) refused with the file, line, field
 // and message its NAME.expected states.
-#include "calib/robot_log.hpp"
+#include "robot/robot_log.hpp"
 
 #include <gtest/gtest.h>
 

@@ -12,13 +12,13 @@
 // (n . R5(q5) w6 = cos(q5 - q5_0)); joint 6 by Paden-Kahan subproblem 1 from
 // R6^T R5^T n = R_G^T R1 n; the sum of joints 2..4 from the remaining rotation about n; joints 2
 // and 3 from the planar two-link problem that places axis 4; joint 4 from the sum. Then the
-// Newton steps of calib/ik_refinement.hpp on the full model (absorbs calibrated DH deviations).
+// Newton steps of robot/ik_refinement.hpp on the full model (absorbs calibrated DH deviations).
 //
 // Configuration flags (constant on each branch, they change only at a singularity):
 // - shoulder_front: W lies, seen from axis 1 along the arm plane's normal, on the side where it
 //   lies at q = 0 ("shoulder left/right" of the UR literature; for the UR URDFs, whose zero pose
 //   reaches out along base -x with W on the -y side, front is the q = 0 side).
-// - elbow_up: as for the spherical wrist (calib/inverse_kinematics.hpp): the elbow above the
+// - elbow_up: as for the spherical wrist (robot/inverse_kinematics.hpp): the elbow above the
 //   shoulder-to-axis-4 line when the arm reaches forward, in a base frame R with z up; defined on
 //   joint 3 alone.
 // - wrist_flip: sin(q5 - q5_0) < 0, q5_0 the wrist-2 angle at which axis 6 is parallel to axes
@@ -39,8 +39,8 @@
 #include <Eigen/Geometry>
 #include <array>
 
-#include "calib/ik_solver.hpp"
-#include "calib/robot_description.hpp"
+#include "robot/ik_solver.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

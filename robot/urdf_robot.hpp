@@ -21,7 +21,7 @@
 #include <filesystem>
 #include <string>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

@@ -5,8 +5,8 @@
 #include <Eigen/Geometry>
 #include <string>
 
-#include "calib/ik_solver.hpp"
-#include "calib/robot_description.hpp"
+#include "robot/ik_solver.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

@@ -6,7 +6,7 @@
 // ChainJntToJacSolver on a chain ending at H).
 #include <Eigen/Core>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 

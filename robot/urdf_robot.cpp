@@ -1,4 +1,4 @@
-#include "calib/urdf_robot.hpp"
+#include "robot/urdf_robot.hpp"
 
 #include <fmt/format.h>
 

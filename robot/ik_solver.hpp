@@ -1,8 +1,8 @@
 #pragma once
 // The common interface of the inverse-kinematics solvers of 6R arms, and the factory that picks
 // the solver from the arm's structure:
-// - calib/inverse_kinematics.hpp: spherical wrist (KUKA KR 16, ABB IRB, Fanuc, PUMA);
-// - calib/ur_inverse_kinematics.hpp: axes 2, 3, 4 parallel with wrist offsets (Universal
+// - robot/inverse_kinematics.hpp: spherical wrist (KUKA KR 16, ABB IRB, Fanuc, PUMA);
+// - robot/ur_inverse_kinematics.hpp: axes 2, 3, 4 parallel with wrist offsets (Universal
 //   Robots UR3/5/10/16, e-Series).
 // Both take the closed form of their class as the start of Newton steps on the full model, fill
 // the same IkResult (failures reported, never thrown) and use the same three configuration flags,
@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "calib/robot_description.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::calib {
 
@@ -98,7 +98,7 @@ class IkSolver {
 
  protected:
   explicit IkSolver(const KinematicModel& model) : model_(model) {}
-  // After the Newton refinement (calib/ik_refinement.hpp), for every solver: converged; for an arm
+  // After the Newton refinement (robot/ik_refinement.hpp), for every solver: converged; for an arm
   // that is not of the ideal structure (whose closed form checked its singularities before),
   // away from a singularity and still on the requested configuration; within the joint limits.
   // Sets result.status and result.reason.

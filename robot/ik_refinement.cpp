@@ -1,12 +1,12 @@
-#include "calib/ik_refinement.hpp"
+#include "robot/ik_refinement.hpp"
 
 #include <fmt/format.h>
 
 #include <Eigen/LU>
 #include <cmath>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/jacobian.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/jacobian.hpp"
 
 namespace imscal::calib {
 namespace {

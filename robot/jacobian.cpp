@@ -1,6 +1,6 @@
-#include "calib/jacobian.hpp"
+#include "robot/jacobian.hpp"
 
-#include "calib/forward_kinematics.hpp"
+#include "robot/forward_kinematics.hpp"
 
 namespace imscal::calib {
 

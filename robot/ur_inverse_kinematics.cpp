@@ -1,4 +1,4 @@
-#include "calib/ur_inverse_kinematics.hpp"
+#include "robot/ur_inverse_kinematics.hpp"
 
 #include <fmt/format.h>
 
@@ -7,9 +7,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "calib/forward_kinematics.hpp"
-#include "calib/ik_geometry.hpp"
-#include "calib/ik_refinement.hpp"
+#include "robot/forward_kinematics.hpp"
+#include "robot/ik_geometry.hpp"
+#include "robot/ik_refinement.hpp"
 
 namespace imscal::calib {
 namespace {
