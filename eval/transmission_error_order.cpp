@@ -22,6 +22,33 @@ constexpr int kSearchOrder = 20;
 // left seed-line's max deviation at 0.515 mm (3 cycles, IMS chain).
 constexpr double kMinGainPoints = 0.15;
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Each joint's held-out joint-error fit [%] of the record identified with `config` (NaN where a
+// joint was not identified).
+std::vector<double> held_out_fits(const ident::JointErrorLog& data,
+                                  const ident::IdentificationConfig& config) {
+  const IdentifiedTable identified = identify_table(data, config, "order search");
+  std::vector<double> fits(data.joint_count(), kNaN);
+  for (std::size_t j = 0; j < identified.joints.size() && j < fits.size(); ++j)
+    fits[j] = summarize_fit(identified.joints[j]).joint_error_fit_percent;
+  return fits;
+}
+
+// The single-harmonic fit of a candidate on a joint (NaN when not among the candidates).
+double fit_of(const TransmissionErrorOrderSearch& search, double harmonic, std::size_t joint) {
+  for (std::size_t c = 0; c < search.candidates.size(); ++c)
+    if (search.candidates[c] == harmonic) return search.fit_percent[c][joint];
+  return kNaN;
+}
+
+// Per joint the best single harmonic, its gain over the config's, and the one chosen.
+void choose_first_harmonics(TransmissionErrorOrderSearch& search,
+                            const ident::IdentificationConfig& config, std::size_t joints);
+// Per joint the best second harmonic beside the chosen one, its gain, and whether any is used.
+void search_second_harmonics(TransmissionErrorOrderSearch& search, const ident::JointErrorLog& data,
+                             const ident::IdentificationConfig& fixed);
+
 }  // namespace
 
 TransmissionErrorOrderSearch search_transmission_error_orders(
@@ -56,12 +83,18 @@ TransmissionErrorOrderSearch search_transmission_error_orders(
   for (double h : candidates) {
     ident::IdentificationConfig candidate = fixed;
     candidate.transmission_error_harmonic_per_joint.assign(joints, h);
-    const IdentifiedTable identified = identify_table(data, candidate, "order search");
-    std::vector<double> fits(joints, std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t j = 0; j < identified.joints.size() && j < joints; ++j)
-      fits[j] = summarize_fit(identified.joints[j]).joint_error_fit_percent;
-    search.fit_percent.push_back(std::move(fits));
+    search.fit_percent.push_back(held_out_fits(data, candidate));
   }
+  choose_first_harmonics(search, config, joints);
+  search_second_harmonics(search, data, fixed);
+  return search;
+}
+
+namespace {
+
+void choose_first_harmonics(TransmissionErrorOrderSearch& search,
+                            const ident::IdentificationConfig& config, std::size_t joints) {
+  const std::vector<double>& candidates = search.candidates;
   for (std::size_t j = 0; j < joints; ++j) {
     const double prior = config.transmission_error_harmonic(j);
     double best = -std::numeric_limits<double>::infinity();
@@ -85,8 +118,45 @@ TransmissionErrorOrderSearch search_transmission_error_orders(
     search.chosen_harmonic.push_back(
         !std::isfinite(best) || (prior_fitted && !(gain > kMinGainPoints)) ? prior : best_h);
   }
-  return search;
 }
+
+void search_second_harmonics(TransmissionErrorOrderSearch& search, const ident::JointErrorLog& data,
+                             const ident::IdentificationConfig& fixed) {
+  const std::size_t joints = search.chosen_harmonic.size();
+  const std::vector<double>& candidates = search.candidates;
+  if (candidates.size() < 2) return;
+  for (double h : candidates) {
+    ident::IdentificationConfig candidate = fixed;
+    candidate.transmission_error_harmonic_per_joint = search.chosen_harmonic;
+    candidate.options.second_transmission_error_input = true;
+    // Where h is the joint's first harmonic, another candidate stands in; its fit is not used.
+    candidate.transmission_error_second_harmonic_per_joint.assign(joints, h);
+    for (std::size_t j = 0; j < joints; ++j)
+      if (search.chosen_harmonic[j] == h)
+        candidate.transmission_error_second_harmonic_per_joint[j] =
+            h == candidates.front() ? candidates[1] : candidates.front();
+    std::vector<double> fits = held_out_fits(data, candidate);
+    for (std::size_t j = 0; j < joints; ++j)
+      if (search.chosen_harmonic[j] == h) fits[j] = kNaN;
+    search.second_fit_percent.push_back(std::move(fits));
+  }
+  for (std::size_t j = 0; j < joints; ++j) {
+    const double first_fit = fit_of(search, search.chosen_harmonic[j], j);
+    double best = -std::numeric_limits<double>::infinity(), best_h = 0.0;
+    for (std::size_t c = 0; c < candidates.size(); ++c)
+      if (const double fit = search.second_fit_percent[c][j]; std::isfinite(fit) && fit > best) {
+        best = fit;
+        best_h = candidates[c];
+      }
+    if (best_h == 0.0)  // no second candidate fitted: the first candidate other than the first
+      best_h = search.chosen_harmonic[j] == candidates.front() ? candidates[1] : candidates.front();
+    search.second_harmonic.push_back(best_h);
+    search.second_gain_points.push_back(std::isfinite(best) ? best - first_fit : kNaN);
+    if (best - first_fit > kMinGainPoints) search.second_harmonic_used = true;
+  }
+}
+
+}  // namespace
 
 std::vector<double> default_order_candidates() {
   return {0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0};
@@ -96,16 +166,24 @@ std::string describe_order_search(const TransmissionErrorOrderSearch& search, st
   std::string fits;
   for (std::size_t c = 0; c < search.candidates.size(); ++c)
     fits += fmt::format(" {}:{:.2f}", search.candidates[c], search.fit_percent[c][joint]);
+  std::string second;
+  if (joint < search.second_harmonic.size())
+    second = fmt::format("; second {} ({:+.2f} points{})", search.second_harmonic[joint],
+                         search.second_gain_points[joint],
+                         search.second_harmonic_used ? "" : ", not used");
   return fmt::format(
       "{} per motor revolution (config {}; best {}, {:+.2f} points of held-out fit over the "
-      "config's); fits [%]{}",
+      "config's); fits [%]{}{}",
       search.chosen_harmonic[joint], search.prior_harmonic[joint], search.best_harmonic[joint],
-      search.gain_points[joint], fits);
+      search.gain_points[joint], fits, second);
 }
 
 ident::IdentificationConfig with_searched_orders(ident::IdentificationConfig config,
                                                  const TransmissionErrorOrderSearch& search) {
   config.transmission_error_harmonic_per_joint = search.chosen_harmonic;
+  config.options.second_transmission_error_input = search.second_harmonic_used;
+  config.transmission_error_second_harmonic_per_joint =
+      search.second_harmonic_used ? search.second_harmonic : std::vector<double>{};
   return config;
 }
 

@@ -5,7 +5,9 @@
 // the config's sweep), and per joint the harmonic whose model fits the record's held-out part
 // best (the joint-error fit of its cells, summarize_fit). A gear whose error repeats twice per
 // motor revolution, modelled as once, leaves that error unexplained in the held-out rows; the
-// right order explains it. The final identification then sweeps the orders as configured.
+// right order explains it. A gear whose error has two orders gets the second as a further pair
+// of inputs when it explains the held-out rows better. The final identification then sweeps the
+// model orders as configured.
 #include <string>
 #include <vector>
 
@@ -27,6 +29,16 @@ struct TransmissionErrorOrderSearch {
   std::vector<double> best_harmonic;
   std::vector<double> gain_points;
   std::vector<double> chosen_harmonic;
+  // The second harmonic: the record identified once more per candidate with the chosen harmonic
+  // and the candidate as a second pair (second_fit_percent [candidate][joint]; NaN where the
+  // candidate is the joint's chosen harmonic). Per joint the best second candidate and its gain
+  // in points over the chosen harmonic alone. The table takes a second pair when some joint
+  // gains more than 0.15 points (second_harmonic_used); every joint then has its best second
+  // (a table's further inputs are the same on every joint).
+  std::vector<std::vector<double>> second_fit_percent;
+  std::vector<double> second_harmonic;
+  std::vector<double> second_gain_points;
+  bool second_harmonic_used = false;
 };
 
 // Every candidate must be > 0 and the config's models must take the transmission-error inputs
@@ -41,10 +53,10 @@ TransmissionErrorOrderSearch search_transmission_error_orders(
 std::vector<double> default_order_candidates();
 
 // One joint's outcome in a line: the chosen harmonic, the prior, the best, its gain and every
-// candidate's fit.
+// candidate's fit; the second harmonic and its gain.
 std::string describe_order_search(const TransmissionErrorOrderSearch& search, std::size_t joint);
 
-// The config with the search's harmonic per joint.
+// The config with the search's harmonic per joint (and the second harmonics, when used).
 ident::IdentificationConfig with_searched_orders(ident::IdentificationConfig config,
                                                  const TransmissionErrorOrderSearch& search);
 

@@ -112,6 +112,13 @@ JointIdentificationOptions IdentificationConfig::joint_options(std::size_t joint
           "identification config: no gear ratio for joint {} (joints.gear_ratio has {})", joint + 1,
           gear_ratio.size()));
     o.transmission_error_rad_per_rad = transmission_error_harmonic(joint) * gear_ratio[joint];
+    if (o.second_transmission_error_input) {
+      if (joint >= transmission_error_second_harmonic_per_joint.size())
+        throw std::invalid_argument(
+            fmt::format("identification config: no second harmonic for joint {}", joint + 1));
+      o.transmission_error_2_rad_per_rad =
+          transmission_error_second_harmonic_per_joint[joint] * gear_ratio[joint];
+    }
     if (joint < gear_stiffness_nm_per_rad.size())
       o.transmission_error_compliance_rad_per_nm = 1.0 / gear_stiffness_nm_per_rad[joint];
   }

@@ -84,9 +84,14 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
         // coefficient is zero, so any positive one serves.
         if (config.options.torque_sign_input)
           outcomes[j].result.parameters.torque_sign_scale_nm = 1.0;
-        if (config.options.transmission_error_input)
+        if (config.options.transmission_error_input) {
+          const JointIdentificationOptions o = config.joint_options(j);
           outcomes[j].result.parameters.transmission_error_rad_per_rad =
-              config.joint_options(j).transmission_error_rad_per_rad;
+              o.transmission_error_rad_per_rad;
+          if (o.second_transmission_error_input)
+            outcomes[j].result.parameters.transmission_error_2_rad_per_rad =
+                o.transmission_error_2_rad_per_rad;
+        }
       } catch (...) {
         errors[j] = std::current_exception();
       }

@@ -3,12 +3,18 @@
 // err twice per motor revolution (datasets/scenarios/deviating-identification.yaml, the known
 // simulated truth) while the identification config says once, the search finds 2 on A1..A3, the
 // joints that carry the error into the path. And a per-joint harmonic list in the config reaches
-// each joint's phase rate.
+// each joint's phase rate. On a plant whose gears err at two orders, the search finds both.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/config_node.hpp"
@@ -62,6 +68,63 @@ TEST(TransmissionErrorOrder, FindsTheDeviatingPlantsTwoPerRevolutionOnA1ToA3) {
   }
   const ident::IdentificationConfig searched = with_searched_orders(config, search);
   EXPECT_EQ(searched.transmission_error_harmonic(1), 2.0);
+}
+
+// The deviating plant with a second order on A1..A3: 2 per motor revolution at 15" (as shipped)
+// plus 3.5 per revolution at 15", 100 deg (the known simulated truth). Candidates 1 (the prior),
+// 2, 3.5 and 4. The two passes find {2, 3.5} on A1..A3 (3.5 first: at the same amplitude its
+// faster phase moves the joint more). The second order gains more than the search's threshold
+// of 0.15 points of held-out joint-error fit on A2 and A3 (measured: A1 +0.06, A2 +0.81, A3 +0.73;
+// A1 carries the error into the record least), and the table takes the pair.
+TEST(TransmissionErrorOrder, FindsASecondOrderBesideTheFirst) {
+  // One simulated identification session and eight identifications: ~15 s in Release.
+  if (std::getenv("IMSCAL_SANITIZED")) GTEST_SKIP() << "slow under the sanitizers";
+  const std::filesystem::path shipped = sim::resolve_scenario("deviating-identification");
+  std::stringstream text;
+  text << std::ifstream(shipped).rdbuf();
+  std::string yaml = text.str();
+  // The copy lives elsewhere: its paths (../robots/...) made absolute.
+  const std::string datasets = shipped.parent_path().parent_path().string() + "/";
+  for (std::size_t at = yaml.find("../"); at != std::string::npos; at = yaml.find("../", at))
+    yaml.replace(at, 3, datasets);
+  const auto replace = [&yaml](const std::string& from, const std::string& to) {
+    const std::size_t at = yaml.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    yaml.replace(at, from.size(), to);
+  };
+  const std::string shapes =
+      "transmission_error_shapes: [{amplitude_arcsec: 15, harmonic_per_motor_rev: 2, phase_deg: "
+      "40}, {amplitude_arcsec: 15, harmonic_per_motor_rev: 3.5, phase_deg: 100}]";
+  replace("  A1: {backlash: false}", "  A1: {backlash: false, " + shapes + "}\n  A2: {" + shapes +
+                                         "}\n  A3: {" + shapes + "}");
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / "imscal-two-order-identification.yaml";
+  std::ofstream(file) << yaml;
+  const sim::Scenario scenario = sim::load_scenario(file);
+  std::filesystem::remove(file);
+  const ident::JointErrorLog log = simulate_truth_joint_errors(scenario);
+  const ident::IdentificationConfig config =
+      ident::load_identification_config(ConfigNode::load_file(kDefaultConfig));
+  const ModelTorqueSource model = scenario_model_torque(scenario);
+  const TransmissionErrorOrderSearch search =
+      search_transmission_error_orders(log, config, {1.0, 2.0, 3.5, 4.0}, &model);
+  ASSERT_EQ(search.second_harmonic.size(), 6u);
+  for (std::size_t j = 0; j < 3; ++j) {
+    SCOPED_TRACE(log.joint_names[j]);
+    fmt::print("{}: {}\n", log.joint_names[j], describe_order_search(search, j));
+    const std::pair<double, double> found{
+        std::min(search.chosen_harmonic[j], search.second_harmonic[j]),
+        std::max(search.chosen_harmonic[j], search.second_harmonic[j])};
+    EXPECT_EQ(found, (std::pair<double, double>{2.0, 3.5}));
+    if (j > 0) {
+      EXPECT_GT(search.second_gain_points[j], 0.15);
+    }
+  }
+  EXPECT_TRUE(search.second_harmonic_used);
+  const ident::IdentificationConfig searched = with_searched_orders(config, search);
+  EXPECT_TRUE(searched.options.second_transmission_error_input);
+  EXPECT_EQ(searched.joint_options(1).transmission_error_2_rad_per_rad,
+            search.second_harmonic[1] * 160.0);
 }
 
 TEST(TransmissionErrorOrder, RefusesAConfigWithoutTheTransmissionError) {
