@@ -53,7 +53,8 @@ void search_second_harmonics(TransmissionErrorOrderSearch& search, const ident::
 
 TransmissionErrorOrderSearch search_transmission_error_orders(
     const ident::JointErrorLog& log, const ident::IdentificationConfig& given_config,
-    const std::vector<double>& candidates, const ModelTorqueSource* torque_model) {
+    const std::vector<double>& candidates, const ModelTorqueSource* torque_model,
+    bool second_harmonic) {
   const ident::IdentificationConfig config =
       given_config.resolved_cycle_s == log.cycle_s
           ? given_config
@@ -86,7 +87,7 @@ TransmissionErrorOrderSearch search_transmission_error_orders(
     search.fit_percent.push_back(held_out_fits(data, candidate));
   }
   choose_first_harmonics(search, config, joints);
-  search_second_harmonics(search, data, fixed);
+  if (second_harmonic) search_second_harmonics(search, data, fixed);
   return search;
 }
 

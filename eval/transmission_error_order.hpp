@@ -43,9 +43,12 @@ struct TransmissionErrorOrderSearch {
 
 // Every candidate must be > 0 and the config's models must take the transmission-error inputs
 // (std::invalid_argument otherwise). torque_model as for identify_table.
+// second_harmonic: also the second pass (off by default: on the development plants 1000-1014
+// it lifted the worst plant but lowered seed-line's median, docs/decisions/0028).
 TransmissionErrorOrderSearch search_transmission_error_orders(
     const ident::JointErrorLog& log, const ident::IdentificationConfig& config,
-    const std::vector<double>& candidates, const ModelTorqueSource* torque_model = nullptr);
+    const std::vector<double>& candidates, const ModelTorqueSource* torque_model = nullptr,
+    bool second_harmonic = false);
 
 // The candidates of the commands' searches: 0.5 .. 4 per motor revolution in steps of 0.5 (a
 // gear's error repeats at its stages' tooth and lobe counts over the motor revolution; halves for

@@ -107,7 +107,7 @@ TEST(TransmissionErrorOrder, FindsASecondOrderBesideTheFirst) {
       ident::load_identification_config(ConfigNode::load_file(kDefaultConfig));
   const ModelTorqueSource model = scenario_model_torque(scenario);
   const TransmissionErrorOrderSearch search =
-      search_transmission_error_orders(log, config, {1.0, 2.0, 3.5, 4.0}, &model);
+      search_transmission_error_orders(log, config, {1.0, 2.0, 3.5, 4.0}, &model, true);
   ASSERT_EQ(search.second_harmonic.size(), 6u);
   for (std::size_t j = 0; j < 3; ++j) {
     SCOPED_TRACE(log.joint_names[j]);
