@@ -6,8 +6,9 @@
 // best (the joint-error fit of its cells, summarize_fit). A gear whose error repeats twice per
 // motor revolution, modelled as once, leaves that error unexplained in the held-out rows; the
 // right order explains it. A gear whose error has two orders gets the second as a further pair
-// of inputs when it explains the held-out rows better. The final identification then sweeps the
-// model orders as configured.
+// of inputs on that joint only, where the held-out rows' BIC says the pair's coefficients pay
+// for themselves (a joint without one keeps zero coefficients for the pair). The final
+// identification then sweeps the model orders as configured.
 #include <string>
 #include <vector>
 
@@ -31,20 +32,23 @@ struct TransmissionErrorOrderSearch {
   std::vector<double> chosen_harmonic;
   // The second harmonic: the record identified once more per candidate with the chosen harmonic
   // and the candidate as a second pair (second_fit_percent [candidate][joint]; NaN where the
-  // candidate is the joint's chosen harmonic). Per joint the best second candidate and its gain
-  // in points over the chosen harmonic alone. The table takes a second pair when some joint
-  // gains more than 0.15 points (second_harmonic_used); every joint then has its best second
-  // (a table's further inputs are the same on every joint).
+  // candidate is the joint's chosen harmonic). Per joint the second candidate with the lowest
+  // BIC against the chosen harmonic alone (second_best_harmonic, second_bic: the held-out rows'
+  // n ln(RSS ratio) + the pair's coefficients x ln n, summed over the cells; its gain in points
+  // of fit beside it), and the second harmonic kept: that candidate where its BIC is negative,
+  // else 0 (the joint's cells get zero coefficients for the pair). second_harmonic_used: some
+  // joint kept one (the table then has the pair).
   std::vector<std::vector<double>> second_fit_percent;
-  std::vector<double> second_harmonic;
+  std::vector<double> second_best_harmonic;
+  std::vector<double> second_bic;
   std::vector<double> second_gain_points;
+  std::vector<double> second_harmonic;
   bool second_harmonic_used = false;
 };
 
 // Every candidate must be > 0 and the config's models must take the transmission-error inputs
 // (std::invalid_argument otherwise). torque_model as for identify_table.
-// second_harmonic: also the second pass (off by default: on the development plants 1000-1014
-// it lifted the worst plant but lowered seed-line's median, docs/decisions/0028).
+// second_harmonic: also the second pass (docs/decisions/0028, 0042).
 TransmissionErrorOrderSearch search_transmission_error_orders(
     const ident::JointErrorLog& log, const ident::IdentificationConfig& config,
     const std::vector<double>& candidates, const ModelTorqueSource* torque_model = nullptr,

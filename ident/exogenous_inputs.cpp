@@ -60,8 +60,9 @@ std::string exogenous_parameters_problem(std::span<const TableInput> inputs,
   const bool second = has_input(inputs, TableInput::kTransmissionError2Sin) ||
                       has_input(inputs, TableInput::kTransmissionError2Cos);
   const double f2 = p.transmission_error_2_rad_per_rad;
-  if (second && !(f2 > 0.0 && std::isfinite(f2) && f2 != f))
-    return "the second transmission-error inputs need a phase rate > 0 other than the first's";
+  if (second && !(f2 >= 0.0 && std::isfinite(f2) && f2 != f))
+    return "the second transmission-error inputs need a phase rate >= 0 other than the first's "
+           "(0: no second order on the joint)";
   if (second && !transmission_error)
     return "the second transmission-error inputs need the first transmission-error inputs";
   return {};

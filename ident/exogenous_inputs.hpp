@@ -75,7 +75,8 @@ struct ExogenousParameters {
   double direction_speed_scale_rad_s = 0.01;
   double torque_sign_scale_nm = 0.0;
   double transmission_error_rad_per_rad = 0.0;
-  double transmission_error_2_rad_per_rad = 0.0;  // the second harmonic's phase rate
+  // The second harmonic's phase rate (0: the joint has no second order, the pair's inputs are 0).
+  double transmission_error_2_rad_per_rad = 0.0;
   double transmission_error_compliance_rad_per_nm = 0.0;
 };
 // A table's constants for one of its joints.
@@ -115,10 +116,18 @@ inline double exogenous_value(TableInput input, const ExogenousParameters& p,
       return std::sin(transmission_error_phase(p, s));
     case TableInput::kTransmissionErrorCos:
       return std::cos(transmission_error_phase(p, s));
+    // A joint without a second order (phase rate 0) has both inputs 0, so that its zero
+    // coefficients are not needed for the pair to do nothing.
     case TableInput::kTransmissionError2Sin:
-      return std::sin(p.transmission_error_2_rad_per_rad * transmission_error_motor_angle(p, s));
+      return p.transmission_error_2_rad_per_rad == 0.0
+                 ? 0.0
+                 : std::sin(p.transmission_error_2_rad_per_rad *
+                            transmission_error_motor_angle(p, s));
     case TableInput::kTransmissionError2Cos:
-      return std::cos(p.transmission_error_2_rad_per_rad * transmission_error_motor_angle(p, s));
+      return p.transmission_error_2_rad_per_rad == 0.0
+                 ? 0.0
+                 : std::cos(p.transmission_error_2_rad_per_rad *
+                            transmission_error_motor_angle(p, s));
   }
   return 0.0;
 }

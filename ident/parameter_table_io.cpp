@@ -298,11 +298,11 @@ void read_transmission_error_keys(const Node& n, JointParameters& j, bool transm
   if (second_transmission_error) {
     const Node te2 = n.child("transmission_error_2_rad_per_rad");
     j.transmission_error_2_rad_per_rad = te2.number();
-    if (!(j.transmission_error_2_rad_per_rad > 0.0) ||
+    if (!(j.transmission_error_2_rad_per_rad >= 0.0) ||
         j.transmission_error_2_rad_per_rad == j.transmission_error_rad_per_rad)
       te2.fail(
           "the table has the second transmission-error inputs: the phase rate must be "
-          "> 0 and differ from the first's");
+          ">= 0 (0: no second order on this joint) and differ from the first's");
   } else if (n.has("transmission_error_2_rad_per_rad")) {
     n.child("transmission_error_2_rad_per_rad")
         .fail("the table has no second transmission-error input");
@@ -388,6 +388,8 @@ JointParameters read_joint(const Node& n, double sample_time_s, int schema_versi
 }  // namespace
 
 std::string parameters_json_text(const ParameterTable& t) {
+  const bool second_transmission_error =
+      std::ranges::find(t.extra_inputs, TableInput::kTransmissionError2Sin) != t.extra_inputs.end();
   json joints = json::array();
   for (const JointParameters& j : t.joints) {
     json dims = json::array();
@@ -414,7 +416,7 @@ std::string parameters_json_text(const ParameterTable& t) {
       joint["transmission_error_compliance_rad_per_nm"] =
           j.transmission_error_compliance_rad_per_nm;
     }
-    if (j.transmission_error_2_rad_per_rad > 0.0)  // version 4, with the second pair only
+    if (second_transmission_error)  // version 4, with the second pair only
       joint["transmission_error_2_rad_per_rad"] = j.transmission_error_2_rad_per_rad;
     joints.push_back(std::move(joint));
   }

@@ -72,7 +72,8 @@ TEST(ExogenousInputs, RefusesMissingTorqueAndBadConstants) {
             "the transmission error's compliance needs the model torque input");
 }
 
-// The second pair is the first pair's maths at its own rate f_2: sin/cos(f_2 (x + τ / k)).
+// The second pair is the first pair's maths at its own rate f_2: sin/cos(f_2 (x + τ / k)); at
+// f_2 = 0 (a joint without a second order) both inputs are 0.
 TEST(ExogenousInputs, SecondPairAtItsOwnRateAndRefusedWithoutARate) {
   ExogenousParameters p;
   p.transmission_error_rad_per_rad = 160.0;
@@ -93,7 +94,12 @@ TEST(ExogenousInputs, SecondPairAtItsOwnRateAndRefusedWithoutARate) {
   EXPECT_EQ(exogenous_parameters_problem(both, p), "");
   p.transmission_error_2_rad_per_rad = 160.0;  // the first's rate: the pairs would be one
   EXPECT_NE(exogenous_parameters_problem(both, p), "");
+  // 0: the joint has no second order; both of the pair's inputs are 0 (a zero cos too).
   p.transmission_error_2_rad_per_rad = 0.0;
+  EXPECT_EQ(exogenous_parameters_problem(both, p), "");
+  EXPECT_EQ(exogenous_value(TableInput::kTransmissionError2Sin, p, s), 0.0);
+  EXPECT_EQ(exogenous_value(TableInput::kTransmissionError2Cos, p, s), 0.0);
+  p.transmission_error_2_rad_per_rad = -400.0;
   EXPECT_NE(exogenous_parameters_problem(both, p), "");
 }
 

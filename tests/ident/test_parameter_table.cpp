@@ -103,8 +103,8 @@ TEST_F(ParameterTableFiles, RoundTripIsExact) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 2 * 4);
 }
 
-// Schema 4's second transmission-error pair: exact round trip; its phase rate must be > 0 and
-// differ from the first's; a version 3 table cannot name it.
+// Schema 4's second transmission-error pair: exact round trip; its phase rate must be >= 0 (0: a
+// joint without a second order) and differ from the first's; a version 3 table cannot name it.
 TEST_F(ParameterTableFiles, SecondHarmonicRoundTripsAndIsChecked) {
   const ident::ParameterTable table = sample_table(true, true);
   const auto file = dir_ / "parameters.json";
@@ -123,6 +123,16 @@ TEST_F(ParameterTableFiles, SecondHarmonicRoundTripsAndIsChecked) {
   same["joints"][0]["transmission_error_2_rad_per_rad"] =
       same["joints"][0]["transmission_error_rad_per_rad"];
   refused(same, "/joints/0/transmission_error_2_rad_per_rad");
+  json negative = good;
+  negative["joints"][0]["transmission_error_2_rad_per_rad"] = -1.0;
+  refused(negative, "/joints/0/transmission_error_2_rad_per_rad");
+  json none = good;  // a joint without a second order: written and read back as 0
+  none["joints"][0]["transmission_error_2_rad_per_rad"] = 0.0;
+  const ident::ParameterTable read = ident::parse_parameters_json(none.dump(), "parameters.json");
+  EXPECT_EQ(read.joints[0].transmission_error_2_rad_per_rad, 0.0);
+  EXPECT_EQ(json::parse(
+                ident::parameters_json_text(read))["joints"][0]["transmission_error_2_rad_per_rad"],
+            0.0);
   json old = good;
   old["schema_version"] = 3;
   refused(old, "/extra_inputs");
