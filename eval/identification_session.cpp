@@ -43,14 +43,14 @@ void attach_session_model_torques(ident::JointErrorLog& log,
 // config's (eval/transmission_error_order.hpp); the search for the report.
 ident::OrderSearchReport search_orders(const ident::JointErrorLog& log,
                                        const std::string& config_file,
-                                       ident::IdentificationConfig& config) {
+                                       ident::IdentificationConfig& config, bool second_order) {
   if (!config.options.transmission_error_input)
     throw InputError(config_file, 0, "model.transmission_error",
                      "--search-transmission-error-order needs the transmission-error "
                      "inputs (model.transmission_error: true)");
   spdlog::info("identify: searching the transmission error's order per motor revolution");
-  const TransmissionErrorOrderSearch search =
-      search_transmission_error_orders(log, config, default_order_candidates());
+  const TransmissionErrorOrderSearch search = search_transmission_error_orders(
+      log, config, default_order_candidates(), nullptr, second_order);
   ident::OrderSearchReport report;
   report.candidates_per_motor_rev = search.candidates;
   for (std::size_t j = 0; j < search.chosen_harmonic.size(); ++j) {
@@ -59,6 +59,10 @@ ident::OrderSearchReport search_orders(const ident::JointErrorLog& log,
     for (const auto& per_candidate : search.fit_percent) fits.push_back(per_candidate[j]);
     report.joints.push_back({log.joint_names[j], search.prior_harmonic[j], search.best_harmonic[j],
                              search.gain_points[j], search.chosen_harmonic[j], fits});
+    if (j < search.second_harmonic.size()) {
+      report.joints.back().second_harmonic_per_motor_rev = search.second_harmonic[j];
+      report.joints.back().second_bic = search.second_bic[j];
+    }
   }
   config = with_searched_orders(std::move(config), search);
   return report;
@@ -154,7 +158,8 @@ IdentificationResult identify_session(PreparedIdentification p,
   const ident::JointErrorLog& log = p.log;
   const std::string& file = p.options.joint_errors;
   std::optional<ident::OrderSearchReport> order_search;
-  if (p.options.search_order) order_search = search_orders(log, p.options.config, p.config);
+  if (p.options.search_order)
+    order_search = search_orders(log, p.options.config, p.config, p.options.search_second_order);
   const auto segments = log.segments();
   IdentificationResult r;
   r.joint_names = log.joint_names;

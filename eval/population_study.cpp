@@ -198,13 +198,22 @@ void step_calibrate_frames(const PlantStepContext& c) {
 }
 
 void step_identify(const PlantStepContext& c) {
-  run_step(
-      "identify",
-      {"identify", "--joint-errors", (c.dir / "calibrate-frames" / "joint_errors.csv").string(),
-       "--config", c.args.ident_config, "--robot", c.args.nominal, "--gravity-m-s2", "0", "0",
-       gravity_down(plant_files(c.dir).identification), "--search-transmission-error-order",
-       "--out", (c.dir / "identify").string()},
-      c.dir, c.args);
+  std::vector<std::string> arguments{"identify",
+                                     "--joint-errors",
+                                     (c.dir / "calibrate-frames" / "joint_errors.csv").string(),
+                                     "--config",
+                                     c.args.ident_config,
+                                     "--robot",
+                                     c.args.nominal,
+                                     "--gravity-m-s2",
+                                     "0",
+                                     "0",
+                                     gravity_down(plant_files(c.dir).identification),
+                                     "--search-transmission-error-order",
+                                     "--out",
+                                     (c.dir / "identify").string()};
+  if (c.args.second_order) arguments.emplace_back("--search-second-transmission-error-order");
+  run_step("identify", arguments, c.dir, c.args);
 }
 
 fs::path identified_table(const PlantStepContext& c) {

@@ -31,6 +31,9 @@ struct PopulationStudyOptions {
   std::string ident_config, calibrate_config, sensor;  // empty: the datasets' defaults
   int cycles = 10;                                     // cycles per verification
   double timeout_s = 3600;                             // time limit of each step of a plant
+  // identify also searches a second transmission-error harmonic per joint
+  // (`--search-second-transmission-error-order`, eval/transmission_error_order.hpp).
+  bool second_order = false;
 };
 
 struct SeedRange {

@@ -27,6 +27,7 @@ ExogenousParameters exogenous_parameters(const ParameterTable& table,
   p.direction_speed_scale_rad_s = table.direction_speed_scale_rad_s;
   p.torque_sign_scale_nm = joint.torque_sign_scale_nm;
   p.transmission_error_rad_per_rad = joint.transmission_error_rad_per_rad;
+  p.transmission_error_2_rad_per_rad = joint.transmission_error_2_rad_per_rad;
   p.transmission_error_compliance_rad_per_nm = joint.transmission_error_compliance_rad_per_nm;
   return p;
 }
@@ -56,6 +57,14 @@ std::string exogenous_parameters_problem(std::span<const TableInput> inputs,
   const double f = p.transmission_error_rad_per_rad;
   if (transmission_error && !(f > 0.0 && std::isfinite(f)))
     return "the transmission-error inputs need a phase rate > 0";
+  const bool second = has_input(inputs, TableInput::kTransmissionError2Sin) ||
+                      has_input(inputs, TableInput::kTransmissionError2Cos);
+  const double f2 = p.transmission_error_2_rad_per_rad;
+  if (second && !(f2 >= 0.0 && std::isfinite(f2) && f2 != f))
+    return "the second transmission-error inputs need a phase rate >= 0 other than the first's "
+           "(0: no second order on the joint)";
+  if (second && !transmission_error)
+    return "the second transmission-error inputs need the first transmission-error inputs";
   return {};
 }
 

@@ -12,7 +12,9 @@
 //  * torque_sign: the side of the gear the model torque presses on, tanh(τ / torque_sign_scale);
 //  * transmission_error_sin / _cos: the gear's angle-transmission error as the pair
 //    sin(f (x + τ / k)), cos(f (x + τ / k)), f = harmonic per motor revolution x gear ratio,
-//    1 / k the gear's compliance (the motor angle the deflected gear sits at).
+//    1 / k the gear's compliance (the motor angle the deflected gear sits at);
+//  * transmission_error_2_sin / _cos: the same pair at a second harmonic f_2 (a gear's error
+//    repeats at several of its stages' tooth and lobe counts over the motor revolution).
 #include <array>
 #include <cmath>
 #include <span>
@@ -28,7 +30,9 @@ enum class TableInput {
   kDirection,
   kTorqueSign,
   kTransmissionErrorSin,
-  kTransmissionErrorCos
+  kTransmissionErrorCos,
+  kTransmissionError2Sin,
+  kTransmissionError2Cos
 };
 
 // One input kind: how parameters.json names it, the words errors use for it, the first table
@@ -46,10 +50,15 @@ inline constexpr ExogenousInputKind kExogenousInputKinds[] = {
     {TableInput::kTorqueSign, "torque_sign", "torque-sign", 2, true},
     {TableInput::kTransmissionErrorSin, "transmission_error_sin", "transmission-error", 3, false},
     {TableInput::kTransmissionErrorCos, "transmission_error_cos", "transmission-error", 3, false},
+    {TableInput::kTransmissionError2Sin, "transmission_error_2_sin", "second transmission-error", 4,
+     false},
+    {TableInput::kTransmissionError2Cos, "transmission_error_2_cos", "second transmission-error", 4,
+     false},
 };
 inline constexpr int kExogenousInputKindCount = int(std::size(kExogenousInputKinds));
 const ExogenousInputKind& kind_of(TableInput input);
-// "model_torque", "direction", "torque_sign", "transmission_error_sin", "transmission_error_cos"
+// "model_torque", "direction", "torque_sign", "transmission_error_sin", "transmission_error_cos",
+// "transmission_error_2_sin", "transmission_error_2_cos"
 const char* to_string(TableInput input);
 
 // The joint state of one sample the inputs are computed from: the model's input path x (the
@@ -66,6 +75,8 @@ struct ExogenousParameters {
   double direction_speed_scale_rad_s = 0.01;
   double torque_sign_scale_nm = 0.0;
   double transmission_error_rad_per_rad = 0.0;
+  // The second harmonic's phase rate (0: the joint has no second order, the pair's inputs are 0).
+  double transmission_error_2_rad_per_rad = 0.0;
   double transmission_error_compliance_rad_per_nm = 0.0;
 };
 // A table's constants for one of its joints.
@@ -78,12 +89,18 @@ std::string exogenous_inputs_problem(std::span<const TableInput> inputs);
 std::string exogenous_parameters_problem(std::span<const TableInput> inputs,
                                          const ExogenousParameters& p);
 
+// The joint angle the motor sits at, x + τ / k [rad]: the transmission error's phase per its
+// phase rate f.
+inline double transmission_error_motor_angle(const ExogenousParameters& p,
+                                             const ExogenousSample& s) noexcept {
+  const double compliance = p.transmission_error_compliance_rad_per_nm;
+  return s.angle_rad + (compliance != 0.0 ? compliance * s.model_torque_nm : 0.0);
+}
+
 // The motor-side phase f (x + τ / k) of the transmission error [rad].
 inline double transmission_error_phase(const ExogenousParameters& p,
                                        const ExogenousSample& s) noexcept {
-  const double compliance = p.transmission_error_compliance_rad_per_nm;
-  const double motor = s.angle_rad + (compliance != 0.0 ? compliance * s.model_torque_nm : 0.0);
-  return p.transmission_error_rad_per_rad * motor;
+  return p.transmission_error_rad_per_rad * transmission_error_motor_angle(p, s);
 }
 
 inline double exogenous_value(TableInput input, const ExogenousParameters& p,
@@ -99,6 +116,18 @@ inline double exogenous_value(TableInput input, const ExogenousParameters& p,
       return std::sin(transmission_error_phase(p, s));
     case TableInput::kTransmissionErrorCos:
       return std::cos(transmission_error_phase(p, s));
+    // A joint without a second order (phase rate 0) has both inputs 0, so that its zero
+    // coefficients are not needed for the pair to do nothing.
+    case TableInput::kTransmissionError2Sin:
+      return p.transmission_error_2_rad_per_rad == 0.0
+                 ? 0.0
+                 : std::sin(p.transmission_error_2_rad_per_rad *
+                            transmission_error_motor_angle(p, s));
+    case TableInput::kTransmissionError2Cos:
+      return p.transmission_error_2_rad_per_rad == 0.0
+                 ? 0.0
+                 : std::cos(p.transmission_error_2_rad_per_rad *
+                            transmission_error_motor_angle(p, s));
   }
   return 0.0;
 }

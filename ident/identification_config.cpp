@@ -112,6 +112,14 @@ JointIdentificationOptions IdentificationConfig::joint_options(std::size_t joint
           "identification config: no gear ratio for joint {} (joints.gear_ratio has {})", joint + 1,
           gear_ratio.size()));
     o.transmission_error_rad_per_rad = transmission_error_harmonic(joint) * gear_ratio[joint];
+    // A joint without a second harmonic (0, or none given) is identified without the pair; the
+    // table then gives it zero coefficients for it (pad_absent_second_transmission_error).
+    const double second = joint < transmission_error_second_harmonic_per_joint.size()
+                              ? transmission_error_second_harmonic_per_joint[joint]
+                              : 0.0;
+    o.second_transmission_error_input = o.second_transmission_error_input && second > 0.0;
+    o.transmission_error_2_rad_per_rad =
+        o.second_transmission_error_input ? second * gear_ratio[joint] : 0.0;
     if (joint < gear_stiffness_nm_per_rad.size())
       o.transmission_error_compliance_rad_per_nm = 1.0 / gear_stiffness_nm_per_rad[joint];
   }

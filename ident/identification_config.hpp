@@ -55,6 +55,10 @@ struct IdentificationConfig {
   std::vector<double> transmission_error_harmonic_per_joint;
   // The harmonic per motor revolution of one joint's transmission error.
   double transmission_error_harmonic(std::size_t joint) const;
+  // Per joint, a second harmonic (found from the data by the order search, other than the
+  // first), with options.second_transmission_error_input; 0 (or a joint beyond the list): the
+  // joint has no second order, its model leaves the pair out (zero coefficients in the table).
+  std::vector<double> transmission_error_second_harmonic_per_joint;
   double nominal_payload_kg = 16.0;
   std::vector<double> speed_fraction_bounds{0.0, 0.2, 0.8, 1.0};  // of max speed (paper, Table 2)
   std::vector<double> payload_fraction_bounds{0.0, 0.5, 1.0};     // of nominal payload

@@ -146,12 +146,15 @@ json order_search_json(const OrderSearchReport& search) {
   for (const OrderSearchJoint& j : search.joints) {
     json fits = json::array();
     for (double fit : j.held_out_joint_error_fit_percent) fits.push_back(number_or_null(fit));
-    joints.push_back({{"name", j.name},
-                      {"config_harmonic_per_motor_rev", j.config_harmonic_per_motor_rev},
-                      {"best_harmonic_per_motor_rev", j.best_harmonic_per_motor_rev},
-                      {"gain_points", number_or_null(j.gain_points)},
-                      {"chosen_harmonic_per_motor_rev", j.chosen_harmonic_per_motor_rev},
-                      {"held_out_joint_error_fit_percent", fits}});
+    joints.push_back(
+        {{"name", j.name},
+         {"config_harmonic_per_motor_rev", j.config_harmonic_per_motor_rev},
+         {"best_harmonic_per_motor_rev", j.best_harmonic_per_motor_rev},
+         {"gain_points", number_or_null(j.gain_points)},
+         {"chosen_harmonic_per_motor_rev", j.chosen_harmonic_per_motor_rev},
+         {"held_out_joint_error_fit_percent", fits},
+         {"second_harmonic_per_motor_rev", number_or_null(j.second_harmonic_per_motor_rev)},
+         {"second_bic", number_or_null(j.second_bic)}});
   }
   return {{"candidates_per_motor_rev", search.candidates_per_motor_rev}, {"joints", joints}};
 }
@@ -252,6 +255,11 @@ OrderSearchReport order_search_of(const JsonField& f) {
                              j["best_harmonic_per_motor_rev"].number(),
                              j["gain_points"].number_or_nan(),
                              j["chosen_harmonic_per_motor_rev"].number(), fits.numbers_or_nan()});
+    // Reports written before the second pass have neither key.
+    if (const auto second = j.optional("second_harmonic_per_motor_rev"))
+      search.joints.back().second_harmonic_per_motor_rev = second->number_or_nan();
+    if (const auto bic = j.optional("second_bic"))
+      search.joints.back().second_bic = bic->number_or_nan();
   }
   return search;
 }

@@ -6,6 +6,7 @@
 // later step uses (not the criterion curves nor the correlation tests).
 #include <cstddef>
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -25,6 +26,11 @@ struct OrderSearchJoint {
   double gain_points = 0.0;  // NaN when not found
   double chosen_harmonic_per_motor_rev = 0.0;
   std::vector<double> held_out_joint_error_fit_percent;  // per candidate; NaN where none
+  // With the second pass (`--search-second-transmission-error-order`): the second harmonic kept
+  // (0: none) and the BIC of the best second candidate against the first alone (negative: kept).
+  // NaN without the second pass.
+  double second_harmonic_per_motor_rev = std::numeric_limits<double>::quiet_NaN();
+  double second_bic = std::numeric_limits<double>::quiet_NaN();
 };
 struct OrderSearchReport {
   std::vector<double> candidates_per_motor_rev;

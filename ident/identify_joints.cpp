@@ -16,12 +16,30 @@ namespace {
 
 IdentifiedStructure structure_beside_config(const JointIdentification& result,
                                             const IdentificationConfig& config, std::size_t joint) {
-  IdentifiedStructure s = identified_structure(result, extra_inputs_of(config.options));
+  // The joint's own inputs: a joint without a second transmission-error order was fitted
+  // without that pair.
+  IdentifiedStructure s =
+      identified_structure(result, extra_inputs_of(config.joint_options(joint)));
   if (joint < config.gear_stiffness_nm_per_rad.size())
     s.nominal_compliance_rad_per_nm = 1.0 / config.gear_stiffness_nm_per_rad[joint];
   if (config.options.transmission_error_input)
     s.transmission_error_harmonic_per_motor_rev = config.transmission_error_harmonic(joint);
   return s;
+}
+
+// A joint identified without the second transmission-error pair in a table that has it: each of
+// its cells gets the pair as two further inputs of one zero coefficient each, as a neutral cell
+// gets every input (the pair is last among the inputs, extra_inputs_of).
+void pad_absent_second_transmission_error(JointParameters& joint) {
+  for (CellParameters& cell : joint.cells) {
+    for (int e = 0; e < 2; ++e) {
+      if (cell.structure.extra_inputs >= kMaxExtraInputs)
+        throw std::logic_error("pad_absent_second_transmission_error: too many further inputs");
+      cell.structure.nx[std::size_t(cell.structure.extra_inputs++)] = 1;
+      cell.c.push_back(0.0);
+    }
+  }
+  joint.transmission_error_2_rad_per_rad = 0.0;
 }
 
 // The config with its durations in counts of the log's cycle (ident/
@@ -70,9 +88,13 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
       try {
         const std::span<const double> torque =
             log.model_torque_nm.empty() ? std::span<const double>() : log.model_torque_nm[j];
+        const JointIdentificationOptions joint_options = config.joint_options(j);
         outcomes[j].result = identify_joint(
             log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j], log.payload_kg,
-            segments, log.cycle_s, config.joint_grid(j), config.joint_options(j), torque);
+            segments, log.cycle_s, config.joint_grid(j), joint_options, torque);
+        if (config.options.second_transmission_error_input &&
+            !joint_options.second_transmission_error_input)
+          pad_absent_second_transmission_error(outcomes[j].result.parameters);
       } catch (const InputError&) {
         errors[j] = std::current_exception();
       } catch (const std::runtime_error& e) {
@@ -84,9 +106,14 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
         // coefficient is zero, so any positive one serves.
         if (config.options.torque_sign_input)
           outcomes[j].result.parameters.torque_sign_scale_nm = 1.0;
-        if (config.options.transmission_error_input)
+        if (config.options.transmission_error_input) {
+          const JointIdentificationOptions o = config.joint_options(j);
           outcomes[j].result.parameters.transmission_error_rad_per_rad =
-              config.joint_options(j).transmission_error_rad_per_rad;
+              o.transmission_error_rad_per_rad;
+          if (o.second_transmission_error_input)
+            outcomes[j].result.parameters.transmission_error_2_rad_per_rad =
+                o.transmission_error_2_rad_per_rad;
+        }
       } catch (...) {
         errors[j] = std::current_exception();
       }

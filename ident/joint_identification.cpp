@@ -297,6 +297,10 @@ std::vector<TableInput> extra_inputs_of(const JointIdentificationOptions& option
   if (options.transmission_error_input) {
     inputs.push_back(TableInput::kTransmissionErrorSin);
     inputs.push_back(TableInput::kTransmissionErrorCos);
+    if (options.second_transmission_error_input) {
+      inputs.push_back(TableInput::kTransmissionError2Sin);
+      inputs.push_back(TableInput::kTransmissionError2Cos);
+    }
   }
   return inputs;
 }
@@ -314,6 +318,8 @@ int extra_input_taps(TableInput input, const JointIdentificationOptions& options
       return options.torque_sign_taps;
     case TableInput::kTransmissionErrorSin:
     case TableInput::kTransmissionErrorCos:
+    case TableInput::kTransmissionError2Sin:
+    case TableInput::kTransmissionError2Cos:
       return options.transmission_error_taps;
   }
   return options.input_taps;
@@ -325,6 +331,8 @@ ExogenousParameters exogenous_parameters(const JointIdentificationOptions& optio
   p.direction_speed_scale_rad_s = options.direction_speed_scale_rad_s;
   p.torque_sign_scale_nm = torque_sign_scale_nm;
   p.transmission_error_rad_per_rad = options.transmission_error_rad_per_rad;
+  p.transmission_error_2_rad_per_rad =
+      options.second_transmission_error_input ? options.transmission_error_2_rad_per_rad : 0.0;
   p.transmission_error_compliance_rad_per_nm = options.transmission_error_compliance_rad_per_nm;
   return p;
 }
@@ -474,6 +482,14 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
     out.parameters.transmission_error_rad_per_rad = options.transmission_error_rad_per_rad;
     out.parameters.transmission_error_compliance_rad_per_nm =
         options.transmission_error_compliance_rad_per_nm;
+    if (options.second_transmission_error_input) {
+      if (!(options.transmission_error_2_rad_per_rad > 0.0) ||
+          options.transmission_error_2_rad_per_rad == options.transmission_error_rad_per_rad)
+        throw std::invalid_argument(
+            "identify_joint: the second transmission-error inputs need a phase rate > 0 other "
+            "than the first's");
+      out.parameters.transmission_error_2_rad_per_rad = options.transmission_error_2_rad_per_rad;
+    }
   }
   const FitSignals signals_of_fit =
       make_fit_signals(q_desired, output, segments, cycle_s, options, model_torque_nm,

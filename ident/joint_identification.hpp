@@ -107,9 +107,13 @@ struct JointIdentificationOptions {
   bool direction_input = false;
   bool torque_sign_input = false;
   bool transmission_error_input = false;
+  // A second transmission-error pair sin(f_2 (x + τ / k)), cos(f_2 (x + τ / k)) beside the first
+  // (needs transmission_error_input; f_2 = transmission_error_2_rad_per_rad, other than f).
+  bool second_transmission_error_input = false;
   double direction_speed_scale_rad_s = 0.01;
   double torque_sign_scale_fraction = 0.01;
-  double transmission_error_rad_per_rad = 0.0;  // of this joint; > 0 with the input
+  double transmission_error_rad_per_rad = 0.0;    // of this joint; > 0 with the input
+  double transmission_error_2_rad_per_rad = 0.0;  // of this joint; > 0 with the second pair
   // The gear's compliance 1 / k [rad/(N m)]: the motor sits τ / k ahead of the link under the
   // model torque τ, so the error's phase is f (q + τ / k) (0: the link angle alone).
   double transmission_error_compliance_rad_per_nm = 0.0;

@@ -18,8 +18,9 @@ namespace imscal::ident {
 // direction_speed_scale_rad_s; per cell nx and c); version 1 tables are read as single-input
 // forward models without preview. Version 3 added the transmission-error inputs and the joints'
 // transmission_error_rad_per_rad and transmission_error_compliance_rad_per_nm (version 2 tables
-// are read with 0 for both).
-inline constexpr int kParameterTableSchemaVersion = 3;
+// are read with 0 for both). Version 4 added the second transmission-error harmonic (inputs
+// transmission_error_2_sin / _cos, the joints' transmission_error_2_rad_per_rad).
+inline constexpr int kParameterTableSchemaVersion = 4;
 
 // What the cells' models are (ident/joint_identification.hpp): forward error models of the
 // loop (paper, eq. 2: the predicted error Δq̂ from q_d), or inverse models (the offset that makes
@@ -82,6 +83,9 @@ struct JointParameters {
   // Phase of the gear's transmission error per rad of joint angle [rad/rad]: harmonic per motor
   // revolution x gear ratio (> 0 when the table has the transmission-error inputs, else 0).
   double transmission_error_rad_per_rad = 0.0;
+  // The second harmonic's phase rate [rad/rad] (> 0 when the table has the second
+  // transmission-error inputs, else 0).
+  double transmission_error_2_rad_per_rad = 0.0;
   // The gear's compliance 1 / k [rad/(N m)]: the error's phase is f (x + compliance x model
   // torque), the motor angle the deflected gear sits at (0: the joint angle alone).
   double transmission_error_compliance_rad_per_nm = 0.0;
@@ -105,6 +109,7 @@ struct JointParameters {
            x.backlash_lag_samples == y.backlash_lag_samples &&
            x.torque_sign_scale_nm == y.torque_sign_scale_nm &&
            x.transmission_error_rad_per_rad == y.transmission_error_rad_per_rad &&
+           x.transmission_error_2_rad_per_rad == y.transmission_error_2_rad_per_rad &&
            x.transmission_error_compliance_rad_per_nm ==
                y.transmission_error_compliance_rad_per_nm &&
            x.offset_envelope_rad == y.offset_envelope_rad &&

@@ -285,20 +285,55 @@ TableInput read_input(const Node& n) {
   n.fail("expected " + expected + ", got '" + name + "'");
 }
 
+// The transmission-error keys of a joint (version 3 on): the phase rates and the compliance.
+void read_transmission_error_keys(const Node& n, JointParameters& j, bool transmission_error,
+                                  bool second_transmission_error) {
+  const Node te = n.child("transmission_error_rad_per_rad");
+  j.transmission_error_rad_per_rad = te.number();
+  if (transmission_error ? !(j.transmission_error_rad_per_rad > 0.0)
+                         : j.transmission_error_rad_per_rad != 0.0)
+    te.fail(transmission_error
+                ? "the table has the transmission-error inputs: the phase rate must be > 0"
+                : "the table has no transmission-error input: the phase rate must be 0");
+  if (second_transmission_error) {
+    const Node te2 = n.child("transmission_error_2_rad_per_rad");
+    j.transmission_error_2_rad_per_rad = te2.number();
+    if (!(j.transmission_error_2_rad_per_rad >= 0.0) ||
+        j.transmission_error_2_rad_per_rad == j.transmission_error_rad_per_rad)
+      te2.fail(
+          "the table has the second transmission-error inputs: the phase rate must be "
+          ">= 0 (0: no second order on this joint) and differ from the first's");
+  } else if (n.has("transmission_error_2_rad_per_rad")) {
+    n.child("transmission_error_2_rad_per_rad")
+        .fail("the table has no second transmission-error input");
+  }
+  const Node compliance = n.child("transmission_error_compliance_rad_per_nm");
+  j.transmission_error_compliance_rad_per_nm = compliance.number();
+  if (!(j.transmission_error_compliance_rad_per_nm >= 0.0) ||
+      (!transmission_error && j.transmission_error_compliance_rad_per_nm != 0.0))
+    compliance.fail(transmission_error ? "must be >= 0 (0: the phase from the joint angle alone)"
+                                       : "the table has no transmission-error input: must be 0");
+}
+
 // extra_inputs: the table's further inputs (-1: schema version 1); torque_sign: whether one of
 // them is the torque's sign (the joint then needs its scale); transmission_error: whether the
 // transmission-error pair is (the joint then needs its phase rate; the key from version 3 on).
 JointParameters read_joint(const Node& n, double sample_time_s, int schema_version,
-                           int extra_inputs, bool torque_sign, bool transmission_error) {
+                           int extra_inputs, bool torque_sign, bool transmission_error,
+                           bool second_transmission_error) {
   if (extra_inputs < 0)
     n.only_keys({"name", "backlash", "dimensions", "cells"});
   else if (schema_version < 3)
     n.only_keys({"name", "backlash", "torque_sign_scale_nm", "offset_envelope_rad",
                  "offset_rate_envelope_rad_s", "dimensions", "cells"});
-  else
+  else if (schema_version < 4)
     n.only_keys({"name", "backlash", "torque_sign_scale_nm", "transmission_error_rad_per_rad",
                  "transmission_error_compliance_rad_per_nm", "offset_envelope_rad",
                  "offset_rate_envelope_rad_s", "dimensions", "cells"});
+  else
+    n.only_keys({"name", "backlash", "torque_sign_scale_nm", "transmission_error_rad_per_rad",
+                 "transmission_error_2_rad_per_rad", "transmission_error_compliance_rad_per_nm",
+                 "offset_envelope_rad", "offset_rate_envelope_rad_s", "dimensions", "cells"});
   JointParameters j;
   j.name = n.child("name").string();
   if (j.name.empty()) n.child("name").fail("empty joint name");
@@ -308,22 +343,8 @@ JointParameters read_joint(const Node& n, double sample_time_s, int schema_versi
       n.child("torque_sign_scale_nm")
           .fail(torque_sign ? "the table has the torque-sign input: the scale must be > 0"
                             : "the table has no torque-sign input: the scale must be 0");
-    if (schema_version >= 3) {
-      const Node te = n.child("transmission_error_rad_per_rad");
-      j.transmission_error_rad_per_rad = te.number();
-      if (transmission_error ? !(j.transmission_error_rad_per_rad > 0.0)
-                             : j.transmission_error_rad_per_rad != 0.0)
-        te.fail(transmission_error
-                    ? "the table has the transmission-error inputs: the phase rate must be > 0"
-                    : "the table has no transmission-error input: the phase rate must be 0");
-      const Node compliance = n.child("transmission_error_compliance_rad_per_nm");
-      j.transmission_error_compliance_rad_per_nm = compliance.number();
-      if (!(j.transmission_error_compliance_rad_per_nm >= 0.0) ||
-          (!transmission_error && j.transmission_error_compliance_rad_per_nm != 0.0))
-        compliance.fail(transmission_error
-                            ? "must be >= 0 (0: the phase from the joint angle alone)"
-                            : "the table has no transmission-error input: must be 0");
-    }
+    if (schema_version >= 3)
+      read_transmission_error_keys(n, j, transmission_error, second_transmission_error);
     for (const auto& [key, value] :
          {std::pair{"offset_envelope_rad", &j.offset_envelope_rad},
           std::pair{"offset_rate_envelope_rad_s", &j.offset_rate_envelope_rad_s}}) {
@@ -367,6 +388,8 @@ JointParameters read_joint(const Node& n, double sample_time_s, int schema_versi
 }  // namespace
 
 std::string parameters_json_text(const ParameterTable& t) {
+  const bool second_transmission_error =
+      std::ranges::find(t.extra_inputs, TableInput::kTransmissionError2Sin) != t.extra_inputs.end();
   json joints = json::array();
   for (const JointParameters& j : t.joints) {
     json dims = json::array();
@@ -393,6 +416,8 @@ std::string parameters_json_text(const ParameterTable& t) {
       joint["transmission_error_compliance_rad_per_nm"] =
           j.transmission_error_compliance_rad_per_nm;
     }
+    if (second_transmission_error)  // version 4, with the second pair only
+      joint["transmission_error_2_rad_per_rad"] = j.transmission_error_2_rad_per_rad;
     joints.push_back(std::move(joint));
   }
   json extra_names = json::array();
@@ -541,7 +566,8 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
     t.joints.push_back(read_joint(
         j, t.sample_time_s, t.schema_version,
         t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1, has(TableInput::kTorqueSign),
-        has(TableInput::kTransmissionErrorSin) || has(TableInput::kTransmissionErrorCos)));
+        has(TableInput::kTransmissionErrorSin) || has(TableInput::kTransmissionErrorCos),
+        has(TableInput::kTransmissionError2Sin) || has(TableInput::kTransmissionError2Cos)));
     if (!names.insert(t.joints.back().name).second)
       j.child("name").fail("joint '" + t.joints.back().name + "' given twice");
   }

@@ -64,6 +64,10 @@ imscal::tools::CommandRegistration registration{
       sub.add_flag("--search-transmission-error-order", args->session.search_order,
                    "find each joint's transmission-error harmonic per motor revolution (0.5 .. "
                    "4) from the joint errors' held-out fit; the config's is the prior");
+      sub.add_flag("--search-second-transmission-error-order", args->session.search_second_order,
+                   "with --search-transmission-error-order: also a second harmonic per joint "
+                   "beside the first, kept where it lowers the held-out rows' BIC")
+          ->needs("--search-transmission-error-order");
       sub.add_flag("--force", args->force, "Overwrite existing outputs");
       sub.callback([args] { run(*args); });
     }};

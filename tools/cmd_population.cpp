@@ -55,6 +55,8 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--out", args->out, "output folder (a rerun skips finished plants)")
           ->required();
       sub.add_option("--cycles", args->study.cycles, "cycles per verification (ISO 9283: 10)");
+      sub.add_flag("--second-transmission-error-order", args->study.second_order,
+                   "identify also searches a second transmission-error harmonic per joint");
       sub.add_option("--ident-config", args->study.ident_config,
                      "identification config (default datasets/identification/ident-default.yaml)");
       sub.add_option("--calibrate-config", args->study.calibrate_config,

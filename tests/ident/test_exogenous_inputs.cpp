@@ -41,9 +41,14 @@ TEST(ExogenousInputs, WithoutComplianceThePhaseIgnoresTheTorque) {
 }
 
 TEST(ExogenousInputs, DescriptorsNameEveryKindInEnumOrder) {
-  const char* names[] = {"model_torque", "direction", "torque_sign", "transmission_error_sin",
-                         "transmission_error_cos"};
-  ASSERT_EQ(kExogenousInputKindCount, 5);
+  const char* names[] = {"model_torque",
+                         "direction",
+                         "torque_sign",
+                         "transmission_error_sin",
+                         "transmission_error_cos",
+                         "transmission_error_2_sin",
+                         "transmission_error_2_cos"};
+  ASSERT_EQ(kExogenousInputKindCount, 7);
   for (int k = 0; k < kExogenousInputKindCount; ++k) {
     EXPECT_EQ(int(kExogenousInputKinds[k].input), k);
     EXPECT_STREQ(to_string(TableInput(k)), names[k]);
@@ -65,6 +70,37 @@ TEST(ExogenousInputs, RefusesMissingTorqueAndBadConstants) {
   p.transmission_error_compliance_rad_per_nm = 1e-5;
   EXPECT_EQ(exogenous_parameters_problem(pair, p),
             "the transmission error's compliance needs the model torque input");
+}
+
+// The second pair is the first pair's maths at its own rate f_2: sin/cos(f_2 (x + τ / k)); at
+// f_2 = 0 (a joint without a second order) both inputs are 0.
+TEST(ExogenousInputs, SecondPairAtItsOwnRateAndRefusedWithoutARate) {
+  ExogenousParameters p;
+  p.transmission_error_rad_per_rad = 160.0;
+  p.transmission_error_2_rad_per_rad = 400.0;
+  p.transmission_error_compliance_rad_per_nm = 2e-6;
+  const ExogenousSample s{0.3, 0.0, 50.0};
+  const double motor = 0.3 + 2e-6 * 50.0;
+  EXPECT_DOUBLE_EQ(exogenous_value(TableInput::kTransmissionError2Sin, p, s),
+                   std::sin(400.0 * motor));
+  EXPECT_DOUBLE_EQ(exogenous_value(TableInput::kTransmissionError2Cos, p, s),
+                   std::cos(400.0 * motor));
+  EXPECT_DOUBLE_EQ(exogenous_value(TableInput::kTransmissionErrorSin, p, s),
+                   std::sin(160.0 * motor));
+  const std::vector<TableInput> both = {TableInput::kModelTorque, TableInput::kTransmissionErrorSin,
+                                        TableInput::kTransmissionErrorCos,
+                                        TableInput::kTransmissionError2Sin,
+                                        TableInput::kTransmissionError2Cos};
+  EXPECT_EQ(exogenous_parameters_problem(both, p), "");
+  p.transmission_error_2_rad_per_rad = 160.0;  // the first's rate: the pairs would be one
+  EXPECT_NE(exogenous_parameters_problem(both, p), "");
+  // 0: the joint has no second order; both of the pair's inputs are 0 (a zero cos too).
+  p.transmission_error_2_rad_per_rad = 0.0;
+  EXPECT_EQ(exogenous_parameters_problem(both, p), "");
+  EXPECT_EQ(exogenous_value(TableInput::kTransmissionError2Sin, p, s), 0.0);
+  EXPECT_EQ(exogenous_value(TableInput::kTransmissionError2Cos, p, s), 0.0);
+  p.transmission_error_2_rad_per_rad = -400.0;
+  EXPECT_NE(exogenous_parameters_problem(both, p), "");
 }
 
 }  // namespace

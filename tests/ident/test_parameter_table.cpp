@@ -18,7 +18,8 @@ using nlohmann::json;
 
 // A two-joint table with random stable models, irregular numbers (to exercise the exact
 // round trip of doubles) and one filled cell.
-ident::ParameterTable sample_table(bool transmission_error = true) {
+// second_harmonic: schema 4's second transmission-error pair too.
+ident::ParameterTable sample_table(bool transmission_error = true, bool second_harmonic = false) {
   std::mt19937_64 rng(42);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   ident::ParameterTable t;
@@ -31,6 +32,10 @@ ident::ParameterTable sample_table(bool transmission_error = true) {
   if (transmission_error) {  // schema 3's inputs and keys
     t.extra_inputs.push_back(ident::TableInput::kTransmissionErrorSin);
     t.extra_inputs.push_back(ident::TableInput::kTransmissionErrorCos);
+  }
+  if (second_harmonic) {
+    t.extra_inputs.push_back(ident::TableInput::kTransmissionError2Sin);
+    t.extra_inputs.push_back(ident::TableInput::kTransmissionError2Cos);
   }
   const int inputs = int(t.extra_inputs.size());
   t.direction_speed_scale_rad_s = 0.0123;
@@ -49,12 +54,14 @@ ident::ParameterTable sample_table(bool transmission_error = true) {
       j.transmission_error_rad_per_rad = 160.0 * uniform(rng) + 1.0;
       j.transmission_error_compliance_rad_per_nm = 1e-5 * uniform(rng);
     }
+    if (second_harmonic) j.transmission_error_2_rad_per_rad = 400.0 * uniform(rng) + 200.0;
     const ident::CellGrid grid(j.dimensions);
     for (int flat = 0; flat < grid.cell_count(); ++flat) {
       ident::CellParameters c;
       c.bands = grid.bands_of(flat);
       c.structure = {2 + flat % 3, 1 + flat % 2, flat % 4, inputs, {3 + flat % 2, 1}};
       if (transmission_error) c.structure.nx = {3 + flat % 2, 1, 2, 1 + flat % 3};
+      if (second_harmonic) c.structure.nx = {3 + flat % 2, 1, 2, 1 + flat % 3, 2, 1 + flat % 2};
       const auto model = imscal::test_support::random_multi_system(c.structure, rng);
       c.a.assign(model.a().data(), model.a().data() + model.a().size());
       c.b.assign(model.b().data(), model.b().data() + model.b().size());
@@ -94,6 +101,44 @@ TEST_F(ParameterTableFiles, RoundTripIsExact) {
   ident::write_parameters_csv(dir_ / "parameters.csv", table);
   const std::string csv = ident::parameters_csv_text(table);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 2 * 4);
+}
+
+// Schema 4's second transmission-error pair: exact round trip; its phase rate must be >= 0 (0: a
+// joint without a second order) and differ from the first's; a version 3 table cannot name it.
+TEST_F(ParameterTableFiles, SecondHarmonicRoundTripsAndIsChecked) {
+  const ident::ParameterTable table = sample_table(true, true);
+  const auto file = dir_ / "parameters.json";
+  ident::write_parameters_json(file, table);
+  EXPECT_TRUE(ident::read_parameters_json(file) == table);
+  const auto refused = [](json j, const std::string& field) {
+    try {
+      ident::parse_parameters_json(j.dump(), "parameters.json");
+      ADD_FAILURE() << "accepted a bad table";
+    } catch (const imscal::InputError& e) {
+      EXPECT_EQ(e.field(), field) << e.what();
+    }
+  };
+  const json good = json::parse(ident::parameters_json_text(table));
+  json same = good;
+  same["joints"][0]["transmission_error_2_rad_per_rad"] =
+      same["joints"][0]["transmission_error_rad_per_rad"];
+  refused(same, "/joints/0/transmission_error_2_rad_per_rad");
+  json negative = good;
+  negative["joints"][0]["transmission_error_2_rad_per_rad"] = -1.0;
+  refused(negative, "/joints/0/transmission_error_2_rad_per_rad");
+  json none = good;  // a joint without a second order: written and read back as 0
+  none["joints"][0]["transmission_error_2_rad_per_rad"] = 0.0;
+  const ident::ParameterTable read = ident::parse_parameters_json(none.dump(), "parameters.json");
+  EXPECT_EQ(read.joints[0].transmission_error_2_rad_per_rad, 0.0);
+  EXPECT_EQ(json::parse(
+                ident::parameters_json_text(read))["joints"][0]["transmission_error_2_rad_per_rad"],
+            0.0);
+  json old = good;
+  old["schema_version"] = 3;
+  refused(old, "/extra_inputs");
+  json without = json::parse(ident::parameters_json_text(sample_table()));
+  without["joints"][1]["transmission_error_2_rad_per_rad"] = 300.0;
+  refused(without, "/joints/1/transmission_error_2_rad_per_rad");
 }
 
 TEST(ParameterTable, Version1TablesReadAsForwardModelsWithoutPreview) {
@@ -170,8 +215,8 @@ TEST_P(LoaderRefuses, WithPathAndMessage) {
 INSTANTIATE_TEST_SUITE_P(
     BadTables, LoaderRefuses,
     ::testing::Values(
-        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 4; }, "/schema_version",
-                "unknown schema version 4"},
+        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 5; }, "/schema_version",
+                "unknown schema version 5"},
         Refusal{"CountsForTheFurtherInputs",
                 [](json& j) { j["joints"][0]["cells"][0]["nx"] = json::array({3}); },
                 "/joints/0/cells/0/nx", "1 counts for the table's 4 further inputs"},

@@ -41,7 +41,9 @@ constexpr double kTeRadPerRad = 160.0, kTeCompliance = 1.0 / 4.5e5;
 // transmission-error pair with transmission_error); the taps per input vary between cells
 // (1..12 for torque and direction, 1 for the torque sign, 1..8 for the pair), so that every sum
 // has its own length. with_inputs = false: the same table with zero further coefficients.
-ParameterTable multi_input_table(bool with_inputs, bool transmission_error = false) {
+// second_pair: also the second transmission-error pair (f_2 = 2.5 x 160 rad/rad).
+ParameterTable multi_input_table(bool with_inputs, bool transmission_error = false,
+                                 bool second_pair = false) {
   std::mt19937_64 rng(61);
   ParameterTable t;
   t.robot = "kr16";
@@ -50,6 +52,10 @@ ParameterTable multi_input_table(bool with_inputs, bool transmission_error = fal
   if (transmission_error) {
     t.extra_inputs.push_back(TableInput::kTransmissionErrorSin);
     t.extra_inputs.push_back(TableInput::kTransmissionErrorCos);
+  }
+  if (second_pair) {
+    t.extra_inputs.push_back(TableInput::kTransmissionError2Sin);
+    t.extra_inputs.push_back(TableInput::kTransmissionError2Cos);
   }
   const int inputs = static_cast<int>(t.extra_inputs.size());
   for (int j = 0; j < 6; ++j) {
@@ -64,20 +70,23 @@ ParameterTable multi_input_table(bool with_inputs, bool transmission_error = fal
       joint.transmission_error_rad_per_rad = kTeRadPerRad;
       joint.transmission_error_compliance_rad_per_nm = kTeCompliance;
     }
+    if (second_pair) joint.transmission_error_2_rad_per_rad = 2.5 * kTeRadPerRad;
     for (int c = 0; c < 6; ++c) {
       CellParameters cp;
       cp.bands = {c / 2, c % 2};
       const int na = 5 + (c + j) % 4, nb = 3 + c % 6;
       cp.structure = {na, nb, (c + j) % 4};
       cp.structure.extra_inputs = inputs;
-      cp.structure.nx = {1 + (5 * c + j) % 12, 1 + (7 * c + 3 * j) % 12, 1, 1 + (3 * c + j) % 8,
-                         1 + (c + 5 * j) % 8};
+      cp.structure.nx = {1 + (5 * c + j) % 12, 1 + (7 * c + 3 * j) % 12, 1,
+                         1 + (3 * c + j) % 8,  1 + (c + 5 * j) % 8,      1 + (2 * c + j) % 8,
+                         1 + (c + 3 * j) % 8};
       const Eigen::VectorXd a =
           test_support::polynomial_from_poles(test_support::random_poles(na, rng));
       const double a_sum = 1.0 + a.sum();  // A(1): coefficients / A(1) give the static gains
       cp.a.assign(a.data(), a.data() + na);
       cp.b.assign(static_cast<std::size_t>(nb), a_sum * (1.0 + 0.002 * c) / nb);  // gains 1..1.01
-      const std::array<double, 5> gain{kTorqueGain, kDirectionGain, kSignGain, kTeGain, kTeGain};
+      const std::array<double, 7> gain{kTorqueGain, kDirectionGain, kSignGain, kTeGain,
+                                       kTeGain,     kTeGain,        kTeGain};
       for (int e = 0; e < inputs; ++e) {
         const int nx = cp.structure.nx[std::size_t(e)];
         for (int i = 0; i < nx; ++i)
@@ -90,8 +99,8 @@ ParameterTable multi_input_table(bool with_inputs, bool transmission_error = fal
   return t;
 }
 
-void expect_same_offsets_as_the_reference(bool transmission_error) {
-  const ParameterTable t = multi_input_table(true, transmission_error);
+void expect_same_offsets_as_the_reference(bool transmission_error, bool second_pair = false) {
+  const ParameterTable t = multi_input_table(true, transmission_error, second_pair);
   PrecontrolOptions o;
   o.offset_tolerance_rad.fill(0.05);
   // The offset's rate reaches the joint speed when a move starts (the models lag the command):
@@ -103,8 +112,8 @@ void expect_same_offsets_as_the_reference(bool transmission_error) {
   std::string why;
   ASSERT_TRUE(Precontrol::create(t, "kr16", o, &p, &why)) << why;
   ASSERT_TRUE(test_support::AllCellsPrecontrol::create(t, "kr16", o, &reference, &why)) << why;
-  ASSERT_TRUE(test_support::AllCellsPrecontrol::create(multi_input_table(false, transmission_error),
-                                                       "kr16", o, &without_inputs, &why))
+  ASSERT_TRUE(test_support::AllCellsPrecontrol::create(
+      multi_input_table(false, transmission_error, second_pair), "kr16", o, &without_inputs, &why))
       << why;
   ASSERT_TRUE(p.needs_model_torque());
   ASSERT_TRUE(reference.needs_model_torque());
@@ -179,6 +188,11 @@ TEST(PrecontrolFurtherInputs, SameOffsetsAsTheAllCellsReferenceWithBlendingAndFa
 // definition (tests/support/reference_precontrol.hpp): the same offsets, the same faults.
 TEST(PrecontrolFurtherInputs, TheTransmissionErrorPairGivesTheReferenceOffsets) {
   expect_same_offsets_as_the_reference(true);
+}
+
+// The second pair sin/cos(f_2 (x + τ / k)) likewise.
+TEST(PrecontrolFurtherInputs, TheSecondTransmissionErrorPairGivesTheReferenceOffsets) {
+  expect_same_offsets_as_the_reference(true, true);
 }
 
 // A table with the pair needs each joint's phase rate (> 0), and the compliance the model torque.
