@@ -16,6 +16,7 @@
 //
 // References (docs/references.md): [KDL], [Featherstone2008] (inverse dynamics).
 #include <Eigen/Core>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -24,6 +25,7 @@
 #include "ident/joint_error_io.hpp"
 #include "ident/joint_identification.hpp"
 #include "sim/desired_path.hpp"
+#include "sim/rigid_body_dynamics.hpp"
 
 namespace imscal::eval {
 
@@ -31,6 +33,19 @@ namespace imscal::eval {
 struct ModelTorqueSource {
   calib::RobotDescription robot;
   Eigen::Vector3d gravity_in_base_m_s2 = Eigen::Vector3d(0.0, 0.0, -9.81);
+};
+
+// The rigid-body model with the payload of the current sample, a point mass at T's origin
+// (rebuilt only when it changes: payloads change a few times per program).
+class PayloadDynamics {
+ public:
+  explicit PayloadDynamics(const ModelTorqueSource& model);
+  calib::JointVector torque(double payload_kg, const calib::JointVector& q,
+                            const calib::JointVector& qd, const calib::JointVector& qdd);
+
+ private:
+  sim::RigidBodyDynamics dynamics_;
+  double payload_kg_ = 0.0;
 };
 
 // Torques [joint][sample] along a sampled path q_rad [joint][sample] with cycle cycle_s and
