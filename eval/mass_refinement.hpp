@@ -2,22 +2,25 @@
 // The mass parameters of the model torque (eval/model_torque.hpp) refined from the
 // identification record: the robot log has no torques, only the joint errors e = q_m − q_d and
 // the path, and e depends on the model torque τ(π) through the drive's filter (compliance, the
-// loop), e_j ≈ G_j(z) τ_j(π) + the motion's own terms, bilinear in (G, π). Alternating least
-// squares:
-//  1. π fixed: per joint a short ARX model of e_j on its own lags, the desired speed's taps,
-//     the direction of motion, a constant and the taps of τ_j(π) (equation error, one cell);
-//  2. the models fixed: one Gauss–Newton step for π over all joints together, from the
-//     residuals r_j and the columns Σ_l c_j,l ∂τ_j/∂π(k − l) with each joint's ARX columns
-//     projected out (what the model can absorb by its own coefficients, e.g. a joint's torque
-//     scale, does not count), weighted by the joint's residual variance, with a Gaussian prior
-//     at the nominal values;
-// a few times. π: each link's mass and centre of mass (4 per link; the inertia about the
-// centre of mass stays nominal), the parameters a data sheet gets wrong. The torque is taken
-// along the desired path (its exact pose to a few arcseconds, derivatives without the
-// measurement's noise). 1σ from the last step's normal matrix (residuals taken as white: an
-// optimistic figure).
+// loop), e_j ≈ G_j(z) τ_j(π) + the motion's own terms, bilinear in (G, π). Separable least
+// squares, linearised at the nominal values:
+//  1. π fixed: per joint a FIR model of e_j on taps of the desired speed and of τ_j(π), the
+//     direction of motion and a constant (no lags of e_j itself: they predict e_j from its own
+//     past and leave the torque's mismatch in no residual);
+//  2. the models fixed: a Gauss–Newton step for π over all joints together, from the residuals
+//     r_j and the columns Σ_l c_j,l ∂τ_j/∂π(k − l) with each joint's model columns projected
+//     out (what the model absorbs by its own coefficients, e.g. a joint's torque scale, does
+//     not count), each joint weighted by its residual variance times the residual's correlation
+//     time (the rows are that many times fewer independent ones), with a Gaussian prior at the
+//     nominal values.
+// One step by default: the drive model is only an approximation of the joint error, and further
+// alternations drift along the directions it explains poorly (measured: decision 0047).
+// π: each link's mass and centre of mass (4 per link; the inertia about the centre of mass stays
+// nominal), the parameters a data sheet gets wrong. The torque is taken along the desired path
+// (its exact pose to a few arcseconds, derivatives without the measurement's noise). 1σ from the
+// last step's normal matrix.
 //
-// References (docs/references.md): [Ljung1999] (ARX, least squares), [Golub2003] (separable
+// References (docs/references.md): [Ljung1999] (ARX, least squares), [GolubPereyra2003] (separable
 // least squares: the linear coefficients projected out), [KDL] (inverse dynamics).
 #include <Eigen/Core>
 #include <array>
@@ -30,7 +33,7 @@ namespace imscal::eval {
 struct MassRefinementOptions {
   double mass_prior_fraction = 0.3;  // 1σ of a link's mass, a fraction of its nominal mass
   double com_prior_m = 0.03;         // 1σ of each coordinate of a link's centre of mass [m]
-  int iterations = 1;
+  int iterations = 1;  // Gauss–Newton steps (each after a new fit of the drive models)
   // Every decimation-th sample (8 ms at 2 ms: the loop's 2 Hz and the gear's ~15 Hz stay below
   // the 62 Hz Nyquist frequency; a quarter of the inverse dynamics passes).
   int decimation = 4;
