@@ -82,21 +82,27 @@ TEST(MassRefinement, BringsTheModelTorqueToThePlantsFromJointErrors) {
       }
   log.q_internal_rad = log.q_measured_rad;
 
-  const MassRefinement refined = refine_mass_parameters(log, nominal);
-  const auto after =
-      model_torques_along(refined.model, log.cycle_s, log.q_desired_rad, log.payload_kg, segments);
-  // A2 and A3 carry the changed links' gravity: their model torque's error must fall to under a
-  // tenth (the prior at the nominal values and the wrist links' weak excitation leave a rest;
-  // measured: a few hundredths).
-  for (std::size_t j : {std::size_t(1), std::size_t(2)}) {
-    const double error_before = rms_difference(before[j], truth[j]);
-    const double error_after = rms_difference(after[j], truth[j]);
-    EXPECT_GT(error_before, 5.0) << "joint " << j + 1 << ": the plant must differ [N m]";
-    EXPECT_LT(error_after, 0.1 * error_before) << "joint " << j + 1;
+  // One Gauss–Newton step (the default): linearised at the nominal values, it leaves the
+  // centres of mass' nonlinearity (measured: A2 13 %, A3 4 % of the error before). Four steps
+  // converge here, where the drive model is exact (the shipped record's is not: decision 0047).
+  for (const auto& [iterations, bound] : {std::pair{1, 0.2}, std::pair{4, 0.1}}) {
+    MassRefinementOptions options;
+    options.iterations = iterations;
+    const MassRefinement refined = refine_mass_parameters(log, nominal, options);
+    const auto after = model_torques_along(refined.model, log.cycle_s, log.q_desired_rad,
+                                           log.payload_kg, segments);
+    // A2 and A3 carry the changed links' gravity.
+    for (std::size_t j : {std::size_t(1), std::size_t(2)}) {
+      const double error_before = rms_difference(before[j], truth[j]);
+      const double error_after = rms_difference(after[j], truth[j]);
+      EXPECT_GT(error_before, 5.0) << "joint " << j + 1 << ": the plant must differ [N m]";
+      EXPECT_LT(error_after, bound * error_before) << "joint " << j + 1 << ", " << iterations;
+    }
+    // The mass of link 2 (the largest change, +10 kg) within 10 % of the plant's.
+    EXPECT_NEAR(refined.links[1].mass_kg, plant.robot.joints[1].link.mass_kg,
+                0.1 * plant.robot.joints[1].link.mass_kg)
+        << iterations;
   }
-  // The mass of link 2 (the largest change, 15 kg) within 10 % of the plant's.
-  EXPECT_NEAR(refined.links[1].mass_kg, plant.robot.joints[1].link.mass_kg,
-              0.1 * plant.robot.joints[1].link.mass_kg);
 }
 
 }  // namespace
