@@ -222,7 +222,7 @@ MassRefinement refine_mass_parameters(const ident::JointErrorLog& log,
   Parameters p = p0;
   MassRefinement out;
   Step step;
-  for (out.iterations = 0; out.iterations < options.iterations; ++out.iterations) {
+  for (out.iterations = 0; out.iterations < std::max(options.iterations, 1); ++out.iterations) {
     step = gauss_newton_step(nominal, p0, p, record, rows, options);
     p += step.delta;
     for (int i = 0; i < calib::kJointCount; ++i)  // a mass stays positive
