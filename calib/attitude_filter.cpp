@@ -30,8 +30,7 @@ AttitudeTrack run_attitude_filter(const ToolImuRecord& record,
   }
   const Eigen::Matrix3d R_T_S = calibration.q_T_S.toRotationMatrix();
   auto rate_T = [&](std::size_t k) -> Eigen::Vector3d {
-    return R_T_S * (record.gyro_rad_s[k] - calibration.gyro_bias_rad_s)
-                       .cwiseQuotient(calibration.gyro_scale);
+    return R_T_S * calibrated_rate_S(calibration, record.gyro_rad_s[k]);
   };
 
   AttitudeTrack track;

@@ -127,8 +127,8 @@ std::vector<WeakDirection> describe_weak_directions(
                                                std::max<std::size_t>(1, flange_rotations.size()))) *
                        kDegPerRad,
                    "deg (rms rotation about the axis)",
-                   fmt::format("add poses that turn the flange about {} (e.g. with A4/A5 for axes "
-                               "across the flange, A6 for its z axis)",
+                   fmt::format("add poses that turn the flange about {} (e.g. with the wrist's "
+                               "joints 4 and 5 for axes across the flange, joint 6 for its z axis)",
                                axis_words(axis_H))});
   }
   if (!time_offset_observed) {

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/input_error.hpp"
@@ -56,9 +57,15 @@ ImuPreintegration::ImuPreintegration(const ims::ImuSeries& imu, double t_begin_s
   Eigen::Vector3d previous_dv = Eigen::Vector3d::Zero();
   bool first = true;
   double t_previous = 0.0;
-  for (std::size_t k = 0; k < imu.samples.size(); ++k) {
+  // The stamps increase strictly (ims/imu_validation.cpp): the samples in (t_begin_s, t_end_s]
+  // start at the first stamp after t_begin_s, so a motion costs its own samples, not the record's.
+  const auto after_begin =
+      std::upper_bound(imu.samples.begin(), imu.samples.end(), t_begin_s,
+                       [](double t, const ims::ImuSample& sample) { return t < sample.t_s; });
+  for (auto k = static_cast<std::size_t>(after_begin - imu.samples.begin()); k < imu.samples.size();
+       ++k) {
     const ims::ImuSample& s = imu.samples[k];
-    if (s.t_s <= t_begin_s || s.t_s > t_end_s) continue;
+    if (s.t_s > t_end_s) break;
     const double interval_start = k == 0 ? s.t_s - imu.nominal_dt_s : imu.samples[k - 1].t_s;
     if (first && std::abs(interval_start - t_begin_s) > 1e-9) {
       throw InputError(source, 0, "t_s",

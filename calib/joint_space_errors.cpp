@@ -169,8 +169,10 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
     if (options.creep_velocity_updates) aids.velocity = motion.creep_velocity;
   }
   ims::ZuptSmootherResult smoothed = ims::smooth_with_zupt(cut, earth, initial, sigma0, zupt, aids);
+  std::vector<ims::ImuSample>().swap(cut.samples);  // released: the record's copy is done with
 
-  // The initial state belongs to the trajectory too (the start of the first increment).
+  // The initial state belongs to the trajectory too (the start of the first increment): the
+  // smoother leaves room for it, so the insertion moves the states instead of copying them.
   ims::SmoothedState first;
   first.state = initial;
   smoothed.states.insert(smoothed.states.begin(), first);

@@ -332,6 +332,32 @@ MountingValidation assess_mounting(const FrameCalibrationResult& combined,
   return v;
 }
 
+namespace {
+
+// The rests [first, last] of `input` without the robot joint series: a part is judged on its
+// T_S_H alone, and the clock offset's rate windows (the only residuals the joint series feeds)
+// share no unknown with the frames (calib/frame_bundle.hpp), so the part's T_S_H and its
+// covariance are those of the bundle with them. Without them a part costs what its own rests
+// cost, instead of the whole record's rate windows and flange-rate grid again.
+FrameCalibrationInput part_input(const FrameCalibrationInput& input, std::size_t first_rest,
+                                 std::size_t last_rest) {
+  FrameCalibrationInput sub;
+  sub.imu = input.imu;
+  sub.site = input.site;
+  sub.kinematics = input.kinematics;
+  sub.rests.assign(input.rests.begin() + std::ptrdiff_t(first_rest),
+                   input.rests.begin() + std::ptrdiff_t(last_rest) + 1);
+  sub.noise = input.noise;
+  sub.time_offset_initial_s = input.time_offset_initial_s;
+  sub.source = input.source;
+  sub.first_rest_position_W_m = input.first_rest_position_W_m;
+  sub.known_frames = input.known_frames;
+  sub.heading_reference = input.heading_reference;
+  return sub;
+}
+
+}  // namespace
+
 SessionPart calibrate_part(const FrameCalibrationInput& input,
                            const FrameCalibrationOptions& options, std::size_t first_rest,
                            std::size_t last_rest, std::string label) {
@@ -343,9 +369,7 @@ SessionPart calibrate_part(const FrameCalibrationInput& input,
     part.failure = "rest range outside the session";
     return part;
   }
-  FrameCalibrationInput sub = input;
-  sub.rests.assign(input.rests.begin() + std::ptrdiff_t(first_rest),
-                   input.rests.begin() + std::ptrdiff_t(last_rest) + 1);
+  FrameCalibrationInput sub = part_input(input, first_rest, last_rest);
   try {
     const FrameCalibrationResult r = calibrate_frames(sub, options);
     part.calibrated = true;

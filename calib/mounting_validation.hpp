@@ -141,7 +141,8 @@ MountingValidation assess_mounting(const FrameCalibrationResult& combined,
                                    std::vector<SessionPart> segments,
                                    const MountingThresholds& thresholds);
 
-// Calibrates the rests [first, last] of `input` alone (same options); a refusal of the bundle
+// Calibrates the rests [first, last] of `input` alone (same options, without the clock offset's
+// rate windows: a part reports T_S_H, which they do not enter); a refusal of the bundle
 // (InputError, HandEyeUnobservable) is recorded in the part, not thrown.
 SessionPart calibrate_part(const FrameCalibrationInput& input,
                            const FrameCalibrationOptions& options, std::size_t first_rest,

@@ -5,6 +5,7 @@
 #include "calib/hand_eye.hpp"
 #include "calib/time_offset.hpp"
 #include "core/input_error.hpp"
+#include "core/percentile.hpp"
 #include "ims/so3.hpp"
 
 namespace imscal::calib {
@@ -13,17 +14,24 @@ OrientationErrorStats orientation_error(const ToolImuRecord& record, double time
                                         const std::vector<double>& t_s,
                                         const std::vector<Eigen::Quaterniond>& q_B_T_estimated) {
   OrientationErrorStats stats;
+  std::vector<double> angles;
+  angles.reserve(t_s.size());
   double sum_sq = 0.0;
   for (std::size_t k = 0; k < t_s.size(); ++k) {
     Eigen::Quaterniond q_robot;
     if (!robot_orientation_at(record, t_s[k] - time_offset_s, q_robot)) continue;
     const double angle = ims::rotation_angle_between(q_robot, q_B_T_estimated[k]);
     sum_sq += angle * angle;
+    angles.push_back(angle);
     stats.max_rad = std::max(stats.max_rad, angle);
     stats.final_rad = angle;
     ++stats.sample_count;
   }
-  if (stats.sample_count > 0) stats.rms_rad = std::sqrt(sum_sq / stats.sample_count);
+  if (stats.sample_count > 0) {
+    stats.rms_rad = std::sqrt(sum_sq / stats.sample_count);
+    stats.median_rad = percentile(angles, 50.0);
+    stats.p90_rad = percentile(angles, 90.0);
+  }
   return stats;
 }
 

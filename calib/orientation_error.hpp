@@ -18,6 +18,8 @@ namespace imscal::calib {
 
 struct OrientationErrorStats {
   double rms_rad = 0.0;
+  double median_rad = 0.0;
+  double p90_rad = 0.0;  // 90th percentile (linear interpolation, core/percentile.hpp)
   double max_rad = 0.0;
   double final_rad = 0.0;  // at the last compared sample
   std::size_t sample_count = 0;

@@ -16,8 +16,7 @@ Eigen::Quaterniond gyro_rotation_T(const ToolImuRecord& record,
                                    std::size_t last, double max_step_s) {
   const Eigen::Matrix3d R_T_S = calibration.q_T_S.toRotationMatrix();
   auto rate_T = [&](std::size_t k) -> Eigen::Vector3d {
-    return R_T_S * (record.gyro_rad_s[k] - calibration.gyro_bias_rad_s)
-                       .cwiseQuotient(calibration.gyro_scale);
+    return R_T_S * calibrated_rate_S(calibration, record.gyro_rad_s[k]);
   };
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
   for (std::size_t k = first; k < last; ++k) {

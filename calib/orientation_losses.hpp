@@ -13,8 +13,8 @@
 // gyro lost (or added) about the axis it turned about, and across it, the axis tilt
 // |d - (d . a) a|. The tilt comes from a misaligned or cross-coupled gyro; a turn of 180 deg
 // doubles it (rot(a, pi)^T rot(b, pi) turns by twice the angle between a and b) and the return
-// turn undoes it: it is reported, not counted as a loss (measured 0.6-4.9 deg on the real ABB
-// records, where the loss about the axis stays within 3 deg outside the lost turns). The segment
+// turn undoes it: it is reported, not counted as a loss (measured 0.0-3.7 deg on the six shipped
+// ABB records with the gyro's cross-coupling calibrated). The segment
 // ends lie at rest, so the poses' ms timing jitter does not enter.
 // Every segment whose loss reaches min_loss_rad is listed. Unlike the check's segment-ratio test
 // (ToolImuCheckOptions::missed_motion_fraction), this compares rotations, not |rate| integrals,

@@ -2,6 +2,7 @@
 
 #include <ceres/ceres.h>
 #include <fmt/format.h>
+#include <Eigen/LU>
 
 #include <algorithm>
 #include <cmath>
@@ -12,21 +13,43 @@
 #include "ims/so3.hpp"
 
 namespace imscal::calib {
+
+Eigen::Matrix3d gyro_scale_matrix(const Eigen::Vector3d& scale, const Eigen::Vector3d& coupling) {
+  Eigen::Matrix3d k = scale.asDiagonal();
+  k(0, 1) = k(1, 0) = coupling.x();
+  k(0, 2) = k(2, 0) = coupling.y();
+  k(1, 2) = k(2, 1) = coupling.z();
+  return k;
+}
+
+Eigen::Vector3d calibrated_rate_S(const RotationCalibration& calibration,
+                                  const Eigen::Vector3d& reading) {
+  return gyro_scale_matrix(calibration.gyro_scale, calibration.gyro_cross_coupling)
+      .partialPivLu()
+      .solve(reading - calibration.gyro_bias_rad_s);
+}
+
 namespace {
 
 // The gyro-integrated rotation over samples [first, last] of the sensor clock, corrected by
 // bias and scale, in S: product of exp(omega_mid * dt) over the sample intervals (trapezoidal
 // rate per interval; the rates are ~100 Hz samples of a motion well below 10 Hz).
-template <typename Bias, typename Scale>
 Eigen::Quaterniond integrate_gyro(const ToolImuRecord& record, std::size_t first, std::size_t last,
-                                  const Bias& bias, const Scale& scale) {
+                                  const Eigen::Vector3d& bias, const Eigen::Matrix3d& to_rate) {
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
   for (std::size_t k = first; k < last; ++k) {
     const Eigen::Vector3d mean_reading = 0.5 * (record.gyro_rad_s[k] + record.gyro_rad_s[k + 1]);
-    const Eigen::Vector3d omega_S = (mean_reading - bias).cwiseQuotient(scale);
+    const Eigen::Vector3d omega_S = to_rate * (mean_reading - bias);
     q = q * ims::quat_exp<double>(omega_S * (record.t_s[k + 1] - record.t_s[k]));
   }
   return q;
+}
+
+// (gyro reading - bias) -> rate in S: the inverse of the gyro's scale-and-coupling matrix.
+Eigen::Matrix3d gyro_rate_matrix(const double* scale, const double* coupling) {
+  return gyro_scale_matrix(Eigen::Vector3d(scale[0], scale[1], scale[2]),
+                           Eigen::Vector3d(coupling[0], coupling[1], coupling[2]))
+      .inverse();
 }
 
 struct WindowCost {
@@ -35,12 +58,12 @@ struct WindowCost {
   std::size_t last;
 
   bool operator()(const double* q_coeffs, const double* bias_p, const double* scale_p,
-                  const double* offset_p, double* residual) const {
+                  const double* coupling_p, const double* offset_p, double* residual) const {
     const Eigen::Quaterniond q_T_S =
         Eigen::Quaterniond(q_coeffs[3], q_coeffs[0], q_coeffs[1], q_coeffs[2]).normalized();
     const Eigen::Map<const Eigen::Vector3d> bias(bias_p);
-    const Eigen::Map<const Eigen::Vector3d> scale(scale_p);
-    const Eigen::Quaterniond dq_S = integrate_gyro(*record, first, last, bias, scale);
+    const Eigen::Quaterniond dq_S =
+        integrate_gyro(*record, first, last, bias, gyro_rate_matrix(scale_p, coupling_p));
     Eigen::Quaterniond q_a, q_b;
     if (!robot_orientation_at(*record, record->t_s[first] - offset_p[0], q_a) ||
         !robot_orientation_at(*record, record->t_s[last] - offset_p[0], q_b)) {
@@ -63,6 +86,7 @@ struct Unknowns {
   double q[4];
   double bias[3];
   double scale[3];
+  double coupling[3];
   double offset[1];
 };
 
@@ -78,78 +102,147 @@ ceres::Solver::Summary solve_small_problem(ceres::Problem& problem, int max_iter
   return summary;
 }
 
-// Solves the window residuals from `x` (updated in place); the problem as calibrate_rotation
-// builds it.
-bool solve_windows(const ToolImuRecord& record, const std::vector<Window>& windows,
-                   const RotationCalibrationOptions& options, Unknowns& x) {
-  ceres::Problem problem;
+// The window residuals on the unknowns `x`, as calibrate_rotation and each bootstrap replicate
+// solve them.
+void add_windows(const ToolImuRecord& record, const std::vector<Window>& windows,
+                 const RotationCalibrationOptions& options, Unknowns& x, ceres::Problem& problem) {
   for (const auto& [a, b] : windows) {
-    auto* cost = new ceres::NumericDiffCostFunction<WindowCost, ceres::CENTRAL, 3, 4, 3, 3, 1>(
+    auto* cost = new ceres::NumericDiffCostFunction<WindowCost, ceres::CENTRAL, 3, 4, 3, 3, 3, 1>(
         new WindowCost{&record, a, b});
     problem.AddResidualBlock(cost, new ceres::CauchyLoss(options.cauchy_scale_rad), x.q, x.bias,
-                             x.scale, x.offset);
+                             x.scale, x.coupling, x.offset);
   }
   problem.SetManifold(x.q, new ceres::EigenQuaternionManifold);
   if (!options.estimate_scale) problem.SetParameterBlockConstant(x.scale);
+  if (!options.estimate_cross_coupling) problem.SetParameterBlockConstant(x.coupling);
+}
+
+// Solves the window residuals from `x` (updated in place).
+bool solve_windows(const ToolImuRecord& record, const std::vector<Window>& windows,
+                   const RotationCalibrationOptions& options, Unknowns& x) {
+  ceres::Problem problem;
+  add_windows(record, windows, options, x, problem);
   return solve_small_problem(problem, options.max_iterations).IsSolutionUsable();
+}
+
+double window_residual_sq(const ToolImuRecord& record, const Window& w, const Unknowns& x,
+                          bool& finite) {
+  double r[3] = {0.0, 0.0, 0.0};
+  finite = WindowCost{&record, w.first, w.second}(x.q, x.bias, x.scale, x.coupling, x.offset, r) &&
+           std::isfinite(r[0] + r[1] + r[2]);
+  return r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
 }
 
 Eigen::Quaterniond rotation_of(const Unknowns& x) {
   return Eigen::Quaterniond(x.q[3], x.q[0], x.q[1], x.q[2]).normalized();
 }
 
-// Moving-block bootstrap (Kuensch 1989; Lahiri, "Resampling Methods for Dependent Data", 2003):
-// the windows' residuals are correlated in time (overlapping windows, the poses' timing jitter,
-// motion-dependent model errors), so the covariance of independent windows is too small. Blocks
-// of consecutive windows, drawn with replacement until the count is reached, are re-solved from
-// the estimate; the spread of the estimates over the replicates is the 1 sigma. Rotation
-// deviations as small angles about the T axes, log(q_b * q^-1).
-void block_bootstrap_sigma(const ToolImuRecord& record, const std::vector<Window>& windows,
-                           const RotationCalibrationOptions& options, const Unknowns& estimate,
-                           RotationCalibration& result) {
+// The resampling units of the bootstrap. Motion segments: the windows from one stop of the robot
+// to the next (the motion and the rest after it), so a replicate draws whole motions and the
+// spread holds how the estimate moves with the motions a record holds. Blocks: every run of
+// `block` consecutive windows (a moving block).
+std::vector<std::vector<Window>> resampling_units(const ToolImuRecord& record,
+                                                  const std::vector<Window>& windows,
+                                                  const RotationCalibrationOptions& options,
+                                                  double time_offset_s) {
+  std::vector<std::vector<Window>> units;
+  if (options.sigma_resampling == SigmaResampling::kMotionSegments) {
+    const std::vector<MotionSegment> segments =
+        motion_segments(record, robot_tool_rate(record), time_offset_s, options.segment_rate_rad_s,
+                        options.min_segment_angle_rad);
+    units.resize(std::max<std::size_t>(segments.size(), 1));
+    for (const Window& w : windows) {
+      const double middle_s = 0.5 * (record.t_s[w.first] + record.t_s[w.second]);
+      std::size_t started = 0;  // segments begun by the window's middle
+      while (started < segments.size() && segments[started].begin_s <= middle_s) ++started;
+      units[started > 0 ? started - 1 : 0].push_back(w);
+    }
+    std::erase_if(units, [](const auto& unit) { return unit.empty(); });
+    return units;
+  }
   const std::size_t n = windows.size();
   const std::size_t block = std::clamp<std::size_t>(
       static_cast<std::size_t>(std::lround(options.bootstrap_block_s / options.window_stride_s)), 1,
       n);
+  for (std::size_t start = 0; start + block <= n; ++start) {
+    units.emplace_back(windows.begin() + static_cast<std::ptrdiff_t>(start),
+                       windows.begin() + static_cast<std::ptrdiff_t>(start + block));
+  }
+  return units;
+}
+
+// Per component the normal-consistent median absolute deviation, 1.4826 * median |d - median d|
+// ([RousseeuwCroux1993]): a replicate that drew no motion about one axis leaves
+// that axis's scale unobservable and lands tens of degrees away; up to half of such replicates
+// do not move it, where they would dominate a standard deviation.
+template <int N>
+Eigen::Matrix<double, N, 1> robust_spread(const std::vector<Eigen::Matrix<double, N, 1>>& values) {
+  Eigen::Matrix<double, N, 1> spread;
+  std::vector<double> column(values.size());
+  auto median = [](std::vector<double>& v) {
+    const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+    std::nth_element(v.begin(), middle, v.end());
+    const double upper = *middle;
+    if (v.size() % 2 == 1) return upper;
+    return 0.5 * (upper + *std::max_element(v.begin(), middle));
+  };
+  for (int i = 0; i < N; ++i) {
+    for (std::size_t k = 0; k < values.size(); ++k) column[k] = values[k][i];
+    const double centre = median(column);
+    for (std::size_t k = 0; k < values.size(); ++k) column[k] = std::abs(values[k][i] - centre);
+    spread[i] = 1.4826 * median(column);
+  }
+  return spread;
+}
+
+// Bootstrap of dependent data (moving blocks: [Kunsch1989]; whole motions as clusters:
+// [DavisonHinkley1997] 2.4):
+// the windows' residuals are correlated in time (overlapping windows, the poses' timing jitter,
+// motion-dependent model errors), so the covariance of independent windows is too small. Units
+// of windows, drawn with replacement until the window count is reached (the last one cut), are
+// re-solved from the estimate; the spread of the estimates over the replicates is the 1 sigma.
+// Rotation deviations as small angles about the T axes, log(q_b * q^-1).
+void block_bootstrap_sigma(const ToolImuRecord& record, const std::vector<Window>& windows,
+                           const RotationCalibrationOptions& options, const Unknowns& estimate,
+                           RotationCalibration& result) {
+  const std::size_t n = windows.size();
+  const auto units = resampling_units(record, windows, options, estimate.offset[0]);
+  result.bootstrap_unit_count = units.size();
+  if (units.size() < 2) return;
   std::mt19937 random(options.bootstrap_seed);
-  std::uniform_int_distribution<std::size_t> pick(0, n - block);
-  std::vector<Eigen::Matrix<double, 10, 1>> deviations;
+  std::uniform_int_distribution<std::size_t> pick(0, units.size() - 1);
+  std::vector<Eigen::Matrix<double, 13, 1>> deviations;
   for (int replicate = 0; replicate < options.bootstrap_replicates; ++replicate) {
     std::vector<Window> sample;
     while (sample.size() < n) {
-      const std::size_t start = pick(random);
-      for (std::size_t i = start; i < start + block && sample.size() < n; ++i) {
-        sample.push_back(windows[i]);
-      }
+      const auto& unit = units[pick(random)];
+      for (std::size_t i = 0; i < unit.size() && sample.size() < n; ++i) sample.push_back(unit[i]);
     }
     Unknowns x = estimate;
     if (!solve_windows(record, sample, options, x)) continue;  // counted in bootstrap_replicates
-    Eigen::Matrix<double, 10, 1> d;
+    Eigen::Matrix<double, 13, 1> d;
     d.head<3>() =
         ims::quat_log(Eigen::Quaterniond(rotation_of(x) * rotation_of(estimate).conjugate()));
     for (int i = 0; i < 3; ++i) {
       d[3 + i] = x.bias[i] - estimate.bias[i];
       d[6 + i] = x.scale[i] - estimate.scale[i];
+      d[10 + i] = x.coupling[i] - estimate.coupling[i];
     }
     d[9] = x.offset[0] - estimate.offset[0];
     deviations.push_back(d);
   }
   result.bootstrap_replicates = deviations.size();
   if (deviations.size() < 10) return;  // too few to tell a spread: keep the covariance's
-  Eigen::Matrix<double, 10, 1> mean = Eigen::Matrix<double, 10, 1>::Zero();
-  for (const auto& d : deviations) mean += d;
-  mean /= static_cast<double>(deviations.size());
-  Eigen::Matrix<double, 10, 1> variance = Eigen::Matrix<double, 10, 1>::Zero();
-  for (const auto& d : deviations) variance += (d - mean).cwiseAbs2();
-  const Eigen::Matrix<double, 10, 1> sigma =
-      (variance / static_cast<double>(deviations.size() - 1)).cwiseSqrt();
+  const Eigen::Matrix<double, 13, 1> sigma = robust_spread(deviations);
   // Per component the larger of the two: a few blocks may miss a motion's spread, and the
   // covariance is the floor that white residuals alone would give.
   result.sigma_rotation_rad = result.sigma_rotation_rad.cwiseMax(sigma.head<3>());
   result.sigma_bias_rad_s = result.sigma_bias_rad_s.cwiseMax(sigma.segment<3>(3));
   if (options.estimate_scale) result.sigma_scale = result.sigma_scale.cwiseMax(sigma.segment<3>(6));
   result.sigma_time_offset_s = std::max(result.sigma_time_offset_s, sigma[9]);
+  if (options.estimate_cross_coupling) result.sigma_cross_coupling = sigma.segment<3>(10);
   result.sigma_from_bootstrap = true;
+  result.sigma_resampling = options.sigma_resampling;
 }
 }  // namespace
 
@@ -246,36 +339,28 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
                                  windows.size(), options.window_s));
   }
 
-  double q_param[4] = {q_T_S.x(), q_T_S.y(), q_T_S.z(), q_T_S.w()};
-  double bias_param[3] = {bias.x(), bias.y(), bias.z()};
-  double scale_param[3] = {scale.x(), scale.y(), scale.z()};
-  double offset_param[1] = {offset};
-
+  Unknowns x{{q_T_S.x(), q_T_S.y(), q_T_S.z(), q_T_S.w()},
+             {bias.x(), bias.y(), bias.z()},
+             {scale.x(), scale.y(), scale.z()},
+             {0.0, 0.0, 0.0},
+             {offset}};
   ceres::Problem problem;
-  std::vector<ceres::ResidualBlockId> ids;
-  for (const auto& [a, b] : windows) {
-    auto* cost = new ceres::NumericDiffCostFunction<WindowCost, ceres::CENTRAL, 3, 4, 3, 3, 1>(
-        new WindowCost{&record, a, b});
-    ids.push_back(problem.AddResidualBlock(cost, new ceres::CauchyLoss(options.cauchy_scale_rad),
-                                           q_param, bias_param, scale_param, offset_param));
-  }
-  problem.SetManifold(q_param, new ceres::EigenQuaternionManifold);
-  if (!options.estimate_scale) problem.SetParameterBlockConstant(scale_param);
+  add_windows(record, windows, options, x, problem);
 
   // Every window has a finite residual at the initial values (else the solve cannot start:
   // name the first that has none).
   double initial_sum = 0.0;
-  for (const auto& [a, b] : windows) {
-    double r[3];
-    if (!WindowCost{&record, a, b}(q_param, bias_param, scale_param, offset_param, r) ||
-        !std::isfinite(r[0] + r[1] + r[2])) {
-      throw InputError(record.file, record.lines[a], "gyro_x_dps",
-                       fmt::format("the rotation calibration's window of lines {}-{} has no "
-                                   "finite residual at the initial values (R_T_S, bias, scale "
-                                   "{:.4g}, time offset {:.4f} s)",
-                                   record.lines[a], record.lines[b], scale.x(), offset));
+  for (const Window& w : windows) {
+    bool finite = false;
+    initial_sum += window_residual_sq(record, w, x, finite);
+    if (!finite) {
+      throw InputError(
+          record.file, record.lines[w.first], "gyro_x_dps",
+          fmt::format("the rotation calibration's window of lines {}-{} has no "
+                      "finite residual at the initial values (R_T_S, bias, scale "
+                      "{:.4g}, time offset {:.4f} s)",
+                      record.lines[w.first], record.lines[w.second], scale.x(), offset));
     }
-    initial_sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
   }
   result.initial_rms_residual_rad = std::sqrt(initial_sum / (3.0 * windows.size()));
 
@@ -290,18 +375,18 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
                     ceres::TerminationTypeToString(summary.termination_type), summary.message));
   }
 
-  result.q_T_S = Eigen::Quaterniond(q_param[3], q_param[0], q_param[1], q_param[2]).normalized();
-  result.gyro_bias_rad_s = Eigen::Vector3d(bias_param);
-  result.gyro_scale = Eigen::Vector3d(scale_param);
-  result.time_offset_s = offset_param[0];
+  result.q_T_S = rotation_of(x);
+  result.gyro_bias_rad_s = Eigen::Vector3d(x.bias);
+  result.gyro_scale = Eigen::Vector3d(x.scale);
+  result.gyro_cross_coupling = Eigen::Vector3d(x.coupling);
+  result.time_offset_s = x.offset[0];
   result.window_count = windows.size();
 
   double sum = 0.0;
-  for (const auto& [a, b] : windows) {
-    double r[3] = {0.0, 0.0, 0.0};
+  for (const Window& w : windows) {
     // The solver accepts only steps where every window evaluates; this holds at its result.
-    WindowCost{&record, a, b}(q_param, bias_param, scale_param, offset_param, r);
-    const double norm_sq = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    bool finite = false;
+    const double norm_sq = window_residual_sq(record, w, x, finite);
     sum += norm_sq;
     if (std::sqrt(norm_sq) > 3.0 * options.cauchy_scale_rad) ++result.outlier_window_count;
   }
@@ -314,27 +399,28 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
   covariance_options.null_space_rank = -1;  // pseudo-inverse when rank deficient
   ceres::Covariance covariance(covariance_options);
   std::vector<std::pair<const double*, const double*>> blocks = {
-      {q_param, q_param}, {bias_param, bias_param}, {offset_param, offset_param}};
-  if (options.estimate_scale) blocks.emplace_back(scale_param, scale_param);
+      {x.q, x.q}, {x.bias, x.bias}, {x.offset, x.offset}};
+  if (options.estimate_scale) blocks.emplace_back(x.scale, x.scale);
   if (covariance.Compute(blocks, &problem)) {
-    const std::size_t parameter_count = options.estimate_scale ? 10 : 7;
+    const std::size_t parameter_count =
+        7 + (options.estimate_scale ? 3 : 0) + (options.estimate_cross_coupling ? 3 : 0);
     const double dof = std::max(1.0, 3.0 * windows.size() - parameter_count);
     const double variance = sum / dof;
     double c3[9];
     // The 3x3 tangent-space block of the rotation. (GetCovarianceMatrixInTangentSpace with the
     // list {q, q} would write the 6x6 joint matrix of that list into this 9-double buffer.)
-    covariance.GetCovarianceBlockInTangentSpace(q_param, q_param, c3);
+    covariance.GetCovarianceBlockInTangentSpace(x.q, x.q, c3);
     for (int i = 0; i < 3; ++i) result.sigma_rotation_rad[i] = std::sqrt(c3[4 * i] * variance);
     // A negative variance means a numerically rank-deficient problem: no usable sigma.
     result.covariance_ok = result.sigma_rotation_rad.allFinite();
-    covariance.GetCovarianceBlock(bias_param, bias_param, c3);
+    covariance.GetCovarianceBlock(x.bias, x.bias, c3);
     for (int i = 0; i < 3; ++i) result.sigma_bias_rad_s[i] = std::sqrt(c3[4 * i] * variance);
     if (options.estimate_scale) {
-      covariance.GetCovarianceBlock(scale_param, scale_param, c3);
+      covariance.GetCovarianceBlock(x.scale, x.scale, c3);
       for (int i = 0; i < 3; ++i) result.sigma_scale[i] = std::sqrt(c3[4 * i] * variance);
     }
     double c1 = 0.0;
-    covariance.GetCovarianceBlock(offset_param, offset_param, &c1);
+    covariance.GetCovarianceBlock(x.offset, x.offset, &c1);
     result.sigma_time_offset_s = std::sqrt(c1 * variance);
     result.covariance_ok = result.covariance_ok && result.sigma_bias_rad_s.allFinite() &&
                            result.sigma_scale.allFinite() &&
@@ -343,14 +429,7 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
 
   result.covariance_sigma_rotation_rad = result.sigma_rotation_rad;
   result.covariance_sigma_time_offset_s = result.sigma_time_offset_s;
-  if (options.bootstrap_replicates > 0) {
-    Unknowns estimate;
-    std::copy(q_param, q_param + 4, estimate.q);
-    std::copy(bias_param, bias_param + 3, estimate.bias);
-    std::copy(scale_param, scale_param + 3, estimate.scale);
-    estimate.offset[0] = offset_param[0];
-    block_bootstrap_sigma(record, windows, options, estimate, result);
-  }
+  if (options.bootstrap_replicates > 0) block_bootstrap_sigma(record, windows, options, x, result);
 
   // Gravity's direction in B from the still samples.
   const RobotRateSeries robot = robot_tool_rate(record);

@@ -4,7 +4,9 @@
 // sensor clock and the robot pose's clock, from a tool-IMU record (calib/tool_imu_record.hpp).
 //
 // Measurement model (per gyro sample, S axes):
-//   gyro_S = diag(k) * omega_S + b,    omega_T = R_T_S * omega_S,
+//   gyro_S = K * omega_S + b,    omega_T = R_T_S * omega_S,
+// with K = diag(k) + the symmetric cross-coupling c of the gyro's axes (its antisymmetric part is
+// a rotation, held by R_T_S; the scale-factor and cross-coupling matrix of [Groves2013] 4.4),
 // and an instant stamped t by the robot is stamped t + offset_s by the sensor.
 // Residuals: over short windows [t_a, t_b] of sensor samples, the gyro-integrated rotation
 // (corrected for b and k, mapped through R_T_S) against the robot's relative tool rotation
@@ -14,8 +16,10 @@
 // Initial values without user guesses: the offset by cross-correlation of |omega|, R_T_S by the
 // Kabsch fit of rate vectors, the scale from |gyro| / |robot rate| (all from
 // check_tool_imu_record), the bias from the samples where the robot stands still.
-// Uncertainty (1 sigma): by a moving-block bootstrap of the windows (the residuals are
-// correlated in time), beside ceres::Covariance scaled by the residual variance.
+// Uncertainty (1 sigma): by a bootstrap that resamples whole motion segments (the residuals are
+// correlated in time and depend on the motion), with a robust spread, beside ceres::Covariance
+// scaled by the residual variance.
+// References: [Groves2013] 4.4; [Kunsch1989]; [DavisonHinkley1997] 2.4; [RousseeuwCroux1993].
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstddef>
@@ -24,6 +28,10 @@
 #include "calib/tool_imu_record.hpp"
 
 namespace imscal::calib {
+
+// What the bootstrap of the 1 sigma resamples: whole motion segments (stop to stop) or moving
+// blocks of bootstrap_block_s.
+enum class SigmaResampling { kMotionSegments, kBlocks };
 
 struct RotationCalibrationOptions {
   double window_s = 0.5;          // length of a residual window [s]
@@ -34,31 +42,42 @@ struct RotationCalibrationOptions {
   // Windows where the robot turns less than this are still used (they fix the bias); windows
   // with any sample at a confirmed gyro rail (ToolImuAnalysis::clipped_axes) are skipped.
   bool estimate_scale = true;  // per-axis scale factors k (else k fixed at the initial)
+  // The gyro's axes' cross-coupling c (symmetric part of the misalignment; else c = 0).
+  bool estimate_cross_coupling = true;
   double cauchy_scale_rad = 0.5 * M_PI / 180.0;  // robust loss scale on the residual [rad]
   // Robot angular rate below which a sample counts as "at rest" for the initial bias [rad/s].
   double rest_rate_rad_s = 0.01;
   int max_iterations = 100;
-  // 1 sigma by a moving-block bootstrap of the windows, per component at least the
-  // covariance's (0 replicates: the covariance's alone, which takes the windows as independent
-  // and is 2-4x too small on the real ABB records). Blocks of bootstrap_block_s hold about one
-  // motion of the robot; the seed makes the sigma repeatable.
+  // 1 sigma by a bootstrap of the windows, per component at least the covariance's (0
+  // replicates: the covariance's alone, which takes the windows as independent). The units
+  // resampled are whole motion segments (stop to stop) or moving blocks of bootstrap_block_s;
+  // the seed makes the sigma repeatable.
   int bootstrap_replicates = 40;
   double bootstrap_block_s = 2.0;
+  SigmaResampling sigma_resampling = SigmaResampling::kMotionSegments;
+  // Motion segments as calib/orientation_losses.hpp judges them: robot |omega| above
+  // segment_rate_rad_s [rad/s], at least min_segment_angle_rad of turn [rad].
+  double segment_rate_rad_s = 0.05;
+  double min_segment_angle_rad = 5.0 * M_PI / 180.0;
   unsigned bootstrap_seed = 1;
 };
 
 struct RotationCalibration {
   Eigen::Quaterniond q_T_S = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();  // b, in S, as labelled units->SI
-  Eigen::Vector3d gyro_scale = Eigen::Vector3d::Ones();       // k per S axis
-  double time_offset_s = 0.0;                                 // t_sensor = t_robot + offset
+  Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();      // b, in S, as labelled units->SI
+  Eigen::Vector3d gyro_scale = Eigen::Vector3d::Ones();           // k per S axis
+  Eigen::Vector3d gyro_cross_coupling = Eigen::Vector3d::Zero();  // c_xy, c_xz, c_yz [-]
+  double time_offset_s = 0.0;                                     // t_sensor = t_robot + offset
   // 1 sigma: rotation about the T axes [rad], bias [rad/s], scale [-], offset [s].
   Eigen::Vector3d sigma_rotation_rad = Eigen::Vector3d::Zero();
   Eigen::Vector3d sigma_bias_rad_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d sigma_scale = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_cross_coupling = Eigen::Vector3d::Zero();  // bootstrap only
   double sigma_time_offset_s = 0.0;
-  bool sigma_from_bootstrap = false;     // else from the covariance (below)
-  std::size_t bootstrap_replicates = 0;  // replicates that solved
+  bool sigma_from_bootstrap = false;  // else from the covariance (below)
+  SigmaResampling sigma_resampling = SigmaResampling::kMotionSegments;  // the bootstrap's units
+  std::size_t bootstrap_replicates = 0;                                 // replicates that solved
+  std::size_t bootstrap_unit_count = 0;  // the units resampled (motion segments or blocks)
   bool covariance_ok = false;
   // 1 sigma of the covariance with independent windows, scaled by the residual variance.
   Eigen::Vector3d covariance_sigma_rotation_rad = Eigen::Vector3d::Zero();
@@ -74,6 +93,15 @@ struct RotationCalibration {
   int iterations = 0;
   std::string summary;  // Ceres' brief report
 };
+
+// The gyro's scale-and-coupling matrix K (gyro_S = K * omega_S + b): diag(k) with the symmetric
+// coupling c_xy, c_xz, c_yz off the diagonal. Its antisymmetric part would be a rotation, which
+// R_T_S holds.
+Eigen::Matrix3d gyro_scale_matrix(const Eigen::Vector3d& scale, const Eigen::Vector3d& coupling);
+
+// The calibrated rate in S of one gyro reading: K^-1 * (reading - b).
+Eigen::Vector3d calibrated_rate_S(const RotationCalibration& calibration,
+                                  const Eigen::Vector3d& reading);
 
 RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolImuAnalysis& analysis,
                                        const RotationCalibrationOptions& options = {});

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -22,6 +23,12 @@ nlohmann::json vector_json(const Eigen::Vector3d& v, double scale = 1.0) {
   return {v.x() * scale, v.y() * scale, v.z() * scale};
 }
 
+const char* sigma_method(const RotationCalibration& c) {
+  if (!c.sigma_from_bootstrap) return "covariance";
+  return c.sigma_resampling == SigmaResampling::kMotionSegments ? "motion-segment bootstrap"
+                                                                : "moving-block bootstrap";
+}
+
 nlohmann::json calibration_json(const RotationCalibration& c) {
   nlohmann::json j;
   j["q_T_S_wxyz"] = {c.q_T_S.w(), c.q_T_S.x(), c.q_T_S.y(), c.q_T_S.z()};
@@ -31,10 +38,13 @@ nlohmann::json calibration_json(const RotationCalibration& c) {
   j["sigma_gyro_bias_deg_s"] = vector_json(c.sigma_bias_rad_s, kDegPerRad);
   j["gyro_scale"] = vector_json(c.gyro_scale);
   j["sigma_gyro_scale"] = vector_json(c.sigma_scale);
+  j["gyro_cross_coupling"] = vector_json(c.gyro_cross_coupling);
+  j["sigma_gyro_cross_coupling"] = vector_json(c.sigma_cross_coupling);
   j["time_offset_s"] = c.time_offset_s;
   j["sigma_time_offset_s"] = c.sigma_time_offset_s;
-  j["sigma_method"] = c.sigma_from_bootstrap ? "moving-block bootstrap" : "covariance";
+  j["sigma_method"] = sigma_method(c);
   j["bootstrap_replicates"] = c.bootstrap_replicates;
+  j["bootstrap_segments"] = c.bootstrap_unit_count;
   j["covariance_sigma_rotation_deg"] = vector_json(c.covariance_sigma_rotation_rad, kDegPerRad);
   j["covariance_sigma_time_offset_s"] = c.covariance_sigma_time_offset_s;
   j["covariance_ok"] = c.covariance_ok;
@@ -49,20 +59,27 @@ void print_calibration(const std::string& title, const RotationCalibration& c,
   print(fmt::format(
       "{}: R_T_S angle {:.3f} deg (1 sigma {:.3f} {:.3f} {:.3f} deg, {}), time offset {:.4f} +- "
       "{:.4f} s,\n  gyro bias {:.4g} {:.4g} {:.4g} deg/s (as labelled), scale {:.5g} {:.5g} "
-      "{:.5g}, window residual RMS {:.3f} deg over {} windows\n",
+      "{:.5g}, cross-coupling {:.3g} {:.3g} {:.3g}, window residual RMS {:.3f} deg over {} "
+      "windows\n",
       title, Eigen::AngleAxisd(c.q_T_S).angle() * kDegPerRad, c.sigma_rotation_rad.x() * kDegPerRad,
-      c.sigma_rotation_rad.y() * kDegPerRad, c.sigma_rotation_rad.z() * kDegPerRad,
-      c.sigma_from_bootstrap ? "block bootstrap" : "covariance", c.time_offset_s,
-      c.sigma_time_offset_s, c.gyro_bias_rad_s.x() * kDegPerRad, c.gyro_bias_rad_s.y() * kDegPerRad,
-      c.gyro_bias_rad_s.z() * kDegPerRad, c.gyro_scale.x(), c.gyro_scale.y(), c.gyro_scale.z(),
-      c.rms_residual_rad * kDegPerRad, c.window_count));
+      c.sigma_rotation_rad.y() * kDegPerRad, c.sigma_rotation_rad.z() * kDegPerRad, sigma_method(c),
+      c.time_offset_s, c.sigma_time_offset_s, c.gyro_bias_rad_s.x() * kDegPerRad,
+      c.gyro_bias_rad_s.y() * kDegPerRad, c.gyro_bias_rad_s.z() * kDegPerRad, c.gyro_scale.x(),
+      c.gyro_scale.y(), c.gyro_scale.z(), c.gyro_cross_coupling.x(), c.gyro_cross_coupling.y(),
+      c.gyro_cross_coupling.z(), c.rms_residual_rad * kDegPerRad, c.window_count));
 }
 
 nlohmann::json error_json(const OrientationErrorStats& e) {
-  return {{"rms_deg", e.rms_rad * kDegPerRad},
-          {"max_deg", e.max_rad * kDegPerRad},
-          {"final_deg", e.final_rad * kDegPerRad},
-          {"samples", e.sample_count}};
+  return {{"rms_deg", e.rms_rad * kDegPerRad},     {"median_deg", e.median_rad * kDegPerRad},
+          {"p90_deg", e.p90_rad * kDegPerRad},     {"max_deg", e.max_rad * kDegPerRad},
+          {"final_deg", e.final_rad * kDegPerRad}, {"samples", e.sample_count}};
+}
+
+std::string error_text(const OrientationErrorStats& e) {
+  return fmt::format(
+      "median {:.2f} deg, 90th percentile {:.2f} deg, RMS {:.2f} deg, max {:.2f} deg",
+      e.median_rad * kDegPerRad, e.p90_rad * kDegPerRad, e.rms_rad * kDegPerRad,
+      e.max_rad * kDegPerRad);
 }
 
 nlohmann::json segment_json(const SegmentRotation& s) {
@@ -123,17 +140,15 @@ nlohmann::json report_orientation(const ToolImuRecord& record, const ToolImuAnal
       restart ? lost_spans(analysis, check) : std::vector<std::pair<double, double>>{};
   const RestartedOrientationError error = orientation_error_with_restarts(record, applied, spans);
   print(fmt::format(
-      "orientation error of the calibrated gyro against the robot: from the start RMS {:.3f} deg, "
-      "max {:.3f} deg over {} samples\n",
-      error.from_start.rms_rad * kDegPerRad, error.from_start.max_rad * kDegPerRad,
-      error.from_start.sample_count));
+      "orientation error of the calibrated gyro against the robot: from the start {} over {} "
+      "samples\n",
+      error_text(error.from_start), error.from_start.sample_count));
   out["from_start"] = error_json(error.from_start);
   if (restart) {
     print(fmt::format(
-        "  restarted from the robot's pose after each of {} lost spans (the spans left out): RMS "
-        "{:.3f} deg, max {:.3f} deg over {} of the {} samples\n",
-        spans.size(), error.with_restarts.rms_rad * kDegPerRad,
-        error.with_restarts.max_rad * kDegPerRad, error.with_restarts.sample_count,
+        "  restarted from the robot's pose after each of {} lost spans (the spans left out): {} "
+        "over {} of the {} samples\n",
+        spans.size(), error_text(error.with_restarts), error.with_restarts.sample_count,
         error.from_start.sample_count));
     out["with_restarts"] = error_json(error.with_restarts);
     out["restart_times_s"] = error.restart_times_s;
@@ -149,9 +164,8 @@ nlohmann::json report_ahrs(const ToolImuRecord& ahrs, const TextSink& print) {
     const OrientationErrorStats error =
         orientation_error(ahrs, alignment.time_offset_s, alignment.t_s, alignment.q_B_T);
     print(fmt::format(
-        "AHRS {} (alignment to tool and base fitted on this same record): RMS {:.3f} deg, max "
-        "{:.3f} deg over {} samples\n",
-        ahrs.file, error.rms_rad * kDegPerRad, error.max_rad * kDegPerRad, error.sample_count));
+        "AHRS {} (alignment to tool and base fitted on this same record): {} over {} samples\n",
+        ahrs.file, error_text(error), error.sample_count));
     nlohmann::json out = error_json(error);
     out["file"] = ahrs.file;
     out["refused"] = false;

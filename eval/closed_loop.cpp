@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -12,15 +13,30 @@ namespace {
 // One precontrol (one cascade stage) along `path`.
 CompensationRun run_stage(const ident::ParameterTable& table, const std::string& robot_name,
                           const sim::DesiredJointPath& path, const CompensationOptions& options) {
+  const std::size_t n = path.samples.size();
+  // The warm-up (path at rest at its start only): cycles 0 .. W-1 at the first sample; the path's
+  // cycle k is then the precontrol's cycle W + k (its counter stays consecutive). Events are
+  // reported on the path's cycles: those of the warm-up on cycle 0.
+  const bool starts_at_rest = n > 1 && path.samples[0].qd_rad_s.norm() == 0.0 &&
+                              path.samples[0].qdd_rad_s2.norm() == 0.0 &&
+                              path.samples[1].q_rad == path.samples[0].q_rad;
+  const std::size_t warm_up = starts_at_rest ? std::size_t(std::max(0, options.warm_up_cycles)) : 0;
   ident::PrecontrolOptions precontrol_options = options.precontrol;
   precontrol_options.caller_cycle_s = path.cycle_s;
+  if (warm_up > 0) {
+    // Powered on at the start pose as the online bridges start it (auto_engage): the models
+    // settle with the offset held at zero, then it fades in. Started active, the first offset
+    // (the start pose's static deflection, 3.6 mrad on the UR10e's shoulder) is a step whose
+    // smoothed rate the supervisor takes for a fault. A deactivation on the path stays final.
+    precontrol_options.auto_engage = true;
+    precontrol_options.reengage_after_s = std::numeric_limits<double>::infinity();
+  }
   // The precontrol is a large fixed-size object (no heap inside its cycle): keep it on the heap.
   auto precontrol = std::make_unique<ident::Precontrol>();
   std::string why;
   if (!ident::Precontrol::create(table, robot_name, precontrol_options, precontrol.get(), &why)) {
     throw std::invalid_argument("precontrol refused the parameter table: " + why);
   }
-  const std::size_t n = path.samples.size();
   std::vector<calib::JointVector> torque;
   if (precontrol->needs_model_torque()) {
     if (!options.model_torque)
@@ -36,13 +52,6 @@ CompensationRun run_stage(const ident::ParameterTable& table, const std::string&
   std::array<ident::PrecontrolEvent, ident::kPrecontrolEventCapacity> events{};
   // An inverse-form table is fed q_d its preview ahead, on top of the smoother's look-ahead.
   const auto look_ahead = std::size_t(options.look_ahead_cycles + table.preview_cycles);
-  // The warm-up (path at rest at its start only): cycles 0 .. W-1 at the first sample; the path's
-  // cycle k is then the precontrol's cycle W + k (its counter stays consecutive). Events are
-  // reported on the path's cycles: those of the warm-up on cycle 0.
-  const bool starts_at_rest = n > 1 && path.samples[0].qd_rad_s.norm() == 0.0 &&
-                              path.samples[0].qdd_rad_s2.norm() == 0.0 &&
-                              path.samples[1].q_rad == path.samples[0].q_rad;
-  const std::size_t warm_up = starts_at_rest ? std::size_t(std::max(0, options.warm_up_cycles)) : 0;
   for (std::size_t i = 0; i < warm_up + n; ++i) {
     const std::size_t k = i < warm_up ? 0 : i - warm_up;
     const std::size_t ahead = i < warm_up ? 0 : std::min(n - 1, k + look_ahead);
@@ -58,6 +67,10 @@ CompensationRun run_stage(const ident::ParameterTable& table, const std::string&
                                                        : precontrol->cycle(q, payload_kg, tau, i);
     const int read = precontrol->read_events(events.data(), int(events.size()));
     for (int e = 0; e < read; ++e) {
+      const ident::PrecontrolCause cause = events[std::size_t(e)].cause;
+      const bool engagement =
+          cause == ident::PrecontrolCause::kEngaging || cause == ident::PrecontrolCause::kEngaged;
+      if (i < warm_up && engagement) continue;  // the power-on, not an event of the run
       run.events.push_back(events[std::size_t(e)]);
       run.events.back().cycle = k;
     }

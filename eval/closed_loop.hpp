@@ -54,7 +54,9 @@ struct CompensationOptions {
   // runs from power-on, so it has settled at the start pose's static offset long before a test
   // path. Without it, a run cut out of a program starts the precontrol cold and its offset ramps
   // in during the first cycles (2 mrad on A2 within 40 ms on seed-line): a jump of the robot that
-  // its own rest does not show.
+  // its own rest does not show. The warm-up powers the precontrol on as the online bridges do
+  // (PrecontrolOptions::auto_engage: settle, then fade in; 0.4 s by default, so W should cover
+  // it); on the path itself a deactivation stays final.
   int warm_up_cycles = 0;
   // The robot's rigid-body model, for tables whose models take the model torque: the precontrol
   // is then fed the torque along the desired path at the sample it is fed (eval/model_torque.hpp).

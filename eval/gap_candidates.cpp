@@ -250,6 +250,7 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
       // joint's error is a linear response to sin, cos (and tau sin, tau cos) of h N theta, whose
       // frequency h N qd sweeps through those modes. Raw, or through Laguerre bases of 3, 10 or
       // 30 ms (the response without knowing the loop's poles), with the ripple through 100 ms.
+      if (joint >= s.q_internal_rad.size()) break;  // the motor angle is not known
       const Column q = to_column(s.q_internal_rad[joint]);
       const double n_gear = s.gear_ratio[joint];
       const Column tau_d = to_column(s.torque_nm[joint]);

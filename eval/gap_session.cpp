@@ -75,6 +75,11 @@ GapSession diagnose_gap_session(const GapSessionOptions& args) {
       real.payload_kg, real.time_s, robot.nominal_payload_kg,
       {args.joint_errors, 0, "payload_kg", fmt::format("robot {} ({})", robot.name, robot.source)});
   check_joint_error_limits(real, args.joint_errors, robot);
+  if (!real.has_q_internal())
+    spdlog::warn(
+        "{}: no q_internal_<joint>_rad columns (motor encoders): the transmission error "
+        "is not tried, the friction and payload candidates follow q_desired",
+        args.joint_errors);
   std::vector<std::vector<double>> sim_errors;
   std::optional<ident::ParameterTable> table;
   if (!args.table.empty()) {

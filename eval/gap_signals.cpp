@@ -90,6 +90,30 @@ Eigen::Matrix<double, 6, 6> adjoint(const Eigen::Isometry3d& t) {
 // industrial arm (~0.1 m .. 1), it only keeps the map finite at a wrist singularity.
 constexpr double kJacobianDamping = 1e-3;
 
+// The arm with the logged payload, with 1 kg at the tool origin and bare.
+struct PayloadDynamics {
+  sim::RigidBodyDynamics *logged, *unit, *bare;
+};
+
+// The rigid-body torque and the unit payload's torque along the drive's actual motion (q_internal
+// and its derivatives) at sample k.
+void set_actual_motion_torques(GapSignals& g, const std::vector<std::vector<double>>& qdd_internal,
+                               std::size_t k, const PayloadDynamics& d) {
+  calib::JointVector qi, qdi, qddi;
+  for (std::size_t j = 0; j < g.joint_count(); ++j) {
+    qi[long(j)] = g.q_internal_rad[j][k];
+    qdi[long(j)] = g.qd_internal_rad_s[j][k];
+    qddi[long(j)] = qdd_internal[j][k];
+  }
+  const calib::JointVector tau = d.logged->inverse_dynamics(qi, qdi, qddi);
+  const calib::JointVector tau_unit =
+      d.unit->inverse_dynamics(qi, qdi, qddi) - d.bare->inverse_dynamics(qi, qdi, qddi);
+  for (std::size_t j = 0; j < g.joint_count(); ++j) {
+    g.torque_internal_nm[j][k] = tau[long(j)];
+    g.unit_payload_internal_nm_kg[j][k] = tau_unit[long(j)];
+  }
+}
+
 }  // namespace
 
 std::vector<GapSignals::ImsChainColumns> ims_chain_columns(
@@ -287,6 +311,9 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
   g.payload_kg = real.payload_kg;
   g.runs = real.segments();
   g.q_desired_rad = real.q_desired_rad;
+  // Without the encoders' q_internal the drive's actual motion stays unknown (empty): the
+  // candidates then take the desired motion, and the transmission error is not tried.
+  const bool internal = real.has_q_internal();
   g.q_internal_rad = real.q_internal_rad;
   g.gap_rad.assign(nj, std::vector<double>(n));
   for (std::size_t j = 0; j < nj; ++j) {
@@ -295,7 +322,8 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
     for (std::size_t k = 0; k < n; ++k)
       g.gap_rad[j][k] =
           real.q_desired_rad[j][k] - real.q_measured_rad[j][k] - sim_joint_error_rad[j][k];
-    g.qd_internal_rad_s.push_back(derivative(real.q_internal_rad[j], g.runs, g.cycle_s));
+    if (internal)
+      g.qd_internal_rad_s.push_back(derivative(real.q_internal_rad[j], g.runs, g.cycle_s));
     g.gear_ratio.push_back(robot.joints[j].drive.gear_ratio);
     g.max_speed_rad_s.push_back(robot.joints[j].max_velocity_rad_s);
     const auto& drive = robot.joints[j].drive;
@@ -313,12 +341,14 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
   g.torque_nm.assign(nj, std::vector<double>(n));
   g.gravity_torque_nm.assign(nj, std::vector<double>(n));
   g.unit_payload_nm_kg.assign(nj, std::vector<double>(n));
-  g.torque_internal_nm.assign(nj, std::vector<double>(n));
-  g.unit_payload_internal_nm_kg.assign(nj, std::vector<double>(n));
+  if (internal) {
+    g.torque_internal_nm.assign(nj, std::vector<double>(n));
+    g.unit_payload_internal_nm_kg.assign(nj, std::vector<double>(n));
+  }
   g.mass_matrix_kg_m2.assign(nj * nj, std::vector<double>(n));
   std::vector<std::vector<double>> qdd_internal;
-  for (std::size_t j = 0; j < nj; ++j)
-    qdd_internal.push_back(derivative(g.qd_internal_rad_s[j], g.runs, g.cycle_s));
+  for (const auto& qd_internal : g.qd_internal_rad_s)
+    qdd_internal.push_back(derivative(qd_internal, g.runs, g.cycle_s));
   double current_mass = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     if (real.payload_kg[k] != current_mass) {
@@ -333,13 +363,7 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
       qdd[long(j)] = g.qdd_desired_rad_s2[j][k];
     }
     const calib::JointVector tau = dynamics.inverse_dynamics(q, qd, qdd);
-    calib::JointVector qi, qdi, qddi;
-    for (std::size_t j = 0; j < nj; ++j) {
-      qi[long(j)] = g.q_internal_rad[j][k];
-      qdi[long(j)] = g.qd_internal_rad_s[j][k];
-      qddi[long(j)] = qdd_internal[j][k];
-    }
-    const calib::JointVector tau_internal = dynamics.inverse_dynamics(qi, qdi, qddi);
+    if (internal) set_actual_motion_torques(g, qdd_internal, k, {&dynamics, &unit, &bare});
     const calib::JointVector tau_gravity = dynamics.gravity_torque(q);
     const sim::JointMatrix mass = dynamics.mass_matrix(q);
     for (std::size_t i = 0; i < nj; ++i)
@@ -347,14 +371,10 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
         g.mass_matrix_kg_m2[i * nj + j][k] = mass(long(i), long(j));
     const calib::JointVector tau_unit =
         unit.inverse_dynamics(q, qd, qdd) - bare.inverse_dynamics(q, qd, qdd);
-    const calib::JointVector tau_unit_internal =
-        unit.inverse_dynamics(qi, qdi, qddi) - bare.inverse_dynamics(qi, qdi, qddi);
     for (std::size_t j = 0; j < nj; ++j) {
       g.torque_nm[j][k] = tau[long(j)];
-      g.torque_internal_nm[j][k] = tau_internal[long(j)];
       g.gravity_torque_nm[j][k] = tau_gravity[long(j)];
       g.unit_payload_nm_kg[j][k] = tau_unit[long(j)];
-      g.unit_payload_internal_nm_kg[j][k] = tau_unit_internal[long(j)];
     }
   }
   g.ims_chain_columns =

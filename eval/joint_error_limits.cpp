@@ -16,7 +16,8 @@ std::size_t check_joint_error_limits(const ident::JointErrorLog& log, const std:
     const std::string& name = log.joint_names[j];
     columns.push_back({fmt::format("q_desired_{}_rad", name), j, log.q_desired_rad[j]});
     columns.push_back({fmt::format("q_measured_{}_rad", name), j, log.q_measured_rad[j]});
-    columns.push_back({fmt::format("q_internal_{}_rad", name), j, log.q_internal_rad[j]});
+    if (log.has_q_internal())
+      columns.push_back({fmt::format("q_internal_{}_rad", name), j, log.q_internal_rad[j]});
   }
   const std::vector<std::size_t>& lines = log.sample_lines;
   const auto line_of = [&lines](std::size_t k) { return k < lines.size() ? lines[k] : 0; };

@@ -2,10 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <optional>
 #include <stdexcept>
 
+#include "core/input_error.hpp"
+
 namespace imscal::eval {
+
 PayloadDynamics::PayloadDynamics(const ModelTorqueSource& model)
     : dynamics_(model.robot, std::nullopt, model.gravity_in_base_m_s2) {}
 
@@ -81,6 +85,31 @@ void attach_model_torques(ident::JointErrorLog& log, const ModelTorqueSource& mo
   const auto& path = torque_along_measured_path(options) ? log.q_measured_rad : log.q_desired_rad;
   log.model_torque_nm =
       model_torques_along(model, log.cycle_s, path, log.payload_kg, log.segments());
+}
+
+ModelTorqueSource load_model_torque_source(
+    const std::string& robot_file, const Eigen::Vector3d& gravity_in_base_m_s2,
+    const std::string& data_robot, const std::string& data_file, const std::string& needed_by_file,
+    const std::string& needed_by_field, double data_cycle_s) {
+  if (robot_file.empty())
+    throw InputError(needed_by_file, 0, needed_by_field,
+                     "the models take the model torque: give the robot description (--robot, or "
+                     "robot= in Python; e.g. datasets/robots/kr16.yaml)");
+  ModelTorqueSource model;
+  model.robot = calib::load_robot_description(robot_file);
+  if (model.robot.name != data_robot)
+    throw InputError(robot_file, 0, "name",
+                     fmt::format("robot '{}', but {} is of robot '{}'", model.robot.name, data_file,
+                                 data_robot));
+  const double robot_cycle_s = model.robot.controller_cycle_s;
+  if (data_cycle_s > 0.0 && std::abs(robot_cycle_s - data_cycle_s) > 1e-9 * data_cycle_s)
+    throw InputError(robot_file, 0, "controller_cycle_s",
+                     fmt::format("the robot's controller cycle is {} s, but {} is sampled every "
+                                 "{} s: a log of another controller or a robot file of another "
+                                 "robot",
+                                 robot_cycle_s, data_file, data_cycle_s));
+  model.gravity_in_base_m_s2 = gravity_in_base_m_s2;
+  return model;
 }
 
 }  // namespace imscal::eval

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 #include <optional>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -47,6 +48,15 @@ class PayloadDynamics {
   sim::RigidBodyDynamics dynamics_;
   double payload_kg_ = 0.0;
 };
+
+// The rigid-body model of `robot_file` for the data of `data_robot` (file `data_file`, for
+// messages): InputError naming `needed_by_file` and `needed_by_field` (what asked for the torque)
+// when robot_file is empty, and the robot file when its robot is not the data's or (data_cycle_s >
+// 0) its controller cycle is not the data's sample time [s].
+ModelTorqueSource load_model_torque_source(
+    const std::string& robot_file, const Eigen::Vector3d& gravity_in_base_m_s2,
+    const std::string& data_robot, const std::string& data_file, const std::string& needed_by_file,
+    const std::string& needed_by_field, double data_cycle_s = 0.0);
 
 // Torques [joint][sample] along a sampled path q_rad [joint][sample] with cycle cycle_s and
 // payload_kg per sample, over the [begin, end) segments (samples outside every segment: 0).

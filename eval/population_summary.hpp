@@ -6,16 +6,14 @@
 #include <string>
 #include <vector>
 
+#include "core/percentile.hpp"
+
 namespace imscal::eval {
 
 struct PopulationTable {
   std::vector<std::string> columns;       // the first is the seed
   std::vector<std::vector<double>> rows;  // one per plant, columns.size() values each
 };
-
-// Percentile p in [0, 100] of `values` by linear interpolation between the sorted values
-// (p = 50: the median). std::invalid_argument when empty.
-double percentile(std::vector<double> values, double p);
 
 // Pearson correlation of two equally long series; 0 when either does not vary.
 double correlation(const std::vector<double>& a, const std::vector<double>& b);

@@ -14,6 +14,7 @@
 #include "core/input_error.hpp"
 #include "core/output_folder.hpp"
 #include "core/payload_plausibility.hpp"
+#include "eval/joint_error_limits.hpp"
 #include "eval/mass_refinement.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "ident/identification_config.hpp"
@@ -150,6 +151,8 @@ SessionTables prepare_tables(const VerificationSessionOptions& options,
                      fmt::format("the joint errors are of robot '{}', the scenarios' "
                                  "nominal robot is '{}'",
                                  source.log->robot, torque_model.robot.name));
+  if (!options.joint_errors.empty())
+    check_joint_error_limits(*source.log, source.file, torque_model.robot);
   std::optional<ident::IdentificationConfig> config;
   if (source.log) config = checked_config(options, source);
   if (options.search_order) {
@@ -183,11 +186,15 @@ void refuse_earlier_outputs(const VerificationSessionOptions& options, const fs:
       throw InputError(file.string(), 0, "--out", "exists already (use --force to replace it)");
 }
 
-// The session's work folder, removed however the session ends.
+// The session's work folder, removed however the session ends, with the output folder when the
+// session created it and published nothing (bad input leaves no trace).
 struct WorkFolder {
-  fs::path path;
-  explicit WorkFolder(const fs::path& out)
-      : path(out / fmt::format(".imscal-verify-work-{}", ::getpid())) {
+  fs::path out, path;
+  bool created_out = false;
+  explicit WorkFolder(const fs::path& out_folder)
+      : out(out_folder),
+        path(out_folder / fmt::format(".imscal-verify-work-{}", ::getpid())),
+        created_out(!fs::exists(out_folder)) {
     create_output_folder(out);
     fs::remove_all(path);
     fs::create_directories(path);
@@ -197,6 +204,7 @@ struct WorkFolder {
   ~WorkFolder() {
     std::error_code ignored;
     fs::remove_all(path, ignored);
+    if (created_out && fs::is_empty(out, ignored)) fs::remove(out, ignored);
   }
 };
 

@@ -34,7 +34,7 @@ using csv::trim;
 // supervisor's tolerance.
 constexpr double kMaxJointError_rad = 0.5;
 
-// Row layout: t_s, payload_kg, q_desired per joint, q_measured per joint, q_internal per joint.
+// Row layout: t_s, payload_kg, q_desired per joint, q_measured per joint[, q_internal per joint].
 void check_joint_errors_plausible(const std::vector<double>& row,
                                   const std::vector<std::string>& joint_names,
                                   const std::string& file, std::size_t line) {
@@ -50,10 +50,13 @@ void check_joint_errors_plausible(const std::vector<double>& row,
   }
 }
 
-std::vector<std::string> expected_columns(const std::vector<std::string>& joints) {
+std::vector<std::string> expected_columns(const std::vector<std::string>& joints,
+                                          bool with_internal) {
   std::vector<std::string> names{"t_s", "payload_kg"};
-  for (const char* family : {"q_desired", "q_measured", "q_internal"})
+  for (const char* family : {"q_desired", "q_measured", "q_internal"}) {
+    if (std::string_view(family) == "q_internal" && !with_internal) break;
     for (const auto& j : joints) names.push_back(fmt::format("{}_{}_rad", family, j));
+  }
   return names;
 }
 
@@ -155,7 +158,9 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
   if (columns.empty()) throw InputError(file, line, "", "no column header line");
   const std::size_t header_line = line;
   log.joint_names = joints_from_header(file, header_line, columns);
-  const std::vector<std::string> expected = expected_columns(log.joint_names);
+  // The q_internal block is there when any column follows q_measured's; then whole.
+  const bool with_internal = columns.size() > 2 + 2 * log.joint_names.size();
+  const std::vector<std::string> expected = expected_columns(log.joint_names, with_internal);
   for (std::size_t c = 0; c < std::max(expected.size(), columns.size()); ++c) {
     if (c >= columns.size())
       throw InputError(file, header_line, expected[c], "column missing from the header");
@@ -167,7 +172,7 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
   const std::size_t joints = log.joint_names.size();
   log.q_desired_rad.assign(joints, {});
   log.q_measured_rad.assign(joints, {});
-  log.q_internal_rad.assign(joints, {});
+  if (with_internal) log.q_internal_rad.assign(joints, {});
   std::vector<double> row(expected.size());
   while (std::getline(in, text)) {
     ++line;
@@ -212,7 +217,7 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
     for (std::size_t j = 0; j < joints; ++j) {
       log.q_desired_rad[j].push_back(row[2 + j]);
       log.q_measured_rad[j].push_back(row[2 + joints + j]);
-      log.q_internal_rad[j].push_back(row[2 + 2 * joints + j]);
+      if (with_internal) log.q_internal_rad[j].push_back(row[2 + 2 * joints + j]);
     }
   }
   if (log.time_s.empty()) throw InputError(file, line, "", "no samples after the header");
@@ -229,11 +234,12 @@ void write_joint_errors_csv(const std::filesystem::path& file, const JointErrorL
   const std::size_t joints = log.joint_count();
   if (joints == 0) throw std::invalid_argument("write_joint_errors_csv: no joints");
   if (log.payload_kg.size() != n || log.q_desired_rad.size() != joints ||
-      log.q_measured_rad.size() != joints || log.q_internal_rad.size() != joints)
+      log.q_measured_rad.size() != joints ||
+      (log.has_q_internal() && log.q_internal_rad.size() != joints))
     throw std::invalid_argument("write_joint_errors_csv: inconsistent sizes");
   for (std::size_t j = 0; j < joints; ++j)
     if (log.q_desired_rad[j].size() != n || log.q_measured_rad[j].size() != n ||
-        log.q_internal_rad[j].size() != n)
+        (log.has_q_internal() && log.q_internal_rad[j].size() != n))
       throw std::invalid_argument("write_joint_errors_csv: inconsistent sizes of joint " +
                                   log.joint_names[j]);
   if (!(log.cycle_s > 0.0)) throw std::invalid_argument("write_joint_errors_csv: cycle_s <= 0");
@@ -246,14 +252,14 @@ void write_joint_errors_csv(const std::filesystem::path& file, const JointErrorL
                    log.robot, log.cycle_s);
   if (!log.source.empty()) s << "# source: " << log.source << '\n';
   for (const auto& [key, value] : log.metadata) s << "# " << key << ": " << value << '\n';
-  const auto names = expected_columns(log.joint_names);
+  const auto names = expected_columns(log.joint_names, log.has_q_internal());
   for (std::size_t c = 0; c < names.size(); ++c) s << (c ? "," : "") << names[c];
   s << '\n';
   std::string line;
   for (std::size_t k = 0; k < n; ++k) {
     line = fmt::format("{:.17g},{:.17g}", log.time_s[k], log.payload_kg[k]);
     for (const auto* family : {&log.q_desired_rad, &log.q_measured_rad, &log.q_internal_rad})
-      for (std::size_t j = 0; j < joints; ++j) {
+      for (std::size_t j = 0; j < family->size(); ++j) {
         const double v = (*family)[j][k];
         if (!std::isfinite(v))
           throw std::invalid_argument(

@@ -7,11 +7,12 @@
 //   # robot: kr16
 //   # cycle_s: 0.002
 //   # source: ...                      (optional; further "# key: value" lines are kept)
-//   t_s,payload_kg,q_desired_A1_rad,..,q_measured_A1_rad,..,q_internal_A1_rad,..
+//   t_s,payload_kg,q_desired_A1_rad,..,q_measured_A1_rad,..[,q_internal_A1_rad,..]
 //
 // q_desired: the robot's desired joint angle; q_measured: the joint angle reached, from the IMS
 // chain (inverse kinematics of the measured flange pose); q_internal: the robot's motor encoders
-// (joint side). The joint error of the paper is Δq = q_desired - q_measured.
+// (joint side), optional as a whole block (a robot with one position sensor per joint has no
+// second reading). The joint error of the paper is Δq = q_desired - q_measured.
 // Time gaps longer than 1.5 cycles split the data into segments (separate runs; a warning, not
 // an error); a time that does not increase is an error.
 #include <cstddef>
@@ -32,7 +33,8 @@ struct JointErrorLog {
   std::vector<std::string> joint_names;                       // "A1".."A6"
   std::vector<double> time_s;
   std::vector<double> payload_kg;
-  // [joint][sample], SI (rad)
+  // [joint][sample], SI (rad). q_internal_rad is empty (no joint) when the file has no
+  // q_internal block.
   std::vector<std::vector<double>> q_desired_rad, q_measured_rad, q_internal_rad;
   // The joint torques of the robot's rigid-body model [joint][sample] [N m], along the path the
   // identification's model form reads (eval/model_torque.hpp); empty unless a caller attached
@@ -45,14 +47,17 @@ struct JointErrorLog {
 
   std::size_t sample_count() const { return time_s.size(); }
   std::size_t joint_count() const { return joint_names.size(); }
+  bool has_q_internal() const { return !q_internal_rad.empty(); }
   // [begin, end) sample ranges of the segments.
   std::vector<std::pair<std::size_t, std::size_t>> segments() const;
 };
 
-// Reads and validates a joint_errors.csv; InputError(file, line, field, problem) on bad input.
+// Reads and validates a joint_errors.csv; InputError(file, line, field, problem) on bad input (a
+// q_internal block that misses a joint's column among them).
 JointErrorLog read_joint_errors_csv(const std::filesystem::path& file);
 
-// Writes the log (17 significant digits, so a round trip is exact), atomically. Throws
+// Writes the log (17 significant digits, so a round trip is exact; the q_internal block only
+// when the log has it), atomically. Throws
 // std::invalid_argument for an inconsistent log (sizes, non-finite values, names).
 void write_joint_errors_csv(const std::filesystem::path& file, const JointErrorLog& log,
                             Overwrite overwrite = Overwrite::kAllow);

@@ -62,12 +62,18 @@ void check_options(const ImuSeries& imu, const ZuptOptions& o) {
 struct Epoch {
   std::size_t last_sample = 0;  // sample index ending the interval (k - 1, k]; unused for k = 0
   double t_s = 0.0;
-  ErrorMatrix transition;                               // from k - 1 to k
-  ErrorMatrix predicted_cov;                            // at k before the updates
-  ErrorMatrix filtered_cov;                             // at k after the updates
   ErrorVector correction = ErrorVector::Zero();         // error estimate fed back at k
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();  // estimates after the updates at k
   Eigen::Vector3d acc_bias = Eigen::Vector3d::Zero();
+};
+
+// The matrices of instant k, which only the backward pass needs: kept apart from Epoch so that
+// they are released before the smoothed states are built (5.4 kB per instant, more than the
+// states of its samples).
+struct EpochCovariances {
+  ErrorMatrix transition;     // from k - 1 to k
+  ErrorMatrix predicted_cov;  // at k before the updates
+  ErrorMatrix filtered_cov;   // at k after the updates
 };
 
 struct UpdateTally {
@@ -147,10 +153,9 @@ RestDetectorOptions rest_options_of(const ZuptOptions& o) {
   return r;
 }
 
-Epoch initial_epoch(const NavState& initial, const Eigen::Matrix<double, 9, 1>& initial_sigma,
-                    const ZuptOptions& options) {
-  Epoch first;
-  first.t_s = initial.t_s;
+EpochCovariances initial_covariances(const Eigen::Matrix<double, 9, 1>& initial_sigma,
+                                     const ZuptOptions& options) {
+  EpochCovariances first;
   first.filtered_cov.setZero();
   first.filtered_cov.diagonal().head<9>() = initial_sigma.cwiseAbs2();
   first.filtered_cov.diagonal().segment<3>(kGyroBias).setConstant(
@@ -159,6 +164,12 @@ Epoch initial_epoch(const NavState& initial, const Eigen::Matrix<double, 9, 1>& 
       options.initial_acc_bias_sigma_m_s2 * options.initial_acc_bias_sigma_m_s2);
   first.predicted_cov = first.filtered_cov;
   first.transition.setIdentity();
+  return first;
+}
+
+Epoch initial_epoch(const NavState& initial, const ZuptOptions& options) {
+  Epoch first;
+  first.t_s = initial.t_s;
   first.gyro_bias = options.initial_gyro_bias_rad_s;
   first.acc_bias = options.initial_acc_bias_m_s2;
   return first;
@@ -174,22 +185,24 @@ struct SmoothedErrors {
 
 // Rauch-Tung-Striebel on the error state. With the estimates fed back, the filtered error is
 // zero after every update and so is its prediction: x_s(k) = C_k x_s^before(k + 1).
-SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs) {
+SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs,
+                                 const std::vector<EpochCovariances>& covariances) {
   const std::size_t last = epochs.size() - 1;
   SmoothedErrors s;
   s.after.resize(epochs.size());
   s.before.resize(epochs.size());
   s.variance.resize(epochs.size());
   s.after[last].setZero();
-  ErrorMatrix smoothed_cov = epochs[last].filtered_cov;
+  ErrorMatrix smoothed_cov = covariances[last].filtered_cov;
   s.variance[last] = smoothed_cov.diagonal();
   s.before[last] = epochs[last].correction;
   for (std::size_t k = last; k-- > 0;) {
-    const Epoch& next = epochs[k + 1];
+    const EpochCovariances& next = covariances[k + 1];
     const ErrorMatrix C =
-        smoother_gain(epochs[k].filtered_cov, next.transition, next.predicted_cov);
+        smoother_gain(covariances[k].filtered_cov, next.transition, next.predicted_cov);
     s.after[k] = C * s.before[k + 1];
-    smoothed_cov = epochs[k].filtered_cov + C * (smoothed_cov - next.predicted_cov) * C.transpose();
+    smoothed_cov =
+        covariances[k].filtered_cov + C * (smoothed_cov - next.predicted_cov) * C.transpose();
     smoothed_cov = 0.5 * (smoothed_cov + smoothed_cov.transpose());
     s.variance[k] = smoothed_cov.diagonal().cwiseMax(0.0);
     s.before[k] = s.after[k] + epochs[k].correction;
@@ -197,21 +210,38 @@ SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs) {
   return s;
 }
 
+// The sample's increment without the biases estimated at the instant before its interval.
+ImuSample bias_corrected(const ImuSeries& imu, std::size_t i, const Epoch& previous) {
+  const double dt = sample_interval(imu, i);
+  ImuSample corrected = imu.samples[i];
+  corrected.gyro -= previous.gyro_bias * dt;
+  corrected.acc -= previous.acc_bias * dt;
+  return corrected;
+}
+
 // The nominal state of every sample corrected by the smoothed error, interpolated linearly in
-// time between the propagation instants that enclose the sample.
-std::vector<SmoothedState> apply_smoothed_errors(const std::vector<NavState>& nominal,
+// time between the propagation instants that enclose the sample. The nominal states are
+// mechanised again from the strapdown kept at each interval's start (the same steps as the
+// forward pass, so the same states), instead of being kept per sample through the forward pass.
+std::vector<SmoothedState> apply_smoothed_errors(const ImuSeries& imu,
+                                                 const std::vector<Strapdown>& interval_start,
                                                  const std::vector<Epoch>& epochs,
                                                  const SmoothedErrors& smoothed) {
-  std::vector<SmoothedState> states(nominal.size());
+  std::vector<SmoothedState> states;
+  states.reserve(imu.samples.size() + 1);  // room for a caller's initial state, without a copy
+  states.resize(imu.samples.size());
   std::size_t i = 0;
   for (std::size_t k = 1; k < epochs.size(); ++k) {
     const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
+    Strapdown strapdown = interval_start[k - 1];
     for (; i <= epochs[k].last_sample; ++i) {
-      const double alpha = (nominal[i].t_s - t0) / (t1 - t0);
+      strapdown.step(bias_corrected(imu, i, epochs[k - 1]));
+      const NavState& nominal = strapdown.state();
+      const double alpha = (nominal.t_s - t0) / (t1 - t0);
       const ErrorVector e = (1.0 - alpha) * smoothed.after[k - 1] + alpha * smoothed.before[k];
       const ErrorVector var =
           (1.0 - alpha) * smoothed.variance[k - 1] + alpha * smoothed.variance[k];
-      states[i].state = apply_error(nominal[i], e);
+      states[i].state = apply_error(nominal, e);
       states[i].sigma = var.head<9>().cwiseSqrt();
     }
   }
@@ -298,10 +328,16 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
   const std::vector<bool> epoch_zero_velocity = rest_interior(options.zero_velocity_edge_margin_s);
 
   // ---- forward pass ----
-  std::vector<NavState> nominal(n);  // per sample, mechanised from the last fed-back state
+  // The strapdown at each interval's start (after the last feedback): the nominal states are
+  // mechanised again from it after the backward pass (apply_smoothed_errors).
+  std::vector<Strapdown> interval_start;
+  interval_start.reserve(epoch_count);
   std::vector<Epoch> epochs;
+  std::vector<EpochCovariances> covariances;
   epochs.reserve(epoch_count + 1);
-  epochs.push_back(initial_epoch(initial, initial_sigma, options));
+  covariances.reserve(epoch_count + 1);
+  epochs.push_back(initial_epoch(initial, options));
+  covariances.push_back(initial_covariances(initial_sigma, options));
   Strapdown strapdown(earth, initial);
   ErrorLinearisation point;
   point.earth_rate_W = earth.earth_rate_W();
@@ -323,23 +359,22 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
     const std::size_t begin = (k - 1) * samples_per_epoch;
     const std::size_t end = std::min(n, begin + samples_per_epoch);
     const Epoch& previous = epochs.back();
+    const ErrorMatrix& previous_filtered_cov = covariances.back().filtered_cov;
     Eigen::Matrix3d sum_R = Eigen::Matrix3d::Zero();
     Eigen::Vector3d sum_dv_W = Eigen::Vector3d::Zero();
     Eigen::Vector3d sum_raw_dtheta = Eigen::Vector3d::Zero();
     const double t_begin = strapdown.state().t_s;
+    interval_start.push_back(strapdown);
     for (std::size_t i = begin; i < end; ++i) {
       const ImuSample& raw = imu.samples[i];
       const double dt = sample_interval(imu, i);
-      ImuSample corrected = raw;
-      corrected.gyro -= previous.gyro_bias * dt;
-      corrected.acc -= previous.acc_bias * dt;
+      const ImuSample corrected = bias_corrected(imu, i, previous);
       const Eigen::Matrix3d R_before = strapdown.state().q_W_S.toRotationMatrix();
       strapdown.step(corrected);
       const Eigen::Matrix3d R_mid = 0.5 * (R_before + strapdown.state().q_W_S.toRotationMatrix());
       sum_R += R_mid * dt;
       sum_dv_W += R_mid * corrected.acc;
       sum_raw_dtheta += raw.gyro;
-      nominal[i] = strapdown.state();
     }
     const double interval = strapdown.state().t_s - t_begin;
     point.mean_R_W_S = sum_R / interval;
@@ -350,13 +385,14 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
     Epoch epoch;
     epoch.last_sample = end - 1;
     epoch.t_s = strapdown.state().t_s;
-    epoch.transition = model.transition;
-    epoch.predicted_cov = model.transition * previous.filtered_cov * model.transition.transpose() +
-                          model.noise_covariance;
-    epoch.predicted_cov = 0.5 * (epoch.predicted_cov + epoch.predicted_cov.transpose());
+    EpochCovariances cov;
+    cov.transition = model.transition;
+    cov.predicted_cov = model.transition * previous_filtered_cov * model.transition.transpose() +
+                        model.noise_covariance;
+    cov.predicted_cov = 0.5 * (cov.predicted_cov + cov.predicted_cov.transpose());
     epoch.gyro_bias = previous.gyro_bias;
     epoch.acc_bias = previous.acc_bias;
-    ErrorMatrix P = epoch.predicted_cov;
+    ErrorMatrix P = cov.predicted_cov;
     ErrorVector x = ErrorVector::Zero();
     if (epoch_zero_velocity[k]) {
       const NavState& state = strapdown.state();
@@ -414,17 +450,19 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
       rest_sum_R.setZero();
       rest_time = 0.0;
     }
-    epoch.filtered_cov = P;
+    cov.filtered_cov = P;
     epoch.correction = x;
     epochs.push_back(std::move(epoch));
+    covariances.push_back(std::move(cov));
   }
   result.summary.zero_velocity = zupt_tally.statistics();
   result.summary.zero_angular_rate = zaru_tally.statistics();
   result.summary.velocity_aid = aid_tally.statistics();
   result.summary.propagation_steps = epoch_count;
 
-  const SmoothedErrors smoothed = rts_backward_pass(epochs);
-  result.states = apply_smoothed_errors(nominal, epochs, smoothed);
+  const SmoothedErrors smoothed = rts_backward_pass(epochs, covariances);
+  std::vector<EpochCovariances>().swap(covariances);  // released before the states are built
+  result.states = apply_smoothed_errors(imu, interval_start, epochs, smoothed);
   result.biases.resize(epochs.size());
   for (std::size_t k = 0; k < epochs.size(); ++k) {
     SmoothedBias& b = result.biases[k];

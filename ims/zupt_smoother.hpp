@@ -74,8 +74,10 @@ struct ZuptSummary {
 };
 
 struct ZuptSmootherResult {
-  std::vector<SmoothedState> states;  // one per IMS sample, at the sample's time stamp
-  std::vector<SmoothedBias> biases;   // one per propagation instant
+  // One per IMS sample, at the sample's time stamp; with room for one more (a caller's initial
+  // state goes in front without a copy of the states).
+  std::vector<SmoothedState> states;
+  std::vector<SmoothedBias> biases;  // one per propagation instant
   ZuptSummary summary;
 };
 

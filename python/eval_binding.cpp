@@ -1,10 +1,15 @@
-// imscal.read_path and imscal.evaluate_paths: path files and their ISO 9283 path
-// characteristics (eval/path_evaluation.hpp), with the keys of `imscal evaluate --out`.
+// imscal.read_path, imscal.evaluate_paths and imscal.diagnose: path files and their ISO 9283 path
+// characteristics (eval/path_evaluation.hpp), with the keys of `imscal evaluate --out`, and the
+// gap diagnosis of `imscal diagnose` (eval/gap_session.hpp).
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "core/input_error.hpp"
+#include "core/json_output.hpp"
+#include "eval/gap_report.hpp"
+#include "eval/gap_session.hpp"
 #include "eval/path_evaluation.hpp"
 #include "python/bindings.hpp"
 
@@ -56,6 +61,21 @@ py::dict evaluate_paths(const std::string& commanded_file,
   return to_python(eval::evaluate_paths(options).document);
 }
 
+// The session of `imscal diagnose` (eval/gap_session.hpp): report.json as a dict (the file's
+// text, through json), report.txt, the verdict and what to measure next, and the gap itself.
+py::dict diagnose(const eval::GapSessionOptions& options) {
+  const eval::GapSession s = eval::diagnose_gap_session(options);
+  const py::object json_loads = py::module_::import("json").attr("loads");
+  const auto& g = s.signals.gap_rad;
+  return py::dict(
+      "report"_a =
+          json_loads(json_text(eval::diagnosis_json(s.signals, s.diagnosis), 1, "diagnosis.json")),
+      "text"_a = eval::diagnosis_text(s.signals, s.diagnosis), "verdict"_a = s.diagnosis.verdict,
+      "measure_next"_a = s.diagnosis.measure_next, "t_s"_a = vector_array(s.signals.time_s),
+      "gap_rad"_a = matrix(s.signals.sample_count(), g.size(),
+                           [&](std::size_t r, std::size_t c) { return g[c][r]; }));
+}
+
 }  // namespace
 
 void bind_eval(py::module_& m) {
@@ -69,6 +89,21 @@ void bind_eval(py::module_& m) {
         "commanded one, as `imscal evaluate`: a dict with the keys of its figures.json (AT_p_mm, "
         "RT_p_mm, AT_a_deg, ..., max_path_deviation_mm, per_cycle). velocity_m_s <= 0: the "
         "commanded top speed.");
+  m.def(
+      "diagnose",
+      [](const std::string& joint_errors, const std::string& robot, const std::string& table,
+         const std::string& sim_joint_errors, double max_analysed_s) {
+        if (table.empty() == sim_joint_errors.empty())
+          throw InputError(joint_errors, 0, "table",
+                           "give the sim side: either table or sim_joint_errors");
+        return diagnose({joint_errors, table, sim_joint_errors, robot, max_analysed_s});
+      },
+      "joint_errors"_a, "robot"_a, py::kw_only(), "table"_a = "", "sim_joint_errors"_a = "",
+      "max_analysed_s"_a = eval::AnalysisWindows{}.max_s,
+      "The sim-to-real gap diagnosis of `imscal diagnose`: the measured joint_errors.csv "
+      "against an identified table (parameters.json) or a second joint_errors.csv. Returns "
+      "'report' (report.json as a dict), 'text' (report.txt), 'verdict', 'measure_next', and "
+      "the analysed samples' t_s (N,) and gap_rad (N, joints), real minus sim joint error.");
 }
 
 }  // namespace imscal::python

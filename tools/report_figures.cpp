@@ -73,18 +73,23 @@ std::string joint_errors_figure(GnuplotRenderer& gnuplot, const ident::JointErro
     std::vector<double> ims(log.sample_count()), internal(log.sample_count());
     for (std::size_t k = 0; k < log.sample_count(); ++k) {
       ims[k] = (log.q_desired_rad[j][k] - log.q_measured_rad[j][k]) * kMdegPerRad;
-      internal[k] = (log.q_desired_rad[j][k] - log.q_internal_rad[j][k]) * kMdegPerRad;
+      if (log.has_q_internal())
+        internal[k] = (log.q_desired_rad[j][k] - log.q_internal_rad[j][k]) * kMdegPerRad;
     }
     const std::string ims_file = gnuplot.data_file(fmt::format("dq-ims-{}.dat", j),
                                                    curve_data(log, ims, max_points_per_curve));
-    const std::string internal_file = gnuplot.data_file(
-        fmt::format("dq-internal-{}.dat", j), curve_data(log, internal, max_points_per_curve));
     script += fmt::format(
         "set title '{}' noenhanced\n"
-        "plot {} using 1:2 with lines lw 1.2 lc rgb '#1f5fbf' title 'IMS: q_d - q_{{measured}}', "
-        "{} using 1:2 with lines lw 1.2 lc rgb '#d0402b' title 'internal sensors: q_d - "
-        "q_{{internal}}'\n",
-        log.joint_names[j], ims_file, internal_file);
+        "plot {} using 1:2 with lines lw 1.2 lc rgb '#1f5fbf' title 'IMS: q_d - q_{{measured}}'",
+        log.joint_names[j], ims_file);
+    // Without the encoders' block (one position sensor per joint) the IMS curve alone.
+    if (log.has_q_internal())
+      script += fmt::format(
+          ", {} using 1:2 with lines lw 1.2 lc rgb '#d0402b' title 'internal sensors: q_d - "
+          "q_{{internal}}'",
+          gnuplot.data_file(fmt::format("dq-internal-{}.dat", j),
+                            curve_data(log, internal, max_points_per_curve)));
+    script += "\n";
   }
   script += "unset multiplot\n";
   const int height = static_cast<int>(280 * rows + 60);

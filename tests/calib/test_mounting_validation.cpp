@@ -312,5 +312,28 @@ TEST(MountingValidation, CleanSessionPassesAndSlippedMountIsLocated) {
   }
 }
 
+TEST(MountingValidation, PartsMountIsThatOfTheBundleWithTheClockOffsetWindows) {
+  // A half or segment is calibrated without the robot joint series (calibrate_part): the rate
+  // windows carry the clock offset and the link share only, so the part's T_S_H is the one the
+  // bundle with them finds, up to where the solver stops (its relative tolerance is on the total
+  // cost, to which the windows add). Tolerance: 1 % of the combined sigma, 300x below the
+  // 3-sigma warn level of the checks that use the parts.
+  SimulatedSession s;
+  simulate_session(s, std::nullopt);
+  const std::size_t first = 0, last = 6;
+  FrameCalibrationInput with_windows = s.input;
+  with_windows.rests.assign(s.input.rests.begin() + first, s.input.rests.begin() + last + 1);
+  ASSERT_FALSE(with_windows.robot.t_robot_s.empty());
+  const FrameCalibrationResult bundle = calibrate_frames(with_windows);
+  ASSERT_TRUE(bundle.converged);
+  EXPECT_NO_THROW((void)bundle.parameter_index("time_offset"));  // the windows were there
+  const SessionPart part = calibrate_part(s.input, {}, first, last, "first 7 rests");
+  ASSERT_TRUE(part.calibrated) << part.failure;
+  const MountingDifference d = compare_mountings(mounting_estimate(bundle), part.estimate);
+  std::printf("part without windows vs bundle with them: %.3g sigma (%.3g deg, %.3g mm)\n",
+              d.normalised, d.rotation_rad * kDegPerRad, d.translation_m * 1e3);
+  EXPECT_LT(d.normalised, 0.01);
+}
+
 }  // namespace
 }  // namespace imscal::calib

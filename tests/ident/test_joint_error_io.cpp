@@ -90,6 +90,37 @@ TEST_F(JointErrorFiles, RoundTripIsExactAndGapsSplitSegments) {
   EXPECT_EQ(back.first_data_line, 7u);  // 5 header comments + the column line
 }
 
+// A robot with one position sensor per joint: no q_internal block. Written without it, read back
+// with the same other columns, bit for bit, and the same as the file with the block.
+TEST_F(JointErrorFiles, TheInternalBlockIsOptional) {
+  const ident::JointErrorLog with = random_log();
+  ident::JointErrorLog without = with;
+  without.q_internal_rad.clear();
+  ident::write_joint_errors_csv(dir_ / "with.csv", with);
+  ident::write_joint_errors_csv(dir_ / "without.csv", without);
+  const ident::JointErrorLog back_with = ident::read_joint_errors_csv(dir_ / "with.csv");
+  const ident::JointErrorLog back = ident::read_joint_errors_csv(dir_ / "without.csv");
+  EXPECT_TRUE(back_with.has_q_internal());
+  EXPECT_FALSE(back.has_q_internal());
+  EXPECT_TRUE(back.q_internal_rad.empty());
+  EXPECT_EQ(back.time_s, back_with.time_s);
+  EXPECT_EQ(back.payload_kg, back_with.payload_kg);
+  EXPECT_EQ(back.q_desired_rad, back_with.q_desired_rad);
+  EXPECT_EQ(back.q_measured_rad, back_with.q_measured_rad);
+  EXPECT_EQ(back.segment_starts, back_with.segment_starts);
+  EXPECT_EQ(back.sample_lines, back_with.sample_lines);
+  // The column line ends with the last q_measured column.
+  std::ifstream in(dir_ / "without.csv");
+  std::string line, columns;
+  while (std::getline(in, line))
+    if (line.starts_with("t_s,")) columns = line;
+  EXPECT_TRUE(columns.ends_with(",q_measured_A3_rad")) << columns;
+  // A row with the internal block's cells on a header without it: too many columns.
+  const std::string header = kHeader.substr(0, kHeader.find(",q_internal_A1_rad")) + "\n";
+  EXPECT_NO_THROW(ident::read_joint_errors_csv(write(header + "0,5,0.1,0.2,0.1,0.2\n")));
+  expect_refused(header + "0,5,0.1,0.2,0.1,0.2,0.1,0.2\n", 5, "", "more than the 6 columns");
+}
+
 TEST_F(JointErrorFiles, WriterRefusesToOverwriteWhenAsked) {
   const ident::JointErrorLog log = random_log();
   ident::write_joint_errors_csv(dir_ / "a.csv", log);

@@ -1,4 +1,4 @@
-// Motion planning on the UR10e (datasets/robots/ur10e.urdf, no side file: kinematics, limits and
+// Motion planning on the UR10e (datasets/robots/ur10e.urdf: kinematics, limits and
 // the URDF's joint velocities): a Cartesian line of 800 mm (the paper's length) through the
 // UR-class inverse kinematics, checked through forward kinematics (independent of the IK the
 // planner used): the flange stays on the line with its orientation, and ends at the target.

@@ -1,7 +1,8 @@
-// The shipped motion programs (datasets/programs/*.yaml) plan on the default robot and do what
-// their comments promise: seed-line is the paper's test path; identification, mounting and
-// iso9283 have the moves, rests, payloads and geometry their briefs ask for. Positions are
-// checked through forward kinematics (independent of the IK the planner used).
+// The shipped motion programs (datasets/programs/*.yaml) plan on their robot (the default robot;
+// the UR10e for ur10e-*.yaml) within its limits and do what their comments promise: seed-line is
+// the paper's test path; identification, mounting and iso9283 have the moves, rests, payloads and
+// geometry their briefs ask for. Positions are checked through forward kinematics (independent of
+// the IK the planner used).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -40,6 +41,13 @@ struct Planned {
   DesiredJointPath path;
 };
 
+// The robot a program is written for: the UR10e's programs are named ur10e-*.
+const calib::RobotDescription& robot_for(const std::string& program) {
+  static const calib::RobotDescription ur10e =
+      calib::load_robot_description(std::string(IMSCAL_SOURCE_DIR) + "/datasets/robots/ur10e.urdf");
+  return program.rfind("ur10e-", 0) == 0 ? ur10e : robot();
+}
+
 // Each program is planned once for all tests.
 const Planned& planned(const std::string& name) {
   static std::map<std::string, Planned> cache;
@@ -47,7 +55,7 @@ const Planned& planned(const std::string& name) {
   if (it == cache.end()) {
     Planned p;
     p.program = load_motion_program(programs_dir() / (name + ".yaml"));
-    p.path = plan_motion(robot(), p.program);
+    p.path = plan_motion(robot_for(name), p.program);
     it = cache.emplace(name, std::move(p)).first;
   }
   return it->second;
@@ -66,9 +74,10 @@ TEST(ShippedPrograms, EveryProgramPlansWithinTheLimits) {
     SCOPED_TRACE(name);
     const Planned& p = planned(name);
     const DesiredJointPath& path = p.path;
-    const auto& k = robot().kinematics;
+    const calib::RobotDescription& r = robot_for(name);
+    const auto& k = r.kinematics;
     ASSERT_GT(path.samples.size(), 1u);
-    EXPECT_EQ(path.cycle_s, robot().controller_cycle_s);
+    EXPECT_EQ(path.cycle_s, r.controller_cycle_s);
     EXPECT_EQ(path.segments.front().begin_s, 0.0);
     EXPECT_EQ(path.segments.back().end_s, path.samples.back().t_s);
     for (std::size_t i = 1; i < path.segments.size(); ++i) {
@@ -87,7 +96,7 @@ TEST(ShippedPrograms, EveryProgramPlansWithinTheLimits) {
       for (int i = 0; i < 6; ++i) {
         outside_limits += s.q_rad(i) < k.lower_limit_rad(i) || s.q_rad(i) > k.upper_limit_rad(i);
         // Rounding slack only: the planner checks the same limit.
-        too_fast += std::abs(s.qd_rad_s(i)) > robot().joints[i].max_velocity_rad_s * (1 + 1e-9);
+        too_fast += std::abs(s.qd_rad_s(i)) > r.joints[i].max_velocity_rad_s * (1 + 1e-9);
       }
     }
     EXPECT_EQ(bad_time, 0);
@@ -122,7 +131,8 @@ TEST(ShippedPrograms, EveryProgramPlansWithinTheLimits) {
       EXPECT_LE(use.jerk, 1.0 + kJointLimitTolerance) << seg.label;
     }
   }
-  EXPECT_EQ(count, 5);  // seed-line, identification, mounting, iso9283, campaign
+  // seed-line, identification, mounting, iso9283, campaign; and each for the UR10e
+  EXPECT_EQ(count, 10);
 }
 
 TEST(ShippedPrograms, SeedLineIsThePapersTestPath) {

@@ -168,6 +168,9 @@ TEST_F(CommandBadInputs, ABadFieldIsRefusedWithFileLineAndField) {
       {"model-joint-errors: A2 at 57 deg", "joint_errors.csv", joint_errors_with_a2("1.0"),
        "model-joint-errors --joint-errors INPUT --robot " + kKr16 + " --out OUT",
        "joint_errors.csv:6", "q_desired_A2_rad"},
+      {"verify: joint errors with A2 at 57 deg", "joint_errors.csv", joint_errors_with_a2("1.0"),
+       "verify --joint-errors INPUT --scenario seed-line --cycles 1 --out OUT",
+       "joint_errors.csv:6", "q_desired_A2_rad"},
       {"serve: a path with A2 at 57 deg", "robot.csv", robot_log_with_a2("1.0"),
        "serve --table " + kTable + " --port 0 --robot " + kKr16 +
            " --idle-timeout-s 1 --path INPUT",
