@@ -29,6 +29,12 @@ void attach_session_model_torques(ident::JointErrorLog& log,
                                   const ident::IdentificationConfig& config,
                                   const IdentificationSessionOptions& options) {
   if (!config.options.model_torque_input) return;
+  // The table's users (run, compensate, serve) take the model torque from the robot file: a
+  // table identified with refined masses would be fed another torque than it was fitted on.
+  if (config.refine_mass_parameters)
+    throw InputError(options.config, 0, "model.refine_mass_parameters",
+                     "is taken by `imscal verify` only (the table's users compute the model "
+                     "torque from the robot file)");
   if (!options.model_torque)
     throw InputError(options.config, 0, "model.model_torque", "no rigid-body model given");
   const ModelTorqueSource model = options.model_torque(

@@ -7,39 +7,27 @@
 #include <stdexcept>
 
 #include "core/input_error.hpp"
-#include "sim/rigid_body_dynamics.hpp"
 
 namespace imscal::eval {
-namespace {
 
-// The rigid-body model with the payload of the current sample (rebuilt only when it changes:
-// payloads change a few times per program).
-class PayloadDynamics {
- public:
-  explicit PayloadDynamics(const ModelTorqueSource& model)
-      : dynamics_(model.robot, std::nullopt, model.gravity_in_base_m_s2) {}
+PayloadDynamics::PayloadDynamics(const ModelTorqueSource& model)
+    : dynamics_(model.robot, std::nullopt, model.gravity_in_base_m_s2) {}
 
-  calib::JointVector torque(double payload_kg, const calib::JointVector& q,
-                            const calib::JointVector& qd, const calib::JointVector& qdd) {
-    if (payload_kg != payload_kg_) {
-      payload_kg_ = payload_kg;
-      std::optional<calib::RigidBodyParameters> body;
-      if (payload_kg > 0.0) {
-        calib::RigidBodyParameters point_mass;  // centre of mass at T's origin, no inertia
-        point_mass.mass_kg = payload_kg;
-        body = point_mass;
-      }
-      dynamics_.set_payload(body);
+calib::JointVector PayloadDynamics::torque(double payload_kg, const calib::JointVector& q,
+                                           const calib::JointVector& qd,
+                                           const calib::JointVector& qdd) {
+  if (payload_kg != payload_kg_) {
+    payload_kg_ = payload_kg;
+    std::optional<calib::RigidBodyParameters> body;
+    if (payload_kg > 0.0) {
+      calib::RigidBodyParameters point_mass;  // centre of mass at T's origin, no inertia
+      point_mass.mass_kg = payload_kg;
+      body = point_mass;
     }
-    return dynamics_.inverse_dynamics(q, qd, qdd);
+    dynamics_.set_payload(body);
   }
-
- private:
-  sim::RigidBodyDynamics dynamics_;
-  double payload_kg_ = 0.0;
-};
-
-}  // namespace
+  return dynamics_.inverse_dynamics(q, qd, qdd);
+}
 
 std::vector<std::vector<double>> model_torques_along(
     const ModelTorqueSource& model, double cycle_s, const std::vector<std::vector<double>>& q_rad,

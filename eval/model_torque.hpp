@@ -16,6 +16,7 @@
 //
 // References (docs/references.md): [KDL], [Featherstone2008] (inverse dynamics).
 #include <Eigen/Core>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -25,6 +26,7 @@
 #include "ident/joint_identification.hpp"
 #include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
+#include "sim/rigid_body_dynamics.hpp"
 
 namespace imscal::eval {
 
@@ -32,6 +34,19 @@ namespace imscal::eval {
 struct ModelTorqueSource {
   calib::RobotDescription robot;
   Eigen::Vector3d gravity_in_base_m_s2 = Eigen::Vector3d(0.0, 0.0, -9.81);
+};
+
+// The rigid-body model with the payload of the current sample, a point mass at T's origin
+// (rebuilt only when it changes: payloads change a few times per program).
+class PayloadDynamics {
+ public:
+  explicit PayloadDynamics(const ModelTorqueSource& model);
+  calib::JointVector torque(double payload_kg, const calib::JointVector& q,
+                            const calib::JointVector& qd, const calib::JointVector& qdd);
+
+ private:
+  sim::RigidBodyDynamics dynamics_;
+  double payload_kg_ = 0.0;
 };
 
 // The rigid-body model of `robot_file` for the data of `data_robot` (file `data_file`, for

@@ -15,6 +15,7 @@
 #include "core/output_folder.hpp"
 #include "core/payload_plausibility.hpp"
 #include "eval/joint_error_limits.hpp"
+#include "eval/mass_refinement.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "ident/identification_config.hpp"
 #include "ident/joint_error_io.hpp"
@@ -112,16 +113,39 @@ std::vector<NamedTable> session_tables(const VerificationSessionOptions& options
   return tables;
 }
 
+// The nominal model with its mass parameters refined from the identification record.
+ModelTorqueSource refined_model_torque(const ident::JointErrorLog& log,
+                                       const ModelTorqueSource& nominal) {
+  spdlog::info("verify: refining the model torque's mass parameters from the record");
+  const MassRefinement refined = refine_mass_parameters(log, nominal);
+  for (std::size_t i = 0; i < refined.links.size(); ++i) {
+    const LinkMassEstimate& l = refined.links[i];
+    spdlog::info(
+        "verify: link {}: mass {:.2f} ± {:.2f} kg (nominal {:.2f}), centre of mass "
+        "[{:.3f} {:.3f} {:.3f}] ± [{:.3f} {:.3f} {:.3f}] m (nominal [{:.3f} {:.3f} {:.3f}])",
+        i + 1, l.mass_kg, l.mass_sigma_kg, l.nominal_mass_kg, l.com_m.x(), l.com_m.y(), l.com_m.z(),
+        l.com_sigma_m.x(), l.com_sigma_m.y(), l.com_sigma_m.z(), l.nominal_com_m.x(),
+        l.nominal_com_m.y(), l.nominal_com_m.z());
+  }
+  return refined.model;
+}
+
+// The session's tables, and the refined model torque when the config refines it (the loop's
+// precontrol then takes its torque from that model, as the tables were identified with it).
+struct SessionTables {
+  std::vector<NamedTable> tables;
+  std::optional<ModelTorqueSource> refined_model;
+};
+
 // The tables of the session: the joint errors' robot checked against the scenarios' nominal
 // robot, whose rigid-body model (never the plant's) serves the multi-input tables.
-std::vector<NamedTable> prepare_tables(const VerificationSessionOptions& options,
-                                       const SessionFolders& folders) {
+SessionTables prepare_tables(const VerificationSessionOptions& options,
+                             const SessionFolders& folders) {
   const JointErrorSource source = joint_error_source(options, folders);
   if (options.table.empty() && !source.log)
     throw InputError("", 0, "--table", "give --table, --joint-errors or --identify-scenario");
-  const ModelTorqueSource torque_model = scenario_model_torque(sim::load_scenario(
-      sim::resolve_scenario(options.identify_scenario.empty() ? options.scenarios.front()
-                                                              : options.identify_scenario)));
+  ModelTorqueSource torque_model = scenario_model_torque(sim::load_scenario(sim::resolve_scenario(
+      options.identify_scenario.empty() ? options.scenarios.front() : options.identify_scenario)));
   if (source.log && source.log->robot != torque_model.robot.name)
     throw InputError(source.file, 0, "robot",
                      fmt::format("the joint errors are of robot '{}', the scenarios' "
@@ -137,7 +161,13 @@ std::vector<NamedTable> prepare_tables(const VerificationSessionOptions& options
                        "needs joint errors and a config with the transmission error");
     search_orders(*source.log, torque_model, *config);
   }
-  return session_tables(options, source, config, torque_model, folders);
+  SessionTables out;
+  if (config && config->refine_mass_parameters) {
+    out.refined_model = refined_model_torque(*source.log, torque_model);
+    torque_model = *out.refined_model;
+  }
+  out.tables = session_tables(options, source, config, torque_model, folders);
+  return out;
 }
 
 // An earlier session's outputs are refused before any work (the output folder checks every file
@@ -206,7 +236,11 @@ void verify_session(const VerificationSessionOptions& options, const fs::path& o
   if (progress) progress("tables", 0.0);
   refuse_earlier_outputs(options, out, overwrite);
   const WorkFolder work(out);
-  const std::vector<NamedTable> tables = prepare_tables(options, {out, work.path});
+  const SessionTables prepared = prepare_tables(options, {out, work.path});
+  const std::vector<NamedTable>& tables = prepared.tables;
+  VerificationOptions verification = options.verification;
+  if (prepared.refined_model && !verification.compensation.model_torque)
+    verification.compensation.model_torque = prepared.refined_model;
   const VerificationRecord record{options.verification.seed,
                                   options.verification.compensation.look_ahead_cycles,
                                   options.verification.compensation.inversion_iterations,
@@ -218,7 +252,7 @@ void verify_session(const VerificationSessionOptions& options, const fs::path& o
     if (progress) progress(scenario.name, double(i) / double(options.scenarios.size()));
     VerificationResult r;
     try {
-      r = verify_scenario(scenario, tables, options.verification);
+      r = verify_scenario(scenario, tables, verification);
     } catch (const std::invalid_argument& e) {
       throw InputError(scenario.file.string(), 0, "", e.what());
     }

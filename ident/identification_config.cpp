@@ -189,12 +189,12 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
         cells->get_double("min_rms_speed_deg_s", o.min_rms_speed_rad_s / kRadPerDeg) * kRadPerDeg;
   }
   if (auto model = root.optional_child("model")) {
-    model->require_only_keys({"form", "preview_cycles", "preview_s", "model_torque", "direction",
-                              "direction_speed_scale_deg_s", "torque_sign",
-                              "torque_sign_scale_fraction", "input_taps", "input_history_s",
-                              "torque_sign_taps", "torque_sign_history_s", "transmission_error",
-                              "transmission_error_harmonic_per_motor_rev",
-                              "transmission_error_taps", "transmission_error_history_s"});
+    model->require_only_keys(
+        {"form", "preview_cycles", "preview_s", "model_torque", "direction",
+         "direction_speed_scale_deg_s", "torque_sign", "torque_sign_scale_fraction", "input_taps",
+         "input_history_s", "torque_sign_taps", "torque_sign_history_s", "transmission_error",
+         "transmission_error_harmonic_per_motor_rev", "transmission_error_taps",
+         "transmission_error_history_s", "refine_mass_parameters"});
     ConfigDurations& d = c.durations;
     d.preview_s = duration_instead_of_count(*model, "model", "preview_s", "preview_cycles", c);
     d.input_history_s =
@@ -230,6 +230,9 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
       model->child("torque_sign_scale_fraction").fail("must be in (0, 1] of the RMS torque");
     if (o.torque_sign_input && !o.model_torque_input)
       model->child("torque_sign").fail("the torque-sign input needs model_torque: true");
+    c.refine_mass_parameters = model->get_bool("refine_mass_parameters", false);
+    if (c.refine_mass_parameters && !o.model_torque_input)
+      model->child("refine_mass_parameters").fail("refines the model torque: needs model_torque");
     o.input_taps = int(model->get_int("input_taps", o.input_taps));
     if (o.input_taps < 1 || o.input_taps > 64)
       model->child("input_taps").fail("must be in 1..64 coefficients per further input");

@@ -64,6 +64,9 @@ struct IdentificationConfig {
   std::vector<double> payload_fraction_bounds{0.0, 0.5, 1.0};     // of nominal payload
   std::vector<ExtraDimension> extra_dimensions;
   JointIdentificationOptions options;
+  // `model.refine_mass_parameters:` the model torque's link masses and centres of mass refined
+  // from the record before the tables are identified (eval/mass_refinement.hpp).
+  bool refine_mass_parameters = false;
 
   // Speed × payload (× extra dimensions) of one joint, in SI. Throws std::invalid_argument for
   // a joint without a maximum speed.

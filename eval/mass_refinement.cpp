@@ -1,0 +1,245 @@
+#include "eval/mass_refinement.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace imscal::eval {
+namespace {
+
+constexpr int kPerLink = 4;  // mass, centre of mass x, y, z
+constexpr int kParameters = calib::kJointCount * kPerLink;
+using Parameters = Eigen::Matrix<double, kParameters, 1>;
+using Torques = std::vector<calib::JointVector>;  // [row]
+
+Parameters parameters_of(const calib::RobotDescription& robot) {
+  Parameters p;
+  for (int i = 0; i < calib::kJointCount; ++i) {
+    const calib::RigidBodyParameters& link = robot.joints[std::size_t(i)].link;
+    p(kPerLink * i) = link.mass_kg;
+    p.segment<3>(kPerLink * i + 1) = link.com_m;
+  }
+  return p;
+}
+
+ModelTorqueSource with_parameters(ModelTorqueSource model, const Parameters& p) {
+  for (int i = 0; i < calib::kJointCount; ++i) {
+    calib::RigidBodyParameters& link = model.robot.joints[std::size_t(i)].link;
+    link.mass_kg = p(kPerLink * i);
+    link.com_m = p.segment<3>(kPerLink * i + 1);
+  }
+  return model;
+}
+
+// The record at every decimation-th sample: the desired path's state (central differences on
+// the full record), the payload, the joint error; runs of consecutive rows, one per segment.
+struct DecimatedRecord {
+  std::vector<calib::JointVector> q, qd, qdd, error;
+  std::vector<double> payload_kg;
+  std::vector<std::pair<std::size_t, std::size_t>> runs;
+};
+
+DecimatedRecord decimated(const ident::JointErrorLog& log, int decimation) {
+  DecimatedRecord out;
+  const double dt = log.cycle_s;
+  for (const auto& [begin, end] : log.segments()) {
+    const std::size_t first_row = out.q.size();
+    for (std::size_t k = begin + 1; k + 1 < end; k += std::size_t(decimation)) {
+      calib::JointVector q, qd, qdd, e;
+      for (int j = 0; j < calib::kJointCount; ++j) {
+        const auto& x = log.q_desired_rad[std::size_t(j)];
+        q(j) = x[k];
+        qd(j) = (x[k + 1] - x[k - 1]) / (2.0 * dt);
+        qdd(j) = (x[k + 1] - 2.0 * x[k] + x[k - 1]) / (dt * dt);
+        e(j) = log.q_measured_rad[std::size_t(j)][k] - x[k];
+      }
+      out.q.push_back(q);
+      out.qd.push_back(qd);
+      out.qdd.push_back(qdd);
+      out.error.push_back(e);
+      out.payload_kg.push_back(log.payload_kg[k]);
+    }
+    if (out.q.size() > first_row) out.runs.emplace_back(first_row, out.q.size());
+  }
+  return out;
+}
+
+Torques torques_of(const ModelTorqueSource& model, const DecimatedRecord& r) {
+  PayloadDynamics dynamics(model);
+  Torques out(r.q.size());
+  for (std::size_t i = 0; i < r.q.size(); ++i)
+    out[i] = dynamics.torque(r.payload_kg[i], r.q[i], r.qd[i], r.qdd[i]);
+  return out;
+}
+
+// ∂τ/∂π_p [row] for every parameter: the torque is linear in a link's mass (its centre of
+// mass and inertia fixed), so the mass's difference quotient is exact; 1 mm for the centre of
+// mass (the parallel-axis term is quadratic in it).
+std::vector<Torques> torque_jacobian(const ModelTorqueSource& nominal, const Parameters& p,
+                                     const DecimatedRecord& r, const Torques& at_p) {
+  std::vector<Torques> out;
+  for (int k = 0; k < kParameters; ++k) {
+    const double step = k % kPerLink == 0 ? std::max(0.01 * p(k), 0.01) : 1e-3;
+    Parameters moved = p;
+    moved(k) += step;
+    Torques t = torques_of(with_parameters(nominal, moved), r);
+    for (std::size_t i = 0; i < t.size(); ++i) t[i] = (t[i] - at_p[i]) / step;
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+// The rows the ARX models use: those with their whole history inside their run.
+std::vector<std::size_t> model_rows(const DecimatedRecord& r, const MassRefinementOptions& o) {
+  const std::size_t history = std::size_t(std::max(o.error_lags, o.input_taps - 1));
+  std::vector<std::size_t> rows;
+  for (const auto& [begin, end] : r.runs)
+    for (std::size_t i = begin + history; i < end; ++i) rows.push_back(i);
+  return rows;
+}
+
+// One joint's ARX fit with the torque τ: its columns' orthonormal basis Q, the residual, its
+// variance and the torque's coefficients.
+struct JointFit {
+  Eigen::MatrixXd basis;
+  Eigen::VectorXd residual;
+  Eigen::VectorXd torque_taps;
+  double variance = 1.0;
+};
+
+// The residual's integrated correlation time in rows, 1 + 2 Σ ρ_k up to its first negative
+// autocorrelation: the rows are that many times fewer independent ones, so the information the
+// data give is that many times less than white residuals would give.
+double correlation_time(const Eigen::VectorXd& r) {
+  const double r0 = r.squaredNorm();
+  if (!(r0 > 0.0)) return 1.0;
+  double sum = 1.0;
+  for (Eigen::Index lag = 1; lag < std::min<Eigen::Index>(r.size() / 4, 500); ++lag) {
+    const double rho = r.head(r.size() - lag).dot(r.tail(r.size() - lag)) / r0;
+    if (rho <= 0.0) break;
+    sum += 2.0 * rho;
+  }
+  return sum;
+}
+
+JointFit fit_joint(int j, const DecimatedRecord& r, const Torques& tau,
+                   const std::vector<std::size_t>& rows, const MassRefinementOptions& o) {
+  const int na = o.error_lags, nb = o.input_taps;
+  const int columns = na + 2 * nb + 2;
+  Eigen::MatrixXd x(Eigen::Index(rows.size()), columns);
+  Eigen::VectorXd y(Eigen::Index(rows.size()));
+  for (std::size_t n = 0; n < rows.size(); ++n) {
+    const std::size_t i = rows[n];
+    const auto row = Eigen::Index(n);
+    y(row) = r.error[i](j);
+    for (int l = 1; l <= na; ++l) x(row, l - 1) = -r.error[i - std::size_t(l)](j);
+    for (int l = 0; l < nb; ++l) {
+      x(row, na + l) = r.qd[i - std::size_t(l)](j);
+      x(row, na + nb + l) = tau[i - std::size_t(l)](j);
+    }
+    x(row, na + 2 * nb) = std::tanh(r.qd[i](j) / o.direction_speed_scale_rad_s);
+    x(row, na + 2 * nb + 1) = 1.0;
+  }
+  // Columns scaled to unit RMS: torques [N m] and errors [rad] differ by ~1e8.
+  const Eigen::VectorXd scale =
+      (x.colwise().norm().array() / std::sqrt(double(rows.size()))).max(1e-300).matrix();
+  const Eigen::MatrixXd scaled = x * scale.cwiseInverse().asDiagonal();
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(scaled);
+  JointFit fit;
+  fit.basis = qr.householderQ() * Eigen::MatrixXd::Identity(scaled.rows(), columns);
+  fit.residual = y - fit.basis * (fit.basis.transpose() * y);
+  const Eigen::VectorXd theta = qr.solve(y).cwiseQuotient(scale);
+  fit.torque_taps = theta.segment(na + nb, nb);
+  fit.variance = std::max(fit.residual.squaredNorm() / double(rows.size() - columns), 1e-300) *
+                 correlation_time(fit.residual);
+  return fit;
+}
+
+// The joint's columns Σ_l c_l ∂τ_j/∂π(i − l), its ARX columns projected out.
+Eigen::MatrixXd projected_columns(int j, const JointFit& fit, const std::vector<Torques>& jac,
+                                  const std::vector<std::size_t>& rows) {
+  Eigen::MatrixXd z(Eigen::Index(rows.size()), kParameters);
+  for (int p = 0; p < kParameters; ++p)
+    for (std::size_t n = 0; n < rows.size(); ++n) {
+      double sum = 0.0;
+      for (Eigen::Index l = 0; l < fit.torque_taps.size(); ++l)
+        sum += fit.torque_taps(l) * jac[std::size_t(p)][rows[n] - std::size_t(l)](j);
+      z(Eigen::Index(n), p) = sum;
+    }
+  return z - fit.basis * (fit.basis.transpose() * z);
+}
+
+Parameters prior_precision(const Parameters& nominal, const MassRefinementOptions& o) {
+  Parameters precision;
+  for (int k = 0; k < kParameters; ++k) {
+    const double sigma =
+        k % kPerLink == 0 ? std::max(o.mass_prior_fraction * nominal(k), 1e-3) : o.com_prior_m;
+    precision(k) = 1.0 / (sigma * sigma);
+  }
+  return precision;
+}
+
+struct Step {
+  Parameters delta;
+  Eigen::Matrix<double, kParameters, kParameters> normal;
+};
+
+// One Gauss–Newton step of π (its models fixed) with the prior at the nominal values.
+Step gauss_newton_step(const ModelTorqueSource& nominal, const Parameters& p0, const Parameters& p,
+                       const DecimatedRecord& r, const std::vector<std::size_t>& rows,
+                       const MassRefinementOptions& o) {
+  const Torques tau = torques_of(with_parameters(nominal, p), r);
+  const std::vector<Torques> jac = torque_jacobian(nominal, p, r, tau);
+  const Parameters precision = prior_precision(p0, o);
+  Step step;
+  step.normal = precision.asDiagonal();
+  Parameters gradient = -precision.cwiseProduct(p - p0);
+  for (int j = 0; j < calib::kJointCount; ++j) {
+    const JointFit fit = fit_joint(j, r, tau, rows, o);
+    const Eigen::MatrixXd z = projected_columns(j, fit, jac, rows);
+    step.normal += z.transpose() * z / fit.variance;
+    gradient += z.transpose() * fit.residual / fit.variance;
+  }
+  step.delta = step.normal.ldlt().solve(gradient);
+  return step;
+}
+
+}  // namespace
+
+MassRefinement refine_mass_parameters(const ident::JointErrorLog& log,
+                                      const ModelTorqueSource& nominal,
+                                      const MassRefinementOptions& options) {
+  if (log.joint_count() != std::size_t(calib::kJointCount))
+    throw std::invalid_argument("refine_mass_parameters: the record needs the robot's 6 joints");
+  const DecimatedRecord record = decimated(log, std::max(options.decimation, 1));
+  const std::vector<std::size_t> rows = model_rows(record, options);
+  if (rows.size() < std::size_t(10 * kParameters))
+    throw std::invalid_argument("refine_mass_parameters: the record is too short");
+  const Parameters p0 = parameters_of(nominal.robot);
+  Parameters p = p0;
+  MassRefinement out;
+  Step step;
+  for (out.iterations = 0; out.iterations < std::max(options.iterations, 1); ++out.iterations) {
+    step = gauss_newton_step(nominal, p0, p, record, rows, options);
+    p += step.delta;
+    for (int i = 0; i < calib::kJointCount; ++i)  // a mass stays positive
+      p(kPerLink * i) = std::max(p(kPerLink * i), 0.1 * p0(kPerLink * i));
+  }
+  const Parameters sigma = step.normal.inverse().diagonal().cwiseSqrt();
+  out.model = with_parameters(nominal, p);
+  for (int i = 0; i < calib::kJointCount; ++i) {
+    LinkMassEstimate& link = out.links[std::size_t(i)];
+    link.nominal_mass_kg = p0(kPerLink * i);
+    link.mass_kg = p(kPerLink * i);
+    link.mass_sigma_kg = sigma(kPerLink * i);
+    link.nominal_com_m = p0.segment<3>(kPerLink * i + 1);
+    link.com_m = p.segment<3>(kPerLink * i + 1);
+    link.com_sigma_m = sigma.segment<3>(kPerLink * i + 1);
+  }
+  return out;
+}
+
+}  // namespace imscal::eval

@@ -1,0 +1,65 @@
+#pragma once
+// The mass parameters of the model torque (eval/model_torque.hpp) refined from the
+// identification record: the robot log has no torques, only the joint errors e = q_m − q_d and
+// the path, and e depends on the model torque τ(π) through the drive's filter (compliance, the
+// loop), e_j ≈ G_j(z) τ_j(π) + the motion's own terms, bilinear in (G, π). Separable least
+// squares, linearised at the nominal values:
+//  1. π fixed: per joint a FIR model of e_j on taps of the desired speed and of τ_j(π), the
+//     direction of motion and a constant (no lags of e_j itself: they predict e_j from its own
+//     past and leave the torque's mismatch in no residual);
+//  2. the models fixed: a Gauss–Newton step for π over all joints together, from the residuals
+//     r_j and the columns Σ_l c_j,l ∂τ_j/∂π(k − l) with each joint's model columns projected
+//     out (what the model absorbs by its own coefficients, e.g. a joint's torque scale, does
+//     not count), each joint weighted by its residual variance times the residual's correlation
+//     time (the rows are that many times fewer independent ones), with a Gaussian prior at the
+//     nominal values.
+// One step by default: the drive model is only an approximation of the joint error, and further
+// alternations drift along the directions it explains poorly (measured: decision 0047).
+// π: each link's mass and centre of mass (4 per link; the inertia about the centre of mass stays
+// nominal), the parameters a data sheet gets wrong. The torque is taken along the desired path
+// (its exact pose to a few arcseconds, derivatives without the measurement's noise). 1σ from the
+// last step's normal matrix.
+//
+// References (docs/references.md): [Ljung1999] (ARX, least squares), [GolubPereyra2003] (separable
+// least squares: the linear coefficients projected out), [KDL] (inverse dynamics).
+#include <Eigen/Core>
+#include <array>
+
+#include "eval/model_torque.hpp"
+#include "ident/joint_error_io.hpp"
+
+namespace imscal::eval {
+
+struct MassRefinementOptions {
+  double mass_prior_fraction = 0.3;  // 1σ of a link's mass, a fraction of its nominal mass
+  double com_prior_m = 0.03;         // 1σ of each coordinate of a link's centre of mass [m]
+  int iterations = 1;  // Gauss–Newton steps (each after a new fit of the drive models)
+  // Every decimation-th sample (8 ms at 2 ms: the loop's 2 Hz and the gear's ~15 Hz stay below
+  // the 62 Hz Nyquist frequency; a quarter of the inverse dynamics passes).
+  int decimation = 4;
+  // The drive's model: no lags of the error itself (they would predict the error from its own
+  // past and leave the torque's mismatch in no residual), 16 taps (128 ms) of the desired speed
+  // and of the torque.
+  int error_lags = 0;
+  int input_taps = 16;
+  double direction_speed_scale_rad_s = 0.01;  // tanh(q̇ / scale)
+};
+
+struct LinkMassEstimate {
+  double nominal_mass_kg = 0.0, mass_kg = 0.0, mass_sigma_kg = 0.0;
+  Eigen::Vector3d nominal_com_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d com_m = Eigen::Vector3d::Zero(), com_sigma_m = Eigen::Vector3d::Zero();
+};
+
+struct MassRefinement {
+  ModelTorqueSource model;  // the nominal model with the refined masses and centres of mass
+  std::array<LinkMassEstimate, calib::kJointCount> links;
+  int iterations = 0;
+};
+
+// Throws std::invalid_argument when the record is not of the model's 6 joints or too short.
+MassRefinement refine_mass_parameters(const ident::JointErrorLog& log,
+                                      const ModelTorqueSource& nominal,
+                                      const MassRefinementOptions& options = {});
+
+}  // namespace imscal::eval

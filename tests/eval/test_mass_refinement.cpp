@@ -1,0 +1,109 @@
+// The model torque's mass parameters refined from joint errors: a record is synthesised from a
+// "plant" whose link masses and centres of mass differ from the nominal robot's (the simulated
+// truth), with the joint error a known drive response to the plant's torque; the refinement,
+// given the nominal robot only, must bring the model torque to the plant's.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "calib/robot_description.hpp"
+#include "eval/mass_refinement.hpp"
+#include "eval/model_torque.hpp"
+
+namespace imscal::eval {
+namespace {
+
+ModelTorqueSource kr16() {
+  return {calib::load_robot_description(IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml"),
+          Eigen::Vector3d(0.0, 0.0, -9.81)};
+}
+
+// Smooth multi-sine moves of every joint in two runs of 20 s, without and with 10 kg.
+ident::JointErrorLog desired_record() {
+  ident::JointErrorLog log;
+  log.robot = "kr16";
+  log.joint_names = {"A1", "A2", "A3", "A4", "A5", "A6"};
+  log.q_desired_rad.assign(6, {});
+  log.q_measured_rad.assign(6, {});
+  log.q_internal_rad.assign(6, {});
+  const double dt = log.cycle_s;
+  for (int run = 0; run < 2; ++run) {
+    if (run == 1) log.segment_starts.push_back(log.time_s.size());
+    for (int k = 0; k < 10000; ++k) {
+      const double t = k * dt;
+      log.time_s.push_back(run * 30.0 + t);
+      log.payload_kg.push_back(run * 10.0);
+      for (int j = 0; j < 6; ++j) {
+        const double w = 0.4 + 0.13 * j + 0.05 * run;
+        const double q = 0.8 * std::sin(w * t + j) + 0.3 * std::sin(2.7 * w * t);
+        log.q_desired_rad[std::size_t(j)].push_back(j == 1 ? q - 1.2 : j == 2 ? q + 1.4 : q);
+      }
+    }
+  }
+  return log;
+}
+
+double rms_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) sum += (a[k] - b[k]) * (a[k] - b[k]);
+  return std::sqrt(sum / double(a.size()));
+}
+
+TEST(MassRefinement, BringsTheModelTorqueToThePlantsFromJointErrors) {
+  const ModelTorqueSource nominal = kr16();
+  ModelTorqueSource plant = nominal;
+  plant.robot.joints[1].link.mass_kg *= 1.25;
+  plant.robot.joints[1].link.com_m += Eigen::Vector3d(0.03, -0.02, 0.0);
+  plant.robot.joints[2].link.mass_kg *= 0.75;
+  plant.robot.joints[2].link.com_m += Eigen::Vector3d(-0.02, 0.0, 0.03);
+
+  // Joint error: the gear's compliance under the plant's torque along the desired path, plus a
+  // following error proportional to the speed and 1 µrad of white measurement noise.
+  ident::JointErrorLog log = desired_record();
+  const auto segments = log.segments();
+  const auto truth =
+      model_torques_along(plant, log.cycle_s, log.q_desired_rad, log.payload_kg, segments);
+  const auto before =
+      model_torques_along(nominal, log.cycle_s, log.q_desired_rad, log.payload_kg, segments);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 1e-6);
+  const double compliance_rad_per_nm[6] = {2.5e-6, 2.2e-6, 5e-6, 3.3e-5, 2e-5, 2.5e-4};
+  for (std::size_t j = 0; j < 6; ++j)
+    for (const auto& [begin, end] : segments)
+      for (std::size_t k = begin; k < end; ++k) {
+        const std::size_t lo = k > begin ? k - 1 : k, hi = k + 1 < end ? k + 1 : k;
+        const double speed =
+            (log.q_desired_rad[j][hi] - log.q_desired_rad[j][lo]) / (double(hi - lo) * log.cycle_s);
+        log.q_measured_rad[j].push_back(log.q_desired_rad[j][k] +
+                                        compliance_rad_per_nm[j] * truth[j][k] - 2e-3 * speed +
+                                        noise(rng));
+      }
+  log.q_internal_rad = log.q_measured_rad;
+
+  // One Gauss–Newton step (the default): linearised at the nominal values, it leaves the
+  // centres of mass' nonlinearity (measured: A2 13 %, A3 4 % of the error before). Four steps
+  // converge here, where the drive model is exact (the shipped record's is not: decision 0047).
+  for (const auto& [iterations, bound] : {std::pair{1, 0.2}, std::pair{4, 0.1}}) {
+    MassRefinementOptions options;
+    options.iterations = iterations;
+    const MassRefinement refined = refine_mass_parameters(log, nominal, options);
+    const auto after = model_torques_along(refined.model, log.cycle_s, log.q_desired_rad,
+                                           log.payload_kg, segments);
+    // A2 and A3 carry the changed links' gravity.
+    for (std::size_t j : {std::size_t(1), std::size_t(2)}) {
+      const double error_before = rms_difference(before[j], truth[j]);
+      const double error_after = rms_difference(after[j], truth[j]);
+      EXPECT_GT(error_before, 5.0) << "joint " << j + 1 << ": the plant must differ [N m]";
+      EXPECT_LT(error_after, bound * error_before) << "joint " << j + 1 << ", " << iterations;
+    }
+    // The mass of link 2 (the largest change, +10 kg) within 10 % of the plant's.
+    EXPECT_NEAR(refined.links[1].mass_kg, plant.robot.joints[1].link.mass_kg,
+                0.1 * plant.robot.joints[1].link.mass_kg)
+        << iterations;
+  }
+}
+
+}  // namespace
+}  // namespace imscal::eval

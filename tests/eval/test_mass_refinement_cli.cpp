@@ -1,0 +1,41 @@
+// `imscal identify` refuses `model.refine_mass_parameters`: the table's users compute the model
+// torque from the robot file, so a table fitted on the refined torque would be fed another one.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "tests/support/run_imscal.hpp"
+#include "tests/support/scratch_dir.hpp"
+
+namespace imscal::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+class MassRefinementCli : public test_support::ScratchDirTest {};
+
+TEST_F(MassRefinementCli, IdentifyRefusesTheKeyNamingIt) {
+  const fs::path source(IMSCAL_SOURCE_DIR);
+  std::string text =
+      test_support::read_file_text(source / "datasets/identification/ident-default.yaml");
+  const std::string off = "refine_mass_parameters: false";
+  const std::size_t at = text.find(off);
+  ASSERT_NE(at, std::string::npos) << "the shipped config states the key";
+  text.replace(at, off.size(), "refine_mass_parameters: true");
+  const fs::path config = dir_ / "ident.yaml", out = dir_ / "out";
+  std::ofstream(config) << text;
+  const int status = test_support::run_imscal(
+      "identify --joint-errors " + (source / "fuzz/corpus/joint_errors/small.csv").string() +
+          " --config " + config.string() + " --robot " +
+          (source / "datasets/robots/kr16.yaml").string() + " --out " + out.string(),
+      dir_ / "message.log");
+  const std::string message = test_support::read_file_text(dir_ / "message.log");
+  EXPECT_EQ(status, 2) << message;
+  EXPECT_NE(message.find("field 'model.refine_mass_parameters'"), std::string::npos) << message;
+  EXPECT_FALSE(fs::exists(out)) << "nothing is written";
+}
+
+}  // namespace
+}  // namespace imscal::eval
