@@ -8,9 +8,9 @@
 #include <random>
 #include <string>
 
-#include "calib/robot_description.hpp"
 #include "eval/mass_refinement.hpp"
 #include "eval/model_torque.hpp"
+#include "robot/robot_description.hpp"
 
 namespace imscal::eval {
 namespace {
