@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -90,6 +92,19 @@ struct Unknowns {
   double offset[1];
 };
 
+// The rests' gyro mean as a prior on the bias: residual weight * (b - mean) per axis, with
+// weight = (the windows' RMS residual) / (the rest mean's 1 sigma) [rad / (rad/s)].
+struct BiasPrior {
+  Eigen::Vector3d mean_rad_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d weight_s = Eigen::Vector3d::Zero();
+
+  template <typename T>
+  bool operator()(const T* bias, T* residual) const {
+    for (int i = 0; i < 3; ++i) residual[i] = T(weight_s[i]) * (bias[i] - T(mean_rad_s[i]));
+    return true;
+  }
+};
+
 // The calibration's problems have 11 unknowns: dense QR on one thread, as the whole record and
 // each bootstrap replicate solve it.
 ceres::Solver::Summary solve_small_problem(ceres::Problem& problem, int max_iterations) {
@@ -105,12 +120,17 @@ ceres::Solver::Summary solve_small_problem(ceres::Problem& problem, int max_iter
 // The window residuals on the unknowns `x`, as calibrate_rotation and each bootstrap replicate
 // solve them.
 void add_windows(const ToolImuRecord& record, const std::vector<Window>& windows,
-                 const RotationCalibrationOptions& options, Unknowns& x, ceres::Problem& problem) {
+                 const RotationCalibrationOptions& options, const BiasPrior* prior, Unknowns& x,
+                 ceres::Problem& problem) {
   for (const auto& [a, b] : windows) {
     auto* cost = new ceres::NumericDiffCostFunction<WindowCost, ceres::CENTRAL, 3, 4, 3, 3, 3, 1>(
         new WindowCost{&record, a, b});
     problem.AddResidualBlock(cost, new ceres::CauchyLoss(options.cauchy_scale_rad), x.q, x.bias,
                              x.scale, x.coupling, x.offset);
+  }
+  if (prior != nullptr) {
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<BiasPrior, 3, 3>(new BiasPrior(*prior)), nullptr, x.bias);
   }
   problem.SetManifold(x.q, new ceres::EigenQuaternionManifold);
   if (!options.estimate_scale) problem.SetParameterBlockConstant(x.scale);
@@ -119,9 +139,9 @@ void add_windows(const ToolImuRecord& record, const std::vector<Window>& windows
 
 // Solves the window residuals from `x` (updated in place).
 bool solve_windows(const ToolImuRecord& record, const std::vector<Window>& windows,
-                   const RotationCalibrationOptions& options, Unknowns& x) {
+                   const RotationCalibrationOptions& options, const BiasPrior* prior, Unknowns& x) {
   ceres::Problem problem;
-  add_windows(record, windows, options, x, problem);
+  add_windows(record, windows, options, prior, x, problem);
   return solve_small_problem(problem, options.max_iterations).IsSolutionUsable();
 }
 
@@ -202,9 +222,10 @@ Eigen::Matrix<double, N, 1> robust_spread(const std::vector<Eigen::Matrix<double
 // of windows, drawn with replacement until the window count is reached (the last one cut), are
 // re-solved from the estimate; the spread of the estimates over the replicates is the 1 sigma.
 // Rotation deviations as small angles about the T axes, log(q_b * q^-1).
+// The rests' prior is data apart from the windows and enters every replicate unchanged.
 void block_bootstrap_sigma(const ToolImuRecord& record, const std::vector<Window>& windows,
-                           const RotationCalibrationOptions& options, const Unknowns& estimate,
-                           RotationCalibration& result) {
+                           const RotationCalibrationOptions& options, const BiasPrior* prior,
+                           const Unknowns& estimate, RotationCalibration& result) {
   const std::size_t n = windows.size();
   const auto units = resampling_units(record, windows, options, estimate.offset[0]);
   result.bootstrap_unit_count = units.size();
@@ -219,7 +240,8 @@ void block_bootstrap_sigma(const ToolImuRecord& record, const std::vector<Window
       for (std::size_t i = 0; i < unit.size() && sample.size() < n; ++i) sample.push_back(unit[i]);
     }
     Unknowns x = estimate;
-    if (!solve_windows(record, sample, options, x)) continue;  // counted in bootstrap_replicates
+    if (!solve_windows(record, sample, options, prior, x))
+      continue;  // counted in bootstrap_replicates
     Eigen::Matrix<double, 13, 1> d;
     d.head<3>() =
         ims::quat_log(Eigen::Quaterniond(rotation_of(x) * rotation_of(estimate).conjugate()));
@@ -244,51 +266,16 @@ void block_bootstrap_sigma(const ToolImuRecord& record, const std::vector<Window
   result.sigma_from_bootstrap = true;
   result.sigma_resampling = options.sigma_resampling;
 }
-}  // namespace
 
-bool gyro_bias_at_rest(const ToolImuRecord& record, double time_offset_s, double rest_rate_rad_s,
-                       Eigen::Vector3d& bias_rad_s, double max_time_s) {
-  const RobotRateSeries robot = robot_tool_rate(record);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  std::size_t count = 0;
-  for (std::size_t k = 0; k < record.t_s.size() && record.t_s[k] <= max_time_s; ++k) {
-    // Still over +-0.1 s around the sample: the robot is not just passing through zero rate.
-    bool still = true;
-    for (double dt : {-0.1, 0.0, 0.1}) {
-      Eigen::Vector3d w;
-      if (!robot_rate_at(robot, record.t_s[k] - time_offset_s + dt, w) ||
-          w.norm() > rest_rate_rad_s) {
-        still = false;
-      }
-    }
-    // The first samples of a record may be zero placeholders (the files' first row is all zero).
-    if (!still || record.gyro_rad_s[k].isZero(0.0)) continue;
-    sum += record.gyro_rad_s[k];
-    ++count;
-  }
-  if (count < 10) return false;
-  bias_rad_s = sum / static_cast<double>(count);
-  return true;
-}
-
-RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolImuAnalysis& analysis,
-                                       const RotationCalibrationOptions& options) {
-  if (!record.has_raw_imu) {
-    throw InputError(record.file, 0, "gyro_x_dps", "rotation calibration needs raw gyro columns");
-  }
-  RotationCalibration result;
-  double offset = analysis.time_offset_s;
-  Eigen::Quaterniond q_T_S(analysis.R_T_S);
-  Eigen::Vector3d bias = Eigen::Vector3d::Zero();
-  gyro_bias_at_rest(record, offset, options.rest_rate_rad_s, bias);
-  Eigen::Vector3d scale = Eigen::Vector3d::Constant(analysis.gyro_scale_ratio);
-
-  // Windows of samples, skipping gaps, rails and spans without valid robot poses (with a margin
-  // of 0.15 s for the offset to move, probed every 5 ms: shorter than any pose gap that
-  // robot_orientation_at refuses, 0.2 s).
+// Windows of samples, skipping gaps, rails and spans without valid robot poses (with a margin
+// of 0.15 s for the offset to move, probed every 5 ms: shorter than any pose gap that
+// robot_orientation_at refuses, 0.2 s). Counts the skipped ones in `skipped`.
+std::vector<Window> usable_windows(const ToolImuRecord& record, const ToolImuAnalysis& analysis,
+                                   const RotationCalibrationOptions& options, double offset,
+                                   std::size_t& skipped) {
   constexpr double kOffsetMargin_s = 0.15;
   constexpr double kOffsetProbeStep_s = 0.005;
-  std::vector<std::pair<std::size_t, std::size_t>> windows;
+  std::vector<Window> windows;
   const auto& t = record.t_s;
   std::size_t first = 0;
   while (first < t.size()) {
@@ -326,74 +313,71 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
     if (usable) {
       windows.emplace_back(first, last);
     } else {
-      ++result.skipped_window_count;
+      ++skipped;
     }
     // Next window start: stride later.
     std::size_t next = first + 1;
     while (next < t.size() && t[next] - t[first] < options.window_stride_s) ++next;
     first = next;
   }
-  if (windows.size() < 10) {
-    throw InputError(record.file, 0, "t_s",
-                     fmt::format("only {} usable windows of {:.2f} s for the rotation calibration",
-                                 windows.size(), options.window_s));
-  }
+  return windows;
+}
 
-  Unknowns x{{q_T_S.x(), q_T_S.y(), q_T_S.z(), q_T_S.w()},
-             {bias.x(), bias.y(), bias.z()},
-             {scale.x(), scale.y(), scale.z()},
-             {0.0, 0.0, 0.0},
-             {offset}};
-  ceres::Problem problem;
-  add_windows(record, windows, options, x, problem);
-
-  // Every window has a finite residual at the initial values (else the solve cannot start:
-  // name the first that has none).
-  double initial_sum = 0.0;
+// Every window has a finite residual at the initial values (else the solve cannot start: names
+// the first that has none). Returns the RMS residual per component [rad].
+double initial_rms_residual(const ToolImuRecord& record, const std::vector<Window>& windows,
+                            const Unknowns& x) {
+  double sum = 0.0;
   for (const Window& w : windows) {
     bool finite = false;
-    initial_sum += window_residual_sq(record, w, x, finite);
+    sum += window_residual_sq(record, w, x, finite);
     if (!finite) {
       throw InputError(
           record.file, record.lines[w.first], "gyro_x_dps",
           fmt::format("the rotation calibration's window of lines {}-{} has no "
                       "finite residual at the initial values (R_T_S, bias, scale "
                       "{:.4g}, time offset {:.4f} s)",
-                      record.lines[w.first], record.lines[w.second], scale.x(), offset));
+                      record.lines[w.first], record.lines[w.second], x.scale[0], x.offset[0]));
     }
   }
-  result.initial_rms_residual_rad = std::sqrt(initial_sum / (3.0 * windows.size()));
+  return std::sqrt(sum / (3.0 * static_cast<double>(windows.size())));
+}
 
+// Solves `problem` from x; a failed solve has no estimate and no covariance (ceres::Covariance
+// on it aborts), so it is refused.
+void solve_or_refuse(const ToolImuRecord& record, const RotationCalibrationOptions& options,
+                     ceres::Problem& problem, RotationCalibration& result) {
   const ceres::Solver::Summary summary = solve_small_problem(problem, options.max_iterations);
   result.summary = summary.BriefReport();
-  result.iterations = static_cast<int>(summary.iterations.size());
-  // A failed solve has no estimate and no covariance (ceres::Covariance on it aborts).
+  result.iterations += static_cast<int>(summary.iterations.size());
   if (!summary.IsSolutionUsable()) {
     throw InputError(
         record.file, 0, "gyro_x_dps",
         fmt::format("the rotation calibration's solve failed ({}): {}",
                     ceres::TerminationTypeToString(summary.termination_type), summary.message));
   }
+}
 
-  result.q_T_S = rotation_of(x);
-  result.gyro_bias_rad_s = Eigen::Vector3d(x.bias);
-  result.gyro_scale = Eigen::Vector3d(x.scale);
-  result.gyro_cross_coupling = Eigen::Vector3d(x.coupling);
-  result.time_offset_s = x.offset[0];
-  result.window_count = windows.size();
-
+// The RMS window residual per component at x [rad], and the windows above 3 Cauchy scales.
+double window_rms(const ToolImuRecord& record, const std::vector<Window>& windows,
+                  const RotationCalibrationOptions& options, const Unknowns& x,
+                  std::size_t& outliers) {
   double sum = 0.0;
+  outliers = 0;
   for (const Window& w : windows) {
     // The solver accepts only steps where every window evaluates; this holds at its result.
     bool finite = false;
     const double norm_sq = window_residual_sq(record, w, x, finite);
     sum += norm_sq;
-    if (std::sqrt(norm_sq) > 3.0 * options.cauchy_scale_rad) ++result.outlier_window_count;
+    if (std::sqrt(norm_sq) > 3.0 * options.cauchy_scale_rad) ++outliers;
   }
-  result.rms_residual_rad = std::sqrt(sum / (3.0 * windows.size()));
+  return std::sqrt(sum / (3.0 * static_cast<double>(windows.size())));
+}
 
-  // Covariance, scaled by the residual variance per component (the windows' residuals are not
-  // in units of their sigma).
+// Covariance, scaled by the residual variance per component (the windows' residuals are not in
+// units of their sigma): the 1 sigma of rotation, bias, scale and offset in `result`.
+void covariance_sigma(const RotationCalibrationOptions& options, std::size_t window_count,
+                      ceres::Problem& problem, Unknowns& x, RotationCalibration& result) {
   ceres::Covariance::Options covariance_options;
   covariance_options.algorithm_type = ceres::DENSE_SVD;
   covariance_options.null_space_rank = -1;  // pseudo-inverse when rank deficient
@@ -401,49 +385,129 @@ RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolIm
   std::vector<std::pair<const double*, const double*>> blocks = {
       {x.q, x.q}, {x.bias, x.bias}, {x.offset, x.offset}};
   if (options.estimate_scale) blocks.emplace_back(x.scale, x.scale);
-  if (covariance.Compute(blocks, &problem)) {
-    const std::size_t parameter_count =
-        7 + (options.estimate_scale ? 3 : 0) + (options.estimate_cross_coupling ? 3 : 0);
-    const double dof = std::max(1.0, 3.0 * windows.size() - parameter_count);
-    const double variance = sum / dof;
-    double c3[9];
-    // The 3x3 tangent-space block of the rotation. (GetCovarianceMatrixInTangentSpace with the
-    // list {q, q} would write the 6x6 joint matrix of that list into this 9-double buffer.)
-    covariance.GetCovarianceBlockInTangentSpace(x.q, x.q, c3);
-    for (int i = 0; i < 3; ++i) result.sigma_rotation_rad[i] = std::sqrt(c3[4 * i] * variance);
-    // A negative variance means a numerically rank-deficient problem: no usable sigma.
-    result.covariance_ok = result.sigma_rotation_rad.allFinite();
-    covariance.GetCovarianceBlock(x.bias, x.bias, c3);
-    for (int i = 0; i < 3; ++i) result.sigma_bias_rad_s[i] = std::sqrt(c3[4 * i] * variance);
-    if (options.estimate_scale) {
-      covariance.GetCovarianceBlock(x.scale, x.scale, c3);
-      for (int i = 0; i < 3; ++i) result.sigma_scale[i] = std::sqrt(c3[4 * i] * variance);
-    }
-    double c1 = 0.0;
-    covariance.GetCovarianceBlock(x.offset, x.offset, &c1);
-    result.sigma_time_offset_s = std::sqrt(c1 * variance);
-    result.covariance_ok = result.covariance_ok && result.sigma_bias_rad_s.allFinite() &&
-                           result.sigma_scale.allFinite() &&
-                           std::isfinite(result.sigma_time_offset_s);
+  if (!covariance.Compute(blocks, &problem)) return;
+  const std::size_t parameter_count =
+      7 + (options.estimate_scale ? 3 : 0) + (options.estimate_cross_coupling ? 3 : 0);
+  const double sum =
+      3.0 * static_cast<double>(window_count) * result.rms_residual_rad * result.rms_residual_rad;
+  const double dof = std::max(1.0, 3.0 * static_cast<double>(window_count) - parameter_count);
+  const double variance = sum / dof;
+  double c3[9];
+  // The 3x3 tangent-space block of the rotation. (GetCovarianceMatrixInTangentSpace with the
+  // list {q, q} would write the 6x6 joint matrix of that list into this 9-double buffer.)
+  covariance.GetCovarianceBlockInTangentSpace(x.q, x.q, c3);
+  for (int i = 0; i < 3; ++i) result.sigma_rotation_rad[i] = std::sqrt(c3[4 * i] * variance);
+  // A negative variance means a numerically rank-deficient problem: no usable sigma.
+  result.covariance_ok = result.sigma_rotation_rad.allFinite();
+  covariance.GetCovarianceBlock(x.bias, x.bias, c3);
+  for (int i = 0; i < 3; ++i) result.sigma_bias_rad_s[i] = std::sqrt(c3[4 * i] * variance);
+  if (options.estimate_scale) {
+    covariance.GetCovarianceBlock(x.scale, x.scale, c3);
+    for (int i = 0; i < 3; ++i) result.sigma_scale[i] = std::sqrt(c3[4 * i] * variance);
   }
+  double c1 = 0.0;
+  covariance.GetCovarianceBlock(x.offset, x.offset, &c1);
+  result.sigma_time_offset_s = std::sqrt(c1 * variance);
+  result.covariance_ok = result.covariance_ok && result.sigma_bias_rad_s.allFinite() &&
+                         result.sigma_scale.allFinite() &&
+                         std::isfinite(result.sigma_time_offset_s);
+}
 
-  result.covariance_sigma_rotation_rad = result.sigma_rotation_rad;
-  result.covariance_sigma_time_offset_s = result.sigma_time_offset_s;
-  if (options.bootstrap_replicates > 0) block_bootstrap_sigma(record, windows, options, x, result);
-
-  // Gravity's direction in B from the still samples.
+// Gravity's direction in B from the still samples.
+Eigen::Vector3d up_in_base(const ToolImuRecord& record, const RotationCalibration& calibration,
+                           double rest_rate_rad_s) {
   const RobotRateSeries robot = robot_tool_rate(record);
   Eigen::Vector3d up_sum = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < t.size(); ++k) {
+  for (std::size_t k = 0; k < record.t_s.size(); ++k) {
     Eigen::Vector3d w;
     Eigen::Quaterniond q_B_T;
+    const double t_robot_s = record.t_s[k] - calibration.time_offset_s;
     if (record.acc_m_s2[k].isZero(0.0)) continue;
-    if (!robot_rate_at(robot, t[k] - result.time_offset_s, w) || w.norm() > options.rest_rate_rad_s)
-      continue;
-    if (!robot_orientation_at(record, t[k] - result.time_offset_s, q_B_T)) continue;
-    up_sum += q_B_T * (result.q_T_S * record.acc_m_s2[k]).normalized();
+    if (!robot_rate_at(robot, t_robot_s, w) || w.norm() > rest_rate_rad_s) continue;
+    if (!robot_orientation_at(record, t_robot_s, q_B_T)) continue;
+    up_sum += q_B_T * (calibration.q_T_S * record.acc_m_s2[k]).normalized();
   }
-  if (up_sum.norm() > 0.0) result.up_B = up_sum.normalized();
+  return up_sum.norm() > 0.0 ? Eigen::Vector3d(up_sum.normalized()) : Eigen::Vector3d::UnitZ();
+}
+
+// The bias prior from the rests (null without one), weighted against windows whose RMS residual
+// per component is window_rms_rad. A zero sigma (identical readings) is floored at 1e-6 rad/s.
+std::optional<BiasPrior> rest_bias_prior(const GyroRestBias& rest, double window_rms_rad) {
+  if (rest.sample_count == 0) return std::nullopt;
+  BiasPrior prior;
+  prior.mean_rad_s = rest.mean_rad_s;
+  prior.weight_s = window_rms_rad * rest.sigma_rad_s.cwiseMax(1e-6).cwiseInverse();
+  return prior;
+}
+}  // namespace
+
+bool gyro_bias_at_rest(const ToolImuRecord& record, double time_offset_s, double rest_rate_rad_s,
+                       Eigen::Vector3d& bias_rad_s, double max_time_s) {
+  GyroRestBias rest;
+  if (!gyro_rest_bias(record, time_offset_s, rest_rate_rad_s, rest, max_time_s)) return false;
+  bias_rad_s = rest.mean_rad_s;
+  return true;
+}
+
+RotationCalibration calibrate_rotation(const ToolImuRecord& record, const ToolImuAnalysis& analysis,
+                                       const RotationCalibrationOptions& options) {
+  if (!record.has_raw_imu) {
+    throw InputError(record.file, 0, "gyro_x_dps", "rotation calibration needs raw gyro columns");
+  }
+  RotationCalibration result;
+  const double offset = analysis.time_offset_s;
+  const Eigen::Quaterniond q_T_S(analysis.R_T_S);
+  GyroRestBias rest;
+  if (gyro_rest_bias(record, offset, options.rest_rate_rad_s, rest)) {
+    result.rest_bias_rad_s = rest.mean_rad_s;
+    result.sigma_rest_bias_rad_s = rest.sigma_rad_s;
+    result.rest_sample_count = rest.sample_count;
+  }
+  const double scale = analysis.gyro_scale_ratio;
+  const std::vector<Window> windows =
+      usable_windows(record, analysis, options, offset, result.skipped_window_count);
+  if (windows.size() < 10) {
+    throw InputError(record.file, 0, "t_s",
+                     fmt::format("only {} usable windows of {:.2f} s for the rotation calibration",
+                                 windows.size(), options.window_s));
+  }
+  const Eigen::Vector3d& bias = rest.mean_rad_s;  // zero without rests
+  Unknowns x{{q_T_S.x(), q_T_S.y(), q_T_S.z(), q_T_S.w()},
+             {bias.x(), bias.y(), bias.z()},
+             {scale, scale, scale},
+             {0.0, 0.0, 0.0},
+             {offset}};
+  result.initial_rms_residual_rad = initial_rms_residual(record, windows, x);
+  result.window_count = windows.size();
+
+  // First the windows alone; then, with the rests as a prior weighted by that fit's scatter,
+  // again from its result.
+  auto problem = std::make_unique<ceres::Problem>();
+  add_windows(record, windows, options, nullptr, x, *problem);
+  solve_or_refuse(record, options, *problem, result);
+  result.rms_residual_rad = window_rms(record, windows, options, x, result.outlier_window_count);
+  const std::optional<BiasPrior> prior =
+      options.rest_bias_prior ? rest_bias_prior(rest, result.rms_residual_rad) : std::nullopt;
+  if (prior) {
+    problem = std::make_unique<ceres::Problem>();
+    add_windows(record, windows, options, &*prior, x, *problem);
+    solve_or_refuse(record, options, *problem, result);
+    result.rms_residual_rad = window_rms(record, windows, options, x, result.outlier_window_count);
+    result.rest_bias_prior_used = true;
+  }
+
+  result.q_T_S = rotation_of(x);
+  result.gyro_bias_rad_s = Eigen::Vector3d(x.bias);
+  result.gyro_scale = Eigen::Vector3d(x.scale);
+  result.gyro_cross_coupling = Eigen::Vector3d(x.coupling);
+  result.time_offset_s = x.offset[0];
+  covariance_sigma(options, windows.size(), *problem, x, result);
+  result.covariance_sigma_rotation_rad = result.sigma_rotation_rad;
+  result.covariance_sigma_time_offset_s = result.sigma_time_offset_s;
+  if (options.bootstrap_replicates > 0) {
+    block_bootstrap_sigma(record, windows, options, prior ? &*prior : nullptr, x, result);
+  }
+  result.up_B = up_in_base(record, result, options.rest_rate_rad_s);
   return result;
 }
 

@@ -15,7 +15,8 @@
 // (the robot pose is interpolated in time, and the offset moves the interpolation).
 // Initial values without user guesses: the offset by cross-correlation of |omega|, R_T_S by the
 // Kabsch fit of rate vectors, the scale from |gyro| / |robot rate| (all from
-// check_tool_imu_record), the bias from the samples where the robot stands still.
+// check_tool_imu_record), the bias from the samples where the robot stands still; optionally
+// those rests stay in the fit as a prior on the bias (RotationCalibrationOptions::rest_bias_prior).
 // Uncertainty (1 sigma): by a bootstrap that resamples whole motion segments (the residuals are
 // correlated in time and depend on the motion), with a robust spread, beside ceres::Covariance
 // scaled by the residual variance.
@@ -25,6 +26,7 @@
 #include <cstddef>
 #include <string>
 
+#include "calib/gyro_rest_bias.hpp"
 #include "calib/tool_imu_record.hpp"
 
 namespace imscal::calib {
@@ -45,8 +47,15 @@ struct RotationCalibrationOptions {
   // The gyro's axes' cross-coupling c (symmetric part of the misalignment; else c = 0).
   bool estimate_cross_coupling = true;
   double cauchy_scale_rad = 0.5 * M_PI / 180.0;  // robust loss scale on the residual [rad]
-  // Robot angular rate below which a sample counts as "at rest" for the initial bias [rad/s].
+  // Robot angular rate below which a sample counts as "at rest" for the bias [rad/s].
   double rest_rate_rad_s = 0.01;
+  // The rests' mean gyro reading (calib/gyro_rest_bias.hpp) as a prior on the bias b: a residual
+  // (b - rest mean) / its 1 sigma per axis, scaled to the windows' RMS residual of a first solve
+  // without it, so that both terms count in units of their own scatter. Off by default: on the
+  // ABB path 3 records the free bias departs from the rests by a tool-frame rate that three
+  // different sensors share (a property of the run, not of one gyro), and pinning it to the rests
+  // helps one record and harms two (decision 0055).
+  bool rest_bias_prior = false;
   int max_iterations = 100;
   // 1 sigma by a bootstrap of the windows, per component at least the covariance's (0
   // replicates: the covariance's alone, which takes the windows as independent). The units
@@ -85,6 +94,12 @@ struct RotationCalibration {
   // Gravity's specific force direction in the robot base B (unit, "up" as the accelerometer
   // sees it), averaged over rest samples: the attitude filter's aiding reference.
   Eigen::Vector3d up_B = Eigen::Vector3d::UnitZ();
+  // The rests' gyro mean and its 1 sigma [rad/s, as labelled], and whether it entered the fit as
+  // a prior (rest_bias_prior and at least 10 still samples).
+  Eigen::Vector3d rest_bias_rad_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_rest_bias_rad_s = Eigen::Vector3d::Zero();
+  std::size_t rest_sample_count = 0;
+  bool rest_bias_prior_used = false;
   std::size_t window_count = 0;
   std::size_t skipped_window_count = 0;
   double rms_residual_rad = 0.0;  // after the fit, over all windows

@@ -36,6 +36,10 @@ nlohmann::json calibration_json(const RotationCalibration& c) {
   j["sigma_rotation_deg"] = vector_json(c.sigma_rotation_rad, kDegPerRad);
   j["gyro_bias_deg_s_as_labelled"] = vector_json(c.gyro_bias_rad_s, kDegPerRad);
   j["sigma_gyro_bias_deg_s"] = vector_json(c.sigma_bias_rad_s, kDegPerRad);
+  j["rest_gyro_bias_deg_s_as_labelled"] = vector_json(c.rest_bias_rad_s, kDegPerRad);
+  j["sigma_rest_gyro_bias_deg_s"] = vector_json(c.sigma_rest_bias_rad_s, kDegPerRad);
+  j["rest_samples"] = c.rest_sample_count;
+  j["rest_bias_prior"] = c.rest_bias_prior_used;
   j["gyro_scale"] = vector_json(c.gyro_scale);
   j["sigma_gyro_scale"] = vector_json(c.sigma_scale);
   j["gyro_cross_coupling"] = vector_json(c.gyro_cross_coupling);
@@ -60,13 +64,19 @@ void print_calibration(const std::string& title, const RotationCalibration& c,
       "{}: R_T_S angle {:.3f} deg (1 sigma {:.3f} {:.3f} {:.3f} deg, {}), time offset {:.4f} +- "
       "{:.4f} s,\n  gyro bias {:.4g} {:.4g} {:.4g} deg/s (as labelled), scale {:.5g} {:.5g} "
       "{:.5g}, cross-coupling {:.3g} {:.3g} {:.3g}, window residual RMS {:.3f} deg over {} "
-      "windows\n",
+      "windows\n  the rests read {:.4g} {:.4g} {:.4g} deg/s (1 sigma {:.2g} {:.2g} {:.2g}, {} "
+      "samples; {})\n",
       title, Eigen::AngleAxisd(c.q_T_S).angle() * kDegPerRad, c.sigma_rotation_rad.x() * kDegPerRad,
       c.sigma_rotation_rad.y() * kDegPerRad, c.sigma_rotation_rad.z() * kDegPerRad, sigma_method(c),
       c.time_offset_s, c.sigma_time_offset_s, c.gyro_bias_rad_s.x() * kDegPerRad,
       c.gyro_bias_rad_s.y() * kDegPerRad, c.gyro_bias_rad_s.z() * kDegPerRad, c.gyro_scale.x(),
       c.gyro_scale.y(), c.gyro_scale.z(), c.gyro_cross_coupling.x(), c.gyro_cross_coupling.y(),
-      c.gyro_cross_coupling.z(), c.rms_residual_rad * kDegPerRad, c.window_count));
+      c.gyro_cross_coupling.z(), c.rms_residual_rad * kDegPerRad, c.window_count,
+      c.rest_bias_rad_s.x() * kDegPerRad, c.rest_bias_rad_s.y() * kDegPerRad,
+      c.rest_bias_rad_s.z() * kDegPerRad, c.sigma_rest_bias_rad_s.x() * kDegPerRad,
+      c.sigma_rest_bias_rad_s.y() * kDegPerRad, c.sigma_rest_bias_rad_s.z() * kDegPerRad,
+      c.rest_sample_count,
+      c.rest_bias_prior_used ? "a prior on the bias" : "the bias's start, not a prior"));
 }
 
 nlohmann::json error_json(const OrientationErrorStats& e) {
