@@ -143,9 +143,11 @@ TEST_F(CheckToolImuGoals, EveryShippedRecordMeetsTheGoals) {
 }
 
 // Each record with its own calibration (the command as a user with one record runs it). Measured
-// medians 0.74-4.10 deg (LSM9DS0 of V_500_Sequencia3 misses the 4 deg goal: its own fit puts the
-// z scale 1.6 % below the other sequence's, a 180 deg turn then loses 3.5 deg, under the 5 deg
-// flag, and the error stays near 4 deg; decision 0046), 90th percentiles 2.20-5.35 deg.
+// medians 0.74-4.10 deg (LSM9DS0 of V_500_Sequencia3 misses the 4 deg goal: a 180 deg turn right
+// after its first restart loses 3.5 deg, under the 5 deg flag, and the error stays near 4 deg;
+// the sensor tilts against the robot's reported tool by 3.9 deg across that turn, as the
+// accelerometer shows at the rests, and no gyro model holds it; decision 0055), 90th
+// percentiles 2.20-5.35 deg.
 // Asserted: exit 0, the 8 deg goal on the 90th percentile, and the median within 4.5 deg (10 %
 // over the worst measured; the 4 deg goal is asserted above on the held-out procedure).
 TEST_F(CheckToolImuGoals, EveryShippedRecordWithItsOwnCalibration) {
