@@ -46,6 +46,15 @@ struct WithheldEffect {
   double size = 0.0;
 };
 
+// The measurement noise added to a case's "real" q_measured. kLow: the harness's (white 3e-6 rad
+// plus a first-order 50 ms coloured part of 3e-6 rad, ~3 um at 1 m). kImsChain: the IMS chain's
+// own error on joint angles, measured 3e-5..9e-5 rad RMS per joint through `simulate` ->
+// `calibrate --frames` -> `model-joint-errors` on a control (test_gap_harness_wide.cpp): per joint
+// an RMS drawn in 5e-5..8e-5 rad, 90 % of its variance a first-order part of 1 s (the chain's
+// error holds at rest and moves with the motions: frames, heading and biases seen from another
+// pose) and 10 % white.
+enum class NoiseLevel { kLow, kImsChain };
+
 inline EffectKind expected_kind(const std::string& name) {
   if (name == "backlash") return EffectKind::kBacklash;
   if (name == "coulomb") return EffectKind::kCoulombFriction;
@@ -225,6 +234,26 @@ struct GapWorld {
       }
     return int(std::max_element(energy.begin(), energy.end()) - energy.begin());
   }
+  // NoiseLevel::kImsChain: each joint's noise scaled to its drawn RMS over the record.
+  static void add_ims_chain_noise(std::mt19937_64& rng, ident::JointErrorLog& log) {
+    std::uniform_real_distribution<double> rms_rad(5e-5, 8e-5);
+    std::normal_distribution<double> unit(0.0, 1.0);
+    const double phi = std::exp(-log.cycle_s / 1.0);
+    for (auto& qm : log.q_measured_rad) {
+      const double rms = rms_rad(rng);
+      std::vector<double> slow(qm.size()), fast(qm.size());
+      double ar = unit(rng), e_slow = 0.0, e_fast = 0.0;
+      for (std::size_t k = 0; k < qm.size(); ++k) {
+        ar = phi * ar + std::sqrt(1.0 - phi * phi) * unit(rng);
+        slow[k] = ar, fast[k] = unit(rng);
+        e_slow += ar * ar, e_fast += fast[k] * fast[k];
+      }
+      const double n = double(qm.size());
+      const double a = rms * std::sqrt(0.9 * n / e_slow), b = rms * std::sqrt(0.1 * n / e_fast);
+      for (std::size_t k = 0; k < qm.size(); ++k) qm[k] += a * slow[k] + b * fast[k];
+    }
+  }
+
   // One speed dimension per joint: joint `joint` identified up to v_id (the band above filled),
   // the others identified over their whole range.
   ident::ParameterTable operating_point_table(int joint, double v_id) const {
@@ -254,7 +283,8 @@ struct GapWorld {
     return t;
   }
 
-  Case make_case(const std::vector<WithheldEffect>& effects, std::uint64_t seed) const {
+  Case make_case(const std::vector<WithheldEffect>& effects, std::uint64_t seed,
+                 NoiseLevel noise = NoiseLevel::kLow) const {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> size(0.7, 1.3);
     sim::PlantConfig real_config = base, sim_config = base;
@@ -384,13 +414,17 @@ struct GapWorld {
         energy[j] += g * g;
       }
     c.spread_joint = int(std::max_element(energy.begin(), energy.end()) - energy.begin());
-    std::normal_distribution<double> white(0.0, 3e-6);
-    const double phi = std::exp(-log.cycle_s / 0.05);
-    for (auto& qm : log.q_measured_rad) {
-      double ar = 0.0;
-      for (double& v : qm) {
-        ar = phi * ar + std::sqrt(1.0 - phi * phi) * white(rng);
-        v += white(rng) + ar;
+    if (noise == NoiseLevel::kImsChain) {
+      add_ims_chain_noise(rng, log);
+    } else {
+      std::normal_distribution<double> white(0.0, 3e-6);
+      const double phi = std::exp(-log.cycle_s / 0.05);
+      for (auto& qm : log.q_measured_rad) {
+        double ar = 0.0;
+        for (double& v : qm) {
+          ar = phi * ar + std::sqrt(1.0 - phi * phi) * white(rng);
+          v += white(rng) + ar;
+        }
       }
     }
     c.real = std::move(log);
