@@ -40,7 +40,7 @@ struct Score {
 
 // One case run blind and scored (see the file's head); its row of the confusion matrix counted.
 inline Score score_case(const GapWorld& world, const HarnessCase& hc,
-                 std::map<std::string, std::map<std::string, int>>& confusion) {
+                        std::map<std::string, std::map<std::string, int>>& confusion) {
   const auto c = world.make_case(hc.effects, hc.seed, hc.noise);
   const GapSignals signals =
       make_gap_signals(c.real, c.sim_joint_error_rad, world.robot, c.table ? &*c.table : nullptr);
@@ -77,8 +77,7 @@ inline Score score_case(const GapWorld& world, const HarnessCase& hc,
       const int joint = spread ? c.spread_joint : e.joint;
       for (std::size_t m : lead) {
         const auto& f = d.candidates[m].fit;
-        s.ranked_first |=
-            f.kind == expected_kind(e.name) && (spread || int(f.joint) == joint);
+        s.ranked_first |= f.kind == expected_kind(e.name) && (spread || int(f.joint) == joint);
       }
       s.joint_located |= int(top.joint) == joint;
     }
@@ -116,6 +115,5 @@ inline Score score_case(const GapWorld& world, const HarnessCase& hc,
              fmt::join(d.refinement.changes, "; "));
   return s;
 }
-
 
 }  // namespace imscal::eval::test

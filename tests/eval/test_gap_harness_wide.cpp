@@ -188,8 +188,8 @@ class GapHarnessWide : public test_support::ScratchDirTest {
   // The mounting session of unit/mount `seed`: its frames.json and the unit's calibration sheet.
   std::pair<fs::path, fs::path> mounting_session(int seed) {
     const std::string tag = fmt::format("mount{}", seed);
-    const fs::path scenario = write_scenario(
-        tag, datasets_ / "programs/mounting.yaml", 0.0123, seed);
+    const fs::path scenario =
+        write_scenario(tag, datasets_ / "programs/mounting.yaml", 0.0123, seed);
     run("simulate --scenario " + scenario.string() + " --out " + (dir_ / tag).string(), tag);
     // The lab's sheet of the unit: scale factors and misalignments, biases left to the bundle.
     std::string sheet = test_support::read_file_text(dir_ / tag / "truth/sensor_errors.yaml");
@@ -214,15 +214,14 @@ class GapHarnessWide : public test_support::ScratchDirTest {
     const fs::path scenario = write_scenario(tag, scenarios_ / program, 0.0371, seed);
     const fs::path sim = dir_ / tag, cal = dir_ / (tag + "-cal");
     run("simulate --scenario " + scenario.string() + " --out " + sim.string(), tag);
-    run(calibrate_arguments(sim, unit, cal) + " --frames " + frames.string(), tag + "-cal",
-        {0, 1});
+    run(calibrate_arguments(sim, unit, cal) + " --frames " + frames.string(), tag + "-cal", {0, 1});
     const fs::path model = dir_ / (tag + "-model.csv"), out = dir_ / (tag + "-diagnose");
     run("model-joint-errors --joint-errors " + (cal / "joint_errors.csv").string() +
             " --scenario " + scenario.string() + " --out " + model.string(),
         tag + "-model");
-    run("diagnose --joint-errors " + (cal / "joint_errors.csv").string() +
-            " --sim-joint-errors " + model.string() + " --robot " +
-            (datasets_ / "robots/kr16.yaml").string() + " --out " + out.string(),
+    run("diagnose --joint-errors " + (cal / "joint_errors.csv").string() + " --sim-joint-errors " +
+            model.string() + " --robot " + (datasets_ / "robots/kr16.yaml").string() + " --out " +
+            out.string(),
         tag + "-diagnose");
     const ident::JointErrorLog measured = ident::read_joint_errors_csv(cal / "joint_errors.csv");
     const ident::JointErrorLog modelled = ident::read_joint_errors_csv(model);
@@ -268,8 +267,8 @@ TEST_F(GapHarnessWide, ProgramsCasesAndChainMeasuredControlsMeetTheGoals) {
       set.alarms += alarm;
     }
   }
-  for (const auto& [label, t] : {std::pair{"development", development},
-                                 std::pair{"held_out", held_out}}) {
+  for (const auto& [label, t] :
+       {std::pair{"development", development}, std::pair{"held_out", held_out}}) {
     fmt::print(
         "\n{}: ranked first {}/{} ({:.0f} %), joint located {}/{} ({:.0f} %), shrinkage within "
         "±20 pp {}/{} ({:.0f} %), every effect of a multi-effect case found {}/{} ({:.0f} %), "
