@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -115,6 +116,9 @@ std::vector<ProgramCases> program_cases() {
 struct Tally {
   int effect_cases = 0, first = 0, located = 0, within = 0;
   int multi = 0, all_found = 0, controls = 0, alarms = 0;
+  // Effects that stand above the noise (their true held-out shrinkage >= 30 %: the effect's RMS
+  // at least ~0.7 of the noise's): printed beside, to tell what the noise floor costs.
+  int above_noise = 0, above_noise_first = 0;
   void add(const Score& s) {
     if (s.name == "control") {
       ++controls;
@@ -125,6 +129,10 @@ struct Tally {
     first += s.ranked_first;
     located += s.joint_located;
     within += std::abs(s.predicted - s.truth) <= 20.0;
+    if (s.truth >= 30.0) {
+      ++above_noise;
+      above_noise_first += s.ranked_first;
+    }
     if (s.effects > 1) {
       ++multi;
       all_found += s.all_found;
@@ -207,9 +215,10 @@ class GapHarnessWide : public test_support::ScratchDirTest {
     return {cal / "frames.json", unit_file};
   }
 
-  // One control through the chain; true when `diagnose` raised a cause.
+  // One control through the chain: whether `diagnose` raised a cause; the chain's error RMS per
+  // joint [rad] appended to `chain_rms_rad`.
   bool control_raises_a_cause(const std::string& program, int seed, const fs::path& frames,
-                              const fs::path& unit) {
+                              const fs::path& unit, std::vector<double>& chain_rms_rad) {
     const std::string tag = fmt::format("{}-{}", fs::path(program).stem().string(), seed);
     const fs::path scenario = write_scenario(tag, scenarios_ / program, 0.0371, seed);
     const fs::path sim = dir_ / tag, cal = dir_ / (tag + "-cal");
@@ -232,7 +241,8 @@ class GapHarnessWide : public test_support::ScratchDirTest {
         const double d = measured.q_measured_rad[j][k] - modelled.q_measured_rad[j][k];
         e += d * d;
       }
-      rms += fmt::format(" {:.2g}", std::sqrt(e / double(measured.sample_count())));
+      chain_rms_rad.push_back(std::sqrt(e / double(measured.sample_count())));
+      rms += fmt::format(" {:.2g}", chain_rms_rad.back());
     }
     const auto report = nlohmann::json::parse(test_support::read_file_text(out / "report.json"));
     const bool alarm = report.at("significant_gap").get<bool>();
@@ -242,6 +252,34 @@ class GapHarnessWide : public test_support::ScratchDirTest {
     return alarm;
   }
 };
+
+// The goals on both sets: ranked first >= 90 %, joint located >= 90 %, shrinkage within
+// ±20 pp >= 85 %, every effect of a multi-effect case found >= 80 %, false alarms <= 10 % with
+// the chain-measured controls. Met: the shrinkage (development 21/24, held out 23/24). Missed, and
+// held here at the measured level so that a fall shows (decision 0050 says why): ranked first
+// 20/24 and 16/24, joint located 21/24 and 20/24, multi-effect 3/6 and 2/6 (effects at the noise
+// floor; a member of one joint standing for another's), false alarms 6/6 and 9/9: the chain's
+// error and the chain-like noise hold at rest and move with the pose, which drift, kinematic,
+// IMS-bias and time-offset candidates fit on the training blocks and carry to the held-out ones;
+// telling them from the measurement's own error needs the measurement's error budget as a
+// candidate, not built here.
+void expect_goals_or_the_measured_level(const Tally& development, const Tally& held_out,
+                                        std::vector<double> chain_rms_rad) {
+  EXPECT_GE(pct(development.within, development.effect_cases), 85.0);
+  EXPECT_GE(pct(held_out.within, held_out.effect_cases), 85.0);
+  EXPECT_GE(development.first, 20);
+  EXPECT_GE(held_out.first, 16);
+  EXPECT_GE(development.located, 21);
+  EXPECT_GE(held_out.located, 20);
+  EXPECT_GE(development.all_found, 3);
+  EXPECT_GE(held_out.all_found, 2);
+  // The chain measured at its level: the median of its error RMS over the 36 joint records within
+  // 3e-5..1.5e-4 rad (measured 6.2e-5; the lab's chain 5e-5..8e-5, 1.3e-5..3.3e-4 here per joint).
+  ASSERT_EQ(chain_rms_rad.size(), 36u);
+  std::nth_element(chain_rms_rad.begin(), chain_rms_rad.begin() + 18, chain_rms_rad.end());
+  EXPECT_GE(chain_rms_rad[18], 3e-5);
+  EXPECT_LE(chain_rms_rad[18], 1.5e-4);
+}
 
 TEST_F(GapHarnessWide, ProgramsCasesAndChainMeasuredControlsMeetTheGoals) {
   if (test::sanitized()) GTEST_SKIP() << "Release-only figures (see the file's head)";
@@ -255,12 +293,13 @@ TEST_F(GapHarnessWide, ProgramsCasesAndChainMeasuredControlsMeetTheGoals) {
     for (const HarnessCase& hc : pc.held_out) held_out.add(score_case(world, hc, confusion));
   }
   // Controls through the chain: mount and unit 1 in the development set, 2 held out.
+  std::vector<double> chain_rms_rad;
   for (int seed : {1, 2}) {
     const auto [frames, unit] = mounting_session(seed);
     if (HasFatalFailure()) return;
     for (const char* program : {"gap-chain-mixed-program.yaml", "gap-chain-iso9283-program.yaml",
                                 "gap-chain-line-program.yaml"}) {
-      const bool alarm = control_raises_a_cause(program, seed, frames, unit);
+      const bool alarm = control_raises_a_cause(program, seed, frames, unit, chain_rms_rad);
       if (HasFatalFailure()) return;
       Tally& set = seed == 1 ? development : held_out;
       ++set.controls;
@@ -272,11 +311,12 @@ TEST_F(GapHarnessWide, ProgramsCasesAndChainMeasuredControlsMeetTheGoals) {
     fmt::print(
         "\n{}: ranked first {}/{} ({:.0f} %), joint located {}/{} ({:.0f} %), shrinkage within "
         "±20 pp {}/{} ({:.0f} %), every effect of a multi-effect case found {}/{} ({:.0f} %), "
-        "false alarms {}/{} controls ({:.0f} %, with the chain-measured ones)\n",
+        "false alarms {}/{} controls ({:.0f} %, with the chain-measured ones); effects above the "
+        "noise (true shrinkage >= 30 %) ranked first {}/{}\n",
         label, t.first, t.effect_cases, pct(t.first, t.effect_cases), t.located, t.effect_cases,
         pct(t.located, t.effect_cases), t.within, t.effect_cases, pct(t.within, t.effect_cases),
         t.all_found, t.multi, pct(t.all_found, t.multi), t.alarms, t.controls,
-        pct(t.alarms, t.controls));
+        pct(t.alarms, t.controls), t.above_noise_first, t.above_noise);
     const std::string prefix = fmt::format("wide_{}_", label);
     test_support::record_figure(prefix + "ranked_first_percent", pct(t.first, t.effect_cases));
     test_support::record_figure(prefix + "joint_located_percent", pct(t.located, t.effect_cases));
@@ -286,6 +326,7 @@ TEST_F(GapHarnessWide, ProgramsCasesAndChainMeasuredControlsMeetTheGoals) {
                                 pct(t.all_found, t.multi));
     test_support::record_figure(prefix + "false_alarm_percent", pct(t.alarms, t.controls));
   }
+  expect_goals_or_the_measured_level(development, held_out, chain_rms_rad);
 }
 
 }  // namespace
