@@ -40,6 +40,7 @@ struct Timing {
 // `binary run` on the shipped campaign into a fresh `folder`; throws when it fails.
 Timing run_campaign(const std::string& binary, const fs::path& folder) {
   fs::remove_all(folder);
+  fs::create_directories(folder.parent_path());
   std::vector<std::string> words{binary, "run", kRunConfig.string(), "--out", folder.string()};
   std::vector<char*> argv;
   for (auto& w : words) argv.push_back(w.data());
