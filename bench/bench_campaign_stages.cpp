@@ -15,6 +15,7 @@
 #include <unistd.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -73,35 +74,38 @@ Timing run_campaign(const std::string& binary, const fs::path& folder) {
   return t;
 }
 
-// Adds `t` to the counters under `prefix` (averaged over the iterations).
-void add(benchmark::State& state, const std::string& prefix, const Timing& t) {
-  const auto avg = benchmark::Counter::kAvgIterations;
-  state.counters[prefix + "wall_s"] += benchmark::Counter(t.wall_s, avg);
-  state.counters[prefix + "cpu_s"] += benchmark::Counter(t.cpu_s, avg);
-  for (const auto& [stage, s] : t.stage_wall_s)
-    state.counters[prefix + stage + "_wall_s"] += benchmark::Counter(s, avg);
-  for (const auto& [stage, s] : t.stage_cpu_s)
-    state.counters[prefix + stage + "_cpu_s"] += benchmark::Counter(s, avg);
+// Adds `t` to `sum`.
+void add(Timing& sum, const Timing& t) {
+  sum.wall_s += t.wall_s, sum.cpu_s += t.cpu_s;
+  for (const auto& [stage, s] : t.stage_wall_s) sum.stage_wall_s[stage] += s;
+  for (const auto& [stage, s] : t.stage_cpu_s) sum.stage_cpu_s[stage] += s;
+}
+
+// The mean per iteration of `sum` as counters named with `prefix`.
+void set_counters(benchmark::State& state, const std::string& prefix, const Timing& sum) {
+  const double n = double(std::max<benchmark::IterationCount>(state.iterations(), 1));
+  state.counters[prefix + "wall_s"] = sum.wall_s / n;
+  state.counters[prefix + "cpu_s"] = sum.cpu_s / n;
+  for (const auto& [stage, s] : sum.stage_wall_s)
+    state.counters[prefix + stage + "_wall_s"] = s / n;
+  for (const auto& [stage, s] : sum.stage_cpu_s) state.counters[prefix + stage + "_cpu_s"] = s / n;
 }
 
 void BM_CampaignRun_StageByStage(benchmark::State& state) {
   const char* baseline = std::getenv("IMSCAL_BASELINE_BINARY");
   const fs::path scratch = fs::temp_directory_path() / "imscal-bench-campaign-stages";
-  double wall = 0.0, cpu = 0.0, base_wall = 0.0, base_cpu = 0.0;
+  Timing ours, base;
   for (auto _ : state) {
-    if (baseline && *baseline) {
-      const Timing b = run_campaign(baseline, scratch / "baseline");
-      add(state, "base_", b);
-      base_wall += b.wall_s, base_cpu += b.cpu_s;
-    }
+    if (baseline && *baseline) add(base, run_campaign(baseline, scratch / "baseline"));
     const Timing t = run_campaign(IMSCAL_BINARY, scratch / "this");
-    add(state, "", t);
-    wall += t.wall_s, cpu += t.cpu_s;
+    add(ours, t);
     state.SetIterationTime(t.wall_s);
   }
-  if (base_wall > 0.0) {
-    state.counters["ratio_wall"] = wall / base_wall;
-    state.counters["ratio_cpu"] = cpu / base_cpu;
+  set_counters(state, "", ours);
+  if (base.wall_s > 0.0) {
+    set_counters(state, "base_", base);
+    state.counters["ratio_wall"] = ours.wall_s / base.wall_s;
+    state.counters["ratio_cpu"] = ours.cpu_s / base.cpu_s;
   }
   fs::remove_all(scratch);
 }
