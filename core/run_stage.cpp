@@ -5,6 +5,7 @@
 #include <spdlog/sinks/basic_file_sink.h>
 #include <spdlog/spdlog.h>
 #include <sys/file.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -196,6 +197,19 @@ class RunLog {
   std::vector<spdlog::level::level_enum> sink_levels_;
 };
 
+// CPU time [s] of this process's threads and of its finished, waited-for children (a stage's
+// subprocess), user plus system.
+double cpu_seconds_so_far() {
+  double total = 0.0;
+  for (int who : {RUSAGE_SELF, RUSAGE_CHILDREN}) {
+    rusage usage{};
+    ::getrusage(who, &usage);
+    for (const timeval& t : {usage.ru_utime, usage.ru_stime})
+      total += double(t.tv_sec) + 1e-6 * double(t.tv_usec);
+  }
+  return total;
+}
+
 std::string config_identity(const RunOptions& options) {
   return options.config_file.empty() ? std::string()
                                      : fs::weakly_canonical(options.config_file).string();
@@ -350,6 +364,7 @@ RunSummary run_stages(const std::vector<std::unique_ptr<Stage>>& stages,
       fs::remove_all(staging);
       fs::create_directories(staging);
       const std::string started = utc_now();
+      const double cpu0 = cpu_seconds_so_far();
       StageOutcome outcome;
       try {
         StageWorkspace workspace(staging, run_dir, completed_upstream, name, &progress);
@@ -374,6 +389,7 @@ RunSummary run_stages(const std::vector<std::unique_ptr<Stage>>& stages,
                                  {"started_utc", started},
                                  {"finished_utc", utc_now()},
                                  {"seconds", seconds},
+                                 {"cpu_seconds", cpu_seconds_so_far() - cpu0},
                                  {"inputs", inputs},
                                  {"outputs", outputs},
                                  {"summary", outcome.summary}};

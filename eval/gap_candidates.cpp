@@ -528,18 +528,32 @@ std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& 
   return out;
 }
 
+namespace {
+
+// The runs of consecutive indices in `rows` (ascending), as [begin, end) positions in rows.
+std::vector<std::pair<Eigen::Index, Eigen::Index>> consecutive_runs(
+    const std::vector<Eigen::Index>& rows) {
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> runs;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (i == 0 || rows[i] != rows[i - 1] + 1)
+      runs.emplace_back(Eigen::Index(i), Eigen::Index(i) + 1);
+    else
+      ++runs.back().second;
+  return runs;
+}
+
+}  // namespace
+
 LinearFit fit_columns(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                       const std::vector<bool>& use) {
   std::vector<Eigen::Index> rows;
   for (std::size_t k = 0; k < use.size(); ++k)
     if (use[k]) rows.push_back(Eigen::Index(k));
   const Eigen::Index m = Eigen::Index(rows.size()), p = columns.cols();
-  Eigen::MatrixXd x(m, p);
+  // Gathered column by column (a column-major matrix's rows are strided).
+  Eigen::MatrixXd x = columns(rows, Eigen::all);
   Eigen::VectorXd b(m);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    x.row(i) = columns.row(rows[std::size_t(i)]);
-    b[i] = y[std::size_t(rows[std::size_t(i)])];
-  }
+  for (Eigen::Index i = 0; i < m; ++i) b[i] = y[std::size_t(rows[std::size_t(i)])];
   // Column scaling keeps the QR well conditioned for columns of very different sizes.
   Eigen::VectorXd scale(p);
   for (Eigen::Index c = 0; c < p; ++c) {
@@ -558,10 +572,12 @@ LinearFit fit_columns(const Eigen::MatrixXd& columns, const std::vector<double>&
   double tau_int = 1.0;
   const double var = r.squaredNorm() / std::max<double>(double(m), 1.0);
   if (var > 0.0) {
+    const std::vector<std::pair<Eigen::Index, Eigen::Index>> runs = consecutive_runs(rows);
     for (Eigen::Index lagk = 1; lagk < std::min<Eigen::Index>(200, m); ++lagk) {
+      // The pairs lagk apart in the same run, in row order.
       double c = 0.0;
-      for (Eigen::Index i = lagk; i < m; ++i)
-        if (rows[std::size_t(i)] - rows[std::size_t(i - lagk)] == lagk) c += r[i] * r[i - lagk];
+      for (const auto& [begin, end] : runs)
+        for (Eigen::Index i = begin + lagk; i < end; ++i) c += r[i] * r[i - lagk];
       const double rho = c / (double(m) * var);
       if (rho <= 0.0) break;
       tau_int += 2.0 * rho;
@@ -620,6 +636,17 @@ std::vector<bool> repeat(const std::vector<bool>& use, std::size_t times) {
   return out;
 }
 
+// The joint whose columns are the only ones, if one joint has columns.
+std::optional<std::size_t> only_joint(const std::vector<Eigen::MatrixXd>& columns) {
+  std::optional<std::size_t> found;
+  for (std::size_t j = 0; j < columns.size(); ++j) {
+    if (columns[j].size() == 0) continue;
+    if (found) return std::nullopt;
+    found = j;
+  }
+  return found;
+}
+
 // Relative margin within which the shape with fewer parameters wins the validation.
 constexpr double kShapeParsimony = 0.01;
 
@@ -638,6 +665,8 @@ std::vector<Eigen::Index> stacked_rows(const std::vector<Eigen::Index>& fold, st
 LinearFit fit_joint_columns(const std::vector<Eigen::MatrixXd>& columns,
                             const std::vector<std::vector<double>>& gap,
                             const std::vector<bool>& use) {
+  // One joint with columns: its rows are the stack (no copy).
+  if (const auto j = only_joint(columns)) return fit_columns(columns[*j], gap[*j], use);
   const Stacked st = stack(columns, gap);
   return fit_columns(st.x, st.y, repeat(use, st.joints.size()));
 }
@@ -788,6 +817,9 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
   const TrainingFolds folds = training_folds(s, training);
   const Eigen::Index n = Eigen::Index(s.sample_count());
   const auto validation_score = [&](const std::vector<Eigen::MatrixXd>& columns) {
+    // One joint with columns: its rows are the stack (no copy).
+    if (const auto j = only_joint(columns))
+      return cross_validation_sse(columns[*j], s.gap_rad[*j], folds);
     const Stacked st = stack(columns, s.gap_rad);
     double sse = 0.0;
     for (std::size_t i = 0; i < folds.folds.size(); ++i)

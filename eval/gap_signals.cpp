@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include "core/parallel_tasks.hpp"
 #include "core/units.hpp"
 #include "ident/arx_model.hpp"
 #include "ident/cell_blending.hpp"
@@ -111,6 +112,50 @@ void set_actual_motion_torques(GapSignals& g, const std::vector<std::vector<doub
   for (std::size_t j = 0; j < g.joint_count(); ++j) {
     g.torque_internal_nm[j][k] = tau[long(j)];
     g.unit_payload_internal_nm_kg[j][k] = tau_unit[long(j)];
+  }
+}
+
+// Torques of the desired motion at samples [begin, end): the logged payload as a point mass at
+// the tool origin (the log has no centre of mass); the unit-payload torque is the change for 1 kg
+// more; the mass matrix; and the actual motion's torques where the drive's motion is known. Each
+// block has its own dynamics, so blocks are independent.
+void fill_model_torques(GapSignals& g, const std::vector<double>& payload_kg,
+                        const calib::RobotDescription& robot,
+                        const std::vector<std::vector<double>>& qdd_internal, std::size_t begin,
+                        std::size_t end) {
+  const std::size_t nj = g.joint_count();
+  const bool internal = !g.torque_internal_nm.empty();
+  const Eigen::Vector3d gravity(0.0, 0.0, -kStandardGravity_m_s2);
+  sim::RigidBodyDynamics dynamics(robot, std::nullopt, gravity);
+  sim::RigidBodyDynamics unit(robot, point_mass(1.0), gravity);
+  sim::RigidBodyDynamics bare(robot, std::nullopt, gravity);
+  double current_mass = 0.0;
+  for (std::size_t k = begin; k < end; ++k) {
+    if (payload_kg[k] != current_mass) {
+      current_mass = payload_kg[k];
+      dynamics.set_payload(current_mass > 0.0 ? std::optional(point_mass(current_mass))
+                                              : std::nullopt);
+    }
+    calib::JointVector q, qd, qdd;
+    for (std::size_t j = 0; j < nj; ++j) {
+      q[long(j)] = g.q_desired_rad[j][k];
+      qd[long(j)] = g.qd_desired_rad_s[j][k];
+      qdd[long(j)] = g.qdd_desired_rad_s2[j][k];
+    }
+    const calib::JointVector tau = dynamics.inverse_dynamics(q, qd, qdd);
+    if (internal) set_actual_motion_torques(g, qdd_internal, k, {&dynamics, &unit, &bare});
+    const calib::JointVector tau_gravity = dynamics.gravity_torque(q);
+    const sim::JointMatrix mass = dynamics.mass_matrix(q);
+    for (std::size_t i = 0; i < nj; ++i)
+      for (std::size_t j = 0; j < nj; ++j)
+        g.mass_matrix_kg_m2[i * nj + j][k] = mass(long(i), long(j));
+    const calib::JointVector tau_unit =
+        unit.inverse_dynamics(q, qd, qdd) - bare.inverse_dynamics(q, qd, qdd);
+    for (std::size_t j = 0; j < nj; ++j) {
+      g.torque_nm[j][k] = tau[long(j)];
+      g.gravity_torque_nm[j][k] = tau_gravity[long(j)];
+      g.unit_payload_nm_kg[j][k] = tau_unit[long(j)];
+    }
   }
 }
 
@@ -332,12 +377,6 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
     g.nominal_half_play_rad.push_back(0.5 * drive.backlash_rad);
     g.nominal_coulomb_nm.push_back(drive.coulomb_nm);
   }
-  // Torques of the desired motion: the logged payload as a point mass at the tool origin (the
-  // log has no centre of mass); the unit-payload torque is the change for 1 kg more.
-  const Eigen::Vector3d gravity(0.0, 0.0, -kStandardGravity_m_s2);
-  sim::RigidBodyDynamics dynamics(robot, std::nullopt, gravity);
-  sim::RigidBodyDynamics unit(robot, point_mass(1.0), gravity);
-  sim::RigidBodyDynamics bare(robot, std::nullopt, gravity);
   g.torque_nm.assign(nj, std::vector<double>(n));
   g.gravity_torque_nm.assign(nj, std::vector<double>(n));
   g.unit_payload_nm_kg.assign(nj, std::vector<double>(n));
@@ -349,34 +388,12 @@ GapSignals make_gap_signals(const ident::JointErrorLog& real,
   std::vector<std::vector<double>> qdd_internal;
   for (const auto& qd_internal : g.qd_internal_rad_s)
     qdd_internal.push_back(derivative(qd_internal, g.runs, g.cycle_s));
-  double current_mass = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    if (real.payload_kg[k] != current_mass) {
-      current_mass = real.payload_kg[k];
-      dynamics.set_payload(current_mass > 0.0 ? std::optional(point_mass(current_mass))
-                                              : std::nullopt);
-    }
-    calib::JointVector q, qd, qdd;
-    for (std::size_t j = 0; j < nj; ++j) {
-      q[long(j)] = g.q_desired_rad[j][k];
-      qd[long(j)] = g.qd_desired_rad_s[j][k];
-      qdd[long(j)] = g.qdd_desired_rad_s2[j][k];
-    }
-    const calib::JointVector tau = dynamics.inverse_dynamics(q, qd, qdd);
-    if (internal) set_actual_motion_torques(g, qdd_internal, k, {&dynamics, &unit, &bare});
-    const calib::JointVector tau_gravity = dynamics.gravity_torque(q);
-    const sim::JointMatrix mass = dynamics.mass_matrix(q);
-    for (std::size_t i = 0; i < nj; ++i)
-      for (std::size_t j = 0; j < nj; ++j)
-        g.mass_matrix_kg_m2[i * nj + j][k] = mass(long(i), long(j));
-    const calib::JointVector tau_unit =
-        unit.inverse_dynamics(q, qd, qdd) - bare.inverse_dynamics(q, qd, qdd);
-    for (std::size_t j = 0; j < nj; ++j) {
-      g.torque_nm[j][k] = tau[long(j)];
-      g.gravity_torque_nm[j][k] = tau_gravity[long(j)];
-      g.unit_payload_nm_kg[j][k] = tau_unit[long(j)];
-    }
-  }
+  // Blocks of samples are independent tasks on the cores (core/parallel_tasks.hpp).
+  constexpr std::size_t kBlock = 4096;
+  run_parallel_tasks((n + kBlock - 1) / kBlock, [&](std::size_t b) {
+    fill_model_torques(g, real.payload_kg, robot, qdd_internal, b * kBlock,
+                       std::min(n, (b + 1) * kBlock));
+  });
   g.ims_chain_columns =
       ims_chain_columns(robot.kinematics, g.q_desired_rad, g.qd_desired_rad_s, g.time_s);
   if (table_or_null) {

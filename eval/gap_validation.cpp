@@ -37,22 +37,30 @@ double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>&
                       const std::vector<Eigen::Index>& fit,
                       const std::vector<Eigen::Index>& check) {
   const Eigen::Index p = columns.cols();
-  Eigen::MatrixXd x(Eigen::Index(fit.size()), p);
+  // Gathered column by column (a column-major matrix's rows are strided).
+  Eigen::MatrixXd x = columns(fit, Eigen::all);
   Eigen::VectorXd b(x.rows());
-  for (std::size_t i = 0; i < fit.size(); ++i) {
-    x.row(Eigen::Index(i)) = columns.row(fit[i]);
-    b[Eigen::Index(i)] = y[std::size_t(fit[i])];
-  }
+  for (std::size_t i = 0; i < fit.size(); ++i) b[Eigen::Index(i)] = y[std::size_t(fit[i])];
   // Column scaling keeps the QR well conditioned for columns of very different sizes.
   Eigen::VectorXd scale(p);
   for (Eigen::Index c = 0; c < p; ++c) {
     scale[c] = x.col(c).norm() > 0.0 ? x.col(c).norm() : 1.0;
     x.col(c) /= scale[c];
   }
-  const Eigen::VectorXd theta = x.colPivHouseholderQr().solve(b).cwiseQuotient(scale);
+  // Decomposed in place: x is not used after.
+  const Eigen::ColPivHouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(x);
+  const Eigen::VectorXd theta = qr.solve(b).cwiseQuotient(scale);
+  // Each check row's prediction summed over the columns in their order, as a row's dot product
+  // sums them, but column by column.
+  Eigen::VectorXd predicted = Eigen::VectorXd::Zero(Eigen::Index(check.size()));
+  for (Eigen::Index c = 0; c < p; ++c)
+    for (std::size_t i = 0; i < check.size(); ++i) {
+      const double term = columns(check[i], c) * theta[c];
+      predicted[Eigen::Index(i)] = c == 0 ? term : predicted[Eigen::Index(i)] + term;
+    }
   double sse = 0.0;
-  for (Eigen::Index k : check) {
-    const double r = y[std::size_t(k)] - columns.row(k).dot(theta);
+  for (std::size_t i = 0; i < check.size(); ++i) {
+    const double r = y[std::size_t(check[i])] - predicted[Eigen::Index(i)];
     sse += r * r;
   }
   return sse;

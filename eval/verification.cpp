@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/parallel_tasks.hpp"
 #include "eval/ims_measured_path.hpp"
 #include "eval/iso9283_path.hpp"
 #include "eval/path_deviation.hpp"
@@ -94,6 +95,75 @@ PoseSeries window(const std::vector<PathPose>& poses, double from_s, double to_s
   PoseSeries out;
   for (const PathPose& p : poses)
     if (p.t_s >= from_s - 1e-9 && p.t_s <= to_s + 1e-9) out.push_back(p);
+  return out;
+}
+
+// Per case (the uncompensated path, then each command) and cycle: the attained path as measured,
+// and the true one.
+struct AttainedPaths {
+  std::vector<std::vector<std::vector<PathPose>>> measured, truth;
+};
+
+// The plant's draws per cycle (friction factors), in the order one loop over the cycles would
+// draw them.
+std::vector<sim::PlantConfig> cycle_plants(const sim::PlantConfig& base,
+                                           const VerificationOptions& options) {
+  std::mt19937_64 rng(options.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<sim::PlantConfig> plants;
+  for (int j = 0; j < options.cycles; ++j) {
+    sim::PlantConfig config = base;
+    for (auto& joint : config.robot.joints) {
+      // Clamped to >= 0.5 so that a rare draw cannot make the friction vanish or turn negative.
+      const double factor = std::max(0.5, 1.0 + options.friction_sigma_fraction * normal(rng));
+      joint.drive.coulomb_nm *= factor;
+      joint.drive.viscous_nm_s_per_rad *= factor;
+    }
+    plants.push_back(std::move(config));
+  }
+  return plants;
+}
+
+// Every (cycle, case) run is an independent task on the cores (core/parallel_tasks.hpp): the
+// draws are made before, each task writes its own slot, so the result does not depend on the
+// threads.
+AttainedPaths simulate_cycles(const sim::Scenario& scenario,
+                              const calib::RobotDescription& plant_robot,
+                              const sim::NominalRobot& nominal, const sim::DesiredJointPath& path,
+                              const std::vector<sim::DesiredJointPath>& commands,
+                              const VerificationOptions& options) {
+  const std::vector<sim::PlantConfig> plants =
+      cycle_plants(scenario_plant(scenario, plant_robot), options);
+  // The standstill at the start of the run: the IMS chain's first rest.
+  double standstill_s = 0.0;
+  for (const auto& sample : path.samples) {
+    if (sample.qd_rad_s.norm() != 0.0 || sample.qdd_rad_s2.norm() != 0.0) break;
+    standstill_s = sample.t_s;
+  }
+  const std::size_t cases = commands.size() + 1, cycle_count = plants.size();
+  AttainedPaths out;
+  out.measured.assign(cases, std::vector<std::vector<PathPose>>(cycle_count));
+  out.truth = out.measured;
+  run_parallel_tasks(cases * cycle_count, [&](std::size_t task) {
+    const std::size_t j = task / cases, c = task % cases;
+    const sim::DesiredJointPath& command = c == 0 ? path : commands[c - 1];
+    const sim::PlantLog plant = sim::simulate_plant(plants[j], command, path.cycle_s);
+    out.truth[c][j] = attained_path(plant_robot, plant);
+    if (!options.measure_with_ims) {
+      out.measured[c][j] = out.truth[c][j];
+      return;
+    }
+    // The controller's log holds the interpolator's desired angles (the offset is added after
+    // it): the chain finds the program's standstills there.
+    const ImsJointMeasurement m =
+        measure_joints_with_ims(scenario, plant_robot, nominal, path, plant, standstill_s,
+                                options.ims_seed + std::uint64_t(j));
+    std::vector<double> t;
+    std::vector<calib::JointVector> q;
+    for (std::size_t k = 0; k < m.q_rad.size(); ++k)
+      if (m.valid[k]) t.push_back(plant.samples[k].t_s), q.push_back(m.q_rad[k]);
+    out.measured[c][j] = flange_path(nominal.description, t, q);
+  });
   return out;
 }
 
@@ -515,46 +585,11 @@ VerificationResult verify_scenario(const sim::Scenario& scenario,
   for (const auto& s : path.samples) t_s.push_back(s.t_s), q_d.push_back(s.q_rad);
   const std::vector<PathPose> desired = flange_path(plant_robot, t_s, q_d);
 
-  const sim::PlantConfig base = scenario_plant(scenario, plant_robot);
-  std::mt19937_64 rng(options.seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
   // Per case and cycle: the attained path as measured, and the true one.
-  std::vector<std::vector<std::vector<PathPose>>> cycles(tables.size() + 1),
-      true_cycles(tables.size() + 1);
-  // The standstill at the start of the run: the IMS chain's first rest.
-  double standstill_s = 0.0;
-  for (const auto& sample : path.samples) {
-    if (sample.qd_rad_s.norm() != 0.0 || sample.qdd_rad_s2.norm() != 0.0) break;
-    standstill_s = sample.t_s;
-  }
-  for (int j = 0; j < options.cycles; ++j) {
-    sim::PlantConfig config = base;
-    for (auto& joint : config.robot.joints) {
-      // Clamped to >= 0.5 so that a rare draw cannot make the friction vanish or turn negative.
-      const double factor = std::max(0.5, 1.0 + options.friction_sigma_fraction * normal(rng));
-      joint.drive.coulomb_nm *= factor;
-      joint.drive.viscous_nm_s_per_rad *= factor;
-    }
-    for (std::size_t c = 0; c <= commands.size(); ++c) {
-      const sim::DesiredJointPath& command = c == 0 ? path : commands[c - 1];
-      const sim::PlantLog plant = sim::simulate_plant(config, command, T);
-      true_cycles[c].push_back(attained_path(plant_robot, plant));
-      if (!options.measure_with_ims) {
-        cycles[c].push_back(true_cycles[c].back());
-        continue;
-      }
-      // The controller's log holds the interpolator's desired angles (the offset is added after
-      // it): the chain finds the program's standstills there.
-      const ImsJointMeasurement m =
-          measure_joints_with_ims(scenario, plant_robot, nominal, path, plant, standstill_s,
-                                  options.ims_seed + std::uint64_t(j));
-      std::vector<double> t;
-      std::vector<calib::JointVector> q;
-      for (std::size_t k = 0; k < m.q_rad.size(); ++k)
-        if (m.valid[k]) t.push_back(plant.samples[k].t_s), q.push_back(m.q_rad[k]);
-      cycles[c].push_back(flange_path(nominal.description, t, q));
-    }
-  }
+  const AttainedPaths attained =
+      simulate_cycles(scenario, plant_robot, nominal, path, commands, options);
+  const auto& cycles = attained.measured;
+  const auto& true_cycles = attained.truth;
 
   auto make_case = [&](const std::string& label, std::size_t index) {
     VerificationCase vc;

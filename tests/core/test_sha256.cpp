@@ -1,4 +1,5 @@
-// core::sha256_hex against the FIPS 180-4 example vectors and, for files of sizes around the
+// core::sha256_hex against the FIPS 180-4 example vectors, its SHA-NI compression against the
+// portable one, and, for files of sizes around the
 // 64-byte block and the 64 KiB read buffer, against coreutils' sha256sum (a second
 // implementation) and ident's file_sha256_hex.
 #include <gtest/gtest.h>
@@ -6,8 +7,10 @@
 #include <cstdio>
 #include <fstream>
 #include <random>
+#include <vector>
 
 #include "core/sha256.hpp"
+#include "core/sha256_blocks.hpp"
 #include "ident/joint_error_io.hpp"
 #include "tests/support/scratch_dir.hpp"
 
@@ -43,5 +46,23 @@ TEST_F(Sha256Test, FilesAgreeWithSha256sumAndIdent) {
     EXPECT_EQ(ours, std::string(line, 64)) << size;
   }
   EXPECT_THROW(imscal::sha256_hex_of_file(dir_ / "missing"), std::runtime_error);
+}
+// The SHA-NI blocks against the portable ones (a second implementation) on random blocks, from
+// the initial state and from a random one; bit-exact, as a hash must be.
+TEST_F(Sha256Test, X86BlocksEqualPortable) {
+  if (!imscal::detail::sha256_x86_available()) GTEST_SKIP() << "no SHA extensions here";
+  std::mt19937 random(11);
+  for (std::size_t blocks : {1u, 2u, 3u, 17u, 1024u}) {
+    std::vector<unsigned char> data(64 * blocks);
+    for (auto& b : data) b = static_cast<unsigned char>(random() & 0xff);
+    imscal::detail::Sha256State portable = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
+                                            0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+    if (blocks == 3)
+      for (auto& word : portable) word = random();
+    imscal::detail::Sha256State x86 = portable;
+    imscal::detail::sha256_blocks_portable(portable, data.data(), blocks);
+    imscal::detail::sha256_blocks_x86(x86, data.data(), blocks);
+    EXPECT_EQ(portable, x86) << blocks;
+  }
 }
 }  // namespace
