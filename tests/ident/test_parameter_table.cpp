@@ -89,6 +89,16 @@ ident::ParameterTable sample_table(bool transmission_error = true, bool second_h
 
 class ParameterTableFiles : public imscal::test_support::ScratchDirTest {};
 
+// The loader refuses `j`, naming the JSON path `field`.
+void refused(const json& j, const std::string& field) {
+  try {
+    ident::parse_parameters_json(j.dump(), "parameters.json");
+    ADD_FAILURE() << "accepted a bad table";
+  } catch (const imscal::InputError& e) {
+    EXPECT_EQ(e.field(), field) << e.what();
+  }
+}
+
 TEST_F(ParameterTableFiles, RoundTripIsExact) {
   const ident::ParameterTable table = sample_table();
   const auto file = dir_ / "parameters.json";
@@ -110,14 +120,6 @@ TEST_F(ParameterTableFiles, SecondHarmonicRoundTripsAndIsChecked) {
   const auto file = dir_ / "parameters.json";
   ident::write_parameters_json(file, table);
   EXPECT_TRUE(ident::read_parameters_json(file) == table);
-  const auto refused = [](json j, const std::string& field) {
-    try {
-      ident::parse_parameters_json(j.dump(), "parameters.json");
-      ADD_FAILURE() << "accepted a bad table";
-    } catch (const imscal::InputError& e) {
-      EXPECT_EQ(e.field(), field) << e.what();
-    }
-  };
   const json good = json::parse(ident::parameters_json_text(table));
   json same = good;
   same["joints"][0]["transmission_error_2_rad_per_rad"] =
@@ -158,14 +160,6 @@ TEST_F(ParameterTableFiles, ModelTorqueLinksRoundTripAndAreChecked) {
   const auto file = dir_ / "parameters.json";
   ident::write_parameters_json(file, table);
   EXPECT_TRUE(ident::read_parameters_json(file) == table);
-  const auto refused = [](json j, const std::string& field) {
-    try {
-      ident::parse_parameters_json(j.dump(), "parameters.json");
-      ADD_FAILURE() << "accepted a bad table";
-    } catch (const imscal::InputError& e) {
-      EXPECT_EQ(e.field(), field) << e.what();
-    }
-  };
   const json good = json::parse(ident::parameters_json_text(table));
   json old = good;
   old["schema_version"] = 4;
