@@ -43,7 +43,9 @@ CompensationRun run_stage(const ident::ParameterTable& table, const std::string&
       throw std::invalid_argument(
           "the parameter table's models take the model torque: the robot's rigid-body model is "
           "needed (CompensationOptions::model_torque)");
-    torque = model_torques_along(*options.model_torque, path);
+    // The table's refined links, when its identification refined them.
+    torque = model_torques_along(with_table_links(*options.model_torque, table, "parameters.json"),
+                                 path);
   }
   CompensationRun run;
   run.offset_rad.resize(n);

@@ -23,11 +23,13 @@ namespace {
 // The joint torques of the robot's rigid-body model along the log's desired path
 // ([joint][sample]; eval/model_torque.hpp), for a table whose models take them.
 std::vector<std::vector<double>> model_torques(const CompensationSessionOptions& args,
+                                               const ident::ParameterTable& table,
                                                const calib::RobotLog& log) {
   if (!args.model_torque)
     throw InputError(args.table, 0, "extra_inputs", "no rigid-body model given");
-  const ModelTorqueSource model =
-      args.model_torque(log.robot_name, args.robot_log, args.table, "extra_inputs");
+  const ModelTorqueSource model = with_table_links(
+      args.model_torque(log.robot_name, args.robot_log, args.table, "extra_inputs"), table,
+      args.table);
   const std::size_t n = log.samples.size();
   std::vector<std::vector<double>> q(calib::kJointCount, std::vector<double>(n));
   std::vector<double> payload(n);
@@ -135,7 +137,7 @@ CompensationRunSummary compensate_robot_log(const CompensationSessionOptions& ar
   summary.offsets_csv = offsets_header(args, log);
   summary.cycles = log.samples.size();
   const std::vector<std::vector<double>> torque = precontrol->needs_model_torque()
-                                                      ? model_torques(args, log)
+                                                      ? model_torques(args, table, log)
                                                       : std::vector<std::vector<double>>{};
   // An inverse-form table is fed the desired path preview_cycles ahead (the interpolator's
   // look-ahead online; the log's later samples here, the last one held).

@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "core/atomic_file.hpp"
 #include "core/config_node.hpp"
@@ -12,6 +13,7 @@
 #include "core/json_output.hpp"
 #include "core/payload_plausibility.hpp"
 #include "eval/joint_error_limits.hpp"
+#include "eval/refined_links_choice.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config_record.hpp"
@@ -24,25 +26,28 @@ namespace fs = std::filesystem;
 namespace {
 
 // The model torques of the log's path (eval/model_torque.hpp), when the config's models take
-// them.
-void attach_session_model_torques(ident::JointErrorLog& log,
-                                  const ident::IdentificationConfig& config,
-                                  const IdentificationSessionOptions& options) {
-  if (!config.options.model_torque_input) return;
-  // The table's users (run, compensate, serve) take the model torque from the robot file: a
-  // table identified with refined masses would be fed another torque than it was fitted on.
-  if (config.refine_mass_parameters)
-    throw InputError(options.config, 0, "model.refine_mass_parameters",
-                     "is taken by `imscal verify` only (the table's users compute the model "
-                     "torque from the robot file)");
+// them; the refined links when the config refines them.
+std::vector<ident::LinkMassParameters> attach_session_model_torques(
+    ident::JointErrorLog& log, const ident::IdentificationConfig& config,
+    const IdentificationSessionOptions& options) {
+  if (!config.options.model_torque_input) return {};
   if (!options.model_torque)
     throw InputError(options.config, 0, "model.model_torque", "no rigid-body model given");
-  const ModelTorqueSource model = options.model_torque(
-      log.robot, options.joint_errors, options.config, "model.model_torque", log.cycle_s);
+  ModelTorqueSource model = options.model_torque(log.robot, options.joint_errors, options.config,
+                                                 "model.model_torque", log.cycle_s);
   check_joint_error_limits(log, options.joint_errors, model.robot);
+  std::vector<ident::LinkMassParameters> links;
+  if (config.refine_mass_parameters) {
+    try {
+      model = refined_and_chosen_model(log, config, model, links, "identify");
+    } catch (const std::invalid_argument& e) {
+      throw InputError(options.joint_errors, 0, "model.refine_mass_parameters", e.what());
+    }
+  }
   spdlog::info("identify: model torques of {} along the {} path", model.robot.name,
                torque_along_measured_path(config.options) ? "measured" : "desired");
   attach_model_torques(log, model, config.options);
+  return links;
 }
 
 // `--search-transmission-error-order`: each joint's harmonic found from the data replaces the
@@ -119,6 +124,7 @@ std::optional<ident::ParameterTable> forward_table_of(const ident::JointErrorLog
   spdlog::info("identify: the forward error model (paper form) for the gap diagnosis");
   const ident::IdentificationConfig forward = paper_form(config);
   ident::ParameterTable forward_table = ident::parameter_table_header(log, forward, table.source);
+  forward_table.model_torque_links = table.model_torque_links;
   for (auto& outcome : ident::identify_joints(log, forward))
     forward_table.joints.push_back(std::move(outcome.result.parameters));
   return forward_table;
@@ -136,7 +142,7 @@ PreparedIdentification prepare_identification(const IdentificationSessionOptions
   p.config = ident::resolve_for_record(ident::load_identification_config(config_node), p.log.robot,
                                        p.log.cycle_s, options.joint_errors, &warnings);
   for (const std::string& w : warnings) spdlog::warn("identify: {}", w);
-  attach_session_model_torques(p.log, p.config, options);
+  p.model_torque_links = attach_session_model_torques(p.log, p.config, options);
   if (p.config.max_speed_rad_s.size() != p.log.joint_count())
     throw InputError(
         options.config, config_node.child("joints").child("max_speed_deg_s").line(),
@@ -171,6 +177,7 @@ IdentificationResult identify_session(PreparedIdentification p,
   r.joint_names = log.joint_names;
   r.table = ident::parameter_table_header(
       log, p.config, {file, ident::file_sha256_hex(file), log.sample_count(), log.source});
+  r.table.model_torque_links = p.model_torque_links;
   spdlog::info("identify: {} joints, {} samples in {} segments, cycle {} s", log.joint_count(),
                log.sample_count(), segments.size(), log.cycle_s);
   spdlog::info("identify: per joint {} cells, order sweep na {}..{} nb {}..{} d {}..{}",
@@ -198,6 +205,8 @@ IdentificationResult identify_session(PreparedIdentification p,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - p.start).count(),
       order_search};
   r.report = ident::identification_report_json(header, r.outcomes);
+  if (!r.table.model_torque_links.empty())
+    r.report["model_torque_links"] = ident::model_torque_links_json(r.table.model_torque_links);
   r.forward_table = forward_table_of(log, p.config, r.table);
   return r;
 }

@@ -44,6 +44,8 @@ struct PreparedIdentification {
   IdentificationSessionOptions options;
   ident::JointErrorLog log;
   ident::IdentificationConfig config;
+  // The model torque's links refined from the log (model.refine_mass_parameters), else empty.
+  std::vector<ident::LinkMassParameters> model_torque_links;
   std::chrono::steady_clock::time_point start;
 };
 PreparedIdentification prepare_identification(const IdentificationSessionOptions& options);

@@ -1,5 +1,7 @@
 #include "eval/mass_refinement.hpp"
 
+#include <fmt/format.h>
+
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <algorithm>
@@ -13,6 +15,7 @@ namespace {
 constexpr int kPerLink = 4;  // mass, centre of mass x, y, z
 constexpr int kParameters = calib::kJointCount * kPerLink;
 using Parameters = Eigen::Matrix<double, kParameters, 1>;
+using Matrix = Eigen::Matrix<double, kParameters, kParameters>;
 using Torques = std::vector<calib::JointVector>;  // [row]
 
 Parameters parameters_of(const calib::RobotDescription& robot) {
@@ -182,29 +185,114 @@ Parameters prior_precision(const Parameters& nominal, const MassRefinementOption
   return precision;
 }
 
-struct Step {
-  Parameters delta;
-  Eigen::Matrix<double, kParameters, kParameters> normal;
+// The data's information about π on a set of rows at π = p (the drive models fitted on those
+// rows): the normal matrix Σ_j Z_jᵀ Z_j / w_j and the gradient Σ_j Z_jᵀ r_j / w_j, w_j the
+// joint's residual variance times its correlation time.
+struct Information {
+  Matrix normal = Matrix::Zero();
+  Parameters gradient = Parameters::Zero();
 };
 
-// One Gauss–Newton step of π (its models fixed) with the prior at the nominal values.
-Step gauss_newton_step(const ModelTorqueSource& nominal, const Parameters& p0, const Parameters& p,
-                       const DecimatedRecord& r, const std::vector<std::size_t>& rows,
-                       const MassRefinementOptions& o) {
-  const Torques tau = torques_of(with_parameters(nominal, p), r);
-  const std::vector<Torques> jac = torque_jacobian(nominal, p, r, tau);
-  const Parameters precision = prior_precision(p0, o);
-  Step step;
-  step.normal = precision.asDiagonal();
-  Parameters gradient = -precision.cwiseProduct(p - p0);
+Information information(const DecimatedRecord& r, const Torques& tau,
+                        const std::vector<Torques>& jac, const std::vector<std::size_t>& rows,
+                        const MassRefinementOptions& o) {
+  Information info;
   for (int j = 0; j < calib::kJointCount; ++j) {
     const JointFit fit = fit_joint(j, r, tau, rows, o);
     const Eigen::MatrixXd z = projected_columns(j, fit, jac, rows);
-    step.normal += z.transpose() * z / fit.variance;
-    gradient += z.transpose() * fit.residual / fit.variance;
+    info.normal += z.transpose() * z / fit.variance;
+    info.gradient += z.transpose() * fit.residual / fit.variance;
   }
-  step.delta = step.normal.ldlt().solve(gradient);
+  return info;
+}
+
+// The Gauss–Newton step with the prior at the nominal values p0, over the parameters `free`
+// (the others stay): δ = (N + P)⁻¹ (g − P (p − p0)) on the free block; its covariance there.
+struct Step {
+  Parameters delta = Parameters::Zero();
+  Matrix covariance = Matrix::Zero();
+};
+
+Step prior_step(const Information& info, const Parameters& precision, const Parameters& p0,
+                const Parameters& p, const std::array<bool, calib::kJointCount>& free) {
+  std::vector<int> index;
+  for (int k = 0; k < kParameters; ++k)
+    if (free[std::size_t(k / kPerLink)]) index.push_back(k);
+  Step step;
+  if (index.empty()) return step;
+  const auto n = Eigen::Index(index.size());
+  Eigen::MatrixXd normal(n, n);
+  Eigen::VectorXd gradient(n);
+  for (Eigen::Index a = 0; a < n; ++a) {
+    const int k = index[std::size_t(a)];
+    gradient(a) = info.gradient(k) - precision(k) * (p(k) - p0(k));
+    for (Eigen::Index b = 0; b < n; ++b) normal(a, b) = info.normal(k, index[std::size_t(b)]);
+    normal(a, a) += precision(k);
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(normal);
+  const Eigen::VectorXd delta = ldlt.solve(gradient);
+  const Eigen::MatrixXd covariance = ldlt.solve(Eigen::MatrixXd::Identity(n, n));
+  for (Eigen::Index a = 0; a < n; ++a) {
+    step.delta(index[std::size_t(a)]) = delta(a);
+    for (Eigen::Index b = 0; b < n; ++b)
+      step.covariance(index[std::size_t(a)], index[std::size_t(b)]) = covariance(a, b);
+  }
   return step;
+}
+
+// The rows of one of two folds: blocks of `block_rows` consecutive rows, alternately.
+std::vector<std::size_t> fold_rows(const std::vector<std::size_t>& rows, int fold, int block_rows) {
+  std::vector<std::size_t> out;
+  for (const std::size_t i : rows)
+    if (int(i / std::size_t(std::max(block_rows, 1)) % 2) == fold) out.push_back(i);
+  return out;
+}
+
+// Each link's held-out test (two folds, each link's step from one fold judged on the other, the
+// other links as the fold's step leaves them): z = Σ g_hᵀδ / √(Σ δᵀ N_h δ), standard normal
+// when the nominal link is right (g_h ~ N(0, N_h), independent of δ), and the held-out χ²
+// change Σ (2 g_hᵀδ − δᵀ N_h δ), > 0 where the step improves the held-out fit.
+struct HeldOutTest {
+  std::array<double, calib::kJointCount> z{}, chi2_gain{};
+};
+
+HeldOutTest held_out_test(const DecimatedRecord& r, const Torques& tau,
+                          const std::vector<Torques>& jac, const std::vector<std::size_t>& rows,
+                          const Parameters& precision, const Parameters& p0,
+                          const MassRefinementOptions& o) {
+  std::array<Information, 2> fold;
+  for (int f = 0; f < 2; ++f)
+    fold[std::size_t(f)] = information(r, tau, jac, fold_rows(rows, f, o.held_out_block_rows), o);
+  std::array<bool, calib::kJointCount> all{};
+  all.fill(true);
+  HeldOutTest test;
+  std::array<double, calib::kJointCount> score{}, variance{};
+  for (int f = 0; f < 2; ++f) {
+    const Parameters delta = prior_step(fold[std::size_t(f)], precision, p0, p0, all).delta;
+    const Information& held_out = fold[std::size_t(1 - f)];
+    for (int i = 0; i < calib::kJointCount; ++i) {
+      const auto d = delta.segment<kPerLink>(kPerLink * i);
+      const double g = held_out.gradient.segment<kPerLink>(kPerLink * i).dot(d);
+      const double v =
+          d.dot(held_out.normal.block<kPerLink, kPerLink>(kPerLink * i, kPerLink * i) * d);
+      score[std::size_t(i)] += g;
+      variance[std::size_t(i)] += v;
+      test.chi2_gain[std::size_t(i)] += 2.0 * g - v;
+    }
+  }
+  for (std::size_t i = 0; i < score.size(); ++i)
+    test.z[i] = variance[i] > 0.0 ? score[i] / std::sqrt(variance[i]) : 0.0;
+  return test;
+}
+
+// The links the held-out test accepts: z above the one-sided normal quantile of the level
+// divided among the links (Bonferroni), and a held-out χ² gain.
+std::array<bool, calib::kJointCount> accepted_links(const HeldOutTest& test,
+                                                    const MassRefinementOptions& o) {
+  std::array<bool, calib::kJointCount> out{};
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = !o.held_out_test || (test.z[i] > o.held_out_z && test.chi2_gain[i] > 0.0);
+  return out;
 }
 
 }  // namespace
@@ -219,27 +307,73 @@ MassRefinement refine_mass_parameters(const ident::JointErrorLog& log,
   if (rows.size() < std::size_t(10 * kParameters))
     throw std::invalid_argument("refine_mass_parameters: the record is too short");
   const Parameters p0 = parameters_of(nominal.robot);
-  Parameters p = p0;
+  const Parameters precision = prior_precision(p0, options);
+  const Torques tau0 = torques_of(nominal, record);
+  const std::vector<Torques> jac0 = torque_jacobian(nominal, p0, record, tau0);
   MassRefinement out;
-  Step step;
-  for (out.iterations = 0; out.iterations < std::max(options.iterations, 1); ++out.iterations) {
-    step = gauss_newton_step(nominal, p0, p, record, rows, options);
+  const HeldOutTest test = held_out_test(record, tau0, jac0, rows, precision, p0, options);
+  const std::array<bool, calib::kJointCount> accepted = accepted_links(test, options);
+  std::array<bool, calib::kJointCount> all{};
+  all.fill(true);
+  // Every link's estimate with its 1σ (reported), and the accepted links' (used).
+  const Information info = information(record, tau0, jac0, rows, options);
+  const Step estimate = prior_step(info, precision, p0, p0, all);
+  Parameters p = p0;
+  Step step = prior_step(info, precision, p0, p, accepted);
+  for (out.iterations = 1;; ++out.iterations) {
     p += step.delta;
     for (int i = 0; i < calib::kJointCount; ++i)  // a mass stays positive
       p(kPerLink * i) = std::max(p(kPerLink * i), 0.1 * p0(kPerLink * i));
+    if (out.iterations >= std::max(options.iterations, 1)) break;
+    const Torques tau = torques_of(with_parameters(nominal, p), record);
+    step = prior_step(
+        information(record, tau, torque_jacobian(nominal, p, record, tau), rows, options),
+        precision, p0, p, accepted);
   }
-  const Parameters sigma = step.normal.inverse().diagonal().cwiseSqrt();
   out.model = with_parameters(nominal, p);
   for (int i = 0; i < calib::kJointCount; ++i) {
     LinkMassEstimate& link = out.links[std::size_t(i)];
+    const bool used = accepted[std::size_t(i)];
+    const Parameters& value = used ? p : Parameters(p0 + estimate.delta);
+    const Parameters sigma = (used ? step : estimate).covariance.diagonal().cwiseSqrt();
+    link.refined = used;
+    link.held_out_z = test.z[std::size_t(i)];
     link.nominal_mass_kg = p0(kPerLink * i);
-    link.mass_kg = p(kPerLink * i);
+    link.mass_kg = value(kPerLink * i);
     link.mass_sigma_kg = sigma(kPerLink * i);
     link.nominal_com_m = p0.segment<3>(kPerLink * i + 1);
-    link.com_m = p.segment<3>(kPerLink * i + 1);
+    link.com_m = value.segment<3>(kPerLink * i + 1);
     link.com_sigma_m = sigma.segment<3>(kPerLink * i + 1);
   }
   return out;
+}
+
+std::vector<ident::LinkMassParameters> table_links(const MassRefinement& refinement) {
+  std::vector<ident::LinkMassParameters> out;
+  for (const LinkMassEstimate& l : refinement.links) {
+    ident::LinkMassParameters t;
+    t.refined = l.refined;
+    t.held_out_z = l.held_out_z;
+    t.nominal_mass_kg = l.nominal_mass_kg;
+    t.mass_kg = l.mass_kg;
+    t.mass_sigma_kg = l.mass_sigma_kg;
+    for (int a = 0; a < 3; ++a) {
+      t.nominal_com_m[std::size_t(a)] = l.nominal_com_m(a);
+      t.com_m[std::size_t(a)] = l.com_m(a);
+      t.com_sigma_m[std::size_t(a)] = l.com_sigma_m(a);
+    }
+    out.push_back(t);
+  }
+  return out;
+}
+
+std::string describe_link(const ident::LinkMassParameters& l) {
+  return fmt::format(
+      "{} (held-out z {:.2f}): mass {:.2f} ± {:.2f} kg (nominal {:.2f}), centre of mass [{:.3f} "
+      "{:.3f} {:.3f}] ± [{:.3f} {:.3f} {:.3f}] m (nominal [{:.3f} {:.3f} {:.3f}])",
+      l.refined ? "refined" : "nominal kept", l.held_out_z, l.mass_kg, l.mass_sigma_kg,
+      l.nominal_mass_kg, l.com_m[0], l.com_m[1], l.com_m[2], l.com_sigma_m[0], l.com_sigma_m[1],
+      l.com_sigma_m[2], l.nominal_com_m[0], l.nominal_com_m[1], l.nominal_com_m[2]);
 }
 
 }  // namespace imscal::eval

@@ -112,4 +112,29 @@ ModelTorqueSource load_model_torque_source(
   return model;
 }
 
+ModelTorqueSource with_table_links(ModelTorqueSource model, const ident::ParameterTable& table,
+                                   const std::string& table_file) {
+  if (table.model_torque_links.empty()) return model;
+  if (table.model_torque_links.size() != model.robot.joints.size())
+    throw InputError(table_file, 0, "model_torque_links",
+                     fmt::format("{} links, but robot '{}' has {}", table.model_torque_links.size(),
+                                 model.robot.name, model.robot.joints.size()));
+  for (std::size_t i = 0; i < model.robot.joints.size(); ++i) {
+    const ident::LinkMassParameters& l = table.model_torque_links[i];
+    calib::RigidBodyParameters& link = model.robot.joints[i].link;
+    const Eigen::Vector3d nominal_com(l.nominal_com_m[0], l.nominal_com_m[1], l.nominal_com_m[2]);
+    // The table's nominal values are the robot file's, written with 17 digits.
+    if (std::abs(l.nominal_mass_kg - link.mass_kg) > 1e-9 * link.mass_kg ||
+        (nominal_com - link.com_m).norm() > 1e-9)
+      throw InputError(table_file, 0, fmt::format("model_torque_links/{}", i),
+                       fmt::format("refined from a nominal link of {} kg, but robot '{}' has "
+                                   "{} kg: the table was identified with another robot file",
+                                   l.nominal_mass_kg, model.robot.name, link.mass_kg));
+    if (!l.refined) continue;
+    link.mass_kg = l.mass_kg;
+    link.com_m = Eigen::Vector3d(l.com_m[0], l.com_m[1], l.com_m[2]);
+  }
+  return model;
+}
+
 }  // namespace imscal::eval

@@ -24,6 +24,7 @@
 
 #include "ident/joint_error_io.hpp"
 #include "ident/joint_identification.hpp"
+#include "ident/parameter_table.hpp"
 #include "robot/robot_description.hpp"
 #include "sim/desired_path.hpp"
 #include "sim/rigid_body_dynamics.hpp"
@@ -77,5 +78,13 @@ bool torque_along_measured_path(const ident::JointIdentificationOptions& options
 // options take no torque input).
 void attach_model_torques(ident::JointErrorLog& log, const ModelTorqueSource& model,
                           const ident::JointIdentificationOptions& options);
+
+// The model with the table's refined links (ident::ParameterTable::model_torque_links: the
+// refined links' masses and centres of mass in place of the robot file's), the torque the table
+// was identified with; the model unchanged for a table without them. InputError naming
+// `table_file` when the table's links are not the model's or its nominal values are not the
+// robot file's (a table refined from another robot file).
+ModelTorqueSource with_table_links(ModelTorqueSource model, const ident::ParameterTable& table,
+                                   const std::string& table_file);
 
 }  // namespace imscal::eval

@@ -26,11 +26,12 @@ bool takes_model_torque(const ident::ParameterTable& table) {
 
 // The model torque along the path [sample][joint] for a table whose models take it.
 std::vector<std::array<double, online::kPathJoints>> torque_along(
-    const ServeSessionOptions& o, const calib::RobotLog& log,
+    const ServeSessionOptions& o, const ident::ParameterTable& table, const calib::RobotLog& log,
     const std::vector<std::vector<double>>& q_rad, const std::vector<double>& payload_kg) {
-  const ModelTorqueSource model =
+  const ModelTorqueSource model = with_table_links(
       load_model_torque_source(o.robot_file, o.gravity_in_base_m_s2, log.robot_name, o.path_file,
-                               o.table_file, "extra_inputs");
+                               o.table_file, "extra_inputs"),
+      table, o.table_file);
   const std::size_t n = payload_kg.size();
   const std::vector<std::pair<std::size_t, std::size_t>> whole{{0, n}};
   const auto torque = model_torques_along(model, log.cycle_s, q_rad, payload_kg, whole);
@@ -62,7 +63,7 @@ online::LoadedPath load_path(const ServeSessionOptions& o, const ident::Paramete
     path.q_rad.push_back(sample);
     path.payload_kg.push_back(log.samples[k].payload_kg);
   }
-  if (takes_model_torque(table)) path.torque_nm = torque_along(o, log, q, path.payload_kg);
+  if (takes_model_torque(table)) path.torque_nm = torque_along(o, table, log, q, path.payload_kg);
   return path;
 }
 

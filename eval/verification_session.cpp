@@ -15,7 +15,7 @@
 #include "core/output_folder.hpp"
 #include "core/payload_plausibility.hpp"
 #include "eval/joint_error_limits.hpp"
-#include "eval/mass_refinement.hpp"
+#include "eval/refined_links_choice.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "ident/identification_config.hpp"
 #include "ident/joint_error_io.hpp"
@@ -85,62 +85,49 @@ void search_orders(const ident::JointErrorLog& log, const ModelTorqueSource& tor
   config = with_searched_orders(std::move(config), search);
 }
 
+// The table identified with `config`, carrying the refined links (`links`, empty without) when
+// its models take the model torque: the loop's precontrol then computes the torque with them.
+ident::ParameterTable identified_table(const JointErrorSource& source,
+                                       const ident::IdentificationConfig& config,
+                                       const ModelTorqueSource& torque_model,
+                                       const std::vector<ident::LinkMassParameters>& links,
+                                       const std::string& label) {
+  IdentifiedTable t = identify_table(*source.log, config, source.file, &torque_model);
+  for (const auto& f : t.failed_joints) spdlog::warn("verify: {}: not identified: {}", label, f);
+  if (config.options.model_torque_input) t.table.model_torque_links = links;
+  return std::move(t.table);
+}
+
 // The compensated table (from the file or identified) and the ablation tables.
 std::vector<NamedTable> session_tables(const VerificationSessionOptions& options,
                                        const JointErrorSource& source,
                                        const std::optional<ident::IdentificationConfig>& config,
                                        const ModelTorqueSource& torque_model,
+                                       const std::vector<ident::LinkMassParameters>& links,
                                        const SessionFolders& folders) {
   std::vector<NamedTable> tables;
   if (!options.table.empty()) {
     tables.push_back({"compensated", ident::read_parameters_json(options.table)});
   } else {
     spdlog::info("verify: identifying the table from {}", source.file);
-    const IdentifiedTable t = identify_table(*source.log, *config, source.file, &torque_model);
-    for (const auto& f : t.failed_joints) spdlog::warn("verify: not identified: {}", f);
-    ident::write_parameters_json(folders.work / "parameters.json", t.table);
-    tables.push_back({"compensated", t.table});
+    const ident::ParameterTable table =
+        identified_table(source, *config, torque_model, links, "compensated");
+    ident::write_parameters_json(folders.work / "parameters.json", table);
+    tables.push_back({"compensated", table});
   }
   if (source.log && options.ablation) {
     for (const auto& [label, cfg] : ablation_configs(*config)) {
       spdlog::info("verify: ablation table '{}'", label);
-      const IdentifiedTable t = identify_table(*source.log, cfg, source.file, &torque_model);
-      for (const auto& f : t.failed_joints)
-        spdlog::warn("verify: {}: not identified: {}", label, f);
-      tables.push_back({label, t.table});
+      tables.push_back({label, identified_table(source, cfg, torque_model, links, label)});
     }
   }
   return tables;
 }
 
-// The nominal model with its mass parameters refined from the identification record.
-ModelTorqueSource refined_model_torque(const ident::JointErrorLog& log,
-                                       const ModelTorqueSource& nominal) {
-  spdlog::info("verify: refining the model torque's mass parameters from the record");
-  const MassRefinement refined = refine_mass_parameters(log, nominal);
-  for (std::size_t i = 0; i < refined.links.size(); ++i) {
-    const LinkMassEstimate& l = refined.links[i];
-    spdlog::info(
-        "verify: link {}: mass {:.2f} ± {:.2f} kg (nominal {:.2f}), centre of mass "
-        "[{:.3f} {:.3f} {:.3f}] ± [{:.3f} {:.3f} {:.3f}] m (nominal [{:.3f} {:.3f} {:.3f}])",
-        i + 1, l.mass_kg, l.mass_sigma_kg, l.nominal_mass_kg, l.com_m.x(), l.com_m.y(), l.com_m.z(),
-        l.com_sigma_m.x(), l.com_sigma_m.y(), l.com_sigma_m.z(), l.nominal_com_m.x(),
-        l.nominal_com_m.y(), l.nominal_com_m.z());
-  }
-  return refined.model;
-}
-
-// The session's tables, and the refined model torque when the config refines it (the loop's
-// precontrol then takes its torque from that model, as the tables were identified with it).
-struct SessionTables {
-  std::vector<NamedTable> tables;
-  std::optional<ModelTorqueSource> refined_model;
-};
-
 // The tables of the session: the joint errors' robot checked against the scenarios' nominal
 // robot, whose rigid-body model (never the plant's) serves the multi-input tables.
-SessionTables prepare_tables(const VerificationSessionOptions& options,
-                             const SessionFolders& folders) {
+std::vector<NamedTable> prepare_tables(const VerificationSessionOptions& options,
+                                       const SessionFolders& folders) {
   const JointErrorSource source = joint_error_source(options, folders);
   if (options.table.empty() && !source.log)
     throw InputError("", 0, "--table", "give --table, --joint-errors or --identify-scenario");
@@ -161,13 +148,12 @@ SessionTables prepare_tables(const VerificationSessionOptions& options,
                        "needs joint errors and a config with the transmission error");
     search_orders(*source.log, torque_model, *config);
   }
-  SessionTables out;
-  if (config && config->refine_mass_parameters) {
-    out.refined_model = refined_model_torque(*source.log, torque_model);
-    torque_model = *out.refined_model;
-  }
-  out.tables = session_tables(options, source, config, torque_model, folders);
-  return out;
+  std::vector<ident::LinkMassParameters> links;
+  const ModelTorqueSource refined =
+      config && config->refine_mass_parameters
+          ? refined_and_chosen_model(*source.log, *config, torque_model, links, "verify")
+          : torque_model;
+  return session_tables(options, source, config, refined, links, folders);
 }
 
 // An earlier session's outputs are refused before any work (the output folder checks every file
@@ -236,11 +222,8 @@ void verify_session(const VerificationSessionOptions& options, const fs::path& o
   if (progress) progress("tables", 0.0);
   refuse_earlier_outputs(options, out, overwrite);
   const WorkFolder work(out);
-  const SessionTables prepared = prepare_tables(options, {out, work.path});
-  const std::vector<NamedTable>& tables = prepared.tables;
-  VerificationOptions verification = options.verification;
-  if (prepared.refined_model && !verification.compensation.model_torque)
-    verification.compensation.model_torque = prepared.refined_model;
+  const std::vector<NamedTable> tables = prepare_tables(options, {out, work.path});
+  const VerificationOptions& verification = options.verification;
   const VerificationRecord record{options.verification.seed,
                                   options.verification.compensation.look_ahead_cycles,
                                   options.verification.compensation.inversion_iterations,

@@ -264,6 +264,25 @@ OrderSearchReport order_search_of(const JsonField& f) {
   return search;
 }
 
+std::array<double, 3> vector3_of(const JsonField& f) {
+  const std::vector<double> v = f.numbers();
+  if (v.size() != 3) f.refuse("expected 3 numbers");
+  return {v[0], v[1], v[2]};
+}
+
+LinkMassParameters link_of(const JsonField& f) {
+  LinkMassParameters l;
+  l.refined = f["refined"].boolean();
+  l.held_out_z = f["held_out_z"].number();
+  l.nominal_mass_kg = f["nominal_mass_kg"].number();
+  l.mass_kg = f["mass_kg"].number();
+  l.mass_sigma_kg = f["mass_sigma_kg"].number();
+  l.nominal_com_m = vector3_of(f["nominal_com_m"]);
+  l.com_m = vector3_of(f["com_m"]);
+  l.com_sigma_m = vector3_of(f["com_sigma_m"]);
+  return l;
+}
+
 IdentificationReportHeader header_of(const JsonField& root) {
   IdentificationReportHeader h;
   h.created_by = root["created_by"].text();
@@ -308,6 +327,9 @@ IdentificationReport read_identification_report(const std::filesystem::path& fil
   report.header = header_of(root);
   const JsonField joints = root["joints"];
   for (std::size_t k = 0; k < joints.size(); ++k) report.joints.push_back(joint_of(joints[k]));
+  if (const auto links = root.optional("model_torque_links"))  // with the refinement only
+    for (std::size_t k = 0; k < links->size(); ++k)
+      report.model_torque_links.push_back(link_of((*links)[k]));
   return report;
 }
 

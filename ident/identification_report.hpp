@@ -94,6 +94,9 @@ struct ReportedJoint {
 struct IdentificationReport {
   IdentificationReportHeader header;
   std::vector<ReportedJoint> joints;
+  // The model torque's links refined from the data (the table's model_torque_links; empty when
+  // the identification did not refine them).
+  std::vector<LinkMassParameters> model_torque_links;
 };
 
 // The document of the identification of every joint (outcomes in joint order).

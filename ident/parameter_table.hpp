@@ -4,6 +4,7 @@
 // (paper, equation 2 and Table 2), the backlash l of equation 3, and how well each model fits.
 // Every cell of the grid has a model: cells that could not be identified are filled from the
 // nearest identified cell, and say so (status "filled", filled_from, reason).
+#include <array>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -19,8 +20,10 @@ namespace imscal::ident {
 // forward models without preview. Version 3 added the transmission-error inputs and the joints'
 // transmission_error_rad_per_rad and transmission_error_compliance_rad_per_nm (version 2 tables
 // are read with 0 for both). Version 4 added the second transmission-error harmonic (inputs
-// transmission_error_2_sin / _cos, the joints' transmission_error_2_rad_per_rad).
-inline constexpr int kParameterTableSchemaVersion = 4;
+// transmission_error_2_sin / _cos, the joints' transmission_error_2_rad_per_rad). Version 5
+// added the model torque's link masses refined from the identification data (model_torque_links,
+// optional).
+inline constexpr int kParameterTableSchemaVersion = 5;
 
 // What the cells' models are (ident/joint_identification.hpp): forward error models of the
 // loop (paper, eq. 2: the predicted error Δq̂ from q_d), or inverse models (the offset that makes
@@ -126,6 +129,19 @@ struct DataSource {
   friend bool operator==(const DataSource&, const DataSource&) = default;
 };
 
+// One link of the model torque's rigid-body model as the identification data refined it
+// (eval/mass_refinement.hpp): the robot file's (nominal) mass [kg] and centre of mass [m, in the
+// link's frame], the estimate with its 1σ, and whether the table's models were identified with
+// the estimate (`refined`) or with the nominal values; held_out_z is the held-out test's score.
+struct LinkMassParameters {
+  bool refined = false;
+  double held_out_z = 0.0;
+  double nominal_mass_kg = 0.0, mass_kg = 0.0, mass_sigma_kg = 0.0;
+  std::array<double, 3> nominal_com_m{}, com_m{}, com_sigma_m{};
+
+  friend bool operator==(const LinkMassParameters&, const LinkMassParameters&) = default;
+};
+
 struct ParameterTable {
   int schema_version = kParameterTableSchemaVersion;
   std::string robot;
@@ -137,6 +153,9 @@ struct ParameterTable {
   double direction_speed_scale_rad_s = 0.01;  // of the direction input [rad/s]
   DataSource source;
   std::vector<JointParameters> joints;
+  // The model torque's links, base to tool, when the identification refined them (its users
+  // compute the torque with the refined links' values); empty: the robot file's values.
+  std::vector<LinkMassParameters> model_torque_links;
 
   friend bool operator==(const ParameterTable&, const ParameterTable&) = default;
 };

@@ -385,7 +385,61 @@ JointParameters read_joint(const Node& n, double sample_time_s, int schema_versi
   return j;
 }
 
+std::array<double, 3> read_vector3(const Node& n, bool non_negative) {
+  const std::vector<double> v = n.numbers();
+  if (v.size() != 3) n.fail("expected 3 numbers [m]");
+  for (const double x : v)
+    if (non_negative && x < 0.0) n.fail("negative standard deviation");
+  return {v[0], v[1], v[2]};
+}
+
+LinkMassParameters read_link_masses(const Node& n) {
+  n.only_keys({"refined", "held_out_z", "nominal_mass_kg", "mass_kg", "mass_sigma_kg",
+               "nominal_com_m", "com_m", "com_sigma_m"});
+  LinkMassParameters l;
+  l.refined = n.child("refined").boolean();
+  l.held_out_z = n.child("held_out_z").number();
+  for (const auto& [key, value] :
+       {std::pair{"nominal_mass_kg", &l.nominal_mass_kg}, std::pair{"mass_kg", &l.mass_kg}}) {
+    *value = n.child(key).number();
+    if (!(*value > 0.0)) n.child(key).fail("a link's mass must be > 0 kg");
+  }
+  l.mass_sigma_kg = n.child("mass_sigma_kg").number();
+  if (l.mass_sigma_kg < 0.0) n.child("mass_sigma_kg").fail("negative standard deviation");
+  l.nominal_com_m = read_vector3(n.child("nominal_com_m"), false);
+  l.com_m = read_vector3(n.child("com_m"), false);
+  l.com_sigma_m = read_vector3(n.child("com_sigma_m"), true);
+  return l;
+}
+
+// Version 5's optional model_torque_links: one per joint's link when given.
+std::vector<LinkMassParameters> read_model_torque_links(const Node& r, int schema_version,
+                                                        std::size_t joints) {
+  if (!r.has("model_torque_links")) return {};
+  const Node links = r.child("model_torque_links");
+  if (schema_version < 5) links.fail("not a key before schema version 5");
+  std::vector<LinkMassParameters> out;
+  for (const Node& l : links.items()) out.push_back(read_link_masses(l));
+  if (out.size() != joints)
+    links.fail(fmt::format("{} links for the table's {} joints", out.size(), joints));
+  return out;
+}
+
 }  // namespace
+
+nlohmann::json model_torque_links_json(const std::vector<LinkMassParameters>& links) {
+  json out = json::array();
+  for (const LinkMassParameters& l : links)
+    out.push_back({{"refined", l.refined},
+                   {"held_out_z", l.held_out_z},
+                   {"nominal_mass_kg", l.nominal_mass_kg},
+                   {"mass_kg", l.mass_kg},
+                   {"mass_sigma_kg", l.mass_sigma_kg},
+                   {"nominal_com_m", l.nominal_com_m},
+                   {"com_m", l.com_m},
+                   {"com_sigma_m", l.com_sigma_m}});
+  return out;
+}
 
 std::string parameters_json_text(const ParameterTable& t) {
   const bool second_transmission_error =
@@ -422,22 +476,24 @@ std::string parameters_json_text(const ParameterTable& t) {
   }
   json extra_names = json::array();
   for (const TableInput input : t.extra_inputs) extra_names.push_back(to_string(input));
-  const json root = {{"schema", kSchemaName},
-                     {"schema_version", t.schema_version},
-                     {"robot", t.robot},
-                     {"sample_time_s", t.sample_time_s},
-                     {"created_by", t.created_by},
-                     {"model_form", to_string(t.model_form)},
-                     {"preview_cycles", t.preview_cycles},
-                     {"extra_inputs", extra_names},
-                     {"direction_speed_scale_rad_s", t.direction_speed_scale_rad_s},
-                     {"units", units()},
-                     {"source",
-                      {{"file", t.source.file},
-                       {"sha256", t.source.sha256},
-                       {"samples", t.source.samples},
-                       {"description", t.source.description}}},
-                     {"joints", joints}};
+  json root = {{"schema", kSchemaName},
+               {"schema_version", t.schema_version},
+               {"robot", t.robot},
+               {"sample_time_s", t.sample_time_s},
+               {"created_by", t.created_by},
+               {"model_form", to_string(t.model_form)},
+               {"preview_cycles", t.preview_cycles},
+               {"extra_inputs", extra_names},
+               {"direction_speed_scale_rad_s", t.direction_speed_scale_rad_s},
+               {"units", units()},
+               {"source",
+                {{"file", t.source.file},
+                 {"sha256", t.source.sha256},
+                 {"samples", t.source.samples},
+                 {"description", t.source.description}}},
+               {"joints", joints}};
+  if (!t.model_torque_links.empty())
+    root["model_torque_links"] = model_torque_links_json(t.model_torque_links);
   return json_text(root, 1, "parameters.json");
 }
 
@@ -500,7 +556,7 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
   const Node r(root, "", origin);
   r.only_keys({"schema", "schema_version", "robot", "sample_time_s", "created_by", "model_form",
                "preview_cycles", "extra_inputs", "direction_speed_scale_rad_s", "units", "source",
-               "joints"});
+               "joints", "model_torque_links"});
   if (r.child("schema").string() != kSchemaName)
     r.child("schema").fail(
         fmt::format("not an imscal parameter table (expected '{}')", kSchemaName));
@@ -572,6 +628,7 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
       j.child("name").fail("joint '" + t.joints.back().name + "' given twice");
   }
   if (t.joints.empty()) joints.fail("no joint");
+  t.model_torque_links = read_model_torque_links(r, t.schema_version, t.joints.size());
   return t;
 }
 

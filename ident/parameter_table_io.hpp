@@ -10,6 +10,7 @@
 // strictly increasing, a band list that does not match the dimensions, an identified model that
 // is unstable, a non-positive sample time, negative backlash, unknown units.
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "core/atomic_file.hpp"
@@ -18,6 +19,9 @@
 namespace imscal::ident {
 
 std::string parameters_json_text(const ParameterTable& table);
+
+// The table's model_torque_links as parameters.json writes them (and the identification report).
+nlohmann::json model_torque_links_json(const std::vector<LinkMassParameters>& links);
 std::string parameters_csv_text(const ParameterTable& table);
 
 void write_parameters_json(const std::filesystem::path& file, const ParameterTable& table,

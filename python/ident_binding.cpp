@@ -83,11 +83,13 @@ py::dict identify(const std::string& joint_errors, const std::string& config_fil
 
 // The joint torques of the robot's rigid-body model along a desired path (N, 6) with its payload
 // (N,), as `imscal compensate --robot` feeds them to a table with the model-torque input
-// (eval/model_torque.hpp: central differences over the whole path).
+// (eval/model_torque.hpp: central differences over the whole path); with a table (its
+// parameters.json), its refined links' masses and centres of mass (eval::with_table_links).
 py::array_t<double> model_torques(const std::string& robot,
                                   const py::array_t<double, py::array::c_style>& q_desired_rad,
                                   const std::vector<double>& payload_kg, double cycle_s,
-                                  const std::array<double, 3>& gravity_m_s2) {
+                                  const std::array<double, 3>& gravity_m_s2,
+                                  const std::string& table) {
   const auto q = q_desired_rad.unchecked<2>();
   const std::size_t n = std::size_t(q.shape(0));
   if (q.shape(1) != calib::kJointCount || payload_kg.size() != n)
@@ -96,6 +98,8 @@ py::array_t<double> model_torques(const std::string& robot,
   eval::ModelTorqueSource model;
   model.robot = calib::load_robot_description(robot);
   model.gravity_in_base_m_s2 = Eigen::Vector3d(gravity_m_s2[0], gravity_m_s2[1], gravity_m_s2[2]);
+  if (!table.empty())
+    model = eval::with_table_links(std::move(model), ident::read_parameters_json(table), table);
   std::vector<std::vector<double>> path(calib::kJointCount, std::vector<double>(n));
   for (std::size_t k = 0; k < n; ++k)
     for (std::size_t j = 0; j < path.size(); ++j) path[j][k] = q(py::ssize_t(k), py::ssize_t(j));
@@ -174,9 +178,12 @@ void bind_ident(py::module_& m) {
         "--gravity-m-s2 do.");
   m.def("model_torques", &model_torques, "robot"_a, "q_desired_rad"_a, "payload_kg"_a, "cycle_s"_a,
         "gravity_m_s2"_a = std::array<double, 3>{0.0, 0.0, -kStandardGravity_m_s2},
+        "table"_a = std::string(),
         "The joint torques [N m] (N, 6) of the robot file's rigid-body model along a desired path "
         "(N, 6) [rad] with its payload (N,) [kg] sampled every cycle_s, as `imscal compensate "
-        "--robot` feeds them to Precontrol.step for a table with the model-torque input.");
+        "--robot` feeds them to Precontrol.step for a table with the model-torque input. With "
+        "table (a parameters.json), the links its identification refined take its masses and "
+        "centres of mass, as compensate does.");
   py::class_<PythonPrecontrol>(m, "Precontrol",
                                "The online error compensation on a parameters.json, one step() "
                                "per controller cycle (as `imscal compensate` runs it).")

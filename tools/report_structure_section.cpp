@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
+#include <vector>
 
 #include "core/units.hpp"
 #include "tools/report_gnuplot.hpp"
@@ -33,7 +35,37 @@ std::string structure_row(const std::string& joint, const ident::IdentifiedStruc
       with_sigma(s.transmission_error_phase_rad, kDegPerRad));
 }
 
+std::string vector_text(const std::array<double, 3>& v, double scale) {
+  return number(v[0] * scale) + " " + number(v[1] * scale) + " " + number(v[2] * scale);
+}
+
+std::string link_row(std::size_t link, const ident::LinkMassParameters& l) {
+  constexpr double kCm = 100.0;
+  return fmt::format(
+      "<tr><td>{}</td><td>{}</td><td>{:.2f}</td><td>{} &plusmn; {}</td><td>{}</td>"
+      "<td>{} &plusmn; {}</td><td>{}</td></tr>\n",
+      link + 1, l.refined ? "refined" : "nominal kept", l.held_out_z, number(l.mass_kg),
+      number(l.mass_sigma_kg), number(l.nominal_mass_kg), vector_text(l.com_m, kCm),
+      vector_text(l.com_sigma_m, kCm), vector_text(l.nominal_com_m, kCm));
+}
+
 }  // namespace
+
+std::string model_torque_links_html(const std::vector<ident::LinkMassParameters>& links) {
+  if (links.empty()) return "";
+  std::string rows;
+  for (std::size_t i = 0; i < links.size(); ++i) rows += link_row(i, links[i]);
+  return "<p>The model torque's link masses and centres of mass (in the link's frame) estimated "
+         "from the identification data (eval/mass_refinement.hpp), with 1&sigma; beside the robot "
+         "file's. Where the links are used (refined), the table's models were identified with "
+         "the estimates and its users compute the model torque with them: the identification "
+         "keeps them only where the tables they give fit the held-out rows better (BIC); z is "
+         "each link's held-out score on the refinement's own drive model.</p>\n"
+         "<table>\n<tr><th>link</th><th>used</th><th>held-out z</th><th>mass [kg]</th>"
+         "<th>robot file's [kg]</th><th>centre of mass [cm]</th><th>robot file's [cm]</th>"
+         "</tr>\n" +
+         rows + "</table>\n";
+}
 
 std::string structure_table_html(const ident::IdentificationReport& report) {
   std::string rows;

@@ -166,6 +166,7 @@ std::string models_body(const ident::ParameterTable& table,
   }
   body += "</table>\n";
   if (report) body += structure_table_html(*report);
+  body += model_torque_links_html(table.model_torque_links);
   for (const auto& joint : table.joints) {
     const ident::CellGrid grid = joint.grid();
     body += fmt::format(

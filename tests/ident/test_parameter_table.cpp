@@ -89,6 +89,16 @@ ident::ParameterTable sample_table(bool transmission_error = true, bool second_h
 
 class ParameterTableFiles : public imscal::test_support::ScratchDirTest {};
 
+// The loader refuses `j`, naming the JSON path `field`.
+void refused(const json& j, const std::string& field) {
+  try {
+    ident::parse_parameters_json(j.dump(), "parameters.json");
+    ADD_FAILURE() << "accepted a bad table";
+  } catch (const imscal::InputError& e) {
+    EXPECT_EQ(e.field(), field) << e.what();
+  }
+}
+
 TEST_F(ParameterTableFiles, RoundTripIsExact) {
   const ident::ParameterTable table = sample_table();
   const auto file = dir_ / "parameters.json";
@@ -110,14 +120,6 @@ TEST_F(ParameterTableFiles, SecondHarmonicRoundTripsAndIsChecked) {
   const auto file = dir_ / "parameters.json";
   ident::write_parameters_json(file, table);
   EXPECT_TRUE(ident::read_parameters_json(file) == table);
-  const auto refused = [](json j, const std::string& field) {
-    try {
-      ident::parse_parameters_json(j.dump(), "parameters.json");
-      ADD_FAILURE() << "accepted a bad table";
-    } catch (const imscal::InputError& e) {
-      EXPECT_EQ(e.field(), field) << e.what();
-    }
-  };
   const json good = json::parse(ident::parameters_json_text(table));
   json same = good;
   same["joints"][0]["transmission_error_2_rad_per_rad"] =
@@ -139,6 +141,38 @@ TEST_F(ParameterTableFiles, SecondHarmonicRoundTripsAndIsChecked) {
   json without = json::parse(ident::parameters_json_text(sample_table()));
   without["joints"][1]["transmission_error_2_rad_per_rad"] = 300.0;
   refused(without, "/joints/1/transmission_error_2_rad_per_rad");
+}
+
+// Schema 5's refined links of the model torque: exact round trip, one per joint, positive masses,
+// not in an older table; a table without them writes no key and reads none.
+TEST_F(ParameterTableFiles, ModelTorqueLinksRoundTripAndAreChecked) {
+  ident::ParameterTable table = sample_table();
+  EXPECT_EQ(json::parse(ident::parameters_json_text(table)).count("model_torque_links"), 0u);
+  for (int i = 0; i < 2; ++i)
+    table.model_torque_links.push_back({i == 0,
+                                        3.1 + i,
+                                        40.0 / 3.0,
+                                        33.3 + i,
+                                        2.2,
+                                        {0.35, 0.0, 0.1 / 3.0},
+                                        {0.33, 0.004, 0.09},
+                                        {0.006, 0.01, 0.008}});
+  const auto file = dir_ / "parameters.json";
+  ident::write_parameters_json(file, table);
+  EXPECT_TRUE(ident::read_parameters_json(file) == table);
+  const json good = json::parse(ident::parameters_json_text(table));
+  json old = good;
+  old["schema_version"] = 4;
+  refused(old, "/model_torque_links");
+  json one = good;
+  one["model_torque_links"].erase(1);
+  refused(one, "/model_torque_links");
+  json massless = good;
+  massless["model_torque_links"][1]["mass_kg"] = 0.0;
+  refused(massless, "/model_torque_links/1/mass_kg");
+  json short_com = good;
+  short_com["model_torque_links"][0]["com_sigma_m"] = json::array({0.1, 0.1});
+  refused(short_com, "/model_torque_links/0/com_sigma_m");
 }
 
 TEST(ParameterTable, Version1TablesReadAsForwardModelsWithoutPreview) {
@@ -215,8 +249,8 @@ TEST_P(LoaderRefuses, WithPathAndMessage) {
 INSTANTIATE_TEST_SUITE_P(
     BadTables, LoaderRefuses,
     ::testing::Values(
-        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 5; }, "/schema_version",
-                "unknown schema version 5"},
+        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 6; }, "/schema_version",
+                "unknown schema version 6"},
         Refusal{"CountsForTheFurtherInputs",
                 [](json& j) { j["joints"][0]["cells"][0]["nx"] = json::array({3}); },
                 "/joints/0/cells/0/nx", "1 counts for the table's 4 further inputs"},
