@@ -14,6 +14,7 @@ TEST(GapEffects, RegistryHoldsOneCompleteDefinitionPerKindInOrder) {
   std::set<std::string> names;
   for (int i = 0; i < kEffectKindCount; ++i) {
     const EffectKind kind = effect_kind_from_index(i);
+    ASSERT_NE(kEffectDefinitions[std::size_t(i)], nullptr) << "registry row " << i << " missing";
     const EffectDefinition& d = effect_definition(kind);
     EXPECT_EQ(d.kind, kind) << "registry row " << i;
     ASSERT_NE(d.name, nullptr);
