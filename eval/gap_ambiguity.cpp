@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace imscal::eval {
 namespace {
@@ -21,65 +22,18 @@ std::size_t own_parameters(const CandidateFit& f) {
 }  // namespace
 
 const char* what_to_measure(EffectKind kind) {
-  switch (kind) {
-    case EffectKind::kBacklash:
-      return "slow reversals of the joint and static poses approached from both sides (play does "
-             "not depend on speed)";
-    case EffectKind::kCoulombFriction:
-      return "reversals of the joint at several speeds (friction transients follow the "
-             "controller, not the play)";
-    case EffectKind::kGearCompliance:
-      return "the same path at two accelerations and with two payloads (deflection scales with "
-             "the torque)";
-    case EffectKind::kTransmissionError:
-      return "a slow constant-speed move of the joint over several motor revolutions (the error "
-             "is periodic in the motor angle)";
-    case EffectKind::kResonance:
-      return "fast stops of the joint recorded by the IMS at its full rate (ring-down frequency "
-             "and damping)";
-    case EffectKind::kTimeOffset:
-      return "sharp starts and stops with both streams stamped by one clock";
-    case EffectKind::kPayloadMismatch:
-      return "the path with and without a known extra mass";
-    case EffectKind::kZeroOffset:
-      return "static poses of the joint (a constant error does not depend on the motion)";
-    case EffectKind::kThermalDrift:
-      return "a repeat of the path after a warm-up and the drive temperatures";
-    case EffectKind::kOperatingPoint:
-      return "identification runs at the speeds and joint positions of this path";
-    case EffectKind::kKinematicParameters:
-      return "static poses spread over the workspace with an external reference (laser tracker), "
-             "or a kinematic calibration (the error depends on the pose, not on the motion)";
-    case EffectKind::kSensorMounting:
-      return "the frame calibration's rest poses again with larger wrist rotations (the mounting "
-             "error grows with the rotation away from the first pose)";
-    case EffectKind::kImsScaleFactor:
-      return "turn tests of the IMS about each axis by a known angle (rotary table or joint 6) "
-             "and a known linear displacement";
-    case EffectKind::kClockOffset:
-      return "sharp starts and stops of several joints with both streams stamped by one clock (a "
-             "common offset shifts every joint's error by the same time)";
-    case EffectKind::kImsBias:
-      return "a longer rest of the IMS before and after the path, and rests during it (the "
-             "rests bound the attitude drift)";
-  }
-  return "";
+  return effect_definition(kind).what_to_measure;
 }
 
 std::string separating_measurement(const GapSignals& s, const CandidateFit& a,
                                    const CandidateFit& b) {
-  const auto is = [&](EffectKind x, EffectKind y) {
-    return (a.kind == x && b.kind == y) || (a.kind == y && b.kind == x);
-  };
-  if (is(EffectKind::kBacklash, EffectKind::kZeroOffset) && a.joint == b.joint) {
-    const std::string& j = s.joint_names[a.joint];
-    return fmt::format(
-        "a path on which the gear torque of {} changes sign (its gravity load reversed by another "
-        "pose of the arm, or reversals fast enough that their inertia torque outweighs it): "
-        "backlash then shows as a step of the full play where the torque reverses, a zero offset "
-        "stays the same constant",
-        j);
-  }
+  // A measurement one of the two effects names for the other on the same joint.
+  if (a.joint == b.joint)
+    for (const auto& [x, y] : {std::pair{&a, &b}, std::pair{&b, &a}}) {
+      const auto separate = effect_definition(x->kind).separate_from;
+      const std::string text = separate ? separate(y->kind, s.joint_names[a.joint]) : "";
+      if (!text.empty()) return text;
+    }
   if (a.kind == b.kind)
     return fmt::format("for {} on {} and on {}: {}", to_string(a.kind), s.joint_names[a.joint],
                        s.joint_names[b.joint], what_to_measure(a.kind));

@@ -9,84 +9,23 @@
 // An effect that moves a link also reaches the other joints through the coupled dynamics: its
 // fit is extended to the joints the validation chooses (eval/gap_coupling.hpp).
 //
-// Candidates (u: the candidate's driving signal; L_tau,i: the i-th discrete Laguerre filter of
-// time scale tau, an orthonormal basis of stable linear responses: the closed joint loop's
-// reaction to u without knowing its poles; HP_tau = 1 - first-order lag; q̇_a, tau_a the
-// velocity and rigid-body torque of the drive's actual motion, q_internal):
-//   backlash        the flank the link rests on: a relay with memory r of the sign of
-//                   z = tau_a / RMS + c tanh(q̇_a / 5 mrad/s) (c = 0 .. 3: the friction at the link
-//                   can outweigh a light axis' inertia torque; hold thresholds 2 / 10 %), or of q̇_a
-//                   alone, as [r] or [r, L_10/30/100ms,0..3 r]; the smooth tanh(tau_a / 1, 5 or
-//                   20 % of its RMS) as [u] or [u, L_10/30/100ms,0..3 u] (when >= 5 % of the
-//                   samples lie on the torque's minority side); tanh(q̇_a / 5 mrad/s) (paper,
-//                   eq. 3) as [u] or [u, LP_30ms u]. A relay that never switches is the one-flank
-//                   shape kOneFlankShape: a constant, half the play
-//   coulomb         u = tanh(q̇_a / v_s), v_s 5, 10, 20 mrad/s: the friction acts on the motor's
-//                   own velocity and the PI loop works it off after every reversal:
-//                   [L_100ms,0..5 u], [L_100ms,0..3 u], [L_30ms,0..5 u] or [HP_30/100/300ms u]
-//   compliance      u = tau_d (inverse dynamics on q_d): deflection tau/k; [u], [G, u - G] (gravity
-//                   and motion parts apart), [u, L_30ms,0..1 u] or [u, L_30ms,0..5 u]
-//   transmission    s, c = sin/cos(h N q_internal), h = 1..3 per motor revolution and the two
-//                   orders of 1..8 whose raw ripple best fits the training rows: raw, through
-//                   L_3ms (x3, x4), L_10ms or L_30ms (x4), or with the ripple torque tau_d s,
-//                   tau_d c (the gear's virtual work on the motor) through L_100ms x3 beside
-//                   L_10ms x3 or L_3ms + L_30ms x3 of s, c: below the loop's bandwidth the link
-//                   follows the error, above the link's mode it does not
-//   resonance       q̈_d through ω²/(s² + 2ζωs + ω²), f 2..40 Hz in 10 % steps x ζ {0.02, 0.04,
-//                   0.07, 0.12, 0.3}; [y, ẏ/ω] (gain and phase)
-//   time_offset     [q̇_d]: the parameter is the offset dt [s] between the streams
-//   clock_offset    all joints at once, one parameter: [q̇_d,j] on every joint j, the offset dt [s]
-//                   of the measuring clock against the robot's (a parameter of the nominal model:
-//                   q_m(t) = q(t - dt), linearised -dt q̇ of the joint error's measured side)
-//   payload         all joints at once (one mass acts on every joint it loads): per joint
-//                   u_j = d tau_j / d m_payload, [u_j], [L_30ms,0..3 u_j], [L_100ms,0..5 u_j] or
-//                   [L_30ms,0..3 u_j, L_100ms,0..5 u_j] with its own parameters per joint (Δm / k_j
-//                   through joint j's loop)
-//   zero_offset     [1]
-//   thermal_drift   [1, t', t'^2], t' = (t - t_mid) / duration
-//   operating_point [o, o sign(q̇_d)], o = how far |q̇_d| lies beyond the identified speed range
-//                   of the table, relative to it (only with a table that has a speed dimension)
-// The geometric errors of the IMS chain (columns of GapSignals::ims_chain_columns, only with a
-// robot model; the joint-space map -Jb^-1 of a flange pose error, eval/gap_signals.hpp) act on
-// all joints with the same parameters: they are fitted to all joints' gaps at once (stacked), and
-// their joint is the one where their modelled gap is largest:
-//   kinematic_parameters  DH a, alpha, d of one link i = 1..6 (3 parameters, link chosen as the
-//                         shape; the joint zero offsets are zero_offset)
-//   sensor_mounting       the mounting twist of the sensor on the flange: rotation (3),
-//                         translation (3) or both (6)
-//   ims_scale_factor      gyro scale per flange axis (3), isotropic gyro scale (1), isotropic
-//                         accelerometer scale (1)
-//   ims_bias              gyro rate bias about the flange axes (3): an attitude drift
+// Each effect's shapes are defined with the effect, in eval/gap_effect_<name>.cpp (the list:
+// eval/gap_effects.hpp). Notation there: u is the candidate's driving signal; L_tau,i the i-th
+// discrete Laguerre filter of time scale tau, an orthonormal basis of stable linear responses (the
+// closed joint loop's reaction to u without knowing its poles); HP_tau = 1 - first-order lag; q̇_a,
+// tau_a the velocity and rigid-body torque of the drive's actual motion, q_internal. The geometric
+// errors of the IMS chain act on all joints with the same parameters: they are fitted to all
+// joints' gaps at once (stacked), and their joint is the one where their modelled gap is largest.
 #include <Eigen/Core>
 #include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "eval/gap_effects.hpp"
 #include "eval/gap_signals.hpp"
 
 namespace imscal::eval {
-
-enum class EffectKind {
-  kBacklash,
-  kCoulombFriction,
-  kGearCompliance,
-  kTransmissionError,
-  kResonance,
-  kTimeOffset,
-  kPayloadMismatch,
-  kZeroOffset,
-  kThermalDrift,
-  kOperatingPoint,
-  kKinematicParameters,
-  kSensorMounting,
-  kImsScaleFactor,
-  kImsBias,
-  kClockOffset,
-};
-inline constexpr int kEffectKindCount = 15;
-const char* to_string(EffectKind kind);
-EffectKind effect_kind_from_index(int index);
 
 // One shape of a candidate: its regressor columns over all samples, per joint (an empty matrix:
 // the candidate does not act on that joint; all others have one column per parameter).
@@ -100,6 +39,9 @@ struct CandidateShape {
   // of the velocity for friction (>= 0 when the nominal model has none). Empty: unbounded.
   Eigen::VectorXd level_signal;
   double level_lower = 0.0;
+  // The shape is a constant on its own joint (a play held on one flank): its size reads as an
+  // offset.
+  bool constant_on_own_joint = false;
 };
 
 // A physical bound of a fit (eval/gap_bounds.hpp): the level of the parameters
@@ -134,11 +76,6 @@ std::vector<double> transmission_orders_by_fit(const GapSignals& signals, std::s
 // a zero offset of the joint (eval/gap_ambiguity.hpp).
 inline constexpr const char* kOneFlankShape =
     "held on one flank (the gear torque never changes sign)";
-
-// Effects that move a link (and so reach the other joints through the coupled dynamics,
-// eval/gap_coupling.hpp), unlike offsets, drifts, time offsets, table extrapolation and errors of
-// the IMS chain, which act on the measurement or the model only.
-bool acts_through_dynamics(EffectKind kind);
 
 struct CandidateFit {
   EffectKind kind = EffectKind::kZeroOffset;

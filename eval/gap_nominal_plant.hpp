@@ -7,14 +7,9 @@
 // (gap = Δq_real - Δq_sim with Δq = q_d - q_link) through the same loop, coupled dynamics and
 // nonlinearities as the nominal model itself, at any size: a friction halved or a transmission
 // error of another order is not the linear response the candidates' Laguerre bases approximate.
-// Parameters, on the member's joint j:
-//   Coulomb friction    ΔF_c [N m] of joint j's drive (switched on when the nominal has it off);
-//                       F_c + ΔF_c >= 0
-//   backlash            Δb [rad], the play's full width (elastic gears only); b + Δb >= 0
-//   transmission error  a_s, a_c [rad] of a further order h per motor revolution,
-//                       a_s sin(h θ_m) + a_c cos(h θ_m), θ_m the motor angle / N (the order from
-//                       a search, eval/gap_refinement.hpp)
-//   payload             Δm [kg] of every payload of the path; m + Δm >= 0
+// The effects that are parameters of the nominal model say so in their definitions
+// (EffectDefinition::nominal, eval/gap_effects.hpp): how many values p has, in which units, and
+// its physical bound.
 #include <Eigen/Core>
 #include <cstddef>
 #include <string>
@@ -37,8 +32,8 @@ struct NominalPlant {
 struct NominalParameter {
   EffectKind kind = EffectKind::kCoulombFriction;
   std::size_t joint = 0;
-  double harmonic_per_motor_rev = 1.0;  // transmission error only
-  Eigen::Index size() const { return kind == EffectKind::kTransmissionError ? 2 : 1; }
+  double harmonic_per_motor_rev = 1.0;  // effects with a per-motor order only
+  Eigen::Index size() const;            // the values of its change p
 };
 
 // Whether `kind` on `joint` is a parameter of this nominal model.

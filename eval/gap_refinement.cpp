@@ -99,12 +99,6 @@ Step gauss_newton_step(Problem& x, const Eigen::VectorXd& p, const Signal& m) {
   return {fit.parameters.head(np), fit.rms};
 }
 
-// The effects of a joint's drive that the nominal model has as parameters, one of which a member
-// may stand for: the linear candidates confuse them (a Coulomb friction raised looks like a play
-// on a joint whose torque and velocity change sign together), the simulated ones less.
-constexpr EffectKind kDriveEffects[] = {EffectKind::kCoulombFriction, EffectKind::kBacklash,
-                                        EffectKind::kTransmissionError};
-
 // How many of the orders the raw ripple fits best are tried by simulation: the link's response
 // to a high order is filtered and delayed by the loop, so the raw ripple's best is not always it.
 constexpr std::size_t kOrdersSimulated = 3;
@@ -115,12 +109,18 @@ std::vector<NominalParameter> drive_alternatives(const Problem& x, std::size_t i
                                                  const Signal& residual) {
   const std::size_t joint = x.parameters[i].joint;
   std::vector<NominalParameter> out;
-  for (EffectKind kind : kDriveEffects) {
+  // The effects of a joint's drive that the nominal model has as parameters
+  // (NominalParameterDefinition::of_drive), one of which a member may stand for: the linear
+  // candidates confuse them (a Coulomb friction raised looks like a play on a joint whose torque
+  // and velocity change sign together), the simulated ones less.
+  for (const EffectDefinition* effect : kEffectDefinitions) {
+    if (!effect->nominal || !effect->nominal->of_drive) continue;
+    const EffectKind kind = effect->kind;
     bool present = false;
     for (std::size_t k = 0; k < x.parameters.size(); ++k)
       present |= k != i && x.parameters[k].kind == kind && x.parameters[k].joint == joint;
     if (present || !has_nominal_parameter(x.plant, kind, joint)) continue;
-    if (kind != EffectKind::kTransmissionError) {
+    if (!effect->nominal->per_motor_order) {
       out.push_back({kind, joint, 1.0});
       continue;
     }
@@ -136,7 +136,7 @@ std::vector<NominalParameter> drive_alternatives(const Problem& x, std::size_t i
 // step, at the nominal model) leaves the least training residual.
 void choose_drive_effects(Problem& x, const Signal& zero, const Signal& residual) {
   for (std::size_t i = 0; i < x.parameters.size(); ++i) {
-    if (x.parameters[i].kind == EffectKind::kPayloadMismatch) continue;
+    if (!effect_definition(x.parameters[i].kind).nominal->of_drive) continue;
     double best = std::numeric_limits<double>::infinity();
     NominalParameter chosen = x.parameters[i];
     for (const NominalParameter& alternative : drive_alternatives(x, i, residual)) {
