@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/input_error.hpp"
+#include "core/record_file.hpp"
 #include "ims/error_state_model.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/so3.hpp"
@@ -67,13 +68,40 @@ struct Epoch {
   Eigen::Vector3d acc_bias = Eigen::Vector3d::Zero();
 };
 
-// The matrices of instant k, which only the backward pass needs: kept apart from Epoch so that
-// they are released before the smoothed states are built (5.4 kB per instant, more than the
-// states of its samples).
+// The matrices of instant k, which only the backward pass needs: 5.4 kB per instant (32 MB
+// per minute at 100 Hz), so they go to a temporary file (CovarianceFile) instead of memory.
 struct EpochCovariances {
   ErrorMatrix transition;     // from k - 1 to k
   ErrorMatrix predicted_cov;  // at k before the updates
   ErrorMatrix filtered_cov;   // at k after the updates
+};
+
+// The forward pass' EpochCovariances, one record per instant, written in order and read back
+// by the backward pass in reverse, bit for bit.
+class CovarianceFile {
+ public:
+  static constexpr std::size_t kValues = 3 * kSize * kSize;
+  // 512 instants per block: 2.8 MB of buffer.
+  CovarianceFile() : file_(kValues, 512, "the smoother's covariances") {}
+  void append(const EpochCovariances& c) {
+    std::copy_n(c.transition.data(), kSize * kSize, values_.data());
+    std::copy_n(c.predicted_cov.data(), kSize * kSize, values_.data() + kSize * kSize);
+    std::copy_n(c.filtered_cov.data(), kSize * kSize, values_.data() + 2 * kSize * kSize);
+    file_.append(values_.data());
+  }
+  EpochCovariances read(std::size_t k) {
+    const double* v = file_.record(k);
+    EpochCovariances c;
+    c.transition = Eigen::Map<const ErrorMatrix>(v);
+    c.predicted_cov = Eigen::Map<const ErrorMatrix>(v + kSize * kSize);
+    c.filtered_cov = Eigen::Map<const ErrorMatrix>(v + 2 * kSize * kSize);
+    return c;
+  }
+  std::size_t size() const { return file_.size(); }
+
+ private:
+  RecordFile file_;
+  std::vector<double> values_ = std::vector<double>(kValues);
 };
 
 struct UpdateTally {
@@ -185,27 +213,26 @@ struct SmoothedErrors {
 
 // Rauch-Tung-Striebel on the error state. With the estimates fed back, the filtered error is
 // zero after every update and so is its prediction: x_s(k) = C_k x_s^before(k + 1).
-SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs,
-                                 const std::vector<EpochCovariances>& covariances) {
+SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs, CovarianceFile& covariances) {
   const std::size_t last = epochs.size() - 1;
   SmoothedErrors s;
   s.after.resize(epochs.size());
   s.before.resize(epochs.size());
   s.variance.resize(epochs.size());
   s.after[last].setZero();
-  ErrorMatrix smoothed_cov = covariances[last].filtered_cov;
+  EpochCovariances next = covariances.read(last);
+  ErrorMatrix smoothed_cov = next.filtered_cov;
   s.variance[last] = smoothed_cov.diagonal();
   s.before[last] = epochs[last].correction;
   for (std::size_t k = last; k-- > 0;) {
-    const EpochCovariances& next = covariances[k + 1];
-    const ErrorMatrix C =
-        smoother_gain(covariances[k].filtered_cov, next.transition, next.predicted_cov);
+    EpochCovariances current = covariances.read(k);
+    const ErrorMatrix C = smoother_gain(current.filtered_cov, next.transition, next.predicted_cov);
     s.after[k] = C * s.before[k + 1];
-    smoothed_cov =
-        covariances[k].filtered_cov + C * (smoothed_cov - next.predicted_cov) * C.transpose();
+    smoothed_cov = current.filtered_cov + C * (smoothed_cov - next.predicted_cov) * C.transpose();
     smoothed_cov = 0.5 * (smoothed_cov + smoothed_cov.transpose());
     s.variance[k] = smoothed_cov.diagonal().cwiseMax(0.0);
     s.before[k] = s.after[k] + epochs[k].correction;
+    next = std::move(current);
   }
   return s;
 }
@@ -219,12 +246,16 @@ ImuSample bias_corrected(const ImuSeries& imu, std::size_t i, const Epoch& previ
   return corrected;
 }
 
+// The feedback of the forward pass at instant k (the same step as there).
+void feed_back(Strapdown& strapdown, const ErrorVector& correction) {
+  if (!correction.isZero(0.0)) strapdown.reset(apply_error(strapdown.state(), correction));
+}
+
 // The nominal state of every sample corrected by the smoothed error, interpolated linearly in
 // time between the propagation instants that enclose the sample. The nominal states are
-// mechanised again from the strapdown kept at each interval's start (the same steps as the
-// forward pass, so the same states), instead of being kept per sample through the forward pass.
-std::vector<SmoothedState> apply_smoothed_errors(const ImuSeries& imu,
-                                                 const std::vector<Strapdown>& interval_start,
+// mechanised again from the initial state with the forward pass' bias estimates and feedbacks
+// (the same steps, so the same states), instead of being kept per sample or per instant.
+std::vector<SmoothedState> apply_smoothed_errors(const ImuSeries& imu, Strapdown strapdown,
                                                  const std::vector<Epoch>& epochs,
                                                  const SmoothedErrors& smoothed) {
   std::vector<SmoothedState> states;
@@ -233,7 +264,6 @@ std::vector<SmoothedState> apply_smoothed_errors(const ImuSeries& imu,
   std::size_t i = 0;
   for (std::size_t k = 1; k < epochs.size(); ++k) {
     const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
-    Strapdown strapdown = interval_start[k - 1];
     for (; i <= epochs[k].last_sample; ++i) {
       strapdown.step(bias_corrected(imu, i, epochs[k - 1]));
       const NavState& nominal = strapdown.state();
@@ -244,6 +274,7 @@ std::vector<SmoothedState> apply_smoothed_errors(const ImuSeries& imu,
       states[i].state = apply_error(nominal, e);
       states[i].sigma = var.head<9>().cwiseSqrt();
     }
+    feed_back(strapdown, epochs[k].correction);
   }
   return states;
 }
@@ -328,17 +359,15 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
   const std::vector<bool> epoch_zero_velocity = rest_interior(options.zero_velocity_edge_margin_s);
 
   // ---- forward pass ----
-  // The strapdown at each interval's start (after the last feedback): the nominal states are
-  // mechanised again from it after the backward pass (apply_smoothed_errors).
-  std::vector<Strapdown> interval_start;
-  interval_start.reserve(epoch_count);
   std::vector<Epoch> epochs;
-  std::vector<EpochCovariances> covariances;
+  CovarianceFile covariances;
   epochs.reserve(epoch_count + 1);
-  covariances.reserve(epoch_count + 1);
   epochs.push_back(initial_epoch(initial, options));
-  covariances.push_back(initial_covariances(initial_sigma, options));
-  Strapdown strapdown(earth, initial);
+  const EpochCovariances first_covariances = initial_covariances(initial_sigma, options);
+  covariances.append(first_covariances);
+  ErrorMatrix previous_filtered_cov = first_covariances.filtered_cov;
+  const Strapdown initial_strapdown(earth, initial);
+  Strapdown strapdown = initial_strapdown;
   ErrorLinearisation point;
   point.earth_rate_W = earth.earth_rate_W();
   point.gravity_gradient_W = earth.gravity_gradient_W();
@@ -359,12 +388,10 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
     const std::size_t begin = (k - 1) * samples_per_epoch;
     const std::size_t end = std::min(n, begin + samples_per_epoch);
     const Epoch& previous = epochs.back();
-    const ErrorMatrix& previous_filtered_cov = covariances.back().filtered_cov;
     Eigen::Matrix3d sum_R = Eigen::Matrix3d::Zero();
     Eigen::Vector3d sum_dv_W = Eigen::Vector3d::Zero();
     Eigen::Vector3d sum_raw_dtheta = Eigen::Vector3d::Zero();
     const double t_begin = strapdown.state().t_s;
-    interval_start.push_back(strapdown);
     for (std::size_t i = begin; i < end; ++i) {
       const ImuSample& raw = imu.samples[i];
       const double dt = sample_interval(imu, i);
@@ -441,7 +468,7 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
       }
     }
     if (!x.isZero(0.0)) {
-      strapdown.reset(apply_error(strapdown.state(), x));
+      feed_back(strapdown, x);
       epoch.gyro_bias += x.segment<3>(kGyroBias);
       epoch.acc_bias += x.segment<3>(kAccBias);
     }
@@ -451,9 +478,10 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
       rest_time = 0.0;
     }
     cov.filtered_cov = P;
+    previous_filtered_cov = P;
     epoch.correction = x;
     epochs.push_back(std::move(epoch));
-    covariances.push_back(std::move(cov));
+    covariances.append(cov);
   }
   result.summary.zero_velocity = zupt_tally.statistics();
   result.summary.zero_angular_rate = zaru_tally.statistics();
@@ -461,8 +489,7 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
   result.summary.propagation_steps = epoch_count;
 
   const SmoothedErrors smoothed = rts_backward_pass(epochs, covariances);
-  std::vector<EpochCovariances>().swap(covariances);  // released before the states are built
-  result.states = apply_smoothed_errors(imu, interval_start, epochs, smoothed);
+  result.states = apply_smoothed_errors(imu, initial_strapdown, epochs, smoothed);
   result.biases.resize(epochs.size());
   for (std::size_t k = 0; k < epochs.size(); ++k) {
     SmoothedBias& b = result.biases[k];
