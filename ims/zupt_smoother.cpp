@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "core/input_error.hpp"
 #include "core/record_file.hpp"
@@ -251,34 +252,6 @@ void feed_back(Strapdown& strapdown, const ErrorVector& correction) {
   if (!correction.isZero(0.0)) strapdown.reset(apply_error(strapdown.state(), correction));
 }
 
-// The nominal state of every sample corrected by the smoothed error, interpolated linearly in
-// time between the propagation instants that enclose the sample. The nominal states are
-// mechanised again from the initial state with the forward pass' bias estimates and feedbacks
-// (the same steps, so the same states), instead of being kept per sample or per instant.
-std::vector<SmoothedState> apply_smoothed_errors(const ImuSeries& imu, Strapdown strapdown,
-                                                 const std::vector<Epoch>& epochs,
-                                                 const SmoothedErrors& smoothed) {
-  std::vector<SmoothedState> states;
-  states.reserve(imu.samples.size() + 1);  // room for a caller's initial state, without a copy
-  states.resize(imu.samples.size());
-  std::size_t i = 0;
-  for (std::size_t k = 1; k < epochs.size(); ++k) {
-    const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
-    for (; i <= epochs[k].last_sample; ++i) {
-      strapdown.step(bias_corrected(imu, i, epochs[k - 1]));
-      const NavState& nominal = strapdown.state();
-      const double alpha = (nominal.t_s - t0) / (t1 - t0);
-      const ErrorVector e = (1.0 - alpha) * smoothed.after[k - 1] + alpha * smoothed.before[k];
-      const ErrorVector var =
-          (1.0 - alpha) * smoothed.variance[k - 1] + alpha * smoothed.variance[k];
-      states[i].state = apply_error(nominal, e);
-      states[i].sigma = var.head<9>().cwiseSqrt();
-    }
-    feed_back(strapdown, epochs[k].correction);
-  }
-  return states;
-}
-
 // Keeps only the rest samples inside the still intervals (sorted) and redoes the runs.
 void restrict_rests(const ImuSeries& imu, const std::vector<TimeInterval>& still,
                     RestDetection& rest) {
@@ -318,13 +291,91 @@ bool aid_velocity_at(const SmootherAids& aids, double t, std::size_t& cursor, Ei
 
 }  // namespace
 
+struct SmoothedStateStream::Record {
+  const ImuSeries* imu = nullptr;
+  Strapdown initial;
+  std::vector<Epoch> epochs;
+  SmoothedErrors smoothed;
+};
+
+// Where the stream stands: the strapdown after sample `sample` - 1, in the interval ending at
+// instant `instant`.
+struct SmoothedStateStream::Cursor {
+  Strapdown strapdown;
+  std::size_t instant = 1;
+  std::size_t sample = 0;
+};
+
+SmoothedStateStream::SmoothedStateStream() = default;
+SmoothedStateStream::SmoothedStateStream(std::unique_ptr<const Record> record)
+    : record_(std::move(record)), cursor_(std::make_unique<Cursor>(Cursor{record_->initial})) {}
+SmoothedStateStream::~SmoothedStateStream() = default;
+SmoothedStateStream::SmoothedStateStream(SmoothedStateStream&&) noexcept = default;
+SmoothedStateStream& SmoothedStateStream::operator=(SmoothedStateStream&&) noexcept = default;
+
+std::size_t SmoothedStateStream::size() const {
+  return record_ ? record_->imu->samples.size() : 0;
+}
+bool SmoothedStateStream::done() const {
+  return !record_ || cursor_->instant >= record_->epochs.size();
+}
+void SmoothedStateStream::rewind() {
+  if (record_) *cursor_ = Cursor{record_->initial};
+}
+
+// The nominal state of every sample corrected by the smoothed error, interpolated linearly in
+// time between the propagation instants that enclose the sample. The nominal states are
+// mechanised again (the same steps as the forward pass, so the same states), instead of being
+// kept per sample or per instant.
+std::size_t SmoothedStateStream::next(std::vector<SmoothedState>& out, std::size_t max_states) {
+  if (!record_) return 0;
+  const std::vector<Epoch>& epochs = record_->epochs;
+  const SmoothedErrors& smoothed = record_->smoothed;
+  Cursor& c = *cursor_;
+  std::size_t given = 0;
+  while (c.instant < epochs.size() && given < max_states) {
+    const std::size_t k = c.instant;
+    const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
+    for (; c.sample <= epochs[k].last_sample && given < max_states; ++c.sample, ++given) {
+      c.strapdown.step(bias_corrected(*record_->imu, c.sample, epochs[k - 1]));
+      const NavState& nominal = c.strapdown.state();
+      const double alpha = (nominal.t_s - t0) / (t1 - t0);
+      const ErrorVector e = (1.0 - alpha) * smoothed.after[k - 1] + alpha * smoothed.before[k];
+      const ErrorVector var =
+          (1.0 - alpha) * smoothed.variance[k - 1] + alpha * smoothed.variance[k];
+      SmoothedState& state = out.emplace_back();
+      state.state = apply_error(nominal, e);
+      state.sigma = var.head<9>().cwiseSqrt();
+    }
+    if (c.sample > epochs[k].last_sample) {
+      feed_back(c.strapdown, epochs[k].correction);
+      ++c.instant;
+    }
+  }
+  return given;
+}
+
 ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& earth,
                                     const NavState& initial,
                                     const Eigen::Matrix<double, 9, 1>& initial_sigma,
                                     const ZuptOptions& options, const SmootherAids& aids) {
+  ZuptSmoothing smoothing =
+      smooth_with_zupt_streamed(imu, earth, initial, initial_sigma, options, aids);
+  ZuptSmootherResult result;
+  result.states.reserve(imu.samples.size() + 1);  // room for a caller's initial state
+  smoothing.states.next(result.states, imu.samples.size());
+  result.biases = std::move(smoothing.biases);
+  result.summary = std::move(smoothing.summary);
+  return result;
+}
+
+ZuptSmoothing smooth_with_zupt_streamed(const ImuSeries& imu, const EarthModel& earth,
+                                        const NavState& initial,
+                                        const Eigen::Matrix<double, 9, 1>& initial_sigma,
+                                        const ZuptOptions& options, const SmootherAids& aids) {
   check_options(imu, options);
   const std::size_t n = imu.samples.size();
-  ZuptSmootherResult result;
+  ZuptSmoothing result;
 
   RestDetection rest = detect_rest(imu, earth, rest_options_of(options));
   if (aids.still) restrict_rests(imu, *aids.still, rest);
@@ -488,8 +539,7 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
   result.summary.velocity_aid = aid_tally.statistics();
   result.summary.propagation_steps = epoch_count;
 
-  const SmoothedErrors smoothed = rts_backward_pass(epochs, covariances);
-  result.states = apply_smoothed_errors(imu, initial_strapdown, epochs, smoothed);
+  SmoothedErrors smoothed = rts_backward_pass(epochs, covariances);
   result.biases.resize(epochs.size());
   for (std::size_t k = 0; k < epochs.size(); ++k) {
     SmoothedBias& b = result.biases[k];
@@ -499,6 +549,9 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
     b.gyro_sigma_rad_s = smoothed.variance[k].segment<3>(kGyroBias).cwiseSqrt();
     b.acc_sigma_m_s2 = smoothed.variance[k].segment<3>(kAccBias).cwiseSqrt();
   }
+  result.states =
+      SmoothedStateStream(std::make_unique<SmoothedStateStream::Record>(SmoothedStateStream::Record{
+          &imu, initial_strapdown, std::move(epochs), std::move(smoothed)}));
   return result;
 }
 
