@@ -81,6 +81,13 @@ class JointErrorRows {
         solver_(make_inverse_kinematics(kinematics)) {
     out.robot = log.robot_name;
     out.cycle_s = log.cycle_s;
+    // At most one row per sample: reserved, the rows take no more than they hold.
+    const std::size_t n = log.samples.size();
+    for (auto* column :
+         {&out.q_desired_rad, &out.q_measured_rad, &out.q_internal_rad, &out.q_measured_sigma_rad})
+      column->reserve(n);
+    out.t_s.reserve(n);
+    out.payload_kg.reserve(n);
   }
 
   // The row of `sample` from the trajectory around its IMS time (counted as outside the record
@@ -287,6 +294,9 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   }
   ims::ZuptSmoothing smoothed =
       ims::smooth_with_zupt_streamed(cut, earth, initial, sigma0, zupt, aids);
+  // The states read the same samples from the whole record: the copy goes.
+  smoothed.states.read_samples_from(imu, std::size_t(first_kept - imu.samples.begin()));
+  std::vector<ims::ImuSample>().swap(cut.samples);
 
   // The trajectory: the initial state (the start of the first increment), then the smoothed
   // states, used block by block (twice with the revisited poses: once where they are looked

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 
 #include "core/input_error.hpp"
 #include "core/record_file.hpp"
@@ -238,10 +239,13 @@ SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs, CovarianceFil
   return s;
 }
 
-// The sample's increment without the biases estimated at the instant before its interval.
-ImuSample bias_corrected(const ImuSeries& imu, std::size_t i, const Epoch& previous) {
-  const double dt = sample_interval(imu, i);
-  ImuSample corrected = imu.samples[i];
+// Sample i of the record's samples from index `first` on, without the biases estimated at the
+// instant before its interval (its interval as sample_interval gives it in a record cut there).
+ImuSample bias_corrected(const ImuSeries& imu, std::size_t first, std::size_t i,
+                         const Epoch& previous) {
+  const std::size_t at = first + i;
+  const double dt = i == 0 ? imu.nominal_dt_s : imu.samples[at].t_s - imu.samples[at - 1].t_s;
+  ImuSample corrected = imu.samples[at];
   corrected.gyro -= previous.gyro_bias * dt;
   corrected.acc -= previous.acc_bias * dt;
   return corrected;
@@ -292,7 +296,6 @@ bool aid_velocity_at(const SmootherAids& aids, double t, std::size_t& cursor, Ei
 }  // namespace
 
 struct SmoothedStateStream::Record {
-  const ImuSeries* imu = nullptr;
   Strapdown initial;
   std::vector<Epoch> epochs;
   SmoothedErrors smoothed;
@@ -307,14 +310,24 @@ struct SmoothedStateStream::Cursor {
 };
 
 SmoothedStateStream::SmoothedStateStream() = default;
-SmoothedStateStream::SmoothedStateStream(std::unique_ptr<const Record> record)
-    : record_(std::move(record)), cursor_(std::make_unique<Cursor>(Cursor{record_->initial})) {}
+SmoothedStateStream::SmoothedStateStream(std::unique_ptr<const Record> record, const ImuSeries& imu)
+    : imu_(&imu),
+      record_(std::move(record)),
+      cursor_(std::make_unique<Cursor>(Cursor{record_->initial})) {}
 SmoothedStateStream::~SmoothedStateStream() = default;
 SmoothedStateStream::SmoothedStateStream(SmoothedStateStream&&) noexcept = default;
 SmoothedStateStream& SmoothedStateStream::operator=(SmoothedStateStream&&) noexcept = default;
 
 std::size_t SmoothedStateStream::size() const {
-  return record_ ? record_->imu->samples.size() : 0;
+  return imu_ ? imu_->samples.size() - first_sample_ : 0;
+}
+
+void SmoothedStateStream::read_samples_from(const ImuSeries& record, std::size_t first_sample) {
+  if (first_sample > record.samples.size() || record.samples.size() - first_sample != size() ||
+      (imu_ && record.nominal_dt_s != imu_->nominal_dt_s))
+    throw std::invalid_argument("smoothed states: another record than the one smoothed");
+  imu_ = &record;
+  first_sample_ = first_sample;
 }
 bool SmoothedStateStream::done() const {
   return !record_ || cursor_->instant >= record_->epochs.size();
@@ -337,7 +350,7 @@ std::size_t SmoothedStateStream::next(std::vector<SmoothedState>& out, std::size
     const std::size_t k = c.instant;
     const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
     for (; c.sample <= epochs[k].last_sample && given < max_states; ++c.sample, ++given) {
-      c.strapdown.step(bias_corrected(*record_->imu, c.sample, epochs[k - 1]));
+      c.strapdown.step(bias_corrected(*imu_, first_sample_, c.sample, epochs[k - 1]));
       const NavState& nominal = c.strapdown.state();
       const double alpha = (nominal.t_s - t0) / (t1 - t0);
       const ErrorVector e = (1.0 - alpha) * smoothed.after[k - 1] + alpha * smoothed.before[k];
@@ -446,7 +459,7 @@ ZuptSmoothing smooth_with_zupt_streamed(const ImuSeries& imu, const EarthModel& 
     for (std::size_t i = begin; i < end; ++i) {
       const ImuSample& raw = imu.samples[i];
       const double dt = sample_interval(imu, i);
-      const ImuSample corrected = bias_corrected(imu, i, previous);
+      const ImuSample corrected = bias_corrected(imu, 0, i, previous);
       const Eigen::Matrix3d R_before = strapdown.state().q_W_S.toRotationMatrix();
       strapdown.step(corrected);
       const Eigen::Matrix3d R_mid = 0.5 * (R_before + strapdown.state().q_W_S.toRotationMatrix());
@@ -551,7 +564,8 @@ ZuptSmoothing smooth_with_zupt_streamed(const ImuSeries& imu, const EarthModel& 
   }
   result.states =
       SmoothedStateStream(std::make_unique<SmoothedStateStream::Record>(SmoothedStateStream::Record{
-          &imu, initial_strapdown, std::move(epochs), std::move(smoothed)}));
+                              initial_strapdown, std::move(epochs), std::move(smoothed)}),
+                          imu);
   return result;
 }
 

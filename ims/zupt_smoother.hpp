@@ -84,7 +84,7 @@ class SmoothedStateStream {
  public:
   struct Record;  // the forward and backward passes' per-instant results (zupt_smoother.cpp)
   SmoothedStateStream();  // no states
-  explicit SmoothedStateStream(std::unique_ptr<const Record> record);
+  SmoothedStateStream(std::unique_ptr<const Record> record, const ImuSeries& imu);
   ~SmoothedStateStream();
   SmoothedStateStream(SmoothedStateStream&&) noexcept;
   SmoothedStateStream& operator=(SmoothedStateStream&&) noexcept;
@@ -96,8 +96,15 @@ class SmoothedStateStream {
   void rewind();
   std::size_t size() const;  // states in all: one per IMS sample
 
+  // Reads the samples from `record` from index `first_sample` on instead of from the record
+  // smoothed: the same samples in the record that one was cut from, so that the cut copy can
+  // go. Throws std::invalid_argument when the count or the nominal interval differs.
+  void read_samples_from(const ImuSeries& record, std::size_t first_sample);
+
  private:
   struct Cursor;
+  const ImuSeries* imu_ = nullptr;  // the samples, from index first_sample_ on
+  std::size_t first_sample_ = 0;
   std::unique_ptr<const Record> record_;
   std::unique_ptr<Cursor> cursor_;
 };
