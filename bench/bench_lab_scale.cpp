@@ -6,10 +6,13 @@
 // for the identification) repeated to the length, on the campaign's scenario with the IMS at 2 kHz,
 // with the campaign's configs (the paper's line in the verify stage). Timed: the imscal binary's
 // `run` as a child process, wall time (UseManualTime), and its peak resident memory (wait4's
-// rusage: the largest of the child and its stages' subprocesses) and CPU time. The shipped 70 s
-// campaign at 1 kHz is the baseline in the same run.
+// rusage: the largest of the child and its stages' subprocesses) and CPU time (user + system),
+// each also per recorded minute. The shipped 70 s campaign at 1 kHz is the baseline in the same
+// run. BM_LabScaleCalibrate times `imscal calibrate` alone on the same records (the stage whose
+// memory grew with the record: the smoother's trajectory, ims/zupt_smoother.hpp).
 //   bench/bench_lab_scale --benchmark_counters_tabular=true
 //   bench/bench_lab_scale --benchmark_filter='Run/(0|5)/'   (the baseline and 5 minutes only)
+//   bench/bench_lab_scale --benchmark_filter='Calibrate'    (calibrate alone)
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -90,6 +93,17 @@ std::string session_program(int minutes) {
   return out;
 }
 
+// <data>/robots and <data>/sensors as links to this source tree's folders (a kept session's
+// links may point to a source tree that is gone).
+void link_shared_folders(const fs::path& data) {
+  for (const char* shared : {"robots", "sensors"}) {
+    const fs::path link = data / shared, target = kSource / "datasets" / shared;
+    if (fs::is_symlink(link) && fs::read_symlink(link) == target) continue;
+    if (fs::is_symlink(link)) fs::remove(link);
+    if (!fs::exists(link)) fs::create_directory_symlink(target, link);
+  }
+}
+
 // A session folder <root>/datasets/session/ laid out like datasets/campaign/ (whose configs it
 // copies; their ../robots etc. resolve through links to the shipped folders).
 fs::path make_session(const fs::path& root, int minutes) {
@@ -98,9 +112,7 @@ fs::path make_session(const fs::path& root, int minutes) {
   fs::create_directories(data / "programs");
   fs::create_directories(data / "scenarios");
   fs::create_directories(data / "session");
-  for (const char* shared : {"robots", "sensors"})
-    if (!fs::exists(data / shared))
-      fs::create_directory_symlink(kSource / "datasets" / shared, data / shared);
+  link_shared_folders(data);
   fs::copy_file(kSource / "datasets/programs/seed-line.yaml", data / "programs/seed-line.yaml",
                 fs::copy_options::overwrite_existing);
   write_text(data / "programs/session.yaml", session_program(minutes));
@@ -160,17 +172,38 @@ std::string stage_times(const fs::path& log) {
   return out;
 }
 
-// Argument 0: the shipped campaign (70 s at 1 kHz); otherwise a session of that many minutes,
-// simulated on the first run and kept in the temporary folder for the next (delete it to
+// The counters of one child run over a record of `recorded_min` minutes.
+void set_counters(benchmark::State& state, const ChildRun& r, double recorded_min) {
+  state.counters["record_min"] = recorded_min;
+  state.counters["wall_s"] = r.wall_s;
+  state.counters["s_per_record_min"] = r.wall_s / recorded_min;
+  state.counters["peak_rss_MB"] = r.peak_rss_mb;
+  state.counters["cpu_s"] = r.cpu_s;  // on a loaded machine the steadier figure (threads add up)
+  state.counters["cpu_s_per_record_min"] = r.cpu_s / recorded_min;
+}
+
+// The run.yaml of argument 0, the shipped campaign (70 s at 1 kHz), or of a session of that
+// many minutes, simulated on the first run and kept in `root` for the next (delete it to
 // simulate again).
+fs::path record_config(int minutes, const fs::path& root) {
+  const fs::path kept = root / "datasets/session/run.yaml";
+  if (minutes == 0) return kSource / "datasets/campaign/run.yaml";
+  if (fs::exists(kept)) {
+    link_shared_folders(root / "datasets");
+    return kept;
+  }
+  fs::remove_all(root);
+  return make_session(root, minutes);
+}
+
+fs::path bench_root(int minutes) {
+  return fs::temp_directory_path() / ("imscal-bench-lab-scale-" + std::to_string(minutes));
+}
+
 void BM_LabScaleRun(benchmark::State& state) {
   const int minutes = int(state.range(0));
-  const fs::path root =
-      fs::temp_directory_path() / ("imscal-bench-lab-scale-" + std::to_string(minutes));
-  const fs::path kept = root / "datasets/session/run.yaml";
-  const fs::path config = minutes == 0       ? kSource / "datasets/campaign/run.yaml"
-                          : fs::exists(kept) ? kept
-                                             : (fs::remove_all(root), make_session(root, minutes));
+  const fs::path root = bench_root(minutes);
+  const fs::path config = record_config(minutes, root);
   fs::create_directories(root);
   const double recorded_min = record_minutes(config);
   ChildRun r;
@@ -180,15 +213,39 @@ void BM_LabScaleRun(benchmark::State& state) {
     state.SetIterationTime(r.wall_s);
   }
   state.SetLabel(stage_times(root / "run.log"));
-  state.counters["record_min"] = recorded_min;
-  state.counters["wall_s"] = r.wall_s;
-  state.counters["s_per_record_min"] = r.wall_s / recorded_min;
-  state.counters["peak_rss_MB"] = r.peak_rss_mb;
-  state.counters["cpu_s"] = r.cpu_s;  // on a loaded machine the steadier figure (threads add up)
+  set_counters(state, r, recorded_min);
   fs::remove_all(root / "run");
 }
 
+// `imscal calibrate` alone with the run's calibrate config on the same records.
+void BM_LabScaleCalibrate(benchmark::State& state) {
+  const int minutes = int(state.range(0));
+  const fs::path root = bench_root(minutes);
+  const fs::path folder = record_config(minutes, root).parent_path();
+  const double recorded_min = record_minutes(folder / "run.yaml");
+  ChildRun r;
+  for (auto _ : state) {
+    r = run_imscal(
+        {"calibrate", "--imu", (folder / "imu.csv").string(), "--robot-log",
+         (folder / "robot.csv").string(), "--config", (folder / "calibrate.yaml").string(), "--out",
+         (root / "calibrate").string(), "--force"},
+        root / "calibrate.log");
+    state.SetIterationTime(r.wall_s);
+  }
+  set_counters(state, r, recorded_min);
+  fs::remove_all(root / "calibrate");
+}
+
 BENCHMARK(BM_LabScaleRun)
+    ->Arg(0)
+    ->Arg(5)
+    ->Arg(15)
+    ->Arg(30)
+    ->UseManualTime()
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
+
+BENCHMARK(BM_LabScaleCalibrate)
     ->Arg(0)
     ->Arg(5)
     ->Arg(15)

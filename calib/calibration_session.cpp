@@ -168,7 +168,7 @@ SessionResult calibrate_session(const SessionInputs& in, const SessionOptions& o
   find_rests_and_time_offset(in, config, progress, out);
 
   report(progress, "bundle", 0.0);
-  const FrameCalibrationInput frame_input = bundle_input(in, config, out);
+  FrameCalibrationInput frame_input = bundle_input(in, config, out);
   out.frames = calibrate_frames(frame_input, bundle_options(in, config));
   spdlog::info("calibrate: bundle {} after {} iterations",
                out.frames.converged ? "converged" : "did NOT converge", out.frames.iterations);
@@ -180,6 +180,7 @@ SessionResult calibrate_session(const SessionInputs& in, const SessionOptions& o
           ? previous_frames_validation(out.frames, config.validation.thresholds,
                                        config.bundle.outlier_threshold_sigma, *in.previous)
           : validate_mounting(frame_input, config.bundle, out.frames, config.validation, progress);
+  frame_input.robot = {};  // the joint series, as long as the record: done with
   if (config.joint_errors) {
     report(progress, "joint errors", 0.0);
     out.joint_errors = session_joint_errors(in, out);

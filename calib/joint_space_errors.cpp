@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <span>
 
 #include "core/input_error.hpp"
 #include "ims/earth_model.hpp"
@@ -67,34 +68,50 @@ bool interpolate_sensor_pose(const std::vector<ims::SmoothedState>& states, doub
   return true;
 }
 
-JointSpaceErrors joint_errors_along(const std::vector<ims::SmoothedState>& trajectory,
-                                    const RobotLog& log, const KinematicModel& kinematics,
-                                    const CalibratedFrames& frames, double min_wrist_sin) {
-  JointSpaceErrors out;
-  out.robot = log.robot_name;
-  out.cycle_s = log.cycle_s;
-  const std::unique_ptr<IkSolver> solver = make_inverse_kinematics(kinematics);
-  const IkSolver& ik = *solver;
-  for (const RobotLogSample& sample : log.samples) {
+namespace {
+
+// The rows of joint_errors_along, one robot sample at a time (in the log's order).
+class JointErrorRows {
+ public:
+  JointErrorRows(const RobotLog& log, const KinematicModel& kinematics,
+                 const CalibratedFrames& frames, double min_wrist_sin)
+      : kinematics_(kinematics),
+        frames_(frames),
+        min_wrist_sin_(min_wrist_sin),
+        solver_(make_inverse_kinematics(kinematics)) {
+    out.robot = log.robot_name;
+    out.cycle_s = log.cycle_s;
+    // At most one row per sample: reserved, the rows take no more than they hold.
+    const std::size_t n = log.samples.size();
+    for (auto* column :
+         {&out.q_desired_rad, &out.q_measured_rad, &out.q_internal_rad, &out.q_measured_sigma_rad})
+      column->reserve(n);
+    out.t_s.reserve(n);
+    out.payload_kg.reserve(n);
+  }
+
+  // The row of `sample` from the trajectory around its IMS time (counted as outside the record
+  // when the trajectory does not span it).
+  void add(const std::vector<ims::SmoothedState>& trajectory, const RobotLogSample& sample) {
     Eigen::Isometry3d T_W_S;
-    if (!interpolate_sensor_pose(trajectory, sample.t_s + frames.time_offset_s, T_W_S)) {
+    const double t_ims = sample.t_s + frames_.time_offset_s;
+    if (!interpolate_sensor_pose(trajectory, t_ims, T_W_S)) {
       ++out.outside_record;
-      continue;
+      return;
     }
-    const Eigen::Isometry3d T_R_H = frames.T_R_W * T_W_S * frames.T_S_H;
+    const Eigen::Isometry3d T_R_H = frames_.T_R_W * T_W_S * frames_.T_S_H;
     // The solution nearest the robot's own reading (either wrist branch): near A5 = 0 the
     // measured pose may lie across the singularity from the encoders' configuration.
-    const IkResult solution = ik.solve_nearest(T_R_H, sample.q_internal_rad);
+    const IkResult solution = solver_->solve_nearest(T_R_H, sample.q_internal_rad);
     if (!solution.ok()) {
-      if (out.ik_failures == 0) {
+      if (out.ik_failures == 0)
         out.first_ik_failure = fmt::format("t = {:.3f} s: {}", sample.t_s, solution.reason);
-      }
       ++out.ik_failures;
-      continue;
+      return;
     }
-    if (ik.singularity_measures(solution.q).wrist < min_wrist_sin) {
+    if (solver_->singularity_measures(solution.q).wrist < min_wrist_sin_) {
       ++out.near_wrist_singularity;
-      continue;
+      return;
     }
     out.t_s.push_back(sample.t_s);
     out.payload_kg.push_back(sample.payload_kg);
@@ -102,16 +119,123 @@ JointSpaceErrors joint_errors_along(const std::vector<ims::SmoothedState>& traje
     out.q_measured_rad.push_back(solution.q);
     out.q_internal_rad.push_back(sample.q_internal_rad);
     // The smoother's sigmas at the nearest state.
-    const double t_ims = sample.t_s + frames.time_offset_s;
     auto nearest =
         std::lower_bound(trajectory.begin(), trajectory.end(), t_ims,
                          [](const ims::SmoothedState& s, double t) { return s.state.t_s < t; });
     if (nearest == trajectory.end()) --nearest;
-    const Eigen::Vector3d r_S_H_W = T_W_S.linear() * frames.T_S_H.translation();  // S to H in W
+    const Eigen::Vector3d r_S_H_W = T_W_S.linear() * frames_.T_S_H.translation();  // S to H in W
     out.q_measured_sigma_rad.push_back(
-        joint_sigma(kinematics, solution.q, nearest->sigma, frames.T_R_W.linear(), r_S_H_W));
+        joint_sigma(kinematics_, solution.q, nearest->sigma, frames_.T_R_W.linear(), r_S_H_W));
   }
-  return out;
+
+  JointSpaceErrors out;
+
+ private:
+  const KinematicModel& kinematics_;
+  const CalibratedFrames& frames_;
+  double min_wrist_sin_;
+  std::unique_ptr<IkSolver> solver_;
+};
+
+// Calls use(block) on consecutive blocks of the trajectory: `first`, then the stream's states
+// (from its start), each block starting with the last state of the one before, so that every
+// time up to a block's last state lies between two of its states as in the whole trajectory.
+// With `errors`, the positions are corrected by them (remove_position_errors), each state once.
+template <typename Use>
+void for_each_block(ims::SmoothedStateStream& stream, std::size_t states_per_block,
+                    const ims::SmoothedState& first, const std::vector<PositionErrorSample>* errors,
+                    Use use) {
+  states_per_block = std::max<std::size_t>(1, states_per_block);
+  stream.rewind();
+  std::vector<ims::SmoothedState> block;
+  block.reserve(states_per_block + 1);
+  block.push_back(first);
+  std::size_t fresh = 0;  // the block's states not corrected yet
+  do {
+    stream.next(block, states_per_block);
+    if (errors) remove_position_errors(std::span(block).subspan(fresh), *errors);
+    use(block);
+    const ims::SmoothedState carried = block.back();
+    block.clear();
+    block.push_back(carried);
+    fresh = 1;
+  } while (!stream.done());
+}
+
+// The states at and before each of `times_ims_s` (sorted): the two interpolate_sensor_pose takes
+// there, so that it gives on them what it gives on the whole trajectory.
+std::vector<ims::SmoothedState> states_around(ims::SmoothedStateStream& stream,
+                                              std::size_t states_per_block,
+                                              const ims::SmoothedState& first,
+                                              const std::vector<double>& times_ims_s) {
+  std::vector<ims::SmoothedState> kept;
+  const auto keep = [&](const ims::SmoothedState& s) {
+    if (kept.empty() || kept.back().state.t_s < s.state.t_s) kept.push_back(s);
+  };
+  std::size_t next = 0;
+  for_each_block(
+      stream, states_per_block, first, nullptr, [&](const std::vector<ims::SmoothedState>& block) {
+        for (; next < times_ims_s.size() && times_ims_s[next] <= block.back().state.t_s; ++next) {
+          if (times_ims_s[next] < block.front().state.t_s) continue;  // before the trajectory
+          const auto at = std::lower_bound(
+              block.begin(), block.end(), times_ims_s[next],
+              [](const ims::SmoothedState& s, double t) { return s.state.t_s < t; });
+          if (at != block.begin()) keep(*std::prev(at));
+          keep(*at);
+        }
+      });
+  return kept;
+}
+
+// The IMS times at which position_errors_at_revisited_poses looks at the trajectory.
+std::vector<double> revisited_pose_times(const RobotLog& log, double time_offset_s,
+                                         const RevisitedPoseOptions& options) {
+  std::vector<double> times;
+  for (const StandstillWindow& w : settled_standstill_windows(log, options))
+    for (std::size_t k = w.first_averaged; k <= w.last; ++k)
+      times.push_back(log.samples[k].t_s + time_offset_s);
+  std::sort(times.begin(), times.end());
+  return times;
+}
+
+// The joint errors along the smoothed trajectory, corrected by `errors`, block by block (the
+// same rows as joint_errors_along on the whole corrected trajectory); with `keep_trajectory`
+// the corrected trajectory too.
+JointSpaceErrors joint_errors_in_blocks(ims::SmoothedStateStream& stream,
+                                        const ims::SmoothedState& first,
+                                        const std::vector<PositionErrorSample>& errors,
+                                        const JointSpaceInput& input,
+                                        const JointSpaceOptions& options) {
+  JointErrorRows rows(*input.log, input.kinematics, input.frames, options.min_wrist_sin);
+  const std::vector<RobotLogSample>& samples = input.log->samples;
+  const double offset_s = input.frames.time_offset_s;
+  std::vector<ims::SmoothedState> trajectory;
+  std::size_t next = 0;
+  std::vector<ims::SmoothedState> last(1);
+  for_each_block(
+      stream, options.states_per_block, first, &errors,
+      [&](const std::vector<ims::SmoothedState>& block) {
+        for (; next < samples.size() && samples[next].t_s + offset_s <= block.back().state.t_s;
+             ++next)
+          rows.add(block, samples[next]);
+        if (options.keep_trajectory)
+          trajectory.insert(trajectory.end(), block.begin() + (trajectory.empty() ? 0 : 1),
+                            block.end());
+        last.front() = block.back();
+      });
+  for (; next < samples.size(); ++next) rows.add(last, samples[next]);  // after the record
+  rows.out.trajectory = std::move(trajectory);
+  return std::move(rows.out);
+}
+
+}  // namespace
+
+JointSpaceErrors joint_errors_along(const std::vector<ims::SmoothedState>& trajectory,
+                                    const RobotLog& log, const KinematicModel& kinematics,
+                                    const CalibratedFrames& frames, double min_wrist_sin) {
+  JointErrorRows rows(log, kinematics, frames, min_wrist_sin);
+  for (const RobotLogSample& sample : log.samples) rows.add(trajectory, sample);
+  return std::move(rows.out);
 }
 
 JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
@@ -168,27 +292,29 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
     if (options.encoder_stillness) aids.still = motion.still;
     if (options.creep_velocity_updates) aids.velocity = motion.creep_velocity;
   }
-  ims::ZuptSmootherResult smoothed = ims::smooth_with_zupt(cut, earth, initial, sigma0, zupt, aids);
-  std::vector<ims::ImuSample>().swap(cut.samples);  // released: the record's copy is done with
+  ims::ZuptSmoothing smoothed =
+      ims::smooth_with_zupt_streamed(cut, earth, initial, sigma0, zupt, aids);
+  // The states read the same samples from the whole record: the copy goes.
+  smoothed.states.read_samples_from(imu, std::size_t(first_kept - imu.samples.begin()));
+  std::vector<ims::ImuSample>().swap(cut.samples);
 
-  // The initial state belongs to the trajectory too (the start of the first increment): the
-  // smoother leaves room for it, so the insertion moves the states instead of copying them.
+  // The trajectory: the initial state (the start of the first increment), then the smoothed
+  // states, used block by block (twice with the revisited poses: once where they are looked
+  // at, once for the joint errors) instead of whole.
   ims::SmoothedState first;
   first.state = initial;
-  smoothed.states.insert(smoothed.states.begin(), first);
   std::vector<PositionErrorSample> errors;
   if (options.revisited_pose_correction) {
-    errors =
-        position_errors_at_revisited_poses(smoothed.states, *input.log, input.kinematics, T_W_R,
-                                           input.frames.T_S_H.inverse().translation(),
-                                           input.frames.time_offset_s, options.revisited_poses);
-    remove_position_errors(smoothed.states, errors);
+    const std::vector<ims::SmoothedState> looked_at = states_around(
+        smoothed.states, options.states_per_block, first,
+        revisited_pose_times(*input.log, input.frames.time_offset_s, options.revisited_poses));
+    errors = position_errors_at_revisited_poses(
+        looked_at, *input.log, input.kinematics, T_W_R, input.frames.T_S_H.inverse().translation(),
+        input.frames.time_offset_s, options.revisited_poses);
   }
-  JointSpaceErrors out = joint_errors_along(smoothed.states, *input.log, input.kinematics,
-                                            input.frames, options.min_wrist_sin);
+  JointSpaceErrors out = joint_errors_in_blocks(smoothed.states, first, errors, input, options);
   out.smoother = smoothed.summary;
   out.revisited_pose_errors = std::move(errors);
-  out.trajectory = std::move(smoothed.states);
   return out;
 }
 

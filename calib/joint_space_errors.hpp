@@ -85,6 +85,11 @@ struct JointSpaceOptions {
   // (calib/revisited_poses.hpp).
   bool revisited_pose_correction = true;
   RevisitedPoseOptions revisited_poses;
+  // Keep the smoothed trajectory in JointSpaceErrors::trajectory (160 bytes per IMS sample:
+  // 19 MB per recorded minute at 2 kHz); off, it is used block by block and not kept.
+  bool keep_trajectory = false;
+  // Smoothed states per block (160 bytes each; 65536: 10 MB); the rows do not depend on it.
+  std::size_t states_per_block = std::size_t(1) << 16;
 };
 
 // One row per kept robot sample (the joint_errors.csv columns) [robot clock, SI].
@@ -106,7 +111,7 @@ struct JointSpaceErrors {
   // The smoothed position's errors found and removed at the settled standstills
   // (calib/revisited_poses.hpp; empty when off).
   std::vector<PositionErrorSample> revisited_pose_errors;
-  // The smoothed trajectory (IMS clock), for reports and checks.
+  // The smoothed trajectory (IMS clock), for checks; JointSpaceOptions::keep_trajectory only.
   std::vector<ims::SmoothedState> trajectory;
 };
 

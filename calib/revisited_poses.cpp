@@ -20,6 +20,26 @@ struct SettledStandstill {
 
 }  // namespace
 
+std::vector<StandstillWindow> settled_standstill_windows(const RobotLog& log,
+                                                         const RevisitedPoseOptions& options) {
+  const std::vector<RobotLogSample>& s = log.samples;
+  std::vector<StandstillWindow> windows;
+  for (std::size_t i = 0; i < s.size();) {
+    std::size_t last = i;
+    while (last + 1 < s.size() && s[last + 1].q_desired_rad == s[i].q_desired_rad &&
+           s[last + 1].payload_kg == s[i].payload_kg)
+      ++last;
+    if (s[last].t_s - s[i].t_s >= options.settle_s) {
+      std::size_t first_averaged = last;
+      while (first_averaged > i && s[last].t_s - s[first_averaged - 1].t_s <= options.average_s)
+        --first_averaged;
+      windows.push_back({i, first_averaged, last});
+    }
+    i = last + 1;
+  }
+  return windows;
+}
+
 std::vector<PositionErrorSample> position_errors_at_revisited_poses(
     const std::vector<ims::SmoothedState>& trajectory, const RobotLog& log,
     const KinematicModel& kinematics, const Eigen::Isometry3d& T_W_R, const Eigen::Vector3d& p_H_S,
@@ -40,20 +60,10 @@ std::vector<PositionErrorSample> position_errors_at_revisited_poses(
     return sum / double(last - first + 1);
   };
   std::vector<SettledStandstill> standstills;
-  for (std::size_t i = 0; i < s.size();) {
-    std::size_t last = i;
-    while (last + 1 < s.size() && s[last + 1].q_desired_rad == s[i].q_desired_rad &&
-           s[last + 1].payload_kg == s[i].payload_kg)
-      ++last;
-    if (s[last].t_s - s[i].t_s >= options.settle_s) {
-      std::size_t first_averaged = last;
-      while (first_averaged > i && s[last].t_s - s[first_averaged - 1].t_s <= options.average_s)
-        --first_averaged;
-      if (const auto d = mean_difference(first_averaged, last))
-        standstills.push_back({i, last, s[last].t_s, s[i].q_desired_rad, s[i].payload_kg, *d});
-    }
-    i = last + 1;
-  }
+  for (const StandstillWindow& w : settled_standstill_windows(log, options))
+    if (const auto d = mean_difference(w.first_averaged, w.last))
+      standstills.push_back(
+          {w.first, w.last, s[w.last].t_s, s[w.first].q_desired_rad, s[w.first].payload_kg, *d});
   // One sample per standstill, at its end; errors from the solve below.
   std::vector<PositionErrorSample> out;
   for (const SettledStandstill& st : standstills)
@@ -108,7 +118,7 @@ std::vector<PositionErrorSample> position_errors_at_revisited_poses(
   return out;
 }
 
-void remove_position_errors(std::vector<ims::SmoothedState>& trajectory,
+void remove_position_errors(std::span<ims::SmoothedState> trajectory,
                             const std::vector<PositionErrorSample>& errors) {
   if (errors.empty()) return;
   std::size_t next = 0;  // first error sample after the state's time

@@ -28,6 +28,7 @@
 // from its forward kinematics; a later one when the record starts later: the corrections are
 // then relative to its error).
 #include <Eigen/Core>
+#include <span>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -63,7 +64,18 @@ struct PositionErrorSample {
   bool revisit = false;
 };
 
+// A commanded standstill (one pose, one payload) of at least settle_s: its robot log samples
+// [first, last], of which [first_averaged, last] are averaged (the last average_s).
+struct StandstillWindow {
+  std::size_t first = 0, first_averaged = 0, last = 0;
+};
+std::vector<StandstillWindow> settled_standstill_windows(const RobotLog& log,
+                                                         const RevisitedPoseOptions& options = {});
+
 // The errors at every settled standstill, sorted by time; the first is zero by definition.
+// The trajectory is interpolated only at the robot samples [first_averaged, last] of
+// settled_standstill_windows (t_ims = t_robot + time_offset_s): the states around those times
+// alone give the same errors.
 // trajectory: the smoothed sensor poses (IMS clock, sorted); T_W_R the robot base in W, p_H_S the
 // sensor's origin in the flange frame, t_ims = t_robot + time_offset_s.
 std::vector<PositionErrorSample> position_errors_at_revisited_poses(
@@ -72,7 +84,7 @@ std::vector<PositionErrorSample> position_errors_at_revisited_poses(
     double time_offset_s, const RevisitedPoseOptions& options = {});
 
 // p_W(t) -= e(t): linear between the samples, held before the first and after the last.
-void remove_position_errors(std::vector<ims::SmoothedState>& trajectory,
+void remove_position_errors(std::span<ims::SmoothedState> trajectory,
                             const std::vector<PositionErrorSample>& errors);
 
 }  // namespace imscal::calib

@@ -4,8 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <stdexcept>
 
 #include "core/input_error.hpp"
+#include "core/record_file.hpp"
 #include "ims/error_state_model.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/so3.hpp"
@@ -67,13 +70,40 @@ struct Epoch {
   Eigen::Vector3d acc_bias = Eigen::Vector3d::Zero();
 };
 
-// The matrices of instant k, which only the backward pass needs: kept apart from Epoch so that
-// they are released before the smoothed states are built (5.4 kB per instant, more than the
-// states of its samples).
+// The matrices of instant k, which only the backward pass needs: 5.4 kB per instant (32 MB
+// per minute at 100 Hz), so they go to a temporary file (CovarianceFile) instead of memory.
 struct EpochCovariances {
   ErrorMatrix transition;     // from k - 1 to k
   ErrorMatrix predicted_cov;  // at k before the updates
   ErrorMatrix filtered_cov;   // at k after the updates
+};
+
+// The forward pass' EpochCovariances, one record per instant, written in order and read back
+// by the backward pass in reverse, bit for bit.
+class CovarianceFile {
+ public:
+  static constexpr std::size_t kValues = 3 * kSize * kSize;
+  // 512 instants per block: 2.8 MB of buffer.
+  CovarianceFile() : file_(kValues, 512, "the smoother's covariances") {}
+  void append(const EpochCovariances& c) {
+    std::copy_n(c.transition.data(), kSize * kSize, values_.data());
+    std::copy_n(c.predicted_cov.data(), kSize * kSize, values_.data() + kSize * kSize);
+    std::copy_n(c.filtered_cov.data(), kSize * kSize, values_.data() + 2 * kSize * kSize);
+    file_.append(values_.data());
+  }
+  EpochCovariances read(std::size_t k) {
+    const double* v = file_.record(k);
+    EpochCovariances c;
+    c.transition = Eigen::Map<const ErrorMatrix>(v);
+    c.predicted_cov = Eigen::Map<const ErrorMatrix>(v + kSize * kSize);
+    c.filtered_cov = Eigen::Map<const ErrorMatrix>(v + 2 * kSize * kSize);
+    return c;
+  }
+  std::size_t size() const { return file_.size(); }
+
+ private:
+  RecordFile file_;
+  std::vector<double> values_ = std::vector<double>(kValues);
 };
 
 struct UpdateTally {
@@ -185,67 +215,45 @@ struct SmoothedErrors {
 
 // Rauch-Tung-Striebel on the error state. With the estimates fed back, the filtered error is
 // zero after every update and so is its prediction: x_s(k) = C_k x_s^before(k + 1).
-SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs,
-                                 const std::vector<EpochCovariances>& covariances) {
+SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs, CovarianceFile& covariances) {
   const std::size_t last = epochs.size() - 1;
   SmoothedErrors s;
   s.after.resize(epochs.size());
   s.before.resize(epochs.size());
   s.variance.resize(epochs.size());
   s.after[last].setZero();
-  ErrorMatrix smoothed_cov = covariances[last].filtered_cov;
+  EpochCovariances next = covariances.read(last);
+  ErrorMatrix smoothed_cov = next.filtered_cov;
   s.variance[last] = smoothed_cov.diagonal();
   s.before[last] = epochs[last].correction;
   for (std::size_t k = last; k-- > 0;) {
-    const EpochCovariances& next = covariances[k + 1];
-    const ErrorMatrix C =
-        smoother_gain(covariances[k].filtered_cov, next.transition, next.predicted_cov);
+    EpochCovariances current = covariances.read(k);
+    const ErrorMatrix C = smoother_gain(current.filtered_cov, next.transition, next.predicted_cov);
     s.after[k] = C * s.before[k + 1];
-    smoothed_cov =
-        covariances[k].filtered_cov + C * (smoothed_cov - next.predicted_cov) * C.transpose();
+    smoothed_cov = current.filtered_cov + C * (smoothed_cov - next.predicted_cov) * C.transpose();
     smoothed_cov = 0.5 * (smoothed_cov + smoothed_cov.transpose());
     s.variance[k] = smoothed_cov.diagonal().cwiseMax(0.0);
     s.before[k] = s.after[k] + epochs[k].correction;
+    next = std::move(current);
   }
   return s;
 }
 
-// The sample's increment without the biases estimated at the instant before its interval.
-ImuSample bias_corrected(const ImuSeries& imu, std::size_t i, const Epoch& previous) {
-  const double dt = sample_interval(imu, i);
-  ImuSample corrected = imu.samples[i];
+// Sample i of the record's samples from index `first` on, without the biases estimated at the
+// instant before its interval (its interval as sample_interval gives it in a record cut there).
+ImuSample bias_corrected(const ImuSeries& imu, std::size_t first, std::size_t i,
+                         const Epoch& previous) {
+  const std::size_t at = first + i;
+  const double dt = i == 0 ? imu.nominal_dt_s : imu.samples[at].t_s - imu.samples[at - 1].t_s;
+  ImuSample corrected = imu.samples[at];
   corrected.gyro -= previous.gyro_bias * dt;
   corrected.acc -= previous.acc_bias * dt;
   return corrected;
 }
 
-// The nominal state of every sample corrected by the smoothed error, interpolated linearly in
-// time between the propagation instants that enclose the sample. The nominal states are
-// mechanised again from the strapdown kept at each interval's start (the same steps as the
-// forward pass, so the same states), instead of being kept per sample through the forward pass.
-std::vector<SmoothedState> apply_smoothed_errors(const ImuSeries& imu,
-                                                 const std::vector<Strapdown>& interval_start,
-                                                 const std::vector<Epoch>& epochs,
-                                                 const SmoothedErrors& smoothed) {
-  std::vector<SmoothedState> states;
-  states.reserve(imu.samples.size() + 1);  // room for a caller's initial state, without a copy
-  states.resize(imu.samples.size());
-  std::size_t i = 0;
-  for (std::size_t k = 1; k < epochs.size(); ++k) {
-    const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
-    Strapdown strapdown = interval_start[k - 1];
-    for (; i <= epochs[k].last_sample; ++i) {
-      strapdown.step(bias_corrected(imu, i, epochs[k - 1]));
-      const NavState& nominal = strapdown.state();
-      const double alpha = (nominal.t_s - t0) / (t1 - t0);
-      const ErrorVector e = (1.0 - alpha) * smoothed.after[k - 1] + alpha * smoothed.before[k];
-      const ErrorVector var =
-          (1.0 - alpha) * smoothed.variance[k - 1] + alpha * smoothed.variance[k];
-      states[i].state = apply_error(nominal, e);
-      states[i].sigma = var.head<9>().cwiseSqrt();
-    }
-  }
-  return states;
+// The feedback of the forward pass at instant k (the same step as there).
+void feed_back(Strapdown& strapdown, const ErrorVector& correction) {
+  if (!correction.isZero(0.0)) strapdown.reset(apply_error(strapdown.state(), correction));
 }
 
 // Keeps only the rest samples inside the still intervals (sorted) and redoes the runs.
@@ -287,13 +295,100 @@ bool aid_velocity_at(const SmootherAids& aids, double t, std::size_t& cursor, Ei
 
 }  // namespace
 
+struct SmoothedStateStream::Record {
+  Strapdown initial;
+  std::vector<Epoch> epochs;
+  SmoothedErrors smoothed;
+};
+
+// Where the stream stands: the strapdown after sample `sample` - 1, in the interval ending at
+// instant `instant`.
+struct SmoothedStateStream::Cursor {
+  Strapdown strapdown;
+  std::size_t instant = 1;
+  std::size_t sample = 0;
+};
+
+SmoothedStateStream::SmoothedStateStream() = default;
+SmoothedStateStream::SmoothedStateStream(std::unique_ptr<const Record> record, const ImuSeries& imu)
+    : imu_(&imu),
+      record_(std::move(record)),
+      cursor_(std::make_unique<Cursor>(Cursor{record_->initial})) {}
+SmoothedStateStream::~SmoothedStateStream() = default;
+SmoothedStateStream::SmoothedStateStream(SmoothedStateStream&&) noexcept = default;
+SmoothedStateStream& SmoothedStateStream::operator=(SmoothedStateStream&&) noexcept = default;
+
+std::size_t SmoothedStateStream::size() const {
+  return imu_ ? imu_->samples.size() - first_sample_ : 0;
+}
+
+void SmoothedStateStream::read_samples_from(const ImuSeries& record, std::size_t first_sample) {
+  if (first_sample > record.samples.size() || record.samples.size() - first_sample != size() ||
+      (imu_ && record.nominal_dt_s != imu_->nominal_dt_s))
+    throw std::invalid_argument("smoothed states: another record than the one smoothed");
+  imu_ = &record;
+  first_sample_ = first_sample;
+}
+bool SmoothedStateStream::done() const {
+  return !record_ || cursor_->instant >= record_->epochs.size();
+}
+void SmoothedStateStream::rewind() {
+  if (record_) *cursor_ = Cursor{record_->initial};
+}
+
+// The nominal state of every sample corrected by the smoothed error, interpolated linearly in
+// time between the propagation instants that enclose the sample. The nominal states are
+// mechanised again (the same steps as the forward pass, so the same states), instead of being
+// kept per sample or per instant.
+std::size_t SmoothedStateStream::next(std::vector<SmoothedState>& out, std::size_t max_states) {
+  if (!record_) return 0;
+  const std::vector<Epoch>& epochs = record_->epochs;
+  const SmoothedErrors& smoothed = record_->smoothed;
+  Cursor& c = *cursor_;
+  std::size_t given = 0;
+  while (c.instant < epochs.size() && given < max_states) {
+    const std::size_t k = c.instant;
+    const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
+    for (; c.sample <= epochs[k].last_sample && given < max_states; ++c.sample, ++given) {
+      c.strapdown.step(bias_corrected(*imu_, first_sample_, c.sample, epochs[k - 1]));
+      const NavState& nominal = c.strapdown.state();
+      const double alpha = (nominal.t_s - t0) / (t1 - t0);
+      const ErrorVector e = (1.0 - alpha) * smoothed.after[k - 1] + alpha * smoothed.before[k];
+      const ErrorVector var =
+          (1.0 - alpha) * smoothed.variance[k - 1] + alpha * smoothed.variance[k];
+      SmoothedState& state = out.emplace_back();
+      state.state = apply_error(nominal, e);
+      state.sigma = var.head<9>().cwiseSqrt();
+    }
+    if (c.sample > epochs[k].last_sample) {
+      feed_back(c.strapdown, epochs[k].correction);
+      ++c.instant;
+    }
+  }
+  return given;
+}
+
 ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& earth,
                                     const NavState& initial,
                                     const Eigen::Matrix<double, 9, 1>& initial_sigma,
                                     const ZuptOptions& options, const SmootherAids& aids) {
+  ZuptSmoothing smoothing =
+      smooth_with_zupt_streamed(imu, earth, initial, initial_sigma, options, aids);
+  ZuptSmootherResult result;
+  result.states.reserve(imu.samples.size() + 1);  // room for a caller's initial state
+  smoothing.states.next(result.states, imu.samples.size());
+  result.biases = std::move(smoothing.biases);
+  result.summary = std::move(smoothing.summary);
+  return result;
+}
+
+ZuptSmoothing smooth_with_zupt_streamed(const ImuSeries& imu, const EarthModel& earth,
+                                        const NavState& initial,
+                                        const Eigen::Matrix<double, 9, 1>& initial_sigma,
+                                        const ZuptOptions& options, const SmootherAids& aids) {
   check_options(imu, options);
   const std::size_t n = imu.samples.size();
-  ZuptSmootherResult result;
+  ZuptSmoothing result;
 
   RestDetection rest = detect_rest(imu, earth, rest_options_of(options));
   if (aids.still) restrict_rests(imu, *aids.still, rest);
@@ -328,17 +423,15 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
   const std::vector<bool> epoch_zero_velocity = rest_interior(options.zero_velocity_edge_margin_s);
 
   // ---- forward pass ----
-  // The strapdown at each interval's start (after the last feedback): the nominal states are
-  // mechanised again from it after the backward pass (apply_smoothed_errors).
-  std::vector<Strapdown> interval_start;
-  interval_start.reserve(epoch_count);
   std::vector<Epoch> epochs;
-  std::vector<EpochCovariances> covariances;
+  CovarianceFile covariances;
   epochs.reserve(epoch_count + 1);
-  covariances.reserve(epoch_count + 1);
   epochs.push_back(initial_epoch(initial, options));
-  covariances.push_back(initial_covariances(initial_sigma, options));
-  Strapdown strapdown(earth, initial);
+  const EpochCovariances first_covariances = initial_covariances(initial_sigma, options);
+  covariances.append(first_covariances);
+  ErrorMatrix previous_filtered_cov = first_covariances.filtered_cov;
+  const Strapdown initial_strapdown(earth, initial);
+  Strapdown strapdown = initial_strapdown;
   ErrorLinearisation point;
   point.earth_rate_W = earth.earth_rate_W();
   point.gravity_gradient_W = earth.gravity_gradient_W();
@@ -359,16 +452,14 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
     const std::size_t begin = (k - 1) * samples_per_epoch;
     const std::size_t end = std::min(n, begin + samples_per_epoch);
     const Epoch& previous = epochs.back();
-    const ErrorMatrix& previous_filtered_cov = covariances.back().filtered_cov;
     Eigen::Matrix3d sum_R = Eigen::Matrix3d::Zero();
     Eigen::Vector3d sum_dv_W = Eigen::Vector3d::Zero();
     Eigen::Vector3d sum_raw_dtheta = Eigen::Vector3d::Zero();
     const double t_begin = strapdown.state().t_s;
-    interval_start.push_back(strapdown);
     for (std::size_t i = begin; i < end; ++i) {
       const ImuSample& raw = imu.samples[i];
       const double dt = sample_interval(imu, i);
-      const ImuSample corrected = bias_corrected(imu, i, previous);
+      const ImuSample corrected = bias_corrected(imu, 0, i, previous);
       const Eigen::Matrix3d R_before = strapdown.state().q_W_S.toRotationMatrix();
       strapdown.step(corrected);
       const Eigen::Matrix3d R_mid = 0.5 * (R_before + strapdown.state().q_W_S.toRotationMatrix());
@@ -441,7 +532,7 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
       }
     }
     if (!x.isZero(0.0)) {
-      strapdown.reset(apply_error(strapdown.state(), x));
+      feed_back(strapdown, x);
       epoch.gyro_bias += x.segment<3>(kGyroBias);
       epoch.acc_bias += x.segment<3>(kAccBias);
     }
@@ -451,18 +542,17 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
       rest_time = 0.0;
     }
     cov.filtered_cov = P;
+    previous_filtered_cov = P;
     epoch.correction = x;
     epochs.push_back(std::move(epoch));
-    covariances.push_back(std::move(cov));
+    covariances.append(cov);
   }
   result.summary.zero_velocity = zupt_tally.statistics();
   result.summary.zero_angular_rate = zaru_tally.statistics();
   result.summary.velocity_aid = aid_tally.statistics();
   result.summary.propagation_steps = epoch_count;
 
-  const SmoothedErrors smoothed = rts_backward_pass(epochs, covariances);
-  std::vector<EpochCovariances>().swap(covariances);  // released before the states are built
-  result.states = apply_smoothed_errors(imu, interval_start, epochs, smoothed);
+  SmoothedErrors smoothed = rts_backward_pass(epochs, covariances);
   result.biases.resize(epochs.size());
   for (std::size_t k = 0; k < epochs.size(); ++k) {
     SmoothedBias& b = result.biases[k];
@@ -472,6 +562,10 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
     b.gyro_sigma_rad_s = smoothed.variance[k].segment<3>(kGyroBias).cwiseSqrt();
     b.acc_sigma_m_s2 = smoothed.variance[k].segment<3>(kAccBias).cwiseSqrt();
   }
+  result.states =
+      SmoothedStateStream(std::make_unique<SmoothedStateStream::Record>(SmoothedStateStream::Record{
+                              initial_strapdown, std::move(epochs), std::move(smoothed)}),
+                          imu);
   return result;
 }
 

@@ -30,6 +30,7 @@
 // zero-angular-rate updates), [RTS1965] (backward pass).
 #include <Eigen/Core>
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "ims/earth_model.hpp"
@@ -73,6 +74,47 @@ struct ZuptSummary {
   std::size_t propagation_steps = 0;
 };
 
+// The smoothed states one block at a time, in sample order: mechanised again from the initial
+// state with the forward pass' bias estimates and feedbacks and corrected by the smoothed
+// errors of the propagation instants around each sample. It keeps per instant what the states
+// are built from (about 600 bytes per 10 ms, against 160 bytes per sample for the states), so
+// a caller that uses the trajectory block by block holds memory that does not grow with the
+// record's rate. Holds a pointer to the IMS record it was smoothed from, which must outlive it.
+class SmoothedStateStream {
+ public:
+  struct Record;  // the forward and backward passes' per-instant results (zupt_smoother.cpp)
+  SmoothedStateStream();  // no states
+  SmoothedStateStream(std::unique_ptr<const Record> record, const ImuSeries& imu);
+  ~SmoothedStateStream();
+  SmoothedStateStream(SmoothedStateStream&&) noexcept;
+  SmoothedStateStream& operator=(SmoothedStateStream&&) noexcept;
+
+  // Appends the next states, at most `max_states`, to `out`; returns how many.
+  std::size_t next(std::vector<SmoothedState>& out, std::size_t max_states);
+  bool done() const;
+  // Starts again at the first sample (for a second pass over the trajectory).
+  void rewind();
+  std::size_t size() const;  // states in all: one per IMS sample
+
+  // Reads the samples from `record` from index `first_sample` on instead of from the record
+  // smoothed: the same samples in the record that one was cut from, so that the cut copy can
+  // go. Throws std::invalid_argument when the count or the nominal interval differs.
+  void read_samples_from(const ImuSeries& record, std::size_t first_sample);
+
+ private:
+  struct Cursor;
+  const ImuSeries* imu_ = nullptr;  // the samples, from index first_sample_ on
+  std::size_t first_sample_ = 0;
+  std::unique_ptr<const Record> record_;
+  std::unique_ptr<Cursor> cursor_;
+};
+
+struct ZuptSmoothing {
+  SmoothedStateStream states;
+  std::vector<SmoothedBias> biases;  // one per propagation instant
+  ZuptSummary summary;
+};
+
 struct ZuptSmootherResult {
   // One per IMS sample, at the sample's time stamp; with room for one more (a caller's initial
   // state goes in front without a copy of the states).
@@ -84,6 +126,12 @@ struct ZuptSmootherResult {
 // `initial`: navigation state at the start of the first increment (samples[0].t_s - its
 // interval); `initial_sigma`: its 1-sigma (attitude [rad] in W, velocity, position).
 // Needs increments; throws InputError otherwise, or for inconsistent options.
+// The same smoothing with the states as a stream (ZuptSmoothing::states); `imu` must outlive it.
+ZuptSmoothing smooth_with_zupt_streamed(const ImuSeries& imu, const EarthModel& earth,
+                                        const NavState& initial,
+                                        const Eigen::Matrix<double, 9, 1>& initial_sigma,
+                                        const ZuptOptions& options, const SmootherAids& aids = {});
+
 ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& earth,
                                     const NavState& initial,
                                     const Eigen::Matrix<double, 9, 1>& initial_sigma,

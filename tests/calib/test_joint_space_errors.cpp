@@ -203,6 +203,7 @@ void print(const char* what, const JointVector& rms, int count) {
 // The smoothed sensor trajectory against the truth (both on the IMS clock, same samples: the
 // record starts with the first rest) [m].
 double worst_position_error(const SimRun& run, const JointSpaceErrors& errors, double* at_s) {
+  EXPECT_GT(errors.trajectory.size(), run.sensor_truth.size() / 2) << "trajectory not kept";
   double worst = 0.0;
   for (std::size_t k = 0; k < errors.trajectory.size() && k < run.sensor_truth.size(); ++k) {
     const ims::NavState& e = errors.trajectory[k].state;
@@ -212,6 +213,13 @@ double worst_position_error(const SimRun& run, const JointSpaceErrors& errors, d
     worst = std::max(worst, (e.p_W - t.p_W).norm());
   }
   return worst;
+}
+
+// The default options with the smoothed trajectory kept (for worst_position_error).
+JointSpaceOptions keeping_the_trajectory() {
+  JointSpaceOptions options;
+  options.keep_trajectory = true;
+  return options;
 }
 
 void print_smoother(const JointSpaceErrors& errors) {
@@ -228,7 +236,7 @@ void print_smoother(const JointSpaceErrors& errors) {
 
 TEST(JointSpaceErrors, MatchTheSimulatorsLinkSideErrorsOnSeedLine) {
   const SimRun& run = seed_line();
-  const JointSpaceErrors errors = joint_space_errors(true_input(run));
+  const JointSpaceErrors errors = joint_space_errors(true_input(run), keeping_the_trajectory());
   print_smoother(errors);
   std::printf("robot samples: %zu kept, %zu outside the IMS record, %zu IK failures %s\n",
               errors.t_s.size(), errors.outside_record, errors.ik_failures,
@@ -272,6 +280,7 @@ TEST(JointSpaceErrors, MatchTheSimulatorsLinkSideErrorsOnSeedLine) {
   ims_only.encoder_stillness = false;
   ims_only.creep_velocity_updates = false;
   ims_only.revisited_pose_correction = false;
+  ims_only.keep_trajectory = true;
   const JointSpaceErrors without = joint_space_errors(true_input(run), ims_only);
   double without_at = 0.0;
   const double without_position = worst_position_error(run, without, &without_at);
@@ -310,7 +319,7 @@ TEST(JointSpaceErrors, OnAnArmThatRestsTheChainReachesTheImsNoiseFloor) {
   // lines lie at 91-95 % of the arm's reach, where the elbow is nearly stretched: there a
   // micrometre of flange position is 3-4 urad of A2/A3 (the inverse Jacobian).
   const SimRun& run = ideal_seed_line();
-  const JointSpaceErrors errors = joint_space_errors(true_input(run));
+  const JointSpaceErrors errors = joint_space_errors(true_input(run), keeping_the_trajectory());
   print_smoother(errors);
   double worst_at = 0.0;
   const double worst_position = worst_position_error(run, errors, &worst_at);
@@ -419,6 +428,39 @@ TEST(JointSpaceErrors, InterpolatesPosesBetweenSamples) {
   EXPECT_NEAR((turned.axis() - axis).norm(), 0.0, 1e-9);
   EXPECT_FALSE(interpolate_sensor_pose(states, 0.9999, pose));
   EXPECT_FALSE(interpolate_sensor_pose(states, 1.0011, pose));
+}
+
+TEST(JointSpaceErrors, BlocksGiveTheRowsOfTheWholeTrajectory) {
+  // The smoothed trajectory is used block by block; the truth is the whole trajectory: the
+  // rows along it (joint_errors_along) and a run whose one block holds it all. Equal bit for
+  // bit: each row interpolates between the same two states, and each state is corrected once.
+  const SimRun& run = seed_line();
+  JointSpaceOptions whole = keeping_the_trajectory();
+  whole.states_per_block = run.imu.samples.size() + 1;
+  JointSpaceOptions blocks = keeping_the_trajectory();
+  blocks.states_per_block = 997;  // blocks end anywhere: in rests, moves, the revisited poses
+  const JointSpaceErrors a = joint_space_errors(true_input(run), whole);
+  const JointSpaceErrors b = joint_space_errors(true_input(run), blocks);
+  ASSERT_GT(a.revisited_pose_errors.size(), 2u);
+  ASSERT_EQ(a.revisited_pose_errors.size(), b.revisited_pose_errors.size());
+  for (std::size_t k = 0; k < a.revisited_pose_errors.size(); ++k)
+    EXPECT_EQ(a.revisited_pose_errors[k].error_W, b.revisited_pose_errors[k].error_W) << k;
+  ASSERT_EQ(a.trajectory.size(), run.imu.samples.size() + 1);  // the initial state in front
+  ASSERT_EQ(b.trajectory.size(), a.trajectory.size());
+  for (std::size_t k = 0; k < a.trajectory.size(); ++k) {
+    ASSERT_EQ(a.trajectory[k].state.p_W, b.trajectory[k].state.p_W) << k;
+    ASSERT_EQ(a.trajectory[k].state.q_W_S.coeffs(), b.trajectory[k].state.q_W_S.coeffs()) << k;
+  }
+  const JointSpaceErrors along =
+      joint_errors_along(a.trajectory, run.log, true_input(run).kinematics, true_input(run).frames);
+  for (const JointSpaceErrors* e : {&a, &b}) {
+    ASSERT_EQ(e->t_s, along.t_s);
+    EXPECT_EQ(e->outside_record, along.outside_record);
+    for (std::size_t k = 0; k < along.t_s.size(); ++k) {
+      ASSERT_EQ(e->q_measured_rad[k], along.q_measured_rad[k]) << k;
+      ASSERT_EQ(e->q_measured_sigma_rad[k], along.q_measured_sigma_rad[k]) << k;
+    }
+  }
 }
 
 TEST(JointSpaceErrors, RefusesAFirstRestOutsideTheRecord) {
