@@ -151,6 +151,7 @@ nlohmann::json diagnosis_json(const GapSignals& s, const Diagnosis& d) {
           {"heldout_gap_rms_rad", d.heldout_rms_rad},
           {"heldout_gap_rms_modelled_rad", d.heldout_rms_modelled_rad},
           {"significant_gap", d.significant_gap},
+          {"measurement", measurement_json(s, d.measurement)},
           {"verdict", d.verdict},
           {"measure_next", d.measure_next},
           {"band_edges_hz", d.where.band_edges_hz},

@@ -38,6 +38,31 @@ std::vector<std::vector<double>> sim_log_joint_errors(const GapSessionOptions& a
   return measured_joint_errors(sim);
 }
 
+// The IMS chain's error budget: the floor from the real joint errors' header, the frames'
+// covariance from --frames. Frames without a floor cannot be tested: refused.
+MeasurementPrior measurement_prior(const GapSessionOptions& args,
+                                   const ident::JointErrorLog& real) {
+  MeasurementPrior prior;
+  prior.noise_floor_rad = noise_floor_from_log(real, args.joint_errors);
+  if (!args.frames.empty()) {
+    if (!prior.known())
+      throw InputError(args.joint_errors, 0, kNoiseFloorKey,
+                       "no IMS noise floor in the header (imscal calibrate writes it), so the "
+                       "frames' covariance cannot be tested against it");
+    prior.covariance_si = chain_covariance_from_frames(args.frames);
+  }
+  prior.source = !prior.known()        ? ""
+                 : args.frames.empty() ? fmt::format("noise floor of {}", args.joint_errors)
+                                       : fmt::format("noise floor of {}, frames of {}",
+                                                     args.joint_errors, args.frames);
+  if (!prior.known())
+    spdlog::info(
+        "diagnose: {} has no IMS noise floor ({}): the gap is not tested against the "
+        "measurement's own error",
+        args.joint_errors, kNoiseFloorKey);
+  return prior;
+}
+
 }  // namespace
 
 namespace {
@@ -96,6 +121,7 @@ GapSession diagnose_gap_session(const GapSessionOptions& args) {
   } else {
     sim_errors = sim_log_joint_errors(args, real);
   }
+  const MeasurementPrior measurement = measurement_prior(args, real);
   keep_analysed_windows(args.max_analysed_s, real, sim_errors);
   GapSession session;
   try {
@@ -103,6 +129,7 @@ GapSession diagnose_gap_session(const GapSessionOptions& args) {
   } catch (const std::invalid_argument& e) {
     throw InputError(args.robot, 0, "joints", e.what());
   }
+  session.signals.measurement = measurement;
   spdlog::info("diagnose: {} samples, {} joints, gap RMS to be analysed",
                session.signals.sample_count(), session.signals.joint_count());
   session.diagnosis = diagnose_gap(session.signals);

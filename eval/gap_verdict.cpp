@@ -154,6 +154,13 @@ std::string candidate_in_words(const GapSignals& s, const CandidateFit& f) {
 
 void write_verdict(const GapSignals& s, const DiagnosisOptions& o, Diagnosis& out) {
   const std::string where = where_in_words(out);
+  if (out.measurement.within) {
+    out.verdict = fmt::format(
+        "{} {} No robot cause is raised: at this level the candidates fit the IMS chain's own "
+        "error.",
+        where, measurement_in_words(s, out.measurement));
+    return;
+  }
   if (!out.significant_gap) {
     out.verdict = fmt::format(
         "{} No significant structured gap: no candidate effect shrinks the held-out gap by at "
