@@ -159,6 +159,12 @@ void write_verdict(const GapSignals& s, const DiagnosisOptions& o, Diagnosis& ou
         "{} {} No robot cause is raised: at this level the candidates fit the IMS chain's own "
         "error.",
         where, measurement_in_words(s, out.measurement));
+    if (!out.candidates.empty())
+      out.measure_next.push_back(fmt::format(
+          "if a gap of {:.3g} rad matters: a better measurement (the floor is the IMS smoother's "
+          "sigma), then the candidate ranked first, {} ({:.0f} % of the held-out gap)",
+          out.heldout_rms_rad, candidate_label(s, out.candidates.front().fit),
+          out.candidates.front().shrinkage_percent));
     return;
   }
   if (!out.significant_gap) {
