@@ -6,7 +6,8 @@
 //             the chain's own error: it must be called within the measurement, no cause raised;
 //   withheld  the campaign's plant with a transmission error of 30" on A2 (once per motor
 //             revolution) that the nominal model lacks: a robot effect of ~2x the chain's error
-//             on that joint, which must be called beyond the measurement and ranked first.
+//             on that joint, which must be called beyond the measurement and ranked first, and
+//             which `diagnose --scenario` sizes by re-simulating the nominal model.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -72,12 +73,13 @@ nlohmann::json diagnose_through_the_chain(const fs::path& dir, const fs::path& r
                 dir / "model.log"),
             0)
       << read(dir / "model.log");
-  EXPECT_EQ(run("diagnose --joint-errors " + (cal / "joint_errors.csv").string() +
-                    " --sim-joint-errors " + (dir / "model.csv").string() + " --robot " + data +
-                    "/robots/kr16.yaml --frames " + (cal / "frames.json").string() + " --out " +
-                    (dir / "out").string(),
-                dir / "diagnose.log"),
-            0)
+  EXPECT_EQ(
+      run("diagnose --joint-errors " + (cal / "joint_errors.csv").string() +
+              " --sim-joint-errors " + (dir / "model.csv").string() + " --robot " + data +
+              "/robots/kr16.yaml --frames " + (cal / "frames.json").string() + " --scenario " +
+              data + "/scenarios/campaign.yaml --out " + (dir / "out").string(),
+          dir / "diagnose.log"),
+      0)
       << read(dir / "diagnose.log");
   return nlohmann::json::parse(read(dir / "out" / "report.json"));
 }
@@ -151,6 +153,19 @@ TEST_F(MeasurementBudgetCli, WithheldTransmissionErrorIsBeyondTheMeasurement) {
   EXPECT_EQ(report["candidates"][0]["joint"], "A2");
   const std::string verdict = report["verdict"];
   EXPECT_NE(verdict.find("beyond what the measurement explains"), std::string::npos) << verdict;
+  // diagnose --scenario: the joint model refined by re-simulating the campaign's nominal model
+  // along the measured record (its gaps mapped onto the simulated grid). Measured: 18 runs,
+  // "A2 transmission error of order 1 per motor revolution, 35 arcsec" against the true 30";
+  // 22..40 allows for the chain's error on A2 (~9" RMS) that the fit shares.
+  const auto& refinement = report["refinement"];
+  ASSERT_TRUE(refinement["applied"].get<bool>()) << refinement.dump();
+  const std::string change = refinement["changes"][0];
+  std::printf("refined: %s\n", change.c_str());
+  const std::string prefix = "A2 transmission error of order 1 per motor revolution, ";
+  ASSERT_EQ(change.rfind(prefix, 0), 0u) << change;
+  const double amplitude_arcsec = std::stod(change.substr(prefix.size()));
+  EXPECT_GT(amplitude_arcsec, 22.0);
+  EXPECT_LT(amplitude_arcsec, 40.0);
 }
 
 }  // namespace
