@@ -287,6 +287,7 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o,
   const double m = double(std::max<std::size_t>(rows.heldout.size(), 1));
   out.heldout_rms_rad = std::sqrt(e0 / m);
   out.heldout_rms_modelled_rad = out.heldout_rms_rad;
+  out.measurement = measurement_budget(s, training, o.block_s, o.alpha);
 
   // Every candidate on every joint.
   std::uint64_t seed = o.seed;
@@ -304,7 +305,8 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o,
                      if (score(a) != score(b)) return score(a) > score(b);
                      return !one_flank(a) && one_flank(b);
                    });
-  out.significant_gap = !out.candidates.empty() && out.candidates.front().supported;
+  out.significant_gap =
+      !out.candidates.empty() && out.candidates.front().supported && !out.measurement.within;
   group_ambiguous(s, rows.heldout, out);
 
   // The joint model: candidates fitted together, chosen by forward-backward selection on the
@@ -320,8 +322,10 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o,
   find_per_joint(s, o, rows.heldout, out);
   test_joints(s, o, rows.heldout, block, seed, out);
   for (const JointSignificance& js : out.joint_significance)
-    out.significant_gap = out.significant_gap || js.significant();
+    out.significant_gap = out.significant_gap || (js.significant() && !out.measurement.within);
   write_verdict(s, o, out);
+  if (out.measurement.known && !out.measurement.within)
+    out.verdict += " " + measurement_in_words(s, out.measurement);
   return out;
 }
 

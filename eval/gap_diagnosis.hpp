@@ -27,6 +27,7 @@
 #include "eval/gap_analysis.hpp"
 #include "eval/gap_candidates.hpp"
 #include "eval/gap_joint_significance.hpp"
+#include "eval/gap_measurement_budget.hpp"
 #include "eval/gap_model_error.hpp"
 #include "eval/gap_nominal_plant.hpp"
 
@@ -98,8 +99,12 @@ struct Diagnosis {
   std::vector<AmbiguityGroup> ambiguity_groups;
   std::vector<JointFinding> joint_findings;           // every joint with candidates, in joint order
   std::vector<JointSignificance> joint_significance;  // every joint, in joint order
+  // Whether the gap is within what the IMS chain's own error explains
+  // (eval/gap_measurement_budget.hpp; known only with the chain's noise floor). Within it, no robot
+  // cause is raised.
+  MeasurementBudget measurement;
   // The first candidate is supported (on all joints), or some joint's gap is significant on its
-  // own (joint_significance).
+  // own (joint_significance), and the gap is not within the measurement.
   bool significant_gap = false;
   std::string verdict;                    // plain words
   std::vector<std::string> measure_next;  // when the evidence is weak

@@ -68,9 +68,12 @@ std::vector<std::vector<double>> simulate_links(const NominalPlant& plant,
   }
   const sim::PlantLog log = sim::simulate_plant(config, path, path.cycle_s);
   const std::size_t n = std::min(log.samples.size(), path.samples.size());
-  std::vector<std::vector<double>> q(config.effects.size(), std::vector<double>(n));
-  for (std::size_t k = 0; k < n; ++k)
-    for (std::size_t j = 0; j < q.size(); ++j) q[j][k] = log.samples[k].q_link_rad[Eigen::Index(j)];
+  const std::size_t rows = plant.samples.empty() ? n : plant.samples.size();
+  std::vector<std::vector<double>> q(config.effects.size(), std::vector<double>(rows));
+  for (std::size_t k = 0; k < rows; ++k) {
+    const std::size_t i = plant.samples.empty() ? k : std::min(plant.samples[k], n - 1);
+    for (std::size_t j = 0; j < q.size(); ++j) q[j][k] = log.samples[i].q_link_rad[Eigen::Index(j)];
+  }
   return q;
 }
 

@@ -26,6 +26,9 @@ namespace imscal::eval {
 struct NominalPlant {
   sim::PlantConfig config;
   sim::DesiredJointPath path;
+  // The path sample of each sample of the gap's record (a measured record has gaps and may be cut
+  // to windows); empty: one to one.
+  std::vector<std::size_t> samples;
 };
 
 // One member's parameter change (see the file's head).
@@ -50,8 +53,8 @@ Eigen::VectorXd physical_parameters(const NominalPlant& plant,
                                     const std::vector<NominalParameter>& parameters,
                                     Eigen::VectorXd p);
 
-// The link angles [joint][sample] of the nominal model with the changes p (stacked in the order of
-// `parameters`).
+// The link angles [joint][sample of the record, NominalPlant::samples] of the nominal model with
+// the changes p (stacked in the order of `parameters`).
 std::vector<std::vector<double>> simulate_links(const NominalPlant& plant,
                                                 const std::vector<NominalParameter>& parameters,
                                                 const Eigen::VectorXd& p);

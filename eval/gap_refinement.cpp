@@ -180,7 +180,8 @@ NominalRefinement refine_on_nominal_plant(const GapSignals& s, const NominalPlan
                                           const std::vector<std::size_t>& heldout,
                                           double linear_heldout_energy) {
   NominalRefinement out;
-  if (s.sample_count() != plant.path.samples.size() || s.q_internal_rad.empty()) return out;
+  const std::size_t rows = plant.samples.empty() ? plant.path.samples.size() : plant.samples.size();
+  if (s.sample_count() != rows || s.q_internal_rad.empty()) return out;
   Problem x{s, plant, training, heldout, {}, {}, {}, {}, 0};
   split_members(x, members, out);
   if (x.parameters.empty()) return out;

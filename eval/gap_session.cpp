@@ -12,9 +12,11 @@
 #include "core/input_error.hpp"
 #include "core/payload_plausibility.hpp"
 #include "eval/joint_error_limits.hpp"
+#include "eval/model_joint_errors.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "robot/robot_description.hpp"
+#include "sim/scenario.hpp"
 
 namespace imscal::eval {
 
@@ -38,6 +40,31 @@ std::vector<std::vector<double>> sim_log_joint_errors(const GapSessionOptions& a
   return measured_joint_errors(sim);
 }
 
+// The IMS chain's error budget: the floor from the real joint errors' header, the frames'
+// covariance from --frames. Frames without a floor cannot be tested: refused.
+MeasurementPrior measurement_prior(const GapSessionOptions& args,
+                                   const ident::JointErrorLog& real) {
+  MeasurementPrior prior;
+  prior.noise_floor_rad = noise_floor_from_log(real, args.joint_errors);
+  if (!args.frames.empty()) {
+    if (!prior.known())
+      throw InputError(args.joint_errors, 0, kNoiseFloorKey,
+                       "no IMS noise floor in the header (imscal calibrate writes it), so the "
+                       "frames' covariance cannot be tested against it");
+    prior.covariance_si = chain_covariance_from_frames(args.frames);
+  }
+  prior.source = !prior.known()        ? ""
+                 : args.frames.empty() ? fmt::format("noise floor of {}", args.joint_errors)
+                                       : fmt::format("noise floor of {}, frames of {}",
+                                                     args.joint_errors, args.frames);
+  if (!prior.known())
+    spdlog::info(
+        "diagnose: {} has no IMS noise floor ({}): the gap is not tested against the "
+        "measurement's own error",
+        args.joint_errors, kNoiseFloorKey);
+  return prior;
+}
+
 }  // namespace
 
 namespace {
@@ -45,7 +72,8 @@ namespace {
 // A record longer than max_s [s]: its analysed windows only (eval/gap_windows.hpp), in both the
 // real joint errors and the sim's.
 void keep_analysed_windows(double max_s, ident::JointErrorLog& real,
-                           std::vector<std::vector<double>>& sim_errors) {
+                           std::vector<std::vector<double>>& sim_errors,
+                           std::optional<NominalPlant>& nominal) {
   AnalysisWindows windows;
   windows.max_s = max_s;
   const std::vector<bool> keep = analysed_samples(real.time_s, windows);
@@ -60,6 +88,30 @@ void keep_analysed_windows(double max_s, ident::JointErrorLog& real,
       real.time_s.back() - real.time_s.front(), windows_count, kept, keep.size(), max_s);
   real = keep_samples(real, keep);
   sim_errors = keep_samples(sim_errors, keep);
+  if (!nominal) return;
+  std::vector<std::size_t> kept_samples;
+  for (std::size_t k = 0; k < keep.size(); ++k)
+    if (keep[k]) kept_samples.push_back(nominal->samples[k]);
+  nominal->samples = std::move(kept_samples);
+}
+
+// The nominal model of --scenario as the refinement's simulator (its nominal robot, never its
+// plant), along the real record's desired path; none without --scenario.
+std::optional<NominalPlant> scenario_nominal_plant(const GapSessionOptions& args,
+                                                   const ident::JointErrorLog& real,
+                                                   const calib::RobotDescription& robot) {
+  if (args.scenario.empty()) return std::nullopt;
+  const sim::Scenario scenario = sim::load_scenario(sim::resolve_scenario(args.scenario));
+  const sim::NominalRobot nominal = sim::load_nominal_robot(scenario);
+  if (nominal.description.name != robot.name)
+    throw InputError(args.scenario, 0, "nominal_robot",
+                     fmt::format("'{}', but --robot {} is '{}'", nominal.description.name,
+                                 args.robot, robot.name));
+  try {
+    return nominal_plant_along(real, nominal, &scenario);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(args.joint_errors, 0, "robot", e.what());
+  }
 }
 
 }  // namespace
@@ -96,16 +148,19 @@ GapSession diagnose_gap_session(const GapSessionOptions& args) {
   } else {
     sim_errors = sim_log_joint_errors(args, real);
   }
-  keep_analysed_windows(args.max_analysed_s, real, sim_errors);
+  const MeasurementPrior measurement = measurement_prior(args, real);
+  std::optional<NominalPlant> nominal = scenario_nominal_plant(args, real, robot);
+  keep_analysed_windows(args.max_analysed_s, real, sim_errors, nominal);
   GapSession session;
   try {
     session.signals = make_gap_signals(real, sim_errors, robot, table ? &*table : nullptr);
   } catch (const std::invalid_argument& e) {
     throw InputError(args.robot, 0, "joints", e.what());
   }
+  session.signals.measurement = measurement;
   spdlog::info("diagnose: {} samples, {} joints, gap RMS to be analysed",
                session.signals.sample_count(), session.signals.joint_count());
-  session.diagnosis = diagnose_gap(session.signals);
+  session.diagnosis = diagnose_gap(session.signals, {}, nominal ? &*nominal : nullptr);
   return session;
 }
 

@@ -21,6 +21,14 @@ struct GapSessionOptions {
   // A record longer than this [s] is analysed on windows spread over it (eval/gap_windows.hpp);
   // 0: the whole record.
   double max_analysed_s = AnalysisWindows{}.max_s;
+  // calibrate's frames.json of the record (optional): the covariance of the chain's frames in the
+  // measurement budget (eval/gap_measurement_prior.hpp), beside the noise floor the real
+  // joint_errors.csv carries.
+  std::string frames;
+  // The scenario (name or file) whose nominal model made sim_joint_errors (`imscal
+  // model-joint-errors --scenario`), optional: the joint model is then refined by re-simulating
+  // that nominal model (eval/gap_refinement.hpp). Only its nominal robot is read, never its plant.
+  std::string scenario;
 };
 
 struct GapSession {

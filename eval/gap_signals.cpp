@@ -172,6 +172,7 @@ std::vector<GapSignals::ImsChainColumns> ims_chain_columns(
     c.gyro_bias.setZero(Eigen::Index(n), 3);
     c.gyro_scale.setZero(Eigen::Index(n), 3);
     c.accel_scale.setZero(Eigen::Index(n), 1);
+    c.world_rate.setZero(Eigen::Index(n), 3);
   }
   if (n == 0) return out;
   const auto joints_at = [&](std::size_t k, const std::vector<std::vector<double>>& x) {
@@ -249,6 +250,8 @@ std::vector<GapSignals::ImsChainColumns> ims_chain_columns(
     const Eigen::Matrix<double, 6, 3> bias_gap = gap_per_twist * bias_twist;
     const Eigen::Matrix<double, 6, 3> scale_gap = gap_per_twist * scale_twist;
     const Twist accel_gap = gap_per_twist * accel_twist;
+    const Eigen::Matrix<double, 6, 3> world_gap =
+        gap_per_twist.rightCols<3>() * R.transpose() * (time_s[k] - time_s[0]);
     const Eigen::Index row = Eigen::Index(k);
     for (std::size_t j = 0; j < nj; ++j) {
       const Eigen::Index jr = Eigen::Index(j);
@@ -257,6 +260,7 @@ std::vector<GapSignals::ImsChainColumns> ims_chain_columns(
       out[j].gyro_bias.row(row) = bias_gap.row(jr);
       out[j].gyro_scale.row(row) = scale_gap.row(jr);
       out[j].accel_scale(row, 0) = accel_gap[jr];
+      out[j].world_rate.row(row) = world_gap.row(jr);
     }
   }
   return out;

@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "eval/gap_measurement_prior.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table.hpp"
 #include "robot/robot_description.hpp"
@@ -70,8 +71,11 @@ struct GapSignals {
     Eigen::MatrixXd gyro_bias;  // 3: rate bias about the flange axes x, y, z [rad/s]
     Eigen::MatrixXd gyro_scale;   // 3: scale factor error of the flange-axis rates [1]
     Eigen::MatrixXd accel_scale;  // 1: isotropic accelerometer scale error [1]
+    Eigen::MatrixXd world_rate;   // 3: rate error fixed in the base axes x, y, z [rad/s]
   };
   std::vector<ImsChainColumns> ims_chain_columns;
+  // The IMS chain's own error budget (eval/gap_measurement_prior.hpp); not known by default.
+  MeasurementPrior measurement;
 
   std::size_t sample_count() const { return time_s.size(); }
   std::size_t joint_count() const { return joint_names.size(); }
@@ -96,6 +100,8 @@ std::vector<std::vector<double>> predict_table_joint_errors(const ident::Paramet
 //   gyro_bias    (0, R^T u), u = integral of R_R_H e_i dt: the attitude drifts in the base frame
 //   gyro_scale   (0, R^T u), u = integral of R_R_H e_i (e_i . w_H) dt: rate scaled per axis
 //   accel_scale  (R^T (p - p0), 0): the travelled displacement scaled
+//   world_rate   (0, R^T e_i (t - t0)): an attitude drift about a base axis (the Earth rate
+//                resolved through a wrong base rotation; eval/gap_measurement_prior.hpp)
 // The sensor is taken to sit at the flange (the diagnosis does not know T_S_H); the smoother's
 // rest updates, which bound these errors in the real chain, are not modelled (open-loop
 // signatures: they give the shape, the fit the size).

@@ -145,6 +145,22 @@ std::string model_in_words(const Diagnosis& d) {
   return fmt::format("these ({})", fmt::join(labels, " + "));
 }
 
+// The gap within what the IMS chain's own error explains (eval/gap_measurement_budget.hpp): no
+// cause is raised; the candidate ranked first is what to look at once the measurement is better.
+void write_within_measurement_verdict(const GapSignals& s, const std::string& where,
+                                      Diagnosis& out) {
+  out.verdict = fmt::format(
+      "{} {} No robot cause is raised: at this level the candidates fit the IMS chain's own "
+      "error.",
+      where, measurement_in_words(s, out.measurement));
+  if (!out.candidates.empty())
+    out.measure_next.push_back(fmt::format(
+        "if a gap of {:.3g} rad matters: a better measurement (the floor is the IMS smoother's "
+        "sigma), then the candidate ranked first, {} ({:.0f} % of the held-out gap)",
+        out.heldout_rms_rad, candidate_label(s, out.candidates.front().fit),
+        out.candidates.front().shrinkage_percent));
+}
+
 }  // namespace
 
 std::string candidate_in_words(const GapSignals& s, const CandidateFit& f) {
@@ -154,6 +170,7 @@ std::string candidate_in_words(const GapSignals& s, const CandidateFit& f) {
 
 void write_verdict(const GapSignals& s, const DiagnosisOptions& o, Diagnosis& out) {
   const std::string where = where_in_words(out);
+  if (out.measurement.within) return write_within_measurement_verdict(s, where, out);
   if (!out.significant_gap) {
     out.verdict = fmt::format(
         "{} No significant structured gap: no candidate effect shrinks the held-out gap by at "

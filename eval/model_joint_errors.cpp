@@ -152,4 +152,14 @@ ident::JointErrorLog nominal_model_joint_errors(const ident::JointErrorLog& meas
   return out;
 }
 
+NominalPlant nominal_plant_along(const ident::JointErrorLog& measured,
+                                 const sim::NominalRobot& nominal, const sim::Scenario* scenario) {
+  check_log_fits(measured, nominal.description);
+  NominalPlant out;
+  out.samples = grid_indices(measured);
+  out.path = desired_path(measured, out.samples, program_payloads(scenario));
+  out.config = nominal_plant(nominal, scenario);
+  return out;
+}
+
 }  // namespace imscal::eval

@@ -17,6 +17,7 @@
 //
 // The result is a log of the nominal robot with the measured log's time stamps, q_desired and
 // payload; q_measured the model's link-side angles, q_internal its motor angles / N.
+#include "eval/gap_nominal_plant.hpp"
 #include "ident/joint_error_io.hpp"
 #include "sim/scenario.hpp"
 
@@ -27,5 +28,12 @@ namespace imscal::eval {
 ident::JointErrorLog nominal_model_joint_errors(const ident::JointErrorLog& measured,
                                                 const sim::NominalRobot& nominal,
                                                 const sim::Scenario* scenario_or_null = nullptr);
+
+// The same nominal model as a simulator for the gap diagnosis (eval/gap_nominal_plant.hpp): the
+// plant and the desired path on the controller-cycle grid, with the grid sample of every logged
+// sample (NominalPlant::samples), so that its re-simulations line up with the log's rows.
+NominalPlant nominal_plant_along(const ident::JointErrorLog& measured,
+                                 const sim::NominalRobot& nominal,
+                                 const sim::Scenario* scenario_or_null = nullptr);
 
 }  // namespace imscal::eval

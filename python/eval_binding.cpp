@@ -92,16 +92,28 @@ void bind_eval(py::module_& m) {
   m.def(
       "diagnose",
       [](const std::string& joint_errors, const std::string& robot, const std::string& table,
-         const std::string& sim_joint_errors, double max_analysed_s) {
+         const std::string& sim_joint_errors, double max_analysed_s, const std::string& frames,
+         const std::string& scenario) {
         if (table.empty() == sim_joint_errors.empty())
           throw InputError(joint_errors, 0, "table",
                            "give the sim side: either table or sim_joint_errors");
-        return diagnose({joint_errors, table, sim_joint_errors, robot, max_analysed_s});
+        eval::GapSessionOptions options;
+        options.joint_errors = joint_errors;
+        options.table = table;
+        options.sim_joint_errors = sim_joint_errors;
+        options.robot = robot;
+        options.max_analysed_s = max_analysed_s;
+        options.frames = frames;
+        options.scenario = scenario;
+        return diagnose(options);
       },
       "joint_errors"_a, "robot"_a, py::kw_only(), "table"_a = "", "sim_joint_errors"_a = "",
-      "max_analysed_s"_a = eval::AnalysisWindows{}.max_s,
+      "max_analysed_s"_a = eval::AnalysisWindows{}.max_s, "frames"_a = "", "scenario"_a = "",
       "The sim-to-real gap diagnosis of `imscal diagnose`: the measured joint_errors.csv "
-      "against an identified table (parameters.json) or a second joint_errors.csv. Returns "
+      "against an identified table (parameters.json) or a second joint_errors.csv; frames: "
+      "calibrate's frames.json for the measurement budget, scenario: the one whose nominal "
+      "model made sim_joint_errors (the joint model refined on it), as the command's options. "
+      "Returns "
       "'report' (report.json as a dict), 'text' (report.txt), 'verdict', 'measure_next', and "
       "the analysed samples' t_s (N,) and gap_rad (N, joints), real minus sim joint error.");
 }

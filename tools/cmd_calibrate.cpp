@@ -57,6 +57,17 @@ ident::JointErrorLog joint_error_log(const calib::JointSpaceErrors& e, const cal
       out.q_measured_rad[std::size_t(j)].push_back(e.q_measured_rad[k][j]);
       out.q_internal_rad[std::size_t(j)].push_back(e.q_internal_rad[k][j]);
     }
+  // The smoother's 1-sigma of q_measured, RMS over the samples per joint: the IMS noise floor in
+  // joint space (diagnose's measurement budget, eval/gap_measurement_budget.hpp).
+  if (!e.q_measured_sigma_rad.empty()) {
+    calib::JointVector sum = calib::JointVector::Zero();
+    for (const calib::JointVector& s : e.q_measured_sigma_rad) sum += s.cwiseAbs2();
+    std::string value;
+    for (int j = 0; j < calib::kJointCount; ++j)
+      value += fmt::format("{}{:.6g}", j ? "," : "",
+                           std::sqrt(sum[j] / double(e.q_measured_sigma_rad.size())));
+    out.metadata.emplace_back("q_measured_sigma_rms_rad", value);
+  }
   ident::split_at_gaps(out);
   return out;
 }

@@ -87,6 +87,16 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--robot", args->session.robot,
                      "robot description (datasets/robots/*.yaml or a .urdf)")
           ->required();
+      sub.add_option("--frames", args->session.frames,
+                     "frames.json of the calibration that measured the real joint errors: the "
+                     "frames' covariance joins the IMS noise floor (joint_errors.csv's "
+                     "q_measured_sigma_rms_rad) in the test of whether the gap is within what "
+                     "the measurement explains");
+      sub.add_option("--scenario", args->session.scenario,
+                     "scenario (name or file) whose nominal model made --sim-joint-errors "
+                     "(model-joint-errors --scenario): the joint model is refined by "
+                     "re-simulating it (its nominal robot only, never its plant)")
+          ->excludes(table);
       sub.add_option("--out", args->out, "output folder (report.json, report.txt)")->required();
       sub.add_flag("--force", args->force, "overwrite existing outputs");
       sub.add_flag("--figures", args->figures,
