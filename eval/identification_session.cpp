@@ -13,6 +13,7 @@
 #include "core/payload_plausibility.hpp"
 #include "eval/joint_error_limits.hpp"
 #include "eval/transmission_error_order.hpp"
+#include "eval/transmission_error_order_spectrum.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config_record.hpp"
 #include "ident/parameter_table_io.hpp"
@@ -72,6 +73,34 @@ ident::OrderSearchReport search_orders(const ident::JointErrorLog& log,
   }
   config = with_searched_orders(std::move(config), search);
   return report;
+}
+
+// `--track-transmission-error-orders`: each joint's strongest significant order of the joint
+// errors' order spectrum replaces the harmonic (the config's, or the held-out search's), the
+// second strongest (if any) becomes the joint's second pair (eval/
+// transmission_error_order_spectrum.hpp). A joint without a significant order keeps its
+// harmonic and no second pair.
+void track_orders(const ident::JointErrorLog& log, const std::string& config_file,
+                  ident::IdentificationConfig& config) {
+  if (!config.options.transmission_error_input)
+    throw InputError(config_file, 0, "model.transmission_error",
+                     "--track-transmission-error-orders needs the transmission-error inputs "
+                     "(model.transmission_error: true)");
+  const std::vector<JointOrderSpectrum> spectra =
+      transmission_error_order_spectra(log, config.gear_ratio);
+  std::vector<double> first, second;
+  for (std::size_t j = 0; j < log.joint_count(); ++j) {
+    const std::vector<OrderLine>& found = spectra[j].significant;
+    spdlog::info("identify: {} order spectrum: {}", log.joint_names[j],
+                 describe_order_spectrum(spectra[j]));
+    first.push_back(found.empty() ? config.transmission_error_harmonic(j) : found[0].order);
+    second.push_back(found.size() > 1 ? found[1].order : 0.0);
+  }
+  config.transmission_error_harmonic_per_joint = first;
+  config.options.second_transmission_error_input =
+      std::ranges::any_of(second, [](double h) { return h > 0.0; });
+  config.transmission_error_second_harmonic_per_joint =
+      config.options.second_transmission_error_input ? second : std::vector<double>{};
 }
 
 // The order sweep's longest model must leave rows to fit it: a segment needs more samples than
@@ -166,6 +195,7 @@ IdentificationResult identify_session(PreparedIdentification p,
   std::optional<ident::OrderSearchReport> order_search;
   if (p.options.search_order)
     order_search = search_orders(log, p.options.config, p.config, p.options.search_second_order);
+  if (p.options.track_orders) track_orders(log, p.options.config, p.config);
   const auto segments = log.segments();
   IdentificationResult r;
   r.joint_names = log.joint_names;
