@@ -76,16 +76,12 @@ ident::OrderSearchReport search_orders(const ident::JointErrorLog& log,
 }
 
 // `--track-transmission-error-orders`: each joint's strongest significant order of the joint
-// errors' order spectrum replaces the harmonic (the config's, or the held-out search's), the
-// second strongest (if any) becomes the joint's second pair (eval/
-// transmission_error_order_spectrum.hpp). A joint without a significant order keeps its
-// harmonic and no second pair.
-void track_orders(const ident::JointErrorLog& log, const std::string& config_file,
-                  ident::IdentificationConfig& config) {
-  if (!config.options.transmission_error_input)
-    throw InputError(config_file, 0, "model.transmission_error",
-                     "--track-transmission-error-orders needs the transmission-error inputs "
-                     "(model.transmission_error: true)");
+// errors' order spectrum replaces the held-out search's harmonic, the second strongest (if any)
+// becomes the joint's second pair (eval/transmission_error_order_spectrum.hpp). A joint without
+// a significant order keeps the search's harmonic and no second pair. The report's search gets
+// the orders used.
+void track_orders(const ident::JointErrorLog& log, ident::IdentificationConfig& config,
+                  ident::OrderSearchReport& report) {
   const std::vector<JointOrderSpectrum> spectra =
       transmission_error_order_spectra(log, config.gear_ratio);
   std::vector<double> first, second;
@@ -95,6 +91,13 @@ void track_orders(const ident::JointErrorLog& log, const std::string& config_fil
                  describe_order_spectrum(spectra[j]));
     first.push_back(found.empty() ? config.transmission_error_harmonic(j) : found[0].order);
     second.push_back(found.size() > 1 ? found[1].order : 0.0);
+    ident::OrderSearchJoint& joint = report.joints.at(j);
+    joint.chosen_harmonic_per_motor_rev = first.back();
+    joint.second_harmonic_per_motor_rev = second.back();
+    joint.tracking_windows = spectra[j].windows;
+    for (const OrderLine& line : found)
+      joint.tracked_orders.push_back({line.order, line.amplitude_rad, line.floor_rad,
+                                      line.noise_significance, line.significance});
   }
   config.transmission_error_harmonic_per_joint = first;
   config.options.second_transmission_error_input =
@@ -195,7 +198,7 @@ IdentificationResult identify_session(PreparedIdentification p,
   std::optional<ident::OrderSearchReport> order_search;
   if (p.options.search_order)
     order_search = search_orders(log, p.options.config, p.config, p.options.search_second_order);
-  if (p.options.track_orders) track_orders(log, p.options.config, p.config);
+  if (p.options.track_orders && order_search) track_orders(log, p.config, *order_search);
   const auto segments = log.segments();
   IdentificationResult r;
   r.joint_names = log.joint_names;

@@ -69,8 +69,10 @@ imscal::tools::CommandRegistration registration{
                    "beside the first, kept where it lowers the held-out rows' BIC")
           ->needs("--search-transmission-error-order");
       sub.add_flag("--track-transmission-error-orders", args->session.track_orders,
-                   "find each joint's transmission-error orders (up to two) as the significant "
-                   "peaks of the joint errors' order spectrum over the motor angle");
+                   "with --search-transmission-error-order: each joint's orders (up to two) from "
+                   "the significant peaks of the joint errors' order spectrum over the motor "
+                   "angle, where it has one")
+          ->needs("--search-transmission-error-order");
       sub.add_flag("--force", args->force, "Overwrite existing outputs");
       sub.callback([args] { run(*args); });
     }};
