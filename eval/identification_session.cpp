@@ -97,7 +97,7 @@ void track_orders(const ident::JointErrorLog& log, ident::IdentificationConfig& 
     joint.tracking_windows = spectra[j].windows;
     for (const OrderLine& line : found)
       joint.tracked_orders.push_back({line.order, line.amplitude_rad, line.floor_rad,
-                                      line.noise_significance, line.significance});
+                                      line.significance_sigma, line.t_statistic});
   }
   config.transmission_error_harmonic_per_joint = first;
   config.options.second_transmission_error_input =

@@ -162,9 +162,9 @@ std::vector<JointOrderSpectrum> transmission_error_order_spectra(
     for (std::size_t o = 0; o < orders.size(); ++o) s.lines.push_back(line_of(powers, orders, o));
     for (const OrderLine& line : s.lines)
       if (is_candidate(line.order) && line.order <= options.max_candidate + 1e-9 &&
-          line.noise_significance > options.min_significance &&
+          line.significance_sigma > options.min_significance &&
           line.amplitude_rad > options.min_amplitude_ratio * line.floor_rad &&
-          line.significance > options.min_t_statistic)
+          line.t_statistic > options.min_t_statistic)
         s.significant.push_back(line);
     std::ranges::sort(s.significant, [](const OrderLine& a, const OrderLine& b) {
       return a.amplitude_rad > b.amplitude_rad;
@@ -179,7 +179,7 @@ std::string describe_order_spectrum(const JointOrderSpectrum& spectrum) {
   for (const OrderLine& line : spectrum.significant)
     text += fmt::format(" {} ({:.1f}″ over {:.1f}″, t {:.1f}, {:.0f}σ)", line.order,
                         line.amplitude_rad * kArcsecPerRad, line.floor_rad * kArcsecPerRad,
-                        line.significance, line.noise_significance);
+                        line.t_statistic, line.significance_sigma);
   text += "; spectrum [″]:";
   for (const OrderLine& line : spectrum.lines)
     text += fmt::format(" {}:{:.2f}", line.order, line.amplitude_rad * kArcsecPerRad);

@@ -1,18 +1,23 @@
 #pragma once
 // The gears' transmission-error orders found by order tracking, as in rotating machinery: each
 // joint's error Δq = q_desired - q_measured resampled onto the motor angle θ = gear ratio x
-// q_desired over the stretches where that motor turns steadily one way, cut into windows of a
-// whole number of motor revolutions, each window detrended (a quadratic in θ: the slow joint
-// error of gravity, friction and the path) and Hann-weighted in θ, and its amplitude taken at
-// every order on a quarter-order grid. A gear's error is a fixed function of the motor angle,
-// so it stands out at its orders in every window, whatever the joint speed; the rest of the
-// joint error (the controller's and the gear mode's response to the path, the measurement's
-// noise) spreads over the orders. An order is kept where its mean power over the windows exceeds
-// the floor of its neighbouring quarter orders by more than min_significance σ, σ the floor's
-// spread over the windows (floor / sqrt(windows): a noise-only order's power is χ² with two
-// degrees of freedom in each window). The Hann window's first nulls fall on the neighbouring
-// quarter orders when the window spans 8 motor revolutions, so a strong order does not raise its
-// own floor. References: [Randall2011] (order tracking, ch. 3), [Harris1978] (the Hann window).
+// q_desired over the stretches where that motor turns one way at a steady speed, cut into
+// windows of 8 motor revolutions, each window detrended (a quadratic in θ: the slow joint error
+// of gravity, friction and the path) and Hann-weighted in θ, and its amplitude taken at every
+// order on a quarter-order grid. A gear's error is a fixed function of the motor angle, so it
+// stands out at its orders in every window, whatever the joint speed; the rest of the joint
+// error (the loop's and the gear mode's response to the path, the measurement's noise) is tied
+// to time, not to the motor angle, and spreads over the orders as the speed changes between
+// windows. The Hann window's first nulls fall on the neighbouring quarter orders at 8
+// revolutions, so a strong order does not raise its own floor.
+// An order (a multiple of 0.5 up to 4) is significant where three things hold, each against the
+// floor of its neighbouring quarter orders: its mean power exceeds the floor by more than
+// min_significance σ of a noise-only floor (χ² with two degrees of freedom per window: σ =
+// floor / sqrt(windows)); its amplitude is min_amplitude_ratio times the floor's; and the
+// excess is consistent over the windows (its t statistic above min_t_statistic: a joint error
+// of the path that happens to fall at the order in a few windows is not). The thresholds were set
+// on the development plants 1000-1014 against their drawn orders (docs/decisions/0053).
+// References: [Randall2011] (order tracking, ch. 3), [Harris1978] (the Hann window).
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -38,15 +43,14 @@ struct OrderLine {
   double order = 0.0;               // per motor revolution
   double amplitude_rad = 0.0;       // sqrt of the windows' mean power: the error's amplitude [rad]
   double floor_rad = 0.0;           // sqrt of the neighbouring orders' mean power [rad]
-  double significance = 0.0;        // the windows' mean excess of power over the floor / its σ
-  double noise_significance = 0.0;  // (power - floor) / (floor / sqrt(windows))
+  double t_statistic = 0.0;         // the windows' mean excess of power over the floor / its σ
+  double significance_sigma = 0.0;  // (power - floor) / (floor / sqrt(windows))
 };
 
 struct JointOrderSpectrum {
   std::size_t windows = 0;
   std::vector<OrderLine> lines;  // every grid order (0.25 .. max_order)
-  // The candidates (multiples of 0.5 on the grid) whose significance exceeds the threshold, the
-  // strongest (by amplitude) first.
+  // The significant orders (above), the strongest (by amplitude) first.
   std::vector<OrderLine> significant;
 };
 

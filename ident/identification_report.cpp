@@ -147,7 +147,7 @@ json order_tracking_json(const OrderSearchJoint& j) {
     orders.push_back({{"order_per_motor_rev", o.order_per_motor_rev},
                       {"amplitude_rad", o.amplitude_rad},
                       {"floor_rad", o.floor_rad},
-                      {"significance_sigma", o.significance},
+                      {"significance_sigma", o.significance_sigma},
                       {"t_statistic", o.t_statistic}});
   return {{"windows", j.tracking_windows}, {"significant_orders", orders}};
 }

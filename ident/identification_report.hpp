@@ -22,10 +22,10 @@ namespace imscal::ident {
 // orders`, eval/transmission_error_order_spectrum.hpp).
 struct TrackedOrder {
   double order_per_motor_rev = 0.0;
-  double amplitude_rad = 0.0;  // the windows' RMS amplitude at the order
-  double floor_rad = 0.0;      // the neighbouring orders' RMS amplitude
-  double significance = 0.0;   // the power's excess over the floor in σ of a noise-only floor
-  double t_statistic = 0.0;    // the excess's t statistic over the windows
+  double amplitude_rad = 0.0;       // the windows' RMS amplitude at the order
+  double floor_rad = 0.0;           // the neighbouring orders' RMS amplitude
+  double significance_sigma = 0.0;  // the power's excess over the floor in σ of a noise-only floor
+  double t_statistic = 0.0;         // the excess's t statistic over the windows
 };
 
 // The search of each joint's transmission-error harmonic (`--search-transmission-error-order`).

@@ -103,7 +103,7 @@ TEST_F(IdentificationReportTest, WhatIsWrittenIsReadBack) {
   EXPECT_EQ(searched.tracked_orders[1].order_per_motor_rev, 4.0);
   EXPECT_EQ(searched.tracked_orders[1].amplitude_rad, 2.5e-5);
   EXPECT_EQ(searched.tracked_orders[1].floor_rad, 7.0e-6);
-  EXPECT_EQ(searched.tracked_orders[1].significance, 115.0);
+  EXPECT_EQ(searched.tracked_orders[1].significance_sigma, 115.0);
   EXPECT_EQ(searched.tracked_orders[1].t_statistic, 2.625);
   ASSERT_EQ(read.joints.size(), 1u);
   const ReportedJoint& j = read.joints[0];
