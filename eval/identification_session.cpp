@@ -15,6 +15,7 @@
 #include "eval/joint_error_limits.hpp"
 #include "eval/refined_links_choice.hpp"
 #include "eval/transmission_error_order.hpp"
+#include "eval/transmission_error_order_spectrum.hpp"
 #include "eval/verification.hpp"
 #include "ident/identification_config_record.hpp"
 #include "ident/parameter_table_io.hpp"
@@ -77,6 +78,37 @@ ident::OrderSearchReport search_orders(const ident::JointErrorLog& log,
   }
   config = with_searched_orders(std::move(config), search);
   return report;
+}
+
+// `--track-transmission-error-orders`: each joint's strongest significant order of the joint
+// errors' order spectrum replaces the held-out search's harmonic, the second strongest (if any)
+// becomes the joint's second pair (eval/transmission_error_order_spectrum.hpp). A joint without
+// a significant order keeps the search's harmonic and no second pair. The report's search gets
+// the orders used.
+void track_orders(const ident::JointErrorLog& log, ident::IdentificationConfig& config,
+                  ident::OrderSearchReport& report) {
+  const std::vector<JointOrderSpectrum> spectra =
+      transmission_error_order_spectra(log, config.gear_ratio);
+  std::vector<double> first, second;
+  for (std::size_t j = 0; j < log.joint_count(); ++j) {
+    const std::vector<OrderLine>& found = spectra[j].significant;
+    spdlog::info("identify: {} order spectrum: {}", log.joint_names[j],
+                 describe_order_spectrum(spectra[j]));
+    first.push_back(found.empty() ? config.transmission_error_harmonic(j) : found[0].order);
+    second.push_back(found.size() > 1 ? found[1].order : 0.0);
+    ident::OrderSearchJoint& joint = report.joints.at(j);
+    joint.chosen_harmonic_per_motor_rev = first.back();
+    joint.second_harmonic_per_motor_rev = second.back();
+    joint.tracking_windows = spectra[j].windows;
+    for (const OrderLine& line : found)
+      joint.tracked_orders.push_back({line.order, line.amplitude_rad, line.floor_rad,
+                                      line.significance_sigma, line.t_statistic});
+  }
+  config.transmission_error_harmonic_per_joint = first;
+  config.options.second_transmission_error_input =
+      std::ranges::any_of(second, [](double h) { return h > 0.0; });
+  config.transmission_error_second_harmonic_per_joint =
+      config.options.second_transmission_error_input ? second : std::vector<double>{};
 }
 
 // The order sweep's longest model must leave rows to fit it: a segment needs more samples than
@@ -172,6 +204,7 @@ IdentificationResult identify_session(PreparedIdentification p,
   std::optional<ident::OrderSearchReport> order_search;
   if (p.options.search_order)
     order_search = search_orders(log, p.options.config, p.config, p.options.search_second_order);
+  if (p.options.track_orders && order_search) track_orders(log, p.config, *order_search);
   const auto segments = log.segments();
   IdentificationResult r;
   r.joint_names = log.joint_names;

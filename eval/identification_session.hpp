@@ -29,6 +29,9 @@ struct IdentificationSessionOptions {
   std::string config;                // identification config
   bool search_order = false;         // the transmission error's order per joint from the data
   bool search_second_order = false;  // with search_order: a second harmonic per joint (BIC)
+  // The orders per joint from the joint errors' order spectrum instead (up to two per joint,
+  // eval/transmission_error_order_spectrum.hpp).
+  bool track_orders = false;
   // The rigid-body model for the data of robot `data_robot` (file `data_file`, sample time
   // data_cycle_s), asked only when the config's models take the model torque; `needed_by_file`
   // and `needed_by_field` name what asked, for its InputError (tools/model_torque_option.hpp).

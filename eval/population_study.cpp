@@ -213,6 +213,7 @@ void step_identify(const PlantStepContext& c) {
                                      "--out",
                                      (c.dir / "identify").string()};
   if (c.args.second_order) arguments.emplace_back("--search-second-transmission-error-order");
+  if (c.args.track_orders) arguments.emplace_back("--track-transmission-error-orders");
   run_step("identify", arguments, c.dir, c.args);
 }
 

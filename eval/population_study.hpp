@@ -34,6 +34,9 @@ struct PopulationStudyOptions {
   // identify also searches a second transmission-error harmonic per joint
   // (`--search-second-transmission-error-order`, eval/transmission_error_order.hpp).
   bool second_order = false;
+  // identify also takes each joint's orders from the joint errors' order spectrum
+  // (`--track-transmission-error-orders`, eval/transmission_error_order_spectrum.hpp).
+  bool track_orders = false;
 };
 
 struct SeedRange {

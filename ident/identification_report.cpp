@@ -141,6 +141,17 @@ json joint_json(const JointIdentification& r, double seconds, const IdentifiedSt
           {"cells", cells}};
 }
 
+json order_tracking_json(const OrderSearchJoint& j) {
+  json orders = json::array();
+  for (const TrackedOrder& o : j.tracked_orders)
+    orders.push_back({{"order_per_motor_rev", o.order_per_motor_rev},
+                      {"amplitude_rad", o.amplitude_rad},
+                      {"floor_rad", o.floor_rad},
+                      {"significance_sigma", o.significance_sigma},
+                      {"t_statistic", o.t_statistic}});
+  return {{"windows", j.tracking_windows}, {"significant_orders", orders}};
+}
+
 json order_search_json(const OrderSearchReport& search) {
   json joints = json::array();
   for (const OrderSearchJoint& j : search.joints) {
@@ -155,6 +166,7 @@ json order_search_json(const OrderSearchReport& search) {
          {"held_out_joint_error_fit_percent", fits},
          {"second_harmonic_per_motor_rev", number_or_null(j.second_harmonic_per_motor_rev)},
          {"second_bic", number_or_null(j.second_bic)}});
+    if (j.tracking_windows > 0) joints.back()["order_tracking"] = order_tracking_json(j);
   }
   return {{"candidates_per_motor_rev", search.candidates_per_motor_rev}, {"joints", joints}};
 }
@@ -241,6 +253,17 @@ ReportedJoint joint_of(const JsonField& f) {
   return j;
 }
 
+void read_order_tracking(const JsonField& f, OrderSearchJoint& joint) {
+  joint.tracking_windows = f["windows"].count();
+  const JsonField orders = f["significant_orders"];
+  for (std::size_t k = 0; k < orders.size(); ++k) {
+    const JsonField o = orders[k];
+    joint.tracked_orders.push_back({o["order_per_motor_rev"].number(), o["amplitude_rad"].number(),
+                                    o["floor_rad"].number(), o["significance_sigma"].number(),
+                                    o["t_statistic"].number()});
+  }
+}
+
 OrderSearchReport order_search_of(const JsonField& f) {
   OrderSearchReport search;
   search.candidates_per_motor_rev = f["candidates_per_motor_rev"].numbers();
@@ -260,6 +283,8 @@ OrderSearchReport order_search_of(const JsonField& f) {
       search.joints.back().second_harmonic_per_motor_rev = second->number_or_nan();
     if (const auto bic = j.optional("second_bic"))
       search.joints.back().second_bic = bic->number_or_nan();
+    if (const auto tracking = j.optional("order_tracking"))
+      read_order_tracking(*tracking, search.joints.back());
   }
   return search;
 }

@@ -18,6 +18,16 @@
 
 namespace imscal::ident {
 
+// An order the joint errors' order spectrum holds significantly (`--track-transmission-error-
+// orders`, eval/transmission_error_order_spectrum.hpp).
+struct TrackedOrder {
+  double order_per_motor_rev = 0.0;
+  double amplitude_rad = 0.0;       // the windows' RMS amplitude at the order
+  double floor_rad = 0.0;           // the neighbouring orders' RMS amplitude
+  double significance_sigma = 0.0;  // the power's excess over the floor in σ of a noise-only floor
+  double t_statistic = 0.0;         // the excess's t statistic over the windows
+};
+
 // The search of each joint's transmission-error harmonic (`--search-transmission-error-order`).
 struct OrderSearchJoint {
   std::string name;
@@ -31,6 +41,11 @@ struct OrderSearchJoint {
   // NaN without the second pass.
   double second_harmonic_per_motor_rev = std::numeric_limits<double>::quiet_NaN();
   double second_bic = std::numeric_limits<double>::quiet_NaN();
+  // With `--track-transmission-error-orders`: the spectrum's windows (0: not tracked) and its
+  // significant orders, strongest first; the first replaces chosen_harmonic_per_motor_rev, the
+  // second second_harmonic_per_motor_rev (0 without one).
+  std::size_t tracking_windows = 0;
+  std::vector<TrackedOrder> tracked_orders{};
 };
 struct OrderSearchReport {
   std::vector<double> candidates_per_motor_rev;

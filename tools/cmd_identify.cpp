@@ -68,6 +68,11 @@ imscal::tools::CommandRegistration registration{
                    "with --search-transmission-error-order: also a second harmonic per joint "
                    "beside the first, kept where it lowers the held-out rows' BIC")
           ->needs("--search-transmission-error-order");
+      sub.add_flag("--track-transmission-error-orders", args->session.track_orders,
+                   "with --search-transmission-error-order: each joint's orders (up to two) from "
+                   "the significant peaks of the joint errors' order spectrum over the motor "
+                   "angle, where it has one")
+          ->needs("--search-transmission-error-order");
       sub.add_flag("--force", args->force, "Overwrite existing outputs");
       sub.callback([args] { run(*args); });
     }};

@@ -57,6 +57,9 @@ imscal::tools::CommandRegistration registration{
       sub.add_option("--cycles", args->study.cycles, "cycles per verification (ISO 9283: 10)");
       sub.add_flag("--second-transmission-error-order", args->study.second_order,
                    "identify also searches a second transmission-error harmonic per joint");
+      sub.add_flag("--track-transmission-error-orders", args->study.track_orders,
+                   "identify also takes each joint's transmission-error orders (up to two) from "
+                   "the joint errors' order spectrum");
       sub.add_option("--ident-config", args->study.ident_config,
                      "identification config (default datasets/identification/ident-default.yaml)");
       sub.add_option("--calibrate-config", args->study.calibrate_config,

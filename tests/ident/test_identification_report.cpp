@@ -76,6 +76,9 @@ IdentificationReportHeader sample_header() {
       OrderSearchReport{}};
   h.order_search->candidates_per_motor_rev = {0.5, 1.0, 2.0};
   h.order_search->joints = {{"A2", 1.0, 2.0, 4.5, 2.0, {10.0, kNaN, 31.0}}};
+  h.order_search->joints[0].tracking_windows = 30;
+  h.order_search->joints[0].tracked_orders = {{3.5, 3.0e-5, 6.5e-6, 184.0, 2.75},
+                                              {4.0, 2.5e-5, 7.0e-6, 115.0, 2.625}};
   return h;
 }
 
@@ -95,6 +98,13 @@ TEST_F(IdentificationReportTest, WhatIsWrittenIsReadBack) {
   EXPECT_EQ(searched.chosen_harmonic_per_motor_rev, 2.0);
   EXPECT_EQ(searched.gain_points, 4.5);
   EXPECT_TRUE(std::isnan(searched.held_out_joint_error_fit_percent.at(1)));
+  EXPECT_EQ(searched.tracking_windows, 30u);
+  ASSERT_EQ(searched.tracked_orders.size(), 2u);
+  EXPECT_EQ(searched.tracked_orders[1].order_per_motor_rev, 4.0);
+  EXPECT_EQ(searched.tracked_orders[1].amplitude_rad, 2.5e-5);
+  EXPECT_EQ(searched.tracked_orders[1].floor_rad, 7.0e-6);
+  EXPECT_EQ(searched.tracked_orders[1].significance_sigma, 115.0);
+  EXPECT_EQ(searched.tracked_orders[1].t_statistic, 2.625);
   ASSERT_EQ(read.joints.size(), 1u);
   const ReportedJoint& j = read.joints[0];
   EXPECT_EQ(j.name, "A2");
