@@ -10,10 +10,9 @@
 //   IMSCAL_BASELINE_BINARY=/path/to/old/imscal bench/bench_campaign_stages
 //   (add --benchmark_counters_tabular=true for a table)
 #include <benchmark/benchmark.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <nlohmann/json.hpp>
+
+#include "child_process.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -42,28 +41,12 @@ struct Timing {
 Timing run_campaign(const std::string& binary, const fs::path& folder) {
   fs::remove_all(folder);
   fs::create_directories(folder.parent_path());
-  std::vector<std::string> words{binary, "run", kRunConfig.string(), "--out", folder.string()};
-  std::vector<char*> argv;
-  for (auto& w : words) argv.push_back(w.data());
-  argv.push_back(nullptr);
   const fs::path log = folder.string() + ".log";
-  const auto start = std::chrono::steady_clock::now();
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("fork failed");
-  if (pid == 0) {
-    if (!freopen(log.c_str(), "w", stdout) || !freopen(log.c_str(), "a", stderr)) _exit(126);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  rusage usage{};
-  if (wait4(pid, &status, 0, &usage) != pid) throw std::runtime_error("wait4 failed");
+  const imscal::bench::ChildRun run =
+      imscal::bench::run_child({binary, "run", kRunConfig.string(), "--out", folder.string()}, log);
   Timing t;
-  t.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw std::runtime_error(binary + " run failed; see " + log.string());
-  t.cpu_s = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-            1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  t.wall_s = run.wall_s;
+  t.cpu_s = run.cpu_s;
   for (const std::string& stage : kStages) {
     std::ifstream in(folder / stage / "stage.json");
     if (!in) continue;

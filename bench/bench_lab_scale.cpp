@@ -14,9 +14,8 @@
 //   bench/bench_lab_scale --benchmark_filter='Run/(0|5)/'   (the baseline and 5 minutes only)
 //   bench/bench_lab_scale --benchmark_filter='Calibrate'    (calibrate alone)
 #include <benchmark/benchmark.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
+
+#include "child_process.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -25,6 +24,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -32,38 +32,13 @@ namespace fs = std::filesystem;
 
 const fs::path kSource(IMSCAL_SOURCE_DIR);
 
-struct ChildRun {
-  double wall_s = 0.0;
-  double peak_rss_mb = 0.0;
-  double cpu_s = 0.0;  // user + system time of the child and its stages
-};
+using imscal::bench::ChildRun;
 
 // Runs imscal with `arguments`, its output into `log`; throws when it fails.
 ChildRun run_imscal(const std::vector<std::string>& arguments, const fs::path& log) {
   std::vector<std::string> words{IMSCAL_BINARY};
   words.insert(words.end(), arguments.begin(), arguments.end());
-  std::vector<char*> argv;
-  for (auto& w : words) argv.push_back(w.data());
-  argv.push_back(nullptr);
-  const auto start = std::chrono::steady_clock::now();
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("fork failed");
-  if (pid == 0) {
-    if (!freopen(log.c_str(), "w", stdout) || !freopen(log.c_str(), "a", stderr)) _exit(126);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  rusage usage{};
-  if (wait4(pid, &status, 0, &usage) != pid) throw std::runtime_error("wait4 failed");
-  ChildRun r;
-  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.peak_rss_mb = double(usage.ru_maxrss) / 1024.0;  // ru_maxrss in KiB on Linux
-  r.cpu_s = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-            1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw std::runtime_error("imscal " + arguments.front() + " failed, see " + log.string());
-  return r;
+  return imscal::bench::run_child(std::move(words), log);
 }
 
 std::string read_text(const fs::path& file) {

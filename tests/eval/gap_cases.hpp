@@ -314,7 +314,7 @@ struct GapWorld {
       }
     }
     Case c;
-    c.nominal = {sim_config, path};
+    c.nominal = {sim_config, path, {}};
     const sim::PlantLog real_plant =
         real_changed ? sim::simulate_plant(real_config, real_path, path.cycle_s) : base_log;
     const sim::PlantLog sim_plant =
