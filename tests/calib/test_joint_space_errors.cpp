@@ -441,7 +441,7 @@ TEST(JointSpaceErrors, BlocksGiveTheRowsOfTheWholeTrajectory) {
   blocks.states_per_block = 997;  // blocks end anywhere: in rests, moves, the revisited poses
   const JointSpaceErrors a = joint_space_errors(true_input(run), whole);
   const JointSpaceErrors b = joint_space_errors(true_input(run), blocks);
-  ASSERT_GT(a.revisited_pose_errors.size(), 2u);
+  ASSERT_GE(a.revisited_pose_errors.size(), 2u);  // two or more (the sanitized line is shorter)
   ASSERT_EQ(a.revisited_pose_errors.size(), b.revisited_pose_errors.size());
   for (std::size_t k = 0; k < a.revisited_pose_errors.size(); ++k)
     EXPECT_EQ(a.revisited_pose_errors[k].error_W, b.revisited_pose_errors[k].error_W) << k;
