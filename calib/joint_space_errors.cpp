@@ -318,4 +318,11 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   return out;
 }
 
+JointVector q_measured_sigma_rms_rad(const JointSpaceErrors& errors) {
+  JointVector sum = JointVector::Zero();
+  if (errors.q_measured_sigma_rad.empty()) return sum;
+  for (const JointVector& sigma : errors.q_measured_sigma_rad) sum += sigma.cwiseAbs2();
+  return (sum / double(errors.q_measured_sigma_rad.size())).cwiseSqrt();
+}
+
 }  // namespace imscal::calib

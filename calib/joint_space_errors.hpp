@@ -120,6 +120,10 @@ struct JointSpaceErrors {
 JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
                                     const JointSpaceOptions& options = {});
 
+// RMS over the samples of q_measured's 1-sigma per joint [rad]: the IMS noise floor in joint
+// space (the gap diagnosis' measurement budget reads it). Zero without samples.
+JointVector q_measured_sigma_rms_rad(const JointSpaceErrors& errors);
+
 // Steps 2-3 alone: the flange poses and inverse kinematics at the robot samples from a given
 // sensor trajectory W_T_S (IMS clock, sorted by time), e.g. the smoother's or a reference's.
 // Fills everything but `smoother` and `trajectory`.

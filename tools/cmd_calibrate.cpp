@@ -25,6 +25,7 @@
 #include "core/progress.hpp"
 #include "core/progress_channel.hpp"
 #include "core/version.hpp"
+#include "eval/gap_measurement_prior.hpp"
 #include "ident/joint_error_io.hpp"
 #include "tools/command_registry.hpp"
 
@@ -57,16 +58,13 @@ ident::JointErrorLog joint_error_log(const calib::JointSpaceErrors& e, const cal
       out.q_measured_rad[std::size_t(j)].push_back(e.q_measured_rad[k][j]);
       out.q_internal_rad[std::size_t(j)].push_back(e.q_internal_rad[k][j]);
     }
-  // The smoother's 1-sigma of q_measured, RMS over the samples per joint: the IMS noise floor in
-  // joint space (diagnose's measurement budget, eval/gap_measurement_budget.hpp).
+  // The IMS noise floor in joint space, for diagnose's measurement budget.
   if (!e.q_measured_sigma_rad.empty()) {
-    calib::JointVector sum = calib::JointVector::Zero();
-    for (const calib::JointVector& s : e.q_measured_sigma_rad) sum += s.cwiseAbs2();
+    const calib::JointVector floor_rad = calib::q_measured_sigma_rms_rad(e);
     std::string value;
     for (int j = 0; j < calib::kJointCount; ++j)
-      value += fmt::format("{}{:.6g}", j ? "," : "",
-                           std::sqrt(sum[j] / double(e.q_measured_sigma_rad.size())));
-    out.metadata.emplace_back("q_measured_sigma_rms_rad", value);
+      value += fmt::format("{}{:.6g}", j ? "," : "", floor_rad[j]);
+    out.metadata.emplace_back(eval::kNoiseFloorKey, value);
   }
   ident::split_at_gaps(out);
   return out;
