@@ -12,6 +12,7 @@
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "core/payload_plausibility.hpp"
+#include "eval/friction_identification.hpp"
 #include "eval/joint_error_limits.hpp"
 #include "eval/refined_links_choice.hpp"
 #include "eval/transmission_error_order.hpp"
@@ -30,13 +31,14 @@ namespace {
 // them; the refined links when the config refines them.
 std::vector<ident::LinkMassParameters> attach_session_model_torques(
     ident::JointErrorLog& log, const ident::IdentificationConfig& config,
-    const IdentificationSessionOptions& options) {
+    const IdentificationSessionOptions& options, std::optional<ModelTorqueSource>& nominal) {
   if (!config.options.model_torque_input) return {};
   if (!options.model_torque)
     throw InputError(options.config, 0, "model.model_torque", "no rigid-body model given");
   ModelTorqueSource model = options.model_torque(log.robot, options.joint_errors, options.config,
                                                  "model.model_torque", log.cycle_s);
   check_joint_error_limits(log, options.joint_errors, model.robot);
+  nominal = model;
   std::vector<ident::LinkMassParameters> links;
   if (config.refine_mass_parameters) {
     try {
@@ -162,6 +164,18 @@ std::optional<ident::ParameterTable> forward_table_of(const ident::JointErrorLog
   return forward_table;
 }
 
+// Each joint's friction levels from the record's motor encoders, beside the nominal robot's
+// (eval/friction_identification.hpp); null when the config gives no rigid-body model.
+nlohmann::json friction_report(const ident::JointErrorLog& log,
+                               const std::optional<ModelTorqueSource>& nominal) {
+  if (!nominal) return nullptr;
+  spdlog::info("identify: friction levels from the motor encoders' following error");
+  const auto levels = identify_friction_levels(log, *nominal);
+  for (std::size_t j = 0; j < levels.size(); ++j)
+    spdlog::info("identify: {} {}", log.joint_names[j], describe_friction_levels(levels[j]));
+  return friction_levels_json(levels, log.joint_names);
+}
+
 }  // namespace
 
 PreparedIdentification prepare_identification(const IdentificationSessionOptions& options) {
@@ -174,7 +188,7 @@ PreparedIdentification prepare_identification(const IdentificationSessionOptions
   p.config = ident::resolve_for_record(ident::load_identification_config(config_node), p.log.robot,
                                        p.log.cycle_s, options.joint_errors, &warnings);
   for (const std::string& w : warnings) spdlog::warn("identify: {}", w);
-  p.model_torque_links = attach_session_model_torques(p.log, p.config, options);
+  p.model_torque_links = attach_session_model_torques(p.log, p.config, options, p.nominal_model);
   if (p.config.max_speed_rad_s.size() != p.log.joint_count())
     throw InputError(
         options.config, config_node.child("joints").child("max_speed_deg_s").line(),
@@ -240,6 +254,7 @@ IdentificationResult identify_session(PreparedIdentification p,
   r.report = ident::identification_report_json(header, r.outcomes);
   if (!r.table.model_torque_links.empty())
     r.report["model_torque_links"] = ident::model_torque_links_json(r.table.model_torque_links);
+  r.report["friction_levels"] = friction_report(log, p.nominal_model);
   r.forward_table = forward_table_of(log, p.config, r.table);
   return r;
 }

@@ -49,6 +49,9 @@ struct PreparedIdentification {
   ident::IdentificationConfig config;
   // The model torque's links refined from the log (model.refine_mass_parameters), else empty.
   std::vector<ident::LinkMassParameters> model_torque_links;
+  // The nominal robot's rigid-body model (before any refinement), when the config takes the model
+  // torque: the friction levels are estimated beside its drive values.
+  std::optional<ModelTorqueSource> nominal_model;
   std::chrono::steady_clock::time_point start;
 };
 PreparedIdentification prepare_identification(const IdentificationSessionOptions& options);

@@ -1,0 +1,33 @@
+#pragma once
+// Every joint's friction levels (Coulomb, viscous) and reflected motor inertia from an
+// identification record, with 1σ, beside the nominal robot's values
+// (ident/friction_levels.hpp): the following error of the motor encoders (the log's q_internal
+// block), the nominal model's torque along the desired path (eval/model_torque.hpp), the desired
+// path's speed and acceleration by central differences within each segment. The nominal robot's
+// drive values are the prior the estimate starts from and is reported beside; the plant is never
+// read.
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "eval/model_torque.hpp"
+#include "ident/friction_levels.hpp"
+#include "ident/joint_error_io.hpp"
+
+namespace imscal::eval {
+
+// One entry per joint of the log; every joint not estimated (with the reason) when the log has
+// no q_internal block. Throws std::invalid_argument when the log is not of the model's joints.
+std::vector<ident::JointFrictionLevels> identify_friction_levels(
+    const ident::JointErrorLog& log, const ModelTorqueSource& nominal,
+    const ident::FrictionLevelOptions& options = {});
+
+// identification_report.json's "friction_levels" (datasets/FORMAT.md): per joint the levels with
+// 1σ and the nominal robot's values.
+nlohmann::json friction_levels_json(const std::vector<ident::JointFrictionLevels>& levels,
+                                    const std::vector<std::string>& joint_names);
+
+// One line per joint for the identification's log.
+std::string describe_friction_levels(const ident::JointFrictionLevels& levels);
+
+}  // namespace imscal::eval
