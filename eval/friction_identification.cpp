@@ -24,14 +24,6 @@ void derivatives(const std::vector<double>& x, double cycle_s,
     }
 }
 
-// value and sigma null where the joint was not estimated.
-nlohmann::json level_json(const ident::FrictionLevel& level, bool estimated) {
-  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
-  return {{"value", estimated ? number(level.value) : nlohmann::json()},
-          {"sigma", estimated ? number(level.sigma) : nlohmann::json()},
-          {"nominal", number(level.nominal)}};
-}
-
 }  // namespace
 
 std::vector<ident::JointFrictionLevels> identify_friction_levels(
@@ -85,29 +77,6 @@ std::vector<ident::JointFrictionLevels> identify_friction_levels(
   }
   if (!best.empty()) out = std::move(best);
   return out;
-}
-
-nlohmann::json friction_levels_json(const std::vector<ident::JointFrictionLevels>& levels,
-                                    const std::vector<std::string>& joint_names) {
-  nlohmann::json joints = nlohmann::json::array();
-  for (std::size_t j = 0; j < levels.size(); ++j) {
-    const ident::JointFrictionLevels& l = levels[j];
-    nlohmann::json joint = {{"name", joint_names.at(j)}, {"estimated", l.estimated}};
-    if (!l.estimated) joint["not_estimated"] = l.not_estimated;
-    joint["coulomb_nm"] = level_json(l.coulomb_nm, l.estimated);
-    joint["viscous_nm_s_per_rad"] = level_json(l.viscous_nm_s_per_rad, l.estimated);
-    joint["reflected_inertia_kg_m2"] = level_json(l.reflected_inertia_kg_m2, l.estimated);
-    if (l.estimated) {
-      joint["rows"] = l.rows;
-      joint["correlation_factor"] = l.correlation_factor;
-      joint["dead_time_cycles"] = l.dead_time_cycles;
-      joint["model_torque_rms_nm"] = l.torque_rms_nm;
-      joint["torque_fit_percent"] = l.torque_fit_percent;
-    }
-    joints.push_back(std::move(joint));
-  }
-  return {{"source", "motor encoders' following error (q_desired - q_internal)"},
-          {"joints", std::move(joints)}};
 }
 
 std::string describe_friction_levels(const ident::JointFrictionLevels& l) {

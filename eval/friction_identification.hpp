@@ -6,7 +6,6 @@
 // path's speed and acceleration by central differences within each segment. The nominal robot's
 // drive values are the prior the estimate starts from and is reported beside; the plant is never
 // read.
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -21,11 +20,6 @@ namespace imscal::eval {
 std::vector<ident::JointFrictionLevels> identify_friction_levels(
     const ident::JointErrorLog& log, const ModelTorqueSource& nominal,
     const ident::FrictionLevelOptions& options = {});
-
-// identification_report.json's "friction_levels" (datasets/FORMAT.md): per joint the levels with
-// 1σ and the nominal robot's values.
-nlohmann::json friction_levels_json(const std::vector<ident::JointFrictionLevels>& levels,
-                                    const std::vector<std::string>& joint_names);
 
 // One line per joint for the identification's log.
 std::string describe_friction_levels(const ident::JointFrictionLevels& levels);

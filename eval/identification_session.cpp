@@ -18,6 +18,7 @@
 #include "eval/transmission_error_order.hpp"
 #include "eval/transmission_error_order_spectrum.hpp"
 #include "eval/verification.hpp"
+#include "ident/friction_levels_report.hpp"
 #include "ident/identification_config_record.hpp"
 #include "ident/parameter_table_io.hpp"
 
@@ -165,15 +166,13 @@ std::optional<ident::ParameterTable> forward_table_of(const ident::JointErrorLog
 }
 
 // Each joint's friction levels from the record's motor encoders, beside the nominal robot's
-// (eval/friction_identification.hpp); null when the config gives no rigid-body model.
-nlohmann::json friction_report(const ident::JointErrorLog& log,
-                               const std::optional<ModelTorqueSource>& nominal) {
-  if (!nominal) return nullptr;
+// (eval/friction_identification.hpp).
+nlohmann::json friction_report(const ident::JointErrorLog& log, const ModelTorqueSource& nominal) {
   spdlog::info("identify: friction levels from the motor encoders' following error");
-  const auto levels = identify_friction_levels(log, *nominal);
+  const auto levels = identify_friction_levels(log, nominal);
   for (std::size_t j = 0; j < levels.size(); ++j)
     spdlog::info("identify: {} {}", log.joint_names[j], describe_friction_levels(levels[j]));
-  return friction_levels_json(levels, log.joint_names);
+  return ident::friction_levels_json(levels, log.joint_names);
 }
 
 }  // namespace
@@ -254,7 +253,7 @@ IdentificationResult identify_session(PreparedIdentification p,
   r.report = ident::identification_report_json(header, r.outcomes);
   if (!r.table.model_torque_links.empty())
     r.report["model_torque_links"] = ident::model_torque_links_json(r.table.model_torque_links);
-  r.report["friction_levels"] = friction_report(log, p.nominal_model);
+  if (p.nominal_model) r.report["friction_levels"] = friction_report(log, *p.nominal_model);
   r.forward_table = forward_table_of(log, p.config, r.table);
   return r;
 }

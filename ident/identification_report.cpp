@@ -355,6 +355,8 @@ IdentificationReport read_identification_report(const std::filesystem::path& fil
   if (const auto links = root.optional("model_torque_links"))  // with the refinement only
     for (std::size_t k = 0; k < links->size(); ++k)
       report.model_torque_links.push_back(link_of((*links)[k]));
+  if (const auto friction = root.optional("friction_levels"))
+    report.friction_levels = friction_levels_of(*friction);
   return report;
 }
 

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "ident/friction_levels_report.hpp"
 #include "ident/identified_structure.hpp"
 #include "ident/identify_joints.hpp"
 #include "ident/parameter_table.hpp"
@@ -112,6 +113,9 @@ struct IdentificationReport {
   // The model torque's links refined from the data (the table's model_torque_links; empty when
   // the identification did not refine them).
   std::vector<LinkMassParameters> model_torque_links;
+  // The friction levels from the motor encoders (ident/friction_levels_report.hpp; empty when
+  // the identification had no rigid-body model or the report predates them).
+  std::vector<ReportedFrictionLevels> friction_levels;
 };
 
 // The document of the identification of every joint (outcomes in joint order).

@@ -49,7 +49,38 @@ std::string link_row(std::size_t link, const ident::LinkMassParameters& l) {
       vector_text(l.com_sigma_m, kCm), vector_text(l.nominal_com_m, kCm));
 }
 
+// "value ± σ (robot file's)" of a level, or the robot file's alone where not estimated.
+std::string level_cell(const ident::FrictionLevel& level, bool estimated) {
+  if (!estimated) return fmt::format("n/a ({})", number(level.nominal));
+  return fmt::format("{} &plusmn; {} ({})", number(level.value), number(level.sigma),
+                     number(level.nominal));
+}
+
+std::string friction_row(const ident::ReportedFrictionLevels& r) {
+  const ident::JointFrictionLevels& l = r.levels;
+  return fmt::format(
+      "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+      html_escape(r.name), level_cell(l.coulomb_nm, l.estimated),
+      level_cell(l.viscous_nm_s_per_rad, l.estimated),
+      level_cell(l.reflected_inertia_kg_m2, l.estimated), number(l.torque_fit_percent),
+      l.dead_time_cycles, l.estimated ? "" : html_escape(l.not_estimated));
+}
+
 }  // namespace
+
+std::string friction_levels_html(const std::vector<ident::ReportedFrictionLevels>& levels) {
+  if (levels.empty()) return "";
+  std::string rows;
+  for (const ident::ReportedFrictionLevels& r : levels) rows += friction_row(r);
+  return "<p>The drives' friction levels and reflected motor inertia from the motor encoders' "
+         "following error against the nominal model torque (ident/friction_levels.hpp), with "
+         "1&sigma; (statistical only: the balance's model error, see its fit, biases them by "
+         "more) beside the robot file's in brackets.</p>\n"
+         "<table>\n<tr><th>joint</th><th>Coulomb [N m]</th><th>viscous [N m s/rad]</th>"
+         "<th>reflected inertia [kg m&sup2;]</th><th>balance fit [%]</th>"
+         "<th>dead time [cycles]</th><th>not estimated</th></tr>\n" +
+         rows + "</table>\n";
+}
 
 std::string model_torque_links_html(const std::vector<ident::LinkMassParameters>& links) {
   if (links.empty()) return "";

@@ -165,7 +165,7 @@ std::string models_body(const ident::ParameterTable& table,
         table_fit_of(report, joint.name));
   }
   body += "</table>\n";
-  if (report) body += structure_table_html(*report);
+  if (report) body += structure_table_html(*report) + friction_levels_html(report->friction_levels);
   body += model_torque_links_html(table.model_torque_links);
   for (const auto& joint : table.joints) {
     const ident::CellGrid grid = joint.grid();
