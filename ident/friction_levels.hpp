@@ -49,8 +49,8 @@ struct FrictionLevelOptions {
   // 2 ms; a linear filter keeps the balance exact): it removes what the balance does not model
   // and the encoder sees, the transmission error's torque ripple through the gear (tens of Hz)
   // and the gear's 15 Hz mode. Measured on two population plants (Coulomb, estimate / truth):
-  // A1 0.40 / 0.31 without, 0.72 / 0.68 with 25, 0.82 / 0.78 with 50 samples; A3 0.78 / 0.80,
-  // 0.89 / 0.87, 0.96 / 0.90; the wrist unchanged; 50 misses the test's 10 % on A2–A5.
+  // A1 0.42 / 0.32 without, 0.72 / 0.68 with 25, 0.82 / 0.78 with 50 samples; A3 0.78 / 0.80,
+  // 0.89 / 0.87, 0.96 / 0.90; the wrist unchanged; 50 misses the test's tolerances.
   int smoothing_samples = 25;
   double direction_speed_scale_rad_s = 0.01;  // s of tanh(q̇ / s)
 };
