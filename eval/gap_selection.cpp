@@ -171,7 +171,7 @@ struct Trial {
   double p_value = 1.0;
 };
 
-// The three candidates whose own columns best explain the model's residual, fitted again to it and
+// The five candidates whose own columns best explain the model's residual, fitted again to it and
 // refitted jointly with the model, tried in the order of their held-out shrinkage less the
 // parsimony charge: the first whose gain is significant, or none.
 std::optional<Trial> forward_step(const Context& x, const std::vector<std::size_t>& pool,
