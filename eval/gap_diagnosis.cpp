@@ -292,10 +292,15 @@ Diagnosis diagnose_gap(const GapSignals& s, const DiagnosisOptions& o,
   // Every candidate on every joint.
   std::uint64_t seed = o.seed;
   out.candidates = fit_every_candidate(s, o, training, rows, block, seed);
-  // Ranked by held-out shrinkage less a parsimony charge of 0.5 percentage points per parameter:
-  // of two candidates that explain the same (a drift that nests an offset), the simpler first.
+  // Ranked by held-out shrinkage less a parsimony charge of 0.5 percentage points per own
+  // parameter: of two candidates that explain the same (a drift that nests an offset), the simpler
+  // first. The coupling's parameters are left aside, as in the per-joint ranking and the joint
+  // model's selection: they carry the effect's known reach into the other joints through the
+  // inertia, not a further explanation (charged, they put a drift on the joint ahead of the
+  // elastic gear that moves it and its neighbours).
   const auto score = [](const CandidateResult& c) {
-    return c.shrinkage_percent - kParsimonyPercentPerParameter * double(c.fit.parameters.size());
+    const double own = double(c.fit.parameters.size() - c.fit.coupling_parameter_count);
+    return c.shrinkage_percent - kParsimonyPercentPerParameter * own;
   };
   // Equal scores (the same modelled gap): a backlash held on one flank after the plain
   // explanation it cannot be told from (a zero offset); eval/gap_ambiguity.hpp groups them.

@@ -107,13 +107,11 @@ struct Context {
   }
 };
 
-// Every candidate that shrinks the held-out gap of all joints or of its own joint at all: an effect
-// hidden behind a larger one may explain little of the gap itself.
+// Every candidate but the first: each is fitted again to the gap the model leaves, so an effect
+// hidden behind a larger one, whose fit to the whole gap explains nothing of it, still competes.
 std::vector<std::size_t> selection_pool(const std::vector<CandidateResult>& candidates) {
   std::vector<std::size_t> pool;
-  for (std::size_t c = 1; c < candidates.size(); ++c)
-    if (candidates[c].shrinkage_percent > 0.0 || candidates[c].joint_shrinkage_percent > 0.0)
-      pool.push_back(c);
+  for (std::size_t c = 1; c < candidates.size(); ++c) pool.push_back(c);
   return pool;
 }
 
@@ -134,7 +132,7 @@ double residual_score(const Context& x, std::size_t c, const Refit& model) {
 }
 
 // How many of the best residual scores are refitted jointly per forward step.
-constexpr std::size_t kJointRefitsPerStep = 3;
+constexpr std::size_t kJointRefitsPerStep = 5;
 
 // The member (not the first) whose loss is least, when that loss is not significant; -1: none.
 int weakest_member(const Context& x, const std::vector<CandidateFit>& set, const Refit& full) {
@@ -173,7 +171,7 @@ struct Trial {
   double p_value = 1.0;
 };
 
-// The three candidates whose own columns best explain the model's residual, fitted again to it and
+// The five candidates whose own columns best explain the model's residual, fitted again to it and
 // refitted jointly with the model, tried in the order of their held-out shrinkage less the
 // parsimony charge: the first whose gain is significant, or none.
 std::optional<Trial> forward_step(const Context& x, const std::vector<std::size_t>& pool,
@@ -228,6 +226,7 @@ JointModel select_joint_model(const GapSignals& s, const DiagnosisOptions& o,
   std::vector<double> p_of = {candidates.front().p_value};
   const std::vector<std::size_t> pool = selection_pool(candidates);
   std::vector<bool> tried(candidates.size(), false);
+  std::vector<std::size_t> dropped;
   GapSignals on_residual = s;
   while (int(set.size()) < o.max_combination) {
     on_residual.gap_rad = model.residual;
@@ -237,8 +236,15 @@ JointModel select_joint_model(const GapSignals& s, const DiagnosisOptions& o,
     index.push_back(added->candidate);
     p_of.push_back(added->p_value);
     model = std::move(added->refit);
+    // Against the grown model's residual, a candidate tried before may now add significantly;
+    // members and those dropped stay out (no cycle).
+    std::fill(tried.begin(), tried.end(), false);
+    for (std::size_t c : index) tried[c] = true;
+    for (std::size_t c : dropped) tried[c] = true;
     const int weakest = weakest_member(x, set, model);
     if (weakest > 0) {
+      dropped.push_back(index[std::size_t(weakest)]);
+      tried[dropped.back()] = true;
       set.erase(set.begin() + weakest);
       index.erase(index.begin() + weakest);
       p_of.erase(p_of.begin() + weakest);

@@ -14,10 +14,11 @@
 //   backward  after each addition, drop a member (not the first) whose loss, with the others
 //             refitted without it, is no longer significant by the same rule
 //
-// The pool: every candidate that shrinks the held-out gap of all joints or of its own joint; per
-// forward step the three whose own columns best explain the model's residual are fitted again to
-// that residual (shape and size: an effect hidden behind a larger one) and refitted jointly. The
-// predicted shrinkage is the final joint refit's held-out one.
+// The pool: every candidate; per forward step the five whose own columns best explain the model's
+// residual are fitted again to that residual (shape and size: an effect hidden behind a larger one,
+// whose fit to the whole gap explains nothing of it) and refitted jointly. After each addition the
+// candidates tried before compete again against the grown model's residual; those the backward
+// step dropped stay out. The predicted shrinkage is the final joint refit's held-out one.
 #include <cstdint>
 #include <vector>
 

@@ -255,10 +255,10 @@ class GapHarnessWide : public test_support::ScratchDirTest {
 
 // The goals on both sets: ranked first >= 90 %, joint located >= 90 %, shrinkage within
 // ±20 pp >= 85 %, every effect of a multi-effect case found >= 80 %, false alarms <= 10 % with
-// the chain-measured controls. Met: the shrinkage (development 21/24, held out 23/24). Missed, and
-// held here at the measured level so that a fall shows (decision 0050 says why): ranked first
-// 20/24 and 16/24, joint located 21/24 and 20/24, multi-effect 3/6 and 2/6 (effects at the noise
-// floor; a member of one joint standing for another's), false alarms 6/6 and 9/9: the chain's
+// the chain-measured controls. Met: the shrinkage (development 22/24, held out 23/24). Missed, and
+// held here at the measured level so that a fall shows (decisions 0050 and 0058 say why): ranked
+// first 20/24 and 18/24, joint located 21/24 and 21/24, multi-effect 4/6 and 2/6 (effects at the
+// noise floor; a member of one joint standing for another's), false alarms 6/6 and 9/9: the chain's
 // error and the chain-like noise hold at rest and move with the pose, which drift, kinematic,
 // IMS-bias and time-offset candidates fit on the training blocks and carry to the held-out ones;
 // telling them from the measurement's own error needs the measurement's error budget as a
@@ -268,10 +268,10 @@ void expect_goals_or_the_measured_level(const Tally& development, const Tally& h
   EXPECT_GE(pct(development.within, development.effect_cases), 85.0);
   EXPECT_GE(pct(held_out.within, held_out.effect_cases), 85.0);
   EXPECT_GE(development.first, 20);
-  EXPECT_GE(held_out.first, 16);
+  EXPECT_GE(held_out.first, 18);
   EXPECT_GE(development.located, 21);
-  EXPECT_GE(held_out.located, 20);
-  EXPECT_GE(development.all_found, 3);
+  EXPECT_GE(held_out.located, 21);
+  EXPECT_GE(development.all_found, 4);
   EXPECT_GE(held_out.all_found, 2);
   // The chain measured at its level: the median of its error RMS over the 36 joint records within
   // 3e-5..1.5e-4 rad (measured 6.2e-5; the lab's chain 5e-5..8e-5, 1.3e-5..3.3e-4 here per joint).
