@@ -259,12 +259,8 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   const auto first_kept =
       std::upper_bound(imu.samples.begin(), imu.samples.end(), start,
                        [](double t, const ims::ImuSample& s) { return t < s.t_s; });
-  ims::ImuSeries cut;
-  cut.quantity = imu.quantity;
-  cut.nominal_dt_s = imu.nominal_dt_s;
-  cut.source = imu.source;
-  cut.site = imu.site;
-  cut.samples.assign(first_kept, imu.samples.end());
+  // The record from there on, without a copy.
+  const ims::ImuSamples cut(imu, std::size_t(first_kept - imu.samples.begin()));
   const double t0 = first_kept == imu.samples.begin() ? start : std::prev(first_kept)->t_s;
 
   // Initial state from the frames and the forward kinematics of the first rest.
@@ -294,9 +290,6 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   }
   ims::ZuptSmoothing smoothed =
       ims::smooth_with_zupt_streamed(cut, earth, initial, sigma0, zupt, aids);
-  // The states read the same samples from the whole record: the copy goes.
-  smoothed.states.read_samples_from(imu, std::size_t(first_kept - imu.samples.begin()));
-  std::vector<ims::ImuSample>().swap(cut.samples);
 
   // The trajectory: the initial state (the start of the first increment), then the smoothed
   // states, used block by block (twice with the revisited poses: once where they are looked

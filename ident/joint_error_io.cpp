@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -76,6 +77,27 @@ std::vector<std::string> joints_from_header(const std::string& file, std::size_t
     throw InputError(file, line, columns.size() > 2 ? columns[2] : "",
                      "expected the columns t_s,payload_kg,q_desired_<joint>_rad...");
   return joints;
+}
+
+// Reserves the columns for the lines left in `in` (counted, then `in` put back): each column
+// then takes what it holds, not up to twice as its vector grows.
+void reserve_rows(std::istream& in, JointErrorLog& log, bool with_internal) {
+  const std::istream::pos_type here = in.tellg();
+  if (here == std::istream::pos_type(-1)) return;
+  std::size_t lines = 1;
+  std::array<char, 1 << 16> buffer{};
+  while (in.read(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0)
+    lines += std::size_t(std::count(buffer.data(), buffer.data() + in.gcount(), '\n'));
+  in.clear();
+  in.seekg(here);
+  log.time_s.reserve(lines);
+  log.payload_kg.reserve(lines);
+  log.sample_lines.reserve(lines);
+  for (std::size_t j = 0; j < log.joint_count(); ++j) {
+    log.q_desired_rad[j].reserve(lines);
+    log.q_measured_rad[j].reserve(lines);
+    if (with_internal) log.q_internal_rad[j].reserve(lines);
+  }
 }
 
 }  // namespace
@@ -173,6 +195,7 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
   log.q_desired_rad.assign(joints, {});
   log.q_measured_rad.assign(joints, {});
   if (with_internal) log.q_internal_rad.assign(joints, {});
+  reserve_rows(in, log, with_internal);
   std::vector<double> row(expected.size());
   while (std::getline(in, text)) {
     ++line;
@@ -228,6 +251,51 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
   return log;
 }
 
+JointErrorsCsvWriter::JointErrorsCsvWriter(const std::filesystem::path& file,
+                                           const JointErrorLog& header, bool with_internal,
+                                           Overwrite overwrite)
+    : out_(file, overwrite), joints_(header.joint_count()), with_internal_(with_internal) {
+  if (joints_ == 0) throw std::invalid_argument("write_joint_errors_csv: no joints");
+  if (!(header.cycle_s > 0.0)) throw std::invalid_argument("write_joint_errors_csv: cycle_s <= 0");
+  for (const auto& name : header.joint_names)
+    if (name.empty() || name.find_first_of(",# \t\n") != std::string::npos)
+      throw std::invalid_argument("write_joint_errors_csv: bad joint name '" + name + "'");
+  auto& s = out_.stream();
+  s << fmt::format("# imscal-joint-errors: {}\n# robot: {}\n# cycle_s: {}\n", kFormatVersion,
+                   header.robot, header.cycle_s);
+  if (!header.source.empty()) s << "# source: " << header.source << '\n';
+  for (const auto& [key, value] : header.metadata) s << "# " << key << ": " << value << '\n';
+  const auto names = expected_columns(header.joint_names, with_internal);
+  for (std::size_t c = 0; c < names.size(); ++c) s << (c ? "," : "") << names[c];
+  s << '\n';
+}
+
+void JointErrorsCsvWriter::add(double t_s, double payload_kg, std::span<const double> q_desired_rad,
+                               std::span<const double> q_measured_rad,
+                               std::span<const double> q_internal_rad) {
+  if (q_desired_rad.size() != joints_ || q_measured_rad.size() != joints_ ||
+      (with_internal_ && q_internal_rad.size() != joints_))
+    throw std::invalid_argument("write_joint_errors_csv: inconsistent sizes");
+  line_ = fmt::format("{:.17g},{:.17g}", t_s, payload_kg);
+  const std::array<std::span<const double>, 3> families{q_desired_rad, q_measured_rad,
+                                                        q_internal_rad};
+  for (std::size_t f = 0; f < (with_internal_ ? 3U : 2U); ++f) {
+    for (const double v : families[f]) {
+      if (!std::isfinite(v))
+        throw std::invalid_argument(
+            fmt::format("write_joint_errors_csv: non-finite value at sample {}", samples_));
+      fmt::format_to(std::back_inserter(line_), ",{:.17g}", v);
+    }
+  }
+  line_ += '\n';
+  out_.stream() << line_;
+  ++samples_;
+}
+
+void JointErrorsCsvWriter::commit() {
+  out_.commit();
+}
+
 void write_joint_errors_csv(const std::filesystem::path& file, const JointErrorLog& log,
                             Overwrite overwrite) {
   const std::size_t n = log.sample_count();
@@ -242,32 +310,15 @@ void write_joint_errors_csv(const std::filesystem::path& file, const JointErrorL
         (log.has_q_internal() && log.q_internal_rad[j].size() != n))
       throw std::invalid_argument("write_joint_errors_csv: inconsistent sizes of joint " +
                                   log.joint_names[j]);
-  if (!(log.cycle_s > 0.0)) throw std::invalid_argument("write_joint_errors_csv: cycle_s <= 0");
-  for (const auto& name : log.joint_names)
-    if (name.empty() || name.find_first_of(",# \t\n") != std::string::npos)
-      throw std::invalid_argument("write_joint_errors_csv: bad joint name '" + name + "'");
-  AtomicFile out(file, overwrite);
-  auto& s = out.stream();
-  s << fmt::format("# imscal-joint-errors: {}\n# robot: {}\n# cycle_s: {}\n", kFormatVersion,
-                   log.robot, log.cycle_s);
-  if (!log.source.empty()) s << "# source: " << log.source << '\n';
-  for (const auto& [key, value] : log.metadata) s << "# " << key << ": " << value << '\n';
-  const auto names = expected_columns(log.joint_names, log.has_q_internal());
-  for (std::size_t c = 0; c < names.size(); ++c) s << (c ? "," : "") << names[c];
-  s << '\n';
-  std::string line;
+  JointErrorsCsvWriter out(file, log, log.has_q_internal(), overwrite);
+  std::vector<double> desired(joints), measured(joints), internal(joints);
   for (std::size_t k = 0; k < n; ++k) {
-    line = fmt::format("{:.17g},{:.17g}", log.time_s[k], log.payload_kg[k]);
-    for (const auto* family : {&log.q_desired_rad, &log.q_measured_rad, &log.q_internal_rad})
-      for (std::size_t j = 0; j < family->size(); ++j) {
-        const double v = (*family)[j][k];
-        if (!std::isfinite(v))
-          throw std::invalid_argument(
-              fmt::format("write_joint_errors_csv: non-finite value at sample {}", k));
-        fmt::format_to(std::back_inserter(line), ",{:.17g}", v);
-      }
-    line += '\n';
-    s << line;
+    for (std::size_t j = 0; j < joints; ++j) {
+      desired[j] = log.q_desired_rad[j][k];
+      measured[j] = log.q_measured_rad[j][k];
+      if (log.has_q_internal()) internal[j] = log.q_internal_rad[j][k];
+    }
+    out.add(log.time_s[k], log.payload_kg[k], desired, measured, internal);
   }
   out.commit();
 }

@@ -17,6 +17,7 @@
 // an error); a time that does not increase is an error.
 #include <cstddef>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -61,6 +62,29 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& file);
 // std::invalid_argument for an inconsistent log (sizes, non-finite values, names).
 void write_joint_errors_csv(const std::filesystem::path& file, const JointErrorLog& log,
                             Overwrite overwrite = Overwrite::kAllow);
+
+// joint_errors.csv written one sample at a time (the bytes write_joint_errors_csv writes), for a
+// caller that holds its rows in another layout and so needs no JointErrorLog copy of them.
+class JointErrorsCsvWriter {
+ public:
+  // The header from `header`'s robot, cycle_s, source, metadata and joint_names (its columns
+  // are not read); `with_internal`: the q_internal block. Throws std::invalid_argument for no
+  // joints, a bad joint name or cycle_s <= 0, std::runtime_error when the file cannot be made.
+  JointErrorsCsvWriter(const std::filesystem::path& file, const JointErrorLog& header,
+                       bool with_internal, Overwrite overwrite = Overwrite::kAllow);
+  // One sample, a value per joint in each span (q_internal not read without the block). Throws
+  // std::invalid_argument for a non-finite value or a span of another size.
+  void add(double t_s, double payload_kg, std::span<const double> q_desired_rad,
+           std::span<const double> q_measured_rad, std::span<const double> q_internal_rad);
+  void commit();
+
+ private:
+  AtomicFile out_;
+  std::size_t joints_ = 0;
+  bool with_internal_ = false;
+  std::size_t samples_ = 0;
+  std::string line_;
+};
 
 // Re-derives segment_starts from the time stamps (gap > 1.5 cycle_s starts a segment).
 void split_at_gaps(JointErrorLog& log);

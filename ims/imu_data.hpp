@@ -3,6 +3,8 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <optional>
+#include <span>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,6 +37,33 @@ struct ImuSeries {
   std::size_t first_data_line = 0;
   std::optional<Site> site;  // where the record was taken, if the file says
   std::vector<std::pair<std::string, std::string>> metadata;  // other header fields, in order
+};
+
+// The samples of a record from index `first` on with its header, without a copy: what the
+// smoother and the rest detector read. As in a record cut there, the first sample's interval is
+// the nominal one. The record must outlive it.
+struct ImuSamples {
+  ImuQuantity quantity = ImuQuantity::kIncrements;
+  double nominal_dt_s = 0.0;
+  std::span<const ImuSample> samples;
+  std::string source;
+  std::size_t first_data_line = 0;  // line of samples[0] in a text file; 0: not known
+
+  ImuSamples() = default;
+  // A whole record reads as its samples wherever ImuSamples is asked for.
+  ImuSamples(const ImuSeries& record, std::size_t first = 0)  // NOLINT(google-explicit-constructor)
+      : quantity(record.quantity),
+        nominal_dt_s(record.nominal_dt_s),
+        source(record.source),
+        first_data_line(record.first_data_line == 0 ? 0 : record.first_data_line + first) {
+    if (first > record.samples.size()) throw std::out_of_range("ImuSamples: first past the end");
+    samples = std::span<const ImuSample>(record.samples).subspan(first);
+  }
+
+  // The interval of sample i [s]: t_i - t_{i-1}, the nominal one for the first.
+  double interval_s(std::size_t i) const {
+    return i == 0 ? nominal_dt_s : samples[i].t_s - samples[i - 1].t_s;
+  }
 };
 
 }  // namespace imscal::ims

@@ -60,9 +60,10 @@ struct RestDetection {
   std::vector<RestInterval> intervals;  // the runs of at_rest, in time order
 };
 
-// Needs increments (ImuQuantity::kIncrements) or rates; throws InputError for a record too
+// Needs increments (ImuQuantity::kIncrements) or rates (a whole ImuSeries or a part of one);
+// memory that does not grow with the record but for `at_rest`. Throws InputError for a record too
 // short for one window or non-positive noise densities.
-RestDetection detect_rest(const ImuSeries& imu, const EarthModel& earth,
+RestDetection detect_rest(const ImuSamples& imu, const EarthModel& earth,
                           const RestDetectorOptions& options);
 
 }  // namespace imscal::ims

@@ -44,7 +44,7 @@ ErrorProcessNoise process_noise_of(const ZuptOptions& o) {
   return noise;
 }
 
-void check_options(const ImuSeries& imu, const ZuptOptions& o) {
+void check_options(const ImuSamples& imu, const ZuptOptions& o) {
   auto refuse = [&](const char* field, const char* problem) {
     throw InputError(imu.source, 0, field, problem);
   };
@@ -239,13 +239,10 @@ SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs, CovarianceFil
   return s;
 }
 
-// Sample i of the record's samples from index `first` on, without the biases estimated at the
-// instant before its interval (its interval as sample_interval gives it in a record cut there).
-ImuSample bias_corrected(const ImuSeries& imu, std::size_t first, std::size_t i,
-                         const Epoch& previous) {
-  const std::size_t at = first + i;
-  const double dt = i == 0 ? imu.nominal_dt_s : imu.samples[at].t_s - imu.samples[at - 1].t_s;
-  ImuSample corrected = imu.samples[at];
+// Sample i without the biases estimated at the instant before its interval.
+ImuSample bias_corrected(const ImuSamples& imu, std::size_t i, const Epoch& previous) {
+  const double dt = imu.interval_s(i);
+  ImuSample corrected = imu.samples[i];
   corrected.gyro -= previous.gyro_bias * dt;
   corrected.acc -= previous.acc_bias * dt;
   return corrected;
@@ -257,7 +254,7 @@ void feed_back(Strapdown& strapdown, const ErrorVector& correction) {
 }
 
 // Keeps only the rest samples inside the still intervals (sorted) and redoes the runs.
-void restrict_rests(const ImuSeries& imu, const std::vector<TimeInterval>& still,
+void restrict_rests(const ImuSamples& imu, const std::vector<TimeInterval>& still,
                     RestDetection& rest) {
   std::size_t j = 0;
   for (std::size_t i = 0; i < imu.samples.size(); ++i) {
@@ -310,8 +307,8 @@ struct SmoothedStateStream::Cursor {
 };
 
 SmoothedStateStream::SmoothedStateStream() = default;
-SmoothedStateStream::SmoothedStateStream(std::unique_ptr<const Record> record, const ImuSeries& imu)
-    : imu_(&imu),
+SmoothedStateStream::SmoothedStateStream(std::unique_ptr<const Record> record, ImuSamples imu)
+    : imu_(std::move(imu)),
       record_(std::move(record)),
       cursor_(std::make_unique<Cursor>(Cursor{record_->initial})) {}
 SmoothedStateStream::~SmoothedStateStream() = default;
@@ -319,16 +316,9 @@ SmoothedStateStream::SmoothedStateStream(SmoothedStateStream&&) noexcept = defau
 SmoothedStateStream& SmoothedStateStream::operator=(SmoothedStateStream&&) noexcept = default;
 
 std::size_t SmoothedStateStream::size() const {
-  return imu_ ? imu_->samples.size() - first_sample_ : 0;
+  return imu_.samples.size();
 }
 
-void SmoothedStateStream::read_samples_from(const ImuSeries& record, std::size_t first_sample) {
-  if (first_sample > record.samples.size() || record.samples.size() - first_sample != size() ||
-      (imu_ && record.nominal_dt_s != imu_->nominal_dt_s))
-    throw std::invalid_argument("smoothed states: another record than the one smoothed");
-  imu_ = &record;
-  first_sample_ = first_sample;
-}
 bool SmoothedStateStream::done() const {
   return !record_ || cursor_->instant >= record_->epochs.size();
 }
@@ -350,7 +340,7 @@ std::size_t SmoothedStateStream::next(std::vector<SmoothedState>& out, std::size
     const std::size_t k = c.instant;
     const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
     for (; c.sample <= epochs[k].last_sample && given < max_states; ++c.sample, ++given) {
-      c.strapdown.step(bias_corrected(*imu_, first_sample_, c.sample, epochs[k - 1]));
+      c.strapdown.step(bias_corrected(imu_, c.sample, epochs[k - 1]));
       const NavState& nominal = c.strapdown.state();
       const double alpha = (nominal.t_s - t0) / (t1 - t0);
       const ErrorVector e = (1.0 - alpha) * smoothed.after[k - 1] + alpha * smoothed.before[k];
@@ -368,7 +358,7 @@ std::size_t SmoothedStateStream::next(std::vector<SmoothedState>& out, std::size
   return given;
 }
 
-ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& earth,
+ZuptSmootherResult smooth_with_zupt(const ImuSamples& imu, const EarthModel& earth,
                                     const NavState& initial,
                                     const Eigen::Matrix<double, 9, 1>& initial_sigma,
                                     const ZuptOptions& options, const SmootherAids& aids) {
@@ -382,7 +372,7 @@ ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& eart
   return result;
 }
 
-ZuptSmoothing smooth_with_zupt_streamed(const ImuSeries& imu, const EarthModel& earth,
+ZuptSmoothing smooth_with_zupt_streamed(const ImuSamples& imu, const EarthModel& earth,
                                         const NavState& initial,
                                         const Eigen::Matrix<double, 9, 1>& initial_sigma,
                                         const ZuptOptions& options, const SmootherAids& aids) {
@@ -458,8 +448,8 @@ ZuptSmoothing smooth_with_zupt_streamed(const ImuSeries& imu, const EarthModel& 
     const double t_begin = strapdown.state().t_s;
     for (std::size_t i = begin; i < end; ++i) {
       const ImuSample& raw = imu.samples[i];
-      const double dt = sample_interval(imu, i);
-      const ImuSample corrected = bias_corrected(imu, 0, i, previous);
+      const double dt = imu.interval_s(i);
+      const ImuSample corrected = bias_corrected(imu, i, previous);
       const Eigen::Matrix3d R_before = strapdown.state().q_W_S.toRotationMatrix();
       strapdown.step(corrected);
       const Eigen::Matrix3d R_mid = 0.5 * (R_before + strapdown.state().q_W_S.toRotationMatrix());

@@ -79,12 +79,12 @@ struct ZuptSummary {
 // errors of the propagation instants around each sample. It keeps per instant what the states
 // are built from (about 600 bytes per 10 ms, against 160 bytes per sample for the states), so
 // a caller that uses the trajectory block by block holds memory that does not grow with the
-// record's rate. Holds a pointer to the IMS record it was smoothed from, which must outlive it.
+// record's rate. Holds a view of the IMS record it was smoothed from, which must outlive it.
 class SmoothedStateStream {
  public:
   struct Record;  // the forward and backward passes' per-instant results (zupt_smoother.cpp)
   SmoothedStateStream();  // no states
-  SmoothedStateStream(std::unique_ptr<const Record> record, const ImuSeries& imu);
+  SmoothedStateStream(std::unique_ptr<const Record> record, ImuSamples imu);
   ~SmoothedStateStream();
   SmoothedStateStream(SmoothedStateStream&&) noexcept;
   SmoothedStateStream& operator=(SmoothedStateStream&&) noexcept;
@@ -96,15 +96,9 @@ class SmoothedStateStream {
   void rewind();
   std::size_t size() const;  // states in all: one per IMS sample
 
-  // Reads the samples from `record` from index `first_sample` on instead of from the record
-  // smoothed: the same samples in the record that one was cut from, so that the cut copy can
-  // go. Throws std::invalid_argument when the count or the nominal interval differs.
-  void read_samples_from(const ImuSeries& record, std::size_t first_sample);
-
  private:
   struct Cursor;
-  const ImuSeries* imu_ = nullptr;  // the samples, from index first_sample_ on
-  std::size_t first_sample_ = 0;
+  ImuSamples imu_;  // a view of the record smoothed
   std::unique_ptr<const Record> record_;
   std::unique_ptr<Cursor> cursor_;
 };
@@ -126,13 +120,14 @@ struct ZuptSmootherResult {
 // `initial`: navigation state at the start of the first increment (samples[0].t_s - its
 // interval); `initial_sigma`: its 1-sigma (attitude [rad] in W, velocity, position).
 // Needs increments; throws InputError otherwise, or for inconsistent options.
-// The same smoothing with the states as a stream (ZuptSmoothing::states); `imu` must outlive it.
-ZuptSmoothing smooth_with_zupt_streamed(const ImuSeries& imu, const EarthModel& earth,
+// The same smoothing with the states as a stream (ZuptSmoothing::states); the record `imu` views
+// must outlive it.
+ZuptSmoothing smooth_with_zupt_streamed(const ImuSamples& imu, const EarthModel& earth,
                                         const NavState& initial,
                                         const Eigen::Matrix<double, 9, 1>& initial_sigma,
                                         const ZuptOptions& options, const SmootherAids& aids = {});
 
-ZuptSmootherResult smooth_with_zupt(const ImuSeries& imu, const EarthModel& earth,
+ZuptSmootherResult smooth_with_zupt(const ImuSamples& imu, const EarthModel& earth,
                                     const NavState& initial,
                                     const Eigen::Matrix<double, 9, 1>& initial_sigma,
                                     const ZuptOptions& options, const SmootherAids& aids = {});

@@ -25,8 +25,7 @@
 #include "core/progress.hpp"
 #include "core/progress_channel.hpp"
 #include "core/version.hpp"
-#include "eval/gap_measurement_prior.hpp"
-#include "ident/joint_error_io.hpp"
+#include "eval/calibration_joint_errors.hpp"
 #include "tools/command_registry.hpp"
 
 namespace {
@@ -40,46 +39,14 @@ struct CalibrateArgs {
   bool force = false;
 };
 
-ident::JointErrorLog joint_error_log(const calib::JointSpaceErrors& e, const calib::RobotLog& log,
-                                     const std::string& source) {
-  ident::JointErrorLog out;
-  out.robot = e.robot.empty() ? log.robot_name : e.robot;
-  out.cycle_s = e.cycle_s;
-  out.source = source;
-  out.joint_names.assign(log.joint_names.begin(), log.joint_names.end());
-  out.time_s = e.t_s;
-  out.payload_kg = e.payload_kg;
-  out.q_desired_rad.assign(calib::kJointCount, {});
-  out.q_measured_rad.assign(calib::kJointCount, {});
-  out.q_internal_rad.assign(calib::kJointCount, {});
-  for (std::size_t k = 0; k < e.t_s.size(); ++k)
-    for (int j = 0; j < calib::kJointCount; ++j) {
-      out.q_desired_rad[std::size_t(j)].push_back(e.q_desired_rad[k][j]);
-      out.q_measured_rad[std::size_t(j)].push_back(e.q_measured_rad[k][j]);
-      out.q_internal_rad[std::size_t(j)].push_back(e.q_internal_rad[k][j]);
-    }
-  // The IMS noise floor in joint space, for diagnose's measurement budget.
-  if (!e.q_measured_sigma_rad.empty()) {
-    const calib::JointVector floor_rad = calib::q_measured_sigma_rms_rad(e);
-    std::string value;
-    for (int j = 0; j < calib::kJointCount; ++j)
-      value += fmt::format("{}{:.6g}", j ? "," : "", floor_rad[j]);
-    out.metadata.emplace_back(eval::kNoiseFloorKey, value);
-  }
-  ident::split_at_gaps(out);
-  return out;
-}
-
 void write_outputs(const CalibrateArgs& args, OutputFolder& folder,
                    const calib::LoadedSession& loaded, const calib::SessionResult& session) {
   const calib::SessionFiles& f = args.files;
   calib::stage_session_outputs(folder, f, loaded, session);
   if (session.joint_errors)
-    ident::write_joint_errors_csv(
-        folder.staged("joint_errors.csv"),
-        joint_error_log(*session.joint_errors, loaded.inputs.log,
-                        fmt::format("imscal {} calibrate --imu {} --robot-log {}", kVersion, f.imu,
-                                    f.robot_log)));
+    eval::write_calibration_joint_errors_csv(
+        folder.staged("joint_errors.csv"), *session.joint_errors, loaded.inputs.log,
+        fmt::format("imscal {} calibrate --imu {} --robot-log {}", kVersion, f.imu, f.robot_log));
   folder.commit();
 }
 

@@ -178,4 +178,33 @@ TEST(RestDetector, FindsThePausesOfRobotMotion) {
   }
 }
 
+// A part of a record read through ImuSamples (no copy) gives exactly what a copy of that part
+// gives: the same rests, sample for sample (a copy's first sample has the nominal interval, as the
+// view's has). 30 s at 1 kHz crosses the detector's blocks of windows (16384 samples) and of
+// running sums (4096); the rests found are the motion's true pauses after the cut.
+TEST(RestDetector, PartOfARecordReadsAsItsCopy) {
+  const ims::EarthModel earth(kSite);
+  const auto motion = ims::make_motion_with_pauses(30.0, 5.0, 21u);
+  const auto raw = ims::synthesize_ideal_increments(*motion, earth, kRateHz);
+  ims::RestDetectorOptions options =
+      options_for(kSpec.gyro.white_noise_density, kSpec.acc.white_noise_density);
+  options.gyro_bias_bound_rad_s = 5.0 * kSpec.gyro.turn_on_bias_sigma;
+  options.acc_bias_bound_m_s2 = 5.0 * (kSpec.acc.turn_on_bias_sigma + 9.81e-4);
+  const std::size_t first = 1234;
+  ims::ImuSeries copy = raw;
+  copy.samples.erase(copy.samples.begin(), copy.samples.begin() + std::ptrdiff_t(first));
+  const auto from_copy = ims::detect_rest(copy, earth, options);
+  const auto from_view = ims::detect_rest(ims::ImuSamples(raw, first), earth, options);
+  std::size_t true_rests = 0;
+  for (const auto& [begin_s, end_s] : motion->rest_intervals())
+    true_rests += end_s > raw.samples[first].t_s ? 1 : 0;
+  EXPECT_EQ(from_copy.intervals.size(), true_rests);
+  EXPECT_EQ(from_view.at_rest, from_copy.at_rest);
+  ASSERT_EQ(from_view.intervals.size(), from_copy.intervals.size());
+  for (std::size_t i = 0; i < from_copy.intervals.size(); ++i) {
+    EXPECT_EQ(from_view.intervals[i].first_sample, from_copy.intervals[i].first_sample);
+    EXPECT_EQ(from_view.intervals[i].last_sample, from_copy.intervals[i].last_sample);
+  }
+}
+
 }  // namespace
