@@ -79,10 +79,11 @@ double residual_autocorrelation_time(const Eigen::VectorXd& r,
   if (var <= 0.0) return tau_int;
   const std::vector<std::pair<Eigen::Index, Eigen::Index>> runs = consecutive_runs(rows);
   for (Eigen::Index lagk = 1; lagk < std::min<Eigen::Index>(200, m); ++lagk) {
-    // The pairs lagk apart in the same run, in row order.
+    // The pairs lagk apart in the same run.
     double c = 0.0;
     for (const auto& [begin, end] : runs)
-      for (Eigen::Index i = begin + lagk; i < end; ++i) c += r[i] * r[i - lagk];
+      if (end - begin > lagk)
+        c += r.segment(begin + lagk, end - begin - lagk).dot(r.segment(begin, end - begin - lagk));
     const double rho = c / (double(m) * var);
     if (rho <= 0.0) break;
     tau_int += 2.0 * rho;

@@ -5,6 +5,13 @@
 #include <algorithm>
 
 namespace imscal::eval {
+namespace {
+
+// Up to this many columns the Gram matrix is summed as dot products of the columns' runs: a
+// matrix product's packing costs more than it saves for so few.
+constexpr Eigen::Index kDotProductColumns = 4;
+
+}  // namespace
 
 void add_augmented_gram(const Eigen::MatrixXd& x, const std::vector<double>& y,
                         const std::vector<Eigen::Index>& rows, Eigen::MatrixXd& a) {
@@ -17,8 +24,15 @@ void add_augmented_gram(const Eigen::MatrixXd& x, const std::vector<double>& y,
     const Eigen::Index begin = rows[i], length = Eigen::Index(end - i);
     const auto xb = x.middleRows(begin, length);
     const Eigen::Map<const Eigen::VectorXd> yb(y.data() + begin, length);
-    xtx.selfadjointView<Eigen::Lower>().rankUpdate(xb.transpose());
-    a.row(p).head(p).noalias() += yb.transpose() * xb;
+    if (p <= kDotProductColumns) {
+      for (Eigen::Index c = 0; c < p; ++c) {
+        for (Eigen::Index d = 0; d <= c; ++d) a(c, d) += xb.col(c).dot(xb.col(d));
+        a(p, c) += yb.dot(xb.col(c));
+      }
+    } else {
+      xtx.selfadjointView<Eigen::Lower>().rankUpdate(xb.transpose());
+      a.row(p).head(p).noalias() += yb.transpose() * xb;
+    }
     a(p, p) += yb.squaredNorm();
     i = end;
   }
