@@ -71,6 +71,22 @@ double direct_sse(const Eigen::MatrixXd& x, const std::vector<double>& y,
   return sse;
 }
 
+// Two folds of chunks of `chunk` rows, every `step` rows each.
+TrainingFolds two_folds(Eigen::Index chunk, Eigen::Index step) {
+  TrainingFolds folds;
+  folds.folds = {chunked_rows(0, chunk, step), chunked_rows(chunk, chunk, step)};
+  folds.complements = {folds.folds[1], folds.folds[0]};
+  return folds;
+}
+
+// The validation error of each fold's QR fit on the other, summed.
+double qr_cross_validation_sse(const Problem& p, const TrainingFolds& folds) {
+  double sse = 0.0;
+  for (std::size_t i = 0; i < 2; ++i)
+    sse += direct_sse(p.x, p.y, folds.folds[i], qr_theta(p.x, p.y, folds.complements[i]));
+  return sse;
+}
+
 TEST(GapNormalEquations, SolutionMatchesTheColumnPivotedQr) {
   const Problem p = random_problem(1);
   const std::vector<Eigen::Index> rows = chunked_rows(0, 50, 120);
@@ -119,12 +135,8 @@ TEST(GapNormalEquations, RefusesIllConditionedOrZeroColumns) {
 
 TEST(GapNormalEquations, CrossValidationMatchesFoldFitsByQr) {
   const Problem p = random_problem(5);
-  TrainingFolds folds;
-  folds.folds = {chunked_rows(0, 30, 90), chunked_rows(30, 30, 90)};
-  folds.complements = {folds.folds[1], folds.folds[0]};
-  double truth = 0.0;
-  for (std::size_t i = 0; i < 2; ++i)
-    truth += direct_sse(p.x, p.y, folds.folds[i], qr_theta(p.x, p.y, folds.complements[i]));
+  const TrainingFolds folds = two_folds(30, 90);
+  const double truth = qr_cross_validation_sse(p, folds);
   // As above: relative error ~eps y'y / sse.
   EXPECT_NEAR(cross_validation_sse(p.x, p.y, folds), truth, 1e-7 * truth);
   EXPECT_NEAR(validation_sse(p.x, p.y, folds.complements[0], folds.folds[0]),
@@ -164,12 +176,8 @@ TEST(GapNormalEquations, IllConditionedFitFallsBackToTheQr) {
   const Eigen::VectorXd theta = qr_theta(p.x, p.y, rows);
   const double rms = std::sqrt(direct_sse(p.x, p.y, rows, theta) / double(rows.size()));
   EXPECT_NEAR(fit.rms, rms, 1e-9 * rms);
-  TrainingFolds folds;
-  folds.folds = {chunked_rows(0, 30, 60), chunked_rows(30, 30, 60)};
-  folds.complements = {folds.folds[1], folds.folds[0]};
-  double truth = 0.0;
-  for (std::size_t i = 0; i < 2; ++i)
-    truth += direct_sse(p.x, p.y, folds.folds[i], qr_theta(p.x, p.y, folds.complements[i]));
+  const TrainingFolds folds = two_folds(30, 60);
+  const double truth = qr_cross_validation_sse(p, folds);
   EXPECT_NEAR(cross_validation_sse(p.x, p.y, folds), truth, 1e-9 * truth);
 }
 
