@@ -14,6 +14,8 @@
 #include "eval/gap_coupling.hpp"
 #include "eval/gap_effect_shapes.hpp"
 #include "eval/gap_filters.hpp"
+#include "eval/gap_joint_stack.hpp"
+#include "eval/gap_normal_equations.hpp"
 #include "eval/gap_validation.hpp"
 
 namespace imscal::eval {
@@ -66,13 +68,52 @@ std::vector<std::pair<Eigen::Index, Eigen::Index>> consecutive_runs(
   return runs;
 }
 
-}  // namespace
+// Integrated autocorrelation time of the residual r on the rows `rows` (consecutive rows only;
+// summed up to the first non-positive correlation, at most 200 lags): the effective number of
+// independent rows is m / tau_int, so sigma grows by sqrt(tau_int).
+double residual_autocorrelation_time(const Eigen::VectorXd& r,
+                                     const std::vector<Eigen::Index>& rows) {
+  const Eigen::Index m = r.size();
+  double tau_int = 1.0;
+  const double var = r.squaredNorm() / std::max<double>(double(m), 1.0);
+  if (var <= 0.0) return tau_int;
+  const std::vector<std::pair<Eigen::Index, Eigen::Index>> runs = consecutive_runs(rows);
+  for (Eigen::Index lagk = 1; lagk < std::min<Eigen::Index>(200, m); ++lagk) {
+    // The pairs lagk apart in the same run.
+    double c = 0.0;
+    for (const auto& [begin, end] : runs)
+      if (end - begin > lagk)
+        c += r.segment(begin + lagk, end - begin - lagk).dot(r.segment(begin, end - begin - lagk));
+    const double rho = c / (double(m) * var);
+    if (rho <= 0.0) break;
+    tau_int += 2.0 * rho;
+  }
+  return tau_int;
+}
 
-LinearFit fit_columns(const Eigen::MatrixXd& columns, const std::vector<double>& y,
-                      const std::vector<bool>& use) {
-  std::vector<Eigen::Index> rows;
-  for (std::size_t k = 0; k < use.size(); ++k)
-    if (use[k]) rows.push_back(Eigen::Index(k));
+// The fit's figures from its residual r on the rows `rows` and the covariance of the scaled
+// parameters up to the residual variance (`scaled_covariance`, columns scaled by `scale`).
+LinearFit finished_fit(const Eigen::VectorXd& theta, const Eigen::VectorXd& r,
+                       const std::vector<Eigen::Index>& rows,
+                       const Eigen::MatrixXd& scaled_covariance, const Eigen::VectorXd& scale) {
+  const Eigen::Index m = r.size(), p = theta.size();
+  LinearFit fit;
+  fit.parameters = theta;
+  fit.rms = m ? std::sqrt(r.squaredNorm() / double(m)) : 0.0;
+  fit.inflation = std::sqrt(residual_autocorrelation_time(r, rows));
+  const double dof = std::max<double>(double(m - p), 1.0);
+  const Eigen::MatrixXd cov = r.squaredNorm() / dof * scaled_covariance;
+  const Eigen::VectorXd inverse_scale = scale.cwiseInverse();
+  fit.covariance = inverse_scale.asDiagonal() * cov * inverse_scale.asDiagonal();
+  fit.covariance *= fit.inflation * fit.inflation;
+  fit.sigma = cov.diagonal().cwiseMax(0.0).cwiseSqrt().cwiseQuotient(scale) * fit.inflation;
+  return fit;
+}
+
+// The column-pivoted QR fit of the scaled columns on the rows `rows` (the fallback of the normal
+// equations: ill-conditioned or rank-deficient columns).
+LinearFit qr_fit(const Eigen::MatrixXd& columns, const std::vector<double>& y,
+                 const std::vector<Eigen::Index>& rows) {
   const Eigen::Index m = Eigen::Index(rows.size()), p = columns.cols();
   // Gathered column by column (a column-major matrix's rows are strided).
   Eigen::MatrixXd x = columns(rows, Eigen::all);
@@ -86,113 +127,79 @@ LinearFit fit_columns(const Eigen::MatrixXd& columns, const std::vector<double>&
     x.col(c) /= scale[c];
   }
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(x);
-  LinearFit fit;
-  Eigen::VectorXd theta = qr.solve(b);
+  const Eigen::VectorXd theta = qr.solve(b);
   const Eigen::VectorXd r = b - x * theta;
-  fit.rms = m ? std::sqrt(r.squaredNorm() / double(m)) : 0.0;
-  // Integrated autocorrelation time of the residual (consecutive rows only; summed up to the first
-  // non-positive correlation, at most 200 lags): the effective number of independent rows is
-  // m / tau_int, so sigma grows by sqrt(tau_int).
-  double tau_int = 1.0;
-  const double var = r.squaredNorm() / std::max<double>(double(m), 1.0);
-  if (var > 0.0) {
-    const std::vector<std::pair<Eigen::Index, Eigen::Index>> runs = consecutive_runs(rows);
-    for (Eigen::Index lagk = 1; lagk < std::min<Eigen::Index>(200, m); ++lagk) {
-      // The pairs lagk apart in the same run, in row order.
-      double c = 0.0;
-      for (const auto& [begin, end] : runs)
-        for (Eigen::Index i = begin + lagk; i < end; ++i) c += r[i] * r[i - lagk];
-      const double rho = c / (double(m) * var);
-      if (rho <= 0.0) break;
-      tau_int += 2.0 * rho;
-    }
-  }
-  fit.inflation = std::sqrt(tau_int);
-  const double dof = std::max<double>(double(m - p), 1.0);
-  const double s2 = r.squaredNorm() / dof;
   const Eigen::MatrixXd rr =
       qr.matrixR().topLeftCorner(p, p).template triangularView<Eigen::Upper>();
-  // Cov(theta_scaled) = s2 (R^T R)^-1 in the pivoted order.
-  Eigen::MatrixXd cov_piv =
-      s2 * (rr.transpose() * rr).completeOrthogonalDecomposition().pseudoInverse();
+  // (R^T R)^-1 in the pivoted order, put back in the columns' order.
+  const Eigen::MatrixXd cov_piv =
+      (rr.transpose() * rr).completeOrthogonalDecomposition().pseudoInverse();
   const auto perm = qr.colsPermutation();
-  const Eigen::MatrixXd cov = perm * cov_piv * perm.transpose();
-  fit.parameters = theta.cwiseQuotient(scale);
-  const Eigen::VectorXd inverse_scale = scale.cwiseInverse();
-  fit.covariance = inverse_scale.asDiagonal() * cov * inverse_scale.asDiagonal();
-  fit.covariance *= fit.inflation * fit.inflation;
-  fit.sigma = cov.diagonal().cwiseMax(0.0).cwiseSqrt().cwiseQuotient(scale) * fit.inflation;
-  return fit;
+  return finished_fit(theta.cwiseQuotient(scale), r, rows, perm * cov_piv * perm.transpose(),
+                      scale);
 }
 
-namespace {
-
-// The rows of the joints that have columns, stacked: joint after joint, all samples each.
-struct Stacked {
-  Eigen::MatrixXd x;
-  std::vector<double> y;
-  std::vector<std::size_t> joints;  // in stacking order
+// The columns and gap of one joint in a stacked fit.
+struct JointRows {
+  const Eigen::MatrixXd& x;
+  const std::vector<double>& y;
 };
 
-Stacked stack(const std::vector<Eigen::MatrixXd>& columns,
-              const std::vector<std::vector<double>>& gap) {
-  Stacked st;
-  Eigen::Index p = 0, n = 0;
-  for (std::size_t j = 0; j < columns.size(); ++j)
-    if (columns[j].size() > 0) {
-      st.joints.push_back(j);
-      p = columns[j].cols();
-      n = columns[j].rows();
+// The fit of one parameter vector to the rows `use_rows` of every joint of `joints` (stacked joint
+// after joint: row i * samples + k) by the normal equations; nullopt when they are
+// ill-conditioned.
+std::optional<LinearFit> gram_fit(const std::vector<JointRows>& joints,
+                                  const std::vector<Eigen::Index>& use_rows) {
+  const Eigen::Index p = joints.front().x.cols(), n = joints.front().x.rows();
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(p + 1, p + 1);
+  for (const JointRows& j : joints) add_augmented_gram(j.x, j.y, use_rows, a);
+  const std::optional<GramSolution> solution = solve_normal_equations(a, true);
+  if (!solution) return std::nullopt;
+  const Eigen::Index m = Eigen::Index(use_rows.size());
+  Eigen::VectorXd r(m * Eigen::Index(joints.size()));
+  const auto runs = consecutive_runs(use_rows);
+  for (std::size_t i = 0; i < joints.size(); ++i)
+    for (const auto& [begin, end] : runs) {
+      const Eigen::Index first = use_rows[std::size_t(begin)], length = end - begin;
+      r.segment(Eigen::Index(i) * m + begin, length) =
+          Eigen::Map<const Eigen::VectorXd>(joints[i].y.data() + first, length) -
+          joints[i].x.middleRows(first, length) * solution->theta;
     }
-  st.x.resize(n * Eigen::Index(st.joints.size()), p);
-  st.y.reserve(std::size_t(st.x.rows()));
-  for (std::size_t i = 0; i < st.joints.size(); ++i) {
-    st.x.middleRows(Eigen::Index(i) * n, n) = columns[st.joints[i]];
-    st.y.insert(st.y.end(), gap[st.joints[i]].begin(), gap[st.joints[i]].end());
-  }
-  return st;
+  return finished_fit(solution->theta, r, stacked_rows(use_rows, joints.size(), n),
+                      solution->inverse_scaled_gram, solution->scale);
 }
 
-std::vector<bool> repeat(const std::vector<bool>& use, std::size_t times) {
-  std::vector<bool> out;
-  out.reserve(use.size() * times);
-  for (std::size_t i = 0; i < times; ++i) out.insert(out.end(), use.begin(), use.end());
-  return out;
-}
-
-// The joint whose columns are the only ones, if one joint has columns.
-std::optional<std::size_t> only_joint(const std::vector<Eigen::MatrixXd>& columns) {
-  std::optional<std::size_t> found;
-  for (std::size_t j = 0; j < columns.size(); ++j) {
-    if (columns[j].size() == 0) continue;
-    if (found) return std::nullopt;
-    found = j;
-  }
-  return found;
-}
-
-// Relative margin within which the shape with fewer parameters wins the validation.
-constexpr double kShapeParsimony = 0.01;
-
-// The rows of `fold` (sample indices) on every stacked joint.
-std::vector<Eigen::Index> stacked_rows(const std::vector<Eigen::Index>& fold, std::size_t joints,
-                                       Eigen::Index samples) {
+std::vector<Eigen::Index> rows_of(const std::vector<bool>& use) {
   std::vector<Eigen::Index> rows;
-  rows.reserve(fold.size() * joints);
-  for (std::size_t i = 0; i < joints; ++i)
-    for (Eigen::Index k : fold) rows.push_back(Eigen::Index(i) * samples + k);
+  for (std::size_t k = 0; k < use.size(); ++k)
+    if (use[k]) rows.push_back(Eigen::Index(k));
   return rows;
 }
 
 }  // namespace
 
+LinearFit fit_columns(const Eigen::MatrixXd& columns, const std::vector<double>& y,
+                      const std::vector<bool>& use) {
+  const std::vector<Eigen::Index> rows = rows_of(use);
+  if (!rows.empty())
+    if (auto fit = gram_fit({{columns, y}}, rows)) return *fit;
+  return qr_fit(columns, y, rows);
+}
+
 LinearFit fit_joint_columns(const std::vector<Eigen::MatrixXd>& columns,
                             const std::vector<std::vector<double>>& gap,
                             const std::vector<bool>& use) {
+  const std::vector<std::size_t> joints = joints_with_columns(columns);
   // One joint with columns: its rows are the stack (no copy).
-  if (const auto j = only_joint(columns)) return fit_columns(columns[*j], gap[*j], use);
-  const Stacked st = stack(columns, gap);
-  return fit_columns(st.x, st.y, repeat(use, st.joints.size()));
+  if (joints.size() == 1) return fit_columns(columns[joints[0]], gap[joints[0]], use);
+  const std::vector<Eigen::Index> rows = rows_of(use);
+  std::vector<JointRows> stack;
+  for (std::size_t j : joints) stack.push_back({columns[j], gap[j]});
+  if (!stack.empty() && !rows.empty())
+    if (auto fit = gram_fit(stack, rows)) return *fit;
+  const StackedJoints st = stack_joints(columns, gap);
+  const Eigen::Index n = joints.empty() ? 0 : columns[joints[0]].rows();
+  return qr_fit(st.x, st.y, stacked_rows(rows, joints.size(), n));
 }
 
 std::vector<std::vector<double>> predict_joint_columns(const std::vector<Eigen::MatrixXd>& columns,
@@ -226,6 +233,9 @@ std::vector<Eigen::MatrixXd> join_columns(const std::vector<Eigen::MatrixXd>& a,
 
 namespace {
 
+// Relative margin within which the shape with fewer parameters wins the validation.
+constexpr double kShapeParsimony = 0.01;
+
 // The size of the effect in words, in the effect's own terms where it has them.
 std::string size_in_words(const CandidateFit& c, const CandidateShape& sh, double own_rms) {
   const auto own_words = effect_definition(c.kind).size_in_words;
@@ -254,21 +264,11 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
   // fewest parameters.
   const TrainingFolds folds = training_folds(s, training);
   const Eigen::Index n = Eigen::Index(s.sample_count());
-  const auto validation_score = [&](const std::vector<Eigen::MatrixXd>& columns) {
-    // One joint with columns: its rows are the stack (no copy).
-    if (const auto j = only_joint(columns))
-      return cross_validation_sse(columns[*j], s.gap_rad[*j], folds);
-    const Stacked st = stack(columns, s.gap_rad);
-    double sse = 0.0;
-    for (std::size_t i = 0; i < folds.folds.size(); ++i)
-      sse += validation_sse(st.x, st.y, stacked_rows(folds.complements[i], st.joints.size(), n),
-                            stacked_rows(folds.folds[i], st.joints.size(), n));
-    return sse;
-  };
   std::size_t chosen = 0;
   if (shapes.size() > 1 && folds.usable()) {
     std::vector<double> score;
-    for (const auto& sh : shapes) score.push_back(validation_score(sh.columns));
+    for (const auto& sh : shapes)
+      score.push_back(cross_validation_sse(sh.columns, s.gap_rad, folds));
     const double best_score = *std::min_element(score.begin(), score.end());
     const auto width = [&](std::size_t i) { return shapes[i].parameter_names.size(); };
     for (std::size_t i = 0; i < shapes.size(); ++i) {

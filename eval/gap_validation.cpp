@@ -3,6 +3,10 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <optional>
+
+#include "eval/gap_joint_stack.hpp"
+#include "eval/gap_normal_equations.hpp"
 
 namespace imscal::eval {
 
@@ -33,9 +37,13 @@ TrainingFolds training_folds(const GapSignals& s, const std::vector<bool>& train
   return f;
 }
 
-double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
-                      const std::vector<Eigen::Index>& fit,
-                      const std::vector<Eigen::Index>& check) {
+namespace {
+
+// The validation error by the column-pivoted QR on the rows `fit` (the fallback of the normal
+// equations: ill-conditioned or rank-deficient columns).
+double qr_validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
+                         const std::vector<Eigen::Index>& fit,
+                         const std::vector<Eigen::Index>& check) {
   const Eigen::Index p = columns.cols();
   // Gathered column by column (a column-major matrix's rows are strided).
   Eigen::MatrixXd x = columns(fit, Eigen::all);
@@ -50,27 +58,74 @@ double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>&
   // Decomposed in place: x is not used after.
   const Eigen::ColPivHouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(x);
   const Eigen::VectorXd theta = qr.solve(b).cwiseQuotient(scale);
-  // Each check row's prediction summed over the columns in their order, as a row's dot product
-  // sums them, but column by column.
-  Eigen::VectorXd predicted = Eigen::VectorXd::Zero(Eigen::Index(check.size()));
-  for (Eigen::Index c = 0; c < p; ++c)
-    for (std::size_t i = 0; i < check.size(); ++i) {
-      const double term = columns(check[i], c) * theta[c];
-      predicted[Eigen::Index(i)] = c == 0 ? term : predicted[Eigen::Index(i)] + term;
-    }
+  // Each check row's residual, the columns summed in their order (the terms of an
+  // ill-conditioned fit may cancel: no quadratic form).
   double sse = 0.0;
   for (std::size_t i = 0; i < check.size(); ++i) {
-    const double r = y[std::size_t(check[i])] - predicted[Eigen::Index(i)];
+    double predicted = 0.0;
+    for (Eigen::Index c = 0; c < p; ++c) predicted += columns(check[i], c) * theta[c];
+    const double r = y[std::size_t(check[i])] - predicted;
     sse += r * r;
   }
   return sse;
 }
 
+// The fit on all folds but `i`, from the folds' Gram matrices; nullopt when ill-conditioned.
+std::optional<GramSolution> fold_fit(const std::vector<Eigen::MatrixXd>& grams, std::size_t i) {
+  Eigen::MatrixXd fit = Eigen::MatrixXd::Zero(grams[i].rows(), grams[i].cols());
+  for (std::size_t j = 0; j < grams.size(); ++j)
+    if (j != i) fit += grams[j];
+  return solve_normal_equations(fit);
+}
+
+}  // namespace
+
+double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
+                      const std::vector<Eigen::Index>& fit,
+                      const std::vector<Eigen::Index>& check) {
+  if (const auto solution = solve_normal_equations(augmented_gram(columns, y, fit)))
+    return sse_of_gram(augmented_gram(columns, y, check), solution->theta);
+  return qr_validation_sse(columns, y, fit, check);
+}
+
 double cross_validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                             const TrainingFolds& folds) {
+  std::vector<Eigen::MatrixXd> grams;
+  for (const auto& fold : folds.folds) grams.push_back(augmented_gram(columns, y, fold));
   double sse = 0.0;
-  for (std::size_t i = 0; i < folds.folds.size(); ++i)
-    sse += validation_sse(columns, y, folds.complements[i], folds.folds[i]);
+  for (std::size_t i = 0; i < folds.folds.size(); ++i) {
+    if (const auto solution = fold_fit(grams, i))
+      sse += sse_of_gram(grams[i], solution->theta);
+    else
+      sse += qr_validation_sse(columns, y, folds.complements[i], folds.folds[i]);
+  }
+  return sse;
+}
+
+double cross_validation_sse(const std::vector<Eigen::MatrixXd>& columns,
+                            const std::vector<std::vector<double>>& y, const TrainingFolds& folds) {
+  if (const auto j = only_joint(columns)) return cross_validation_sse(columns[*j], y[*j], folds);
+  const std::vector<std::size_t> joints = joints_with_columns(columns);
+  std::vector<Eigen::MatrixXd> grams;
+  for (const auto& fold : folds.folds) {
+    const Eigen::Index p = columns[joints.front()].cols();
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(p + 1, p + 1);
+    for (std::size_t j : joints) add_augmented_gram(columns[j], y[j], fold, a);
+    grams.push_back(std::move(a));
+  }
+  double sse = 0.0;
+  std::optional<StackedJoints> stacked;  // for the QR, only when needed
+  for (std::size_t i = 0; i < folds.folds.size(); ++i) {
+    if (const auto solution = fold_fit(grams, i)) {
+      sse += sse_of_gram(grams[i], solution->theta);
+      continue;
+    }
+    if (!stacked) stacked = stack_joints(columns, y);
+    const Eigen::Index n = columns[joints.front()].rows();
+    sse += qr_validation_sse(stacked->x, stacked->y,
+                             stacked_rows(folds.complements[i], joints.size(), n),
+                             stacked_rows(folds.folds[i], joints.size(), n));
+  }
   return sse;
 }
 

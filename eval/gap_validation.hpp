@@ -21,12 +21,20 @@ struct TrainingFolds {
 TrainingFolds training_folds(const GapSignals& signals, const std::vector<bool>& training);
 
 // Sum of squared residuals on the rows `check` of the LS fit of columns to y on the rows `fit`
-// (parameters only: no sigma is needed to choose a shape).
+// (parameters only: no sigma is needed to choose a shape). Solved by the normal equations of the
+// scaled columns when they are well conditioned, by the column-pivoted QR otherwise
+// (eval/gap_normal_equations.hpp): each fold's Gram matrix is formed once and the folds' fits
+// are summed from them.
 double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                       const std::vector<Eigen::Index>& fit, const std::vector<Eigen::Index>& check);
 
 // The validation error summed over the folds.
 double cross_validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                             const TrainingFolds& folds);
+
+// The same for one parameter vector over several joints (the rows of every joint that has
+// columns, eval/gap_joint_stack.hpp; the folds' rows on each).
+double cross_validation_sse(const std::vector<Eigen::MatrixXd>& columns,
+                            const std::vector<std::vector<double>>& y, const TrainingFolds& folds);
 
 }  // namespace imscal::eval
