@@ -49,6 +49,8 @@ struct PreparedIdentification {
   ident::IdentificationConfig config;
   // The model torque's links refined from the log (model.refine_mass_parameters), else empty.
   std::vector<ident::LinkMassParameters> model_torque_links;
+  // The rigid-body model the torques were attached with (when the config's models take them).
+  std::optional<ModelTorqueSource> model_torque;
   std::chrono::steady_clock::time_point start;
 };
 PreparedIdentification prepare_identification(const IdentificationSessionOptions& options);
