@@ -54,7 +54,7 @@ TEST(TransmissionErrorGearMode, PairIsTheModesSteadyStateResponse) {
   for (const double ratio : {0.5, 0.9, 1.0, 1.3, -1.3, 3.0}) {
     const double speed = ratio * kMode_rad_s / kPhaseRate, x0 = 0.1;
     const double gain = std::abs(ident::gear_mode_response(p, kPhaseRate, speed));
-    for (const double extra_s : {0.0, 0.0123, 0.031}) {
+    for (const double extra_s : {0.0, 0.0123}) {
       const double t = settle_s + extra_s;
       const ident::ExogenousSample s{x0 + speed * t, speed, 0.0};
       for (const bool sine : {true, false}) {
@@ -67,7 +67,9 @@ TEST(TransmissionErrorGearMode, PairIsTheModesSteadyStateResponse) {
             << "Ω/ω " << ratio << (sine ? " sin" : " cos");
       }
     }
-    if (ratio == 1.0) EXPECT_NEAR(gain, 1.0 / (2.0 * kDamping), 1e-12);  // |H| at resonance
+    if (ratio == 1.0) {
+      EXPECT_NEAR(gain, 1.0 / (2.0 * kDamping), 1e-12);  // |H| at resonance
+    }
   }
 }
 

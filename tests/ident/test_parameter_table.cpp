@@ -284,8 +284,8 @@ TEST_P(LoaderRefuses, WithPathAndMessage) {
 INSTANTIATE_TEST_SUITE_P(
     BadTables, LoaderRefuses,
     ::testing::Values(
-        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 6; }, "/schema_version",
-                "unknown schema version 6"},
+        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 7; }, "/schema_version",
+                "unknown schema version 7"},
         Refusal{"CountsForTheFurtherInputs",
                 [](json& j) { j["joints"][0]["cells"][0]["nx"] = json::array({3}); },
                 "/joints/0/cells/0/nx", "1 counts for the table's 4 further inputs"},
