@@ -15,6 +15,7 @@
 #include "eval/friction_identification.hpp"
 #include "eval/joint_error_limits.hpp"
 #include "eval/refined_links_choice.hpp"
+#include "eval/transmission_error_gear_mode.hpp"
 #include "eval/transmission_error_order.hpp"
 #include "eval/transmission_error_order_spectrum.hpp"
 #include "eval/verification.hpp"
@@ -33,6 +34,7 @@ namespace {
 std::vector<ident::LinkMassParameters> attach_session_model_torques(
     ident::JointErrorLog& log, const ident::IdentificationConfig& config,
     const IdentificationSessionOptions& options, std::optional<ModelTorqueSource>& nominal) {
+    const IdentificationSessionOptions& options, std::optional<ModelTorqueSource>& used) {
   if (!config.options.model_torque_input) return {};
   if (!options.model_torque)
     throw InputError(options.config, 0, "model.model_torque", "no rigid-body model given");
@@ -51,6 +53,7 @@ std::vector<ident::LinkMassParameters> attach_session_model_torques(
   spdlog::info("identify: model torques of {} along the {} path", model.robot.name,
                torque_along_measured_path(config.options) ? "measured" : "desired");
   attach_model_torques(log, model, config.options);
+  used = model;
   return links;
 }
 
@@ -188,6 +191,7 @@ PreparedIdentification prepare_identification(const IdentificationSessionOptions
                                        p.log.cycle_s, options.joint_errors, &warnings);
   for (const std::string& w : warnings) spdlog::warn("identify: {}", w);
   p.model_torque_links = attach_session_model_torques(p.log, p.config, options, p.nominal_model);
+  p.model_torque_links = attach_session_model_torques(p.log, p.config, options, p.model_torque);
   if (p.config.max_speed_rad_s.size() != p.log.joint_count())
     throw InputError(
         options.config, config_node.child("joints").child("max_speed_deg_s").line(),
@@ -218,6 +222,9 @@ IdentificationResult identify_session(PreparedIdentification p,
   if (p.options.search_order)
     order_search = search_orders(log, p.options.config, p.config, p.options.search_second_order);
   if (p.options.track_orders && order_search) track_orders(log, p.config, *order_search);
+  // The config's loading ensures the model torque (and so the model) with the gear mode.
+  if (p.config.transmission_error_gear_mode && p.model_torque)
+    set_transmission_error_gear_modes(p.config, log, *p.model_torque);
   const auto segments = log.segments();
   IdentificationResult r;
   r.joint_names = log.joint_names;

@@ -52,6 +52,8 @@ struct PreparedIdentification {
   // The nominal robot's rigid-body model (before any refinement), when the config takes the model
   // torque: the friction levels are estimated beside its drive values.
   std::optional<ModelTorqueSource> nominal_model;
+  // The rigid-body model the torques were attached with (when the config's models take them).
+  std::optional<ModelTorqueSource> model_torque;
   std::chrono::steady_clock::time_point start;
 };
 PreparedIdentification prepare_identification(const IdentificationSessionOptions& options);

@@ -13,6 +13,7 @@
 #include "eval/ims_measured_path.hpp"
 #include "eval/iso9283_path.hpp"
 #include "eval/path_deviation.hpp"
+#include "eval/transmission_error_gear_mode.hpp"
 #include "ident/identification_config_record.hpp"
 #include "ident/identify_joints.hpp"
 #include "ims/earth_model.hpp"
@@ -404,12 +405,14 @@ IdentifiedTable identify_table(const ident::JointErrorLog& log,
                                const ident::IdentificationConfig& given_config,
                                const std::string& source_file,
                                const ModelTorqueSource* torque_model) {
-  const ident::IdentificationConfig config =
+  ident::IdentificationConfig config =
       given_config.resolved_cycle_s == log.cycle_s
           ? given_config
           : ident::resolve_for_record(given_config, log.robot, log.cycle_s, source_file);
   if (needs_model_torques(log, config, torque_model, "identify_table"))
-    return identify_table(with_model_torques(log, *torque_model, config), config, source_file);
+    return identify_table(with_model_torques(log, *torque_model, config), config, source_file,
+                          torque_model);
+  if (torque_model != nullptr) set_transmission_error_gear_modes(config, log, *torque_model);
   if (config.max_speed_rad_s.size() != log.joint_count()) {
     throw std::invalid_argument(fmt::format("identify_table: config has {} joints, the data {}",
                                             config.max_speed_rad_s.size(), log.joint_count()));

@@ -75,7 +75,8 @@ ModelTorqueSource scenario_model_torque(const sim::Scenario& scenario);
 // identify_joint for every joint of the log (as `imscal identify`). source_file names the data.
 // A config whose models take the model torque needs `torque_model` (the torques are attached to
 // a copy of the log along the path its form reads) or torques already in the log
-// (std::invalid_argument otherwise).
+// (std::invalid_argument otherwise). With config.transmission_error_gear_mode, the joints' gear
+// modes come from `torque_model` (eval/transmission_error_gear_mode.hpp); without a model, none.
 IdentifiedTable identify_table(const ident::JointErrorLog& log,
                                const ident::IdentificationConfig& config,
                                const std::string& source_file = "simulator truth",

@@ -29,6 +29,8 @@ ExogenousParameters exogenous_parameters(const ParameterTable& table,
   p.transmission_error_rad_per_rad = joint.transmission_error_rad_per_rad;
   p.transmission_error_2_rad_per_rad = joint.transmission_error_2_rad_per_rad;
   p.transmission_error_compliance_rad_per_nm = joint.transmission_error_compliance_rad_per_nm;
+  p.transmission_error_mode_rad_s = joint.transmission_error_mode_rad_s;
+  p.transmission_error_mode_damping = joint.transmission_error_mode_damping;
   return p;
 }
 
@@ -65,6 +67,13 @@ std::string exogenous_parameters_problem(std::span<const TableInput> inputs,
            "(0: no second order on the joint)";
   if (second && !transmission_error)
     return "the second transmission-error inputs need the first transmission-error inputs";
+  const double mode = p.transmission_error_mode_rad_s, damping = p.transmission_error_mode_damping;
+  if (!(mode >= 0.0 && std::isfinite(mode) && damping >= 0.0 && std::isfinite(damping)))
+    return "the transmission error's gear mode needs a finite frequency and damping >= 0";
+  if (mode > 0.0 && !(damping > 0.0))
+    return "the transmission error's gear mode needs a damping ratio > 0";
+  if (mode > 0.0 && !transmission_error)
+    return "the transmission error's gear mode needs the transmission-error inputs";
   return {};
 }
 

@@ -15,8 +15,15 @@
 //    1 / k the gear's compliance (the motor angle the deflected gear sits at);
 //  * transmission_error_2_sin / _cos: the same pair at a second harmonic f_2 (a gear's error
 //    repeats at several of its stages' tooth and lobe counts over the motor revolution).
+// With a gear mode (natural frequency ω_n > 0, damping ratio ζ) each pair is the error's
+// steady-state response through that mode instead: the error is a displacement between motor and
+// link, and at the joint speed ẋ it oscillates at Ω = f ẋ, where the locked-motor mode
+// H(s) = ω_n² / (s² + 2 ζ ω_n s + ω_n²) turns sin φ into Im(H(jΩ) e^{jφ}) and cos φ into
+// Re(H(jΩ) e^{jφ}). The pair then carries the resonance the inputs' FIR taps cannot follow
+// (decay time 1 / (ζ ω_n) ≈ 0.2 s at 15 Hz, 5 %); ω_n = 0 gives H = 1, the plain pair.
 #include <array>
 #include <cmath>
+#include <complex>
 #include <span>
 #include <string>
 
@@ -78,6 +85,9 @@ struct ExogenousParameters {
   // The second harmonic's phase rate (0: the joint has no second order, the pair's inputs are 0).
   double transmission_error_2_rad_per_rad = 0.0;
   double transmission_error_compliance_rad_per_nm = 0.0;
+  // The joint's locked-motor gear mode the error passes through (0: none, the plain pair).
+  double transmission_error_mode_rad_s = 0.0;
+  double transmission_error_mode_damping = 0.0;
 };
 // A table's constants for one of its joints.
 ExogenousParameters exogenous_parameters(const ParameterTable& table, const JointParameters& joint);
@@ -103,6 +113,31 @@ inline double transmission_error_phase(const ExogenousParameters& p,
   return p.transmission_error_rad_per_rad * transmission_error_motor_angle(p, s);
 }
 
+// The gear mode's response H(jΩ) = ω_n² / (ω_n² − Ω² + 2 j ζ ω_n Ω) at the error's frequency
+// Ω = phase rate × speed [rad/s] (signed: H(−jΩ) is H(jΩ)'s conjugate); 1 without a mode.
+inline std::complex<double> gear_mode_response(const ExogenousParameters& p,
+                                               double phase_rate_rad_per_rad,
+                                               double speed_rad_s) noexcept {
+  const double w = p.transmission_error_mode_rad_s;
+  if (!(w > 0.0)) return {1.0, 0.0};
+  const double omega = phase_rate_rad_per_rad * speed_rad_s;
+  return w * w /
+         std::complex<double>(w * w - omega * omega,
+                              2.0 * p.transmission_error_mode_damping * w * omega);
+}
+
+// The pair (Im, Re) of H(jΩ) e^{jφ}: the response of sin φ and of cos φ through the gear mode.
+inline double transmission_error_pair_value(const ExogenousParameters& p,
+                                            double phase_rate_rad_per_rad, const ExogenousSample& s,
+                                            bool sine) noexcept {
+  const double phase = phase_rate_rad_per_rad * transmission_error_motor_angle(p, s);
+  const double sin_phase = std::sin(phase), cos_phase = std::cos(phase);
+  if (!(p.transmission_error_mode_rad_s > 0.0)) return sine ? sin_phase : cos_phase;
+  const std::complex<double> h = gear_mode_response(p, phase_rate_rad_per_rad, s.speed_rad_s);
+  return sine ? h.real() * sin_phase + h.imag() * cos_phase
+              : h.real() * cos_phase - h.imag() * sin_phase;
+}
+
 inline double exogenous_value(TableInput input, const ExogenousParameters& p,
                               const ExogenousSample& s) noexcept {
   switch (input) {
@@ -113,21 +148,19 @@ inline double exogenous_value(TableInput input, const ExogenousParameters& p,
     case TableInput::kTorqueSign:
       return std::tanh(s.model_torque_nm / p.torque_sign_scale_nm);
     case TableInput::kTransmissionErrorSin:
-      return std::sin(transmission_error_phase(p, s));
+      return transmission_error_pair_value(p, p.transmission_error_rad_per_rad, s, true);
     case TableInput::kTransmissionErrorCos:
-      return std::cos(transmission_error_phase(p, s));
+      return transmission_error_pair_value(p, p.transmission_error_rad_per_rad, s, false);
     // A joint without a second order (phase rate 0) has both inputs 0, so that its zero
     // coefficients are not needed for the pair to do nothing.
     case TableInput::kTransmissionError2Sin:
       return p.transmission_error_2_rad_per_rad == 0.0
                  ? 0.0
-                 : std::sin(p.transmission_error_2_rad_per_rad *
-                            transmission_error_motor_angle(p, s));
+                 : transmission_error_pair_value(p, p.transmission_error_2_rad_per_rad, s, true);
     case TableInput::kTransmissionError2Cos:
       return p.transmission_error_2_rad_per_rad == 0.0
                  ? 0.0
-                 : std::cos(p.transmission_error_2_rad_per_rad *
-                            transmission_error_motor_angle(p, s));
+                 : transmission_error_pair_value(p, p.transmission_error_2_rad_per_rad, s, false);
   }
   return 0.0;
 }

@@ -122,6 +122,11 @@ JointIdentificationOptions IdentificationConfig::joint_options(std::size_t joint
         o.second_transmission_error_input ? second * gear_ratio[joint] : 0.0;
     if (joint < gear_stiffness_nm_per_rad.size())
       o.transmission_error_compliance_rad_per_nm = 1.0 / gear_stiffness_nm_per_rad[joint];
+    if (joint < transmission_error_mode_rad_s.size() &&
+        joint < transmission_error_mode_damping.size()) {
+      o.transmission_error_mode_rad_s = transmission_error_mode_rad_s[joint];
+      o.transmission_error_mode_damping = transmission_error_mode_damping[joint];
+    }
   }
   return o;
 }
@@ -194,7 +199,7 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
          "direction_speed_scale_deg_s", "torque_sign", "torque_sign_scale_fraction", "input_taps",
          "input_history_s", "torque_sign_taps", "torque_sign_history_s", "transmission_error",
          "transmission_error_harmonic_per_motor_rev", "transmission_error_taps",
-         "transmission_error_history_s", "refine_mass_parameters"});
+         "transmission_error_history_s", "transmission_error_gear_mode", "refine_mass_parameters"});
     ConfigDurations& d = c.durations;
     d.preview_s = duration_instead_of_count(*model, "model", "preview_s", "preview_cycles", c);
     d.input_history_s =
@@ -250,6 +255,12 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
           .fail(
               "the transmission error's phase with the gear's deflection (joints."
               "gear_stiffness_nm_per_rad) needs model_torque: true");
+    c.transmission_error_gear_mode = model->get_bool("transmission_error_gear_mode", false);
+    if (c.transmission_error_gear_mode && !(o.transmission_error_input && o.model_torque_input))
+      model->child("transmission_error_gear_mode")
+          .fail(
+              "the gear mode is the transmission error's, its inertia the rigid-body model's: "
+              "needs transmission_error: true and model_torque: true");
     // One harmonic for every joint, or a list with one per joint.
     if (const auto harmonic = model->optional_child("transmission_error_harmonic_per_motor_rev")) {
       if (harmonic->is_sequence()) {

@@ -59,6 +59,13 @@ struct IdentificationConfig {
   // first), with options.second_transmission_error_input; 0 (or a joint beyond the list): the
   // joint has no second order, its model leaves the pair out (zero coefficients in the table).
   std::vector<double> transmission_error_second_harmonic_per_joint;
+  // `model.transmission_error_gear_mode:` each joint's transmission-error pairs through its
+  // locked-motor gear mode (ident/exogenous_inputs.hpp), the mode found before identifying
+  // (eval/transmission_error_gear_mode.hpp): per joint its natural frequency [rad/s] and damping
+  // ratio (empty, or 0 for a joint: the plain pair).
+  bool transmission_error_gear_mode = false;
+  std::vector<double> transmission_error_mode_rad_s;
+  std::vector<double> transmission_error_mode_damping;
   double nominal_payload_kg = 16.0;
   std::vector<double> speed_fraction_bounds{0.0, 0.2, 0.8, 1.0};  // of max speed (paper, Table 2)
   std::vector<double> payload_fraction_bounds{0.0, 0.5, 1.0};     // of nominal payload

@@ -334,6 +334,8 @@ ExogenousParameters exogenous_parameters(const JointIdentificationOptions& optio
   p.transmission_error_2_rad_per_rad =
       options.second_transmission_error_input ? options.transmission_error_2_rad_per_rad : 0.0;
   p.transmission_error_compliance_rad_per_nm = options.transmission_error_compliance_rad_per_nm;
+  p.transmission_error_mode_rad_s = options.transmission_error_mode_rad_s;
+  p.transmission_error_mode_damping = options.transmission_error_mode_damping;
   return p;
 }
 
@@ -482,6 +484,8 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
     out.parameters.transmission_error_rad_per_rad = options.transmission_error_rad_per_rad;
     out.parameters.transmission_error_compliance_rad_per_nm =
         options.transmission_error_compliance_rad_per_nm;
+    out.parameters.transmission_error_mode_rad_s = options.transmission_error_mode_rad_s;
+    out.parameters.transmission_error_mode_damping = options.transmission_error_mode_damping;
     if (options.second_transmission_error_input) {
       if (!(options.transmission_error_2_rad_per_rad > 0.0) ||
           options.transmission_error_2_rad_per_rad == options.transmission_error_rad_per_rad)

@@ -117,6 +117,10 @@ struct JointIdentificationOptions {
   // The gear's compliance 1 / k [rad/(N m)]: the motor sits τ / k ahead of the link under the
   // model torque τ, so the error's phase is f (q + τ / k) (0: the link angle alone).
   double transmission_error_compliance_rad_per_nm = 0.0;
+  // The joint's locked-motor gear mode the error passes through (ident/exogenous_inputs.hpp):
+  // natural frequency [rad/s] and damping ratio; 0: none, the plain pair.
+  double transmission_error_mode_rad_s = 0.0;
+  double transmission_error_mode_damping = 0.0;
   int input_taps = 32;
   int torque_sign_taps = 1;
   int transmission_error_taps = 8;

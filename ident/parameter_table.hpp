@@ -22,8 +22,9 @@ namespace imscal::ident {
 // are read with 0 for both). Version 4 added the second transmission-error harmonic (inputs
 // transmission_error_2_sin / _cos, the joints' transmission_error_2_rad_per_rad). Version 5
 // added the model torque's link masses refined from the identification data (model_torque_links,
-// optional).
-inline constexpr int kParameterTableSchemaVersion = 5;
+// optional). Version 6 added the joints' gear mode the transmission error passes through
+// (transmission_error_gear_mode, optional: natural frequency and damping ratio).
+inline constexpr int kParameterTableSchemaVersion = 6;
 
 // What the cells' models are (ident/joint_identification.hpp): forward error models of the
 // loop (paper, eq. 2: the predicted error Δq̂ from q_d), or inverse models (the offset that makes
@@ -92,6 +93,11 @@ struct JointParameters {
   // The gear's compliance 1 / k [rad/(N m)]: the error's phase is f (x + compliance x model
   // torque), the motor angle the deflected gear sits at (0: the joint angle alone).
   double transmission_error_compliance_rad_per_nm = 0.0;
+  // The locked-motor gear mode the transmission error passes through to the link
+  // (ident/exogenous_inputs.hpp): natural frequency [rad/s] and damping ratio; 0: none (the
+  // plain sin/cos pair, every table before version 6).
+  double transmission_error_mode_rad_s = 0.0;
+  double transmission_error_mode_damping = 0.0;
   // The largest joint error |q_d - q| and its largest rate (over 8 ms) in the identification
   // data [rad, rad/s]: what the models were identified on. The precontrol's supervisor derives
   // its default tolerances from them (ident/precontrol.hpp). 0: not known (version 1 tables).
@@ -115,6 +121,8 @@ struct JointParameters {
            x.transmission_error_2_rad_per_rad == y.transmission_error_2_rad_per_rad &&
            x.transmission_error_compliance_rad_per_nm ==
                y.transmission_error_compliance_rad_per_nm &&
+           x.transmission_error_mode_rad_s == y.transmission_error_mode_rad_s &&
+           x.transmission_error_mode_damping == y.transmission_error_mode_damping &&
            x.offset_envelope_rad == y.offset_envelope_rad &&
            x.offset_rate_envelope_rad_s == y.offset_rate_envelope_rad_s && x.cells == y.cells;
   }

@@ -285,6 +285,22 @@ TableInput read_input(const Node& n) {
   n.fail("expected " + expected + ", got '" + name + "'");
 }
 
+// The gear mode the transmission error passes through (version 6 on, optional): natural
+// frequency > 0 and damping ratio > 0.
+void read_gear_mode_key(const Node& n, JointParameters& j, bool transmission_error) {
+  if (!n.has("transmission_error_gear_mode")) return;
+  const Node mode = n.child("transmission_error_gear_mode");
+  if (!transmission_error) mode.fail("the table has no transmission-error input");
+  mode.only_keys({"natural_frequency_rad_s", "damping_ratio"});
+  j.transmission_error_mode_rad_s = mode.child("natural_frequency_rad_s").number();
+  j.transmission_error_mode_damping = mode.child("damping_ratio").number();
+  if (!(j.transmission_error_mode_rad_s > 0.0 && std::isfinite(j.transmission_error_mode_rad_s)))
+    mode.child("natural_frequency_rad_s").fail("must be finite and > 0");
+  if (!(j.transmission_error_mode_damping > 0.0 &&
+        std::isfinite(j.transmission_error_mode_damping)))
+    mode.child("damping_ratio").fail("must be finite and > 0");
+}
+
 // The transmission-error keys of a joint (version 3 on): the phase rates and the compliance.
 void read_transmission_error_keys(const Node& n, JointParameters& j, bool transmission_error,
                                   bool second_transmission_error) {
@@ -307,6 +323,7 @@ void read_transmission_error_keys(const Node& n, JointParameters& j, bool transm
     n.child("transmission_error_2_rad_per_rad")
         .fail("the table has no second transmission-error input");
   }
+  read_gear_mode_key(n, j, transmission_error);
   const Node compliance = n.child("transmission_error_compliance_rad_per_nm");
   j.transmission_error_compliance_rad_per_nm = compliance.number();
   if (!(j.transmission_error_compliance_rad_per_nm >= 0.0) ||
@@ -330,10 +347,15 @@ JointParameters read_joint(const Node& n, double sample_time_s, int schema_versi
     n.only_keys({"name", "backlash", "torque_sign_scale_nm", "transmission_error_rad_per_rad",
                  "transmission_error_compliance_rad_per_nm", "offset_envelope_rad",
                  "offset_rate_envelope_rad_s", "dimensions", "cells"});
-  else
+  else if (schema_version < 6)
     n.only_keys({"name", "backlash", "torque_sign_scale_nm", "transmission_error_rad_per_rad",
                  "transmission_error_2_rad_per_rad", "transmission_error_compliance_rad_per_nm",
                  "offset_envelope_rad", "offset_rate_envelope_rad_s", "dimensions", "cells"});
+  else
+    n.only_keys({"name", "backlash", "torque_sign_scale_nm", "transmission_error_rad_per_rad",
+                 "transmission_error_2_rad_per_rad", "transmission_error_compliance_rad_per_nm",
+                 "transmission_error_gear_mode", "offset_envelope_rad",
+                 "offset_rate_envelope_rad_s", "dimensions", "cells"});
   JointParameters j;
   j.name = n.child("name").string();
   if (j.name.empty()) n.child("name").fail("empty joint name");
@@ -472,6 +494,10 @@ std::string parameters_json_text(const ParameterTable& t) {
     }
     if (second_transmission_error)  // version 4, with the second pair only
       joint["transmission_error_2_rad_per_rad"] = j.transmission_error_2_rad_per_rad;
+    if (j.transmission_error_mode_rad_s > 0.0)  // version 6, with a gear mode only
+      joint["transmission_error_gear_mode"] = {
+          {"natural_frequency_rad_s", j.transmission_error_mode_rad_s},
+          {"damping_ratio", j.transmission_error_mode_damping}};
     joints.push_back(std::move(joint));
   }
   json extra_names = json::array();

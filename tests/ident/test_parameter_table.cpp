@@ -175,6 +175,41 @@ TEST_F(ParameterTableFiles, ModelTorqueLinksRoundTripAndAreChecked) {
   refused(short_com, "/model_torque_links/0/com_sigma_m");
 }
 
+// Schema 6's gear mode of the transmission error: exact round trip; a joint without one writes
+// no key and reads 0 (as every older table); frequency and damping > 0; not in a version 5 table,
+// nor in a table without the transmission-error inputs.
+TEST_F(ParameterTableFiles, GearModeRoundTripsAndIsChecked) {
+  ident::ParameterTable table = sample_table();
+  table.joints[0].transmission_error_mode_rad_s = 94.28090415820634;
+  table.joints[0].transmission_error_mode_damping = 0.050677;
+  const auto file = dir_ / "parameters.json";
+  ident::write_parameters_json(file, table);
+  EXPECT_TRUE(ident::read_parameters_json(file) == table);
+  const json good = json::parse(ident::parameters_json_text(table));
+  EXPECT_EQ(good["schema_version"], 6);
+  EXPECT_EQ(good["joints"][1].count("transmission_error_gear_mode"), 0u);
+  json old = good;
+  old["schema_version"] = 5;
+  refused(old, "/joints/0/transmission_error_gear_mode");
+  json still = good;  // a version 5 table without the key reads as before: no mode
+  still["schema_version"] = 5;
+  still["joints"][0].erase("transmission_error_gear_mode");
+  EXPECT_EQ(ident::parse_parameters_json(still.dump(), "parameters.json")
+                .joints[0]
+                .transmission_error_mode_rad_s,
+            0.0);
+  json zero = good;
+  zero["joints"][0]["transmission_error_gear_mode"]["natural_frequency_rad_s"] = 0.0;
+  refused(zero, "/joints/0/transmission_error_gear_mode/natural_frequency_rad_s");
+  json undamped = good;
+  undamped["joints"][0]["transmission_error_gear_mode"]["damping_ratio"] = 0.0;
+  refused(undamped, "/joints/0/transmission_error_gear_mode/damping_ratio");
+  json without = json::parse(ident::parameters_json_text(sample_table(false)));
+  without["joints"][0]["transmission_error_gear_mode"] =
+      good["joints"][0]["transmission_error_gear_mode"];
+  refused(without, "/joints/0/transmission_error_gear_mode");
+}
+
 TEST(ParameterTable, Version1TablesReadAsForwardModelsWithoutPreview) {
   json j = json::parse(ident::parameters_json_text(sample_table()));
   j["schema_version"] = 1;
@@ -249,8 +284,8 @@ TEST_P(LoaderRefuses, WithPathAndMessage) {
 INSTANTIATE_TEST_SUITE_P(
     BadTables, LoaderRefuses,
     ::testing::Values(
-        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 6; }, "/schema_version",
-                "unknown schema version 6"},
+        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 7; }, "/schema_version",
+                "unknown schema version 7"},
         Refusal{"CountsForTheFurtherInputs",
                 [](json& j) { j["joints"][0]["cells"][0]["nx"] = json::array({3}); },
                 "/joints/0/cells/0/nx", "1 counts for the table's 4 further inputs"},
