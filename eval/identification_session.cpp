@@ -30,11 +30,12 @@ namespace fs = std::filesystem;
 namespace {
 
 // The model torques of the log's path (eval/model_torque.hpp), when the config's models take
-// them; the refined links when the config refines them.
+// them; the refined links when the config refines them. `nominal` gets the robot file's model,
+// `used` the one the torques were attached with (refined or not).
 std::vector<ident::LinkMassParameters> attach_session_model_torques(
     ident::JointErrorLog& log, const ident::IdentificationConfig& config,
-    const IdentificationSessionOptions& options, std::optional<ModelTorqueSource>& nominal) {
-    const IdentificationSessionOptions& options, std::optional<ModelTorqueSource>& used) {
+    const IdentificationSessionOptions& options, std::optional<ModelTorqueSource>& nominal,
+    std::optional<ModelTorqueSource>& used) {
   if (!config.options.model_torque_input) return {};
   if (!options.model_torque)
     throw InputError(options.config, 0, "model.model_torque", "no rigid-body model given");
@@ -190,8 +191,8 @@ PreparedIdentification prepare_identification(const IdentificationSessionOptions
   p.config = ident::resolve_for_record(ident::load_identification_config(config_node), p.log.robot,
                                        p.log.cycle_s, options.joint_errors, &warnings);
   for (const std::string& w : warnings) spdlog::warn("identify: {}", w);
-  p.model_torque_links = attach_session_model_torques(p.log, p.config, options, p.nominal_model);
-  p.model_torque_links = attach_session_model_torques(p.log, p.config, options, p.model_torque);
+  p.model_torque_links =
+      attach_session_model_torques(p.log, p.config, options, p.nominal_model, p.model_torque);
   if (p.config.max_speed_rad_s.size() != p.log.joint_count())
     throw InputError(
         options.config, config_node.child("joints").child("max_speed_deg_s").line(),
