@@ -39,10 +39,10 @@ std::optional<std::string> rest_shortage(const RestPoseResult& rests, const Robo
       "both ends; {} standstill{} of the IMS not used), the robot log's commanded standstills "
       "last [{}] s. Needed: a first rest of at least {:.0f} s{} and at least 2 usable rests, each "
       "a commanded standstill of at least {:.1f} s (the IMS still for {:.1f} s once the gears "
-      "stop ringing, ~{:.0f} s after a stop). With one rest the gear deflection of that pose "
-      "cannot "
-      "be split over the joints, and every joint error carries its error (about a tenth of the "
-      "gear wind-up, ~2e-4 rad)",
+      "stop ringing, ~{:.1f} s after a stop). With one rest the gear deflection of that pose "
+      "cannot be split over the joints, and every joint error carries its error (about a tenth "
+      "of the gear wind-up, ~2e-4 rad); the joint errors' diagnosis counts it as the "
+      "measurement's own (diagnose --frames)",
       rests.rests.size(), rests.rests.size() == 1 ? "" : "s",
       used.empty() ? "none" : fmt::format("{}", fmt::join(used, ", ")), options.edge_trim_s,
       rests.rejected.size(), rests.rejected.size() == 1 ? "" : "s", fmt::join(commanded, ", "),

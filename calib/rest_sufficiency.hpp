@@ -6,7 +6,8 @@
 //     deflection scales keep their prior there, and every later joint error carries the first
 //     rest's error (a tenth of the gear wind-up: ~2e-4 rad on A3 of a KR 16 with 16 kg);
 //   - for a standstill to count as such a rest, the IMS must be still for min_duration_s, which
-//     begins only once the gears have stopped ringing (~1 s after a stop on the KR 16): a
+//     begins only once the gears have stopped ringing (3-3.5 s after a stop on the KR 16: on the
+//     wide harness's ISO set, standstills of 3 s gave 0.5 s of IMS stillness, of 5 s about 2 s): a
 //     commanded standstill of min_duration_s + kRingDown_s or longer.
 // The commanded standstills are the robot log's spans of constant q_desired.
 #include <optional>
@@ -20,7 +21,7 @@
 namespace imscal::calib {
 
 inline constexpr double kFirstRestNeeded_s = 10.0;
-inline constexpr double kRingDown_s = 1.0;
+inline constexpr double kRingDown_s = 3.5;
 
 // Spans [begin, end) of the log [robot clock, s] where no joint's q_desired changes, at least
 // min_s long.
