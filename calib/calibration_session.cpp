@@ -7,6 +7,7 @@
 
 #include <algorithm>
 
+#include "calib/rest_sufficiency.hpp"
 #include "core/input_error.hpp"
 #include "ims/zupt_options.hpp"
 
@@ -63,6 +64,10 @@ void find_rests_and_time_offset(const SessionInputs& in, const CalibrationConfig
   for (const auto& why : out.rests.trimmed) spdlog::warn("calibrate: rest used in part: {}", why);
   spdlog::info("calibrate: {} rest poses ({} rejected)", out.rests.rests.size(),
                out.rests.rejected.size());
+  if (auto shortage = rest_shortage(out.rests, in.log, rest_options)) {
+    spdlog::warn("calibrate: {}", *shortage);
+    out.rest_shortage = std::move(*shortage);
+  }
 }
 
 FrameCalibrationInput bundle_input(const SessionInputs& in, const CalibrationConfig& config,

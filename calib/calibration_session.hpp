@@ -49,6 +49,8 @@ struct SessionResult {
   FrameCalibrationResult frames;
   MountingValidation validation;
   std::optional<JointSpaceErrors> joint_errors;  // when config.joint_errors
+  // Why the record lacks the rests the chain needs (calib/rest_sufficiency.hpp); empty: it has.
+  std::string rest_shortage;
 };
 
 // Stage names in order: "rests", "time offset", "rests" (0.5), "bundle", the validation's

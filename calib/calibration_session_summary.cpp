@@ -41,6 +41,7 @@ void header_and_verdict(Lines& line, const SessionSummarySources& sources,
   line(fmt::format("rests used: {}, rejected: {}", rests.rests.size(), rests.rejected.size()));
   for (const auto& why : rests.rejected) line("  rejected: " + why);
   for (const auto& why : rests.trimmed) line("  trimmed: " + why);
+  if (!session.rest_shortage.empty()) line("  WARNING: " + session.rest_shortage);
   line(fmt::format("initial time offset (cross-correlation): {:.3f} ms (peak {:.3f})",
                    session.initial_time_offset.offset_s * 1e3,
                    session.initial_time_offset.peak_correlation));

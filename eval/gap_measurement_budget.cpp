@@ -7,20 +7,45 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/units.hpp"
 
 namespace imscal::eval {
 namespace {
 
+// The first sample's gear wind-up tau_g / k and play taken up (+-half the play, the sign of
+// tau_g) per joint [rad], as calib/static_deflection.hpp models them; zero where not known.
+std::pair<std::vector<double>, std::vector<double>> first_sample_deflection(const GapSignals& s) {
+  std::vector<double> windup(s.joint_count(), 0.0), play(s.joint_count(), 0.0);
+  for (std::size_t j = 0; j < s.joint_count(); ++j) {
+    if (j >= s.gravity_torque_nm.size() || s.gravity_torque_nm[j].empty()) continue;
+    const double tau = s.gravity_torque_nm[j].front();
+    if (j < s.nominal_compliance_rad_per_nm.size())
+      windup[j] = s.nominal_compliance_rad_per_nm[j] * tau;
+    if (j < s.nominal_half_play_rad.size())
+      play[j] = std::copysign(s.nominal_half_play_rad[j], tau);
+  }
+  return {windup, play};
+}
+
 // The budget's columns of joint j (samples x kMeasurementParameterCount, in the order of
-// kMeasurementParameterNames): mounting, gyro bias, world rate, and q̇_d for the clock offset.
-Eigen::MatrixXd budget_columns(const GapSignals& s, std::size_t j) {
+// kMeasurementParameterNames): mounting, gyro bias, world rate, q̇_d for the clock offset, and
+// the first rest's wind-up and play scales through the start pose's signature.
+Eigen::MatrixXd budget_columns(
+    const GapSignals& s, std::size_t j,
+    const std::pair<std::vector<double>, std::vector<double>>& deflection) {
   const GapSignals::ImsChainColumns& c = s.ims_chain_columns[j];
   const Eigen::Index n = Eigen::Index(s.sample_count());
-  Eigen::MatrixXd a(n, kMeasurementParameterCount);
-  a << c.mounting, c.gyro_bias, c.world_rate,
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, kMeasurementParameterCount);
+  a.leftCols(kFirstDeflectionParameter) << c.mounting, c.gyro_bias, c.world_rate,
       Eigen::Map<const Eigen::VectorXd>(s.qd_desired_rad_s[j].data(), n);
+  if (c.start_pose.rows() == n)
+    for (Eigen::Index i = 0; i < c.start_pose.cols() && i < 6; ++i) {
+      a.col(kFirstDeflectionParameter + i) = c.start_pose.col(i) * deflection.first[std::size_t(i)];
+      a.col(kFirstDeflectionParameter + 6 + i) =
+          c.start_pose.col(i) * deflection.second[std::size_t(i)];
+    }
   return a;
 }
 
@@ -56,8 +81,9 @@ Fitted fit_measurement(const GapSignals& s, const std::vector<bool>& training,
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(r);
   std::vector<Eigen::MatrixXd> B(nj);
   Fitted f;
+  const auto deflection = first_sample_deflection(s);
   for (std::size_t j = 0; j < nj; ++j) {
-    B[j] = budget_columns(s, j) * W;
+    B[j] = budget_columns(s, j, deflection) * W;
     f.expected_ms.push_back(B[j].rowwise().squaredNorm().mean());
     const double sigma = s.measurement.noise_floor_rad[j];
     const double w =

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <sstream>
 
 #include "core/input_error.hpp"
@@ -17,17 +18,26 @@ const std::array<const char*, kMeasurementParameterCount> kMeasurementParameterN
     "mount_t_x_m",       "mount_t_y_m",        "mount_t_z_m",        "mount_r_x_rad",
     "mount_r_y_rad",     "mount_r_z_rad",      "gyro_bias_x_rad_s",  "gyro_bias_y_rad_s",
     "gyro_bias_z_rad_s", "world_rate_x_rad_s", "world_rate_y_rad_s", "world_rate_z_rad_s",
-    "clock_offset_s"};
+    "clock_offset_s",    "windup_scale_A1",    "windup_scale_A2",    "windup_scale_A3",
+    "windup_scale_A4",   "windup_scale_A5",    "windup_scale_A6",    "play_scale_A1",
+    "play_scale_A2",     "play_scale_A3",      "play_scale_A4",      "play_scale_A5",
+    "play_scale_A6"};
 
 namespace {
 
 // The Earth's rotation rate [rad/s] (WGS84).
 constexpr double kEarthRateRadS = 7.292115e-5;
 
-// The index of `name` in frames.json's parameter_names; refused when absent.
-std::size_t frames_index(const JsonField& names, const std::string& name) {
+// The index of `name` in frames.json's parameter_names; none when absent.
+std::optional<std::size_t> find_frames_index(const JsonField& names, const std::string& name) {
   for (std::size_t k = 0; k < names.size(); ++k)
     if (names[k].text() == name) return k;
+  return std::nullopt;
+}
+
+// The same, refused when absent.
+std::size_t frames_index(const JsonField& names, const std::string& name) {
+  if (const auto k = find_frames_index(names, name)) return *k;
   names.refuse(fmt::format("no parameter '{}' (not calibrate's covariance layout)", name));
 }
 
@@ -54,7 +64,8 @@ std::vector<double> noise_floor_from_log(const ident::JointErrorLog& log, const 
   return {};
 }
 
-Eigen::MatrixXd chain_covariance_from_frames(const std::filesystem::path& frames_json) {
+Eigen::MatrixXd chain_covariance_from_frames(const std::filesystem::path& frames_json,
+                                             const std::vector<std::string>& joint_names) {
   const JsonDocument doc = read_json_document(frames_json);
   doc.check_version("imscal-frames", 1, "a frames.json of imscal calibrate");
   const JsonField root = doc.root();
@@ -90,6 +101,19 @@ Eigen::MatrixXd chain_covariance_from_frames(const std::filesystem::path& frames
       M(6 + a, Eigen::Index(bias[std::size_t(b)])) = R_H_S(a, b);
     }
   M(12, Eigen::Index(dt)) = 1.0;
+  // The first rest's deflection only where it was the record's one rest: several rests at other
+  // poses tie the deflection's split to the tilts they see, one rest does not (the chain's error
+  // then reaches ~0.13 of the wind-up on A3 and A5; the scales keep their prior of 1-sigma 1 in
+  // that direction either way, so their covariance overstates what several rests leave).
+  const auto rests = root.optional("rests");
+  const auto used = rests ? rests->optional("used") : std::nullopt;
+  const bool one_rest = used && used->count() <= 1;
+  for (std::size_t j = 0; one_rest && j < joint_names.size() && j < 6; ++j) {
+    const auto w = find_frames_index(names, "windup_scale_deviation." + joint_names[j]);
+    const auto p_j = find_frames_index(names, "play_scale_deviation." + joint_names[j]);
+    if (w) M(kFirstDeflectionParameter + Eigen::Index(j), Eigen::Index(*w)) = 1.0;
+    if (p_j) M(kFirstDeflectionParameter + 6 + Eigen::Index(j), Eigen::Index(*p_j)) = 1.0;
+  }
   Eigen::MatrixXd P = M * C * M.transpose();
   double base_trace = 0.0;
   for (std::size_t i : base) base_trace += C(Eigen::Index(i), Eigen::Index(i));

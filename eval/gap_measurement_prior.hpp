@@ -19,6 +19,18 @@
 //                                            frames.json has no latitude, so it is taken isotropic
 //                                            with the same energy: sigma^2 = Omega^2 tr(P_R_W_R)/3
 //     clock_offset_s                         the clock offset's error (time_offset.dt)
+//     windup_scale_A1..6, play_scale_A1..6   the first rest's gear wind-up and backlash play,
+//                                            scaled by the factors the calibration fitted
+//                                            (windup_scale_deviation.*, play_scale_deviation.*;
+//                                            0 where it fitted none): the chain starts its
+//                                            smoothing from that rest's angles, so their error
+//                                            dq0_j = dk_w w_j + dk_p p_j (w_j = tau_g / k_j,
+//                                            p_j = +-half the play, at the first sample) stays in
+//                                            every later pose. One rest sees only its tilt, not
+//                                            how the deflection splits over A2, A3, A5: there
+//                                            the factors keep most of their prior (1-sigma 1).
+//                                            Taken only when the frames say the record had one
+//                                            rest (rests.used); zero otherwise
 //   The accelerometer biases are left out: the smoother's rest updates bound the position they
 //   would drive, and its sigmas (the floor) hold what remains.
 #include <Eigen/Core>
@@ -34,7 +46,9 @@ struct JointErrorLog;
 namespace imscal::eval {
 
 inline constexpr const char* kNoiseFloorKey = "q_measured_sigma_rms_rad";
-inline constexpr int kMeasurementParameterCount = 13;
+inline constexpr int kMeasurementParameterCount = 25;
+// The first of the 6 wind-up and 6 play scale deviations.
+inline constexpr int kFirstDeflectionParameter = 13;
 extern const std::array<const char*, kMeasurementParameterCount> kMeasurementParameterNames;
 
 struct MeasurementPrior {
@@ -50,8 +64,11 @@ struct MeasurementPrior {
 // it is not one finite positive number per joint.
 std::vector<double> noise_floor_from_log(const ident::JointErrorLog& log, const std::string& file);
 
-// The frames' covariance in the budget's parameters, from calibrate's frames.json. InputError
-// naming the file and the field when a parameter, the covariance or T_S_H is missing or invalid.
-Eigen::MatrixXd chain_covariance_from_frames(const std::filesystem::path& frames_json);
+// The frames' covariance in the budget's parameters, from calibrate's frames.json; the deflection
+// scales of the joints `joint_names` (windup_scale_deviation.<name>, play_scale_deviation.<name>)
+// where the frames have them. InputError naming the file and the field when a parameter, the
+// covariance or T_S_H is missing or invalid.
+Eigen::MatrixXd chain_covariance_from_frames(const std::filesystem::path& frames_json,
+                                             const std::vector<std::string>& joint_names);
 
 }  // namespace imscal::eval

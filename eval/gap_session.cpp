@@ -51,7 +51,7 @@ MeasurementPrior measurement_prior(const GapSessionOptions& args,
       throw InputError(args.joint_errors, 0, kNoiseFloorKey,
                        "no IMS noise floor in the header (imscal calibrate writes it), so the "
                        "frames' covariance cannot be tested against it");
-    prior.covariance_si = chain_covariance_from_frames(args.frames);
+    prior.covariance_si = chain_covariance_from_frames(args.frames, real.joint_names);
   }
   prior.source = !prior.known()        ? ""
                  : args.frames.empty() ? fmt::format("noise floor of {}", args.joint_errors)

@@ -91,6 +91,50 @@ Eigen::Matrix<double, 6, 6> adjoint(const Eigen::Isometry3d& t) {
 // industrial arm (~0.1 m .. 1), it only keeps the map finite at a wrist singularity.
 constexpr double kJacobianDamping = 1e-3;
 
+// The body Jacobian (flange axes, translation first) from the geometric one and the flange's
+// attitude R = R_R_H.
+Eigen::Matrix<double, 6, 6> body_jacobian(const calib::Jacobian& jg, const Eigen::Matrix3d& R) {
+  Eigen::Matrix<double, 6, 6> jb;
+  jb.topRows<3>() = R.transpose() * jg.topRows<3>();
+  jb.bottomRows<3>() = R.transpose() * jg.bottomRows<3>();
+  return jb;
+}
+
+// Damped least-squares inverse Jb^T (Jb Jb^T + λ² I)^-1.
+Eigen::Matrix<double, 6, 6> damped_inverse(const Eigen::Matrix<double, 6, 6>& jb) {
+  return jb.transpose() * (jb * jb.transpose() + kJacobianDamping * kJacobianDamping *
+                                                     Eigen::Matrix<double, 6, 6>::Identity())
+                              .inverse();
+}
+
+// The start-pose block of ImsChainColumns: the chain starts its smoothing at the first sample's
+// pose from that rest's estimated joint angles q0 + dq0, and the IMS measures only the motion from
+// there, so every later flange pose carries the same base-frame error D = T(q0 + dq0) T(q0)^-1;
+// in the flange at time t that is the body twist Ad(T(t)^-1 T(q0)) Jb(q0) dq0, which the inverse
+// kinematics turns into the gap -Jb(q(t))^-1 of it (-dq0 at the start).
+void add_start_pose_columns(const calib::KinematicModel& kin,
+                            const std::vector<std::vector<double>>& q_rad,
+                            std::vector<GapSignals::ImsChainColumns>& out) {
+  const std::size_t n = q_rad.empty() ? 0 : q_rad.front().size(), nj = out.size();
+  for (auto& c : out) c.start_pose.setZero(Eigen::Index(n), 6);
+  if (n == 0 || nj != std::size_t(calib::kJointCount)) return;
+  const auto pose = [&](std::size_t k, calib::JointVector& q) {
+    for (std::size_t j = 0; j < nj; ++j) q[long(j)] = q_rad[j][k];
+    return calib::forward_kinematics<double>(kin, q);
+  };
+  calib::JointVector q;
+  const Eigen::Isometry3d T0 = pose(0, q);
+  const Eigen::Matrix<double, 6, 6> jb0 =
+      body_jacobian(calib::geometric_jacobian(kin, q), T0.linear());
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Isometry3d T = pose(k, q);
+    const Eigen::Matrix<double, 6, 6> gap =
+        -damped_inverse(body_jacobian(calib::geometric_jacobian(kin, q), T.linear())) *
+        adjoint(T.inverse() * T0) * jb0;
+    for (std::size_t j = 0; j < nj; ++j) out[j].start_pose.row(Eigen::Index(k)) = gap.row(long(j));
+  }
+}
+
 // The arm with the logged payload, with 1 kg at the tool origin and bare.
 struct PayloadDynamics {
   sim::RigidBodyDynamics *logged, *unit, *bare;
@@ -192,16 +236,8 @@ std::vector<GapSignals::ImsChainColumns> ims_chain_columns(
     const Eigen::Isometry3d T = poses.T_R_H;
     const Eigen::Matrix3d& R = T.linear();
     const calib::Jacobian jg = calib::geometric_jacobian(kin, q);
-    Eigen::Matrix<double, 6, 6> jb;
-    jb.topRows<3>() = R.transpose() * jg.topRows<3>();
-    jb.bottomRows<3>() = R.transpose() * jg.bottomRows<3>();
-    // Damped least-squares inverse Jb^T (Jb Jb^T + λ² I)^-1.
-    const Eigen::Matrix<double, 6, 6> jb_inv =
-        jb.transpose() * (jb * jb.transpose() + kJacobianDamping * kJacobianDamping *
-                                                    Eigen::Matrix<double, 6, 6>::Identity())
-                             .inverse();
     // The gap per unit body twist of the flange pose error: -(q_m - q).
-    const Eigen::Matrix<double, 6, 6> gap_per_twist = -jb_inv;
+    const Eigen::Matrix<double, 6, 6> gap_per_twist = -damped_inverse(body_jacobian(jg, R));
 
     // DH sensitivities: a change of link i's numbers is a local twist xi_l after link frame i+1
     // (central differences of the link transform alone), moved to the flange by the adjoint.
@@ -263,6 +299,7 @@ std::vector<GapSignals::ImsChainColumns> ims_chain_columns(
       out[j].world_rate.row(row) = world_gap.row(jr);
     }
   }
+  add_start_pose_columns(kin, q_rad, out);
   return out;
 }
 

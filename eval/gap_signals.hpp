@@ -72,6 +72,7 @@ struct GapSignals {
     Eigen::MatrixXd gyro_scale;   // 3: scale factor error of the flange-axis rates [1]
     Eigen::MatrixXd accel_scale;  // 1: isotropic accelerometer scale error [1]
     Eigen::MatrixXd world_rate;   // 3: rate error fixed in the base axes x, y, z [rad/s]
+    Eigen::MatrixXd start_pose;   // 6: error of the first sample's joint angles dq0 [rad]
   };
   std::vector<ImsChainColumns> ims_chain_columns;
   // The IMS chain's own error budget (eval/gap_measurement_prior.hpp); not known by default.
@@ -102,6 +103,8 @@ std::vector<std::vector<double>> predict_table_joint_errors(const ident::Paramet
 //   accel_scale  (R^T (p - p0), 0): the travelled displacement scaled
 //   world_rate   (0, R^T e_i (t - t0)): an attitude drift about a base axis (the Earth rate
 //                resolved through a wrong base rotation; eval/gap_measurement_prior.hpp)
+//   start_pose   Ad(T^-1 T0) Jb(q0) e_i: the first sample's joint angles, from which the chain
+//                starts, off by dq0 (a constant base-frame pose error of every later sample)
 // The sensor is taken to sit at the flange (the diagnosis does not know T_S_H); the smoother's
 // rest updates, which bound these errors in the real chain, are not modelled (open-loop
 // signatures: they give the shape, the fit the size).

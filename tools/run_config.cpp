@@ -12,6 +12,20 @@ double positive(const ConfigNode& node) {
   if (!(value > 0.0)) node.fail("must be > 0");
   return value;
 }
+
+// A scenario as a stage names it: a shipped scenario's name (datasets/scenarios/NAME.yaml) as
+// given, or a .yaml file (must exist; appended to `files`, checksummed as an input).
+std::string scenario_reference(const ConfigNode& item, std::vector<fs::path>& files) {
+  const std::string name = item.as_string();
+  if (name.ends_with(".yaml")) {
+    files.push_back(item.as_existing_file());
+    return files.back().string();
+  }
+  if (name.empty() || name.find('/') != std::string::npos)
+    item.fail("a shipped scenario name (datasets/scenarios/NAME.yaml) or a .yaml file");
+  return name;
+}
+
 }  // namespace
 
 RunConfig load_run_config(const fs::path& file) {
@@ -67,17 +81,8 @@ RunConfig load_run_config(const fs::path& file) {
     VerifySettings settings;
     if (auto list = v->optional_child("scenarios")) {
       settings.scenarios.clear();
-      for (const ConfigNode& item : list->as_sequence()) {
-        const std::string name = item.as_string();
-        if (name.ends_with(".yaml")) {
-          settings.scenario_files.push_back(item.as_existing_file());
-          settings.scenarios.push_back(settings.scenario_files.back().string());
-        } else if (name.empty() || name.find('/') != std::string::npos) {
-          item.fail("a shipped scenario name (datasets/scenarios/NAME.yaml) or a .yaml file");
-        } else {
-          settings.scenarios.push_back(name);
-        }
-      }
+      for (const ConfigNode& item : list->as_sequence())
+        settings.scenarios.push_back(scenario_reference(item, settings.scenario_files));
       if (settings.scenarios.empty()) list->fail("names no scenario");
     }
     if (auto n = v->optional_child("cycles")) {
@@ -89,10 +94,15 @@ RunConfig load_run_config(const fs::path& file) {
     config.verify = settings;
   }
   if (auto d = root.optional_child("diagnose")) {
-    d->require_only_keys({"robot", "timeout_s"});
+    d->require_only_keys({"robot", "scenario", "timeout_s"});
     if (!config.identify) d->fail("a diagnose section needs an identify section (the table)");
     DiagnoseSettings settings;
     settings.robot = d->child("robot").as_existing_file();
+    if (auto n = d->optional_child("scenario")) {
+      std::vector<fs::path> files;
+      settings.scenario = scenario_reference(*n, files);
+      if (!files.empty()) settings.scenario_file = files.front();
+    }
     if (auto n = d->optional_child("timeout_s")) settings.timeout_s = positive(*n);
     config.diagnose = settings;
   }

@@ -65,6 +65,10 @@ struct VerifySettings {
 
 struct DiagnoseSettings {
   std::filesystem::path robot;
+  // The scenario (name or file) of the nominal model (`diagnose --scenario`): the joint model is
+  // then refined by re-simulating it. Empty: linear only.
+  std::string scenario;
+  std::filesystem::path scenario_file;  // when `scenario` is a file (a stage input)
   double timeout_s = 1800.0;
 };
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <optional>
 #include <stdexcept>
 
 #include "tools/stage_subcommand.hpp"
@@ -50,6 +51,14 @@ std::optional<fs::path> chain_joint_errors(const RunConfig& config, const StageW
 }
 
 namespace {
+// calibrate's frames.json when that stage made the joint errors; none otherwise.
+std::optional<fs::path> calibrate_frames_of(const RunConfig& config, const StageWorkspace& ws) {
+  if (config.joint_errors) return std::nullopt;
+  const auto dir = ws.upstream_dir("calibrate");
+  if (dir && fs::exists(*dir / "frames.json")) return *dir / "frames.json";
+  return std::nullopt;
+}
+
 fs::path joint_errors_of(const RunConfig& config, const StageWorkspace& ws) {
   const auto joint_errors = chain_joint_errors(config, ws);
   if (!joint_errors) throw std::runtime_error("the calibrate stage left no joint_errors.csv");
@@ -147,17 +156,31 @@ std::unique_ptr<Stage> make_diagnose_stage(const RunConfig& config) {
     in.upstream = {"identify"};
     declare_joint_errors(config, in);
     in.files.emplace_back("robot", config.diagnose->robot);
+    if (!config.diagnose->scenario_file.empty())
+      in.files.emplace_back("scenario", config.diagnose->scenario_file);
     in.config = {{"robot", config.diagnose->robot.string()},
+                 {"scenario", config.diagnose->scenario},
                  {"timeout_s", config.diagnose->timeout_s}};
     return in;
   };
   spec.arguments = [&config](const StageWorkspace& ws, const fs::path& out) {
     const fs::path joint_errors = joint_errors_of(config, ws);
-    return std::vector<std::string>{"--joint-errors", joint_errors.string(),
-                                    "--table",        forward_table_of(ws).string(),
-                                    "--robot",        config.diagnose->robot.string(),
-                                    "--figures",      "--out",
-                                    out.string()};
+    std::vector<std::string> args{"--joint-errors", joint_errors.string(),
+                                  "--table",        forward_table_of(ws).string(),
+                                  "--robot",        config.diagnose->robot.string(),
+                                  "--figures",      "--out",
+                                  out.string()};
+    // The chain's frames with their covariance (the measurement budget's prior) when calibrate
+    // made the joint errors.
+    if (const auto frames = calibrate_frames_of(config, ws)) {
+      args.emplace_back("--frames");
+      args.push_back(frames->string());
+    }
+    if (!config.diagnose->scenario.empty()) {
+      args.emplace_back("--scenario");
+      args.push_back(config.diagnose->scenario);
+    }
+    return args;
   };
   spec.success_message = "gap diagnosis written";
   return std::make_unique<SubcommandStage>(std::move(spec));

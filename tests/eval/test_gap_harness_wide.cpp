@@ -228,9 +228,11 @@ class GapHarnessWide : public test_support::ScratchDirTest {
     run("model-joint-errors --joint-errors " + (cal / "joint_errors.csv").string() +
             " --scenario " + scenario.string() + " --out " + model.string(),
         tag + "-model");
+    // With the record's frames.json (its covariance: the measurement budget's prior), as `imscal
+    // run` passes it.
     run("diagnose --joint-errors " + (cal / "joint_errors.csv").string() + " --sim-joint-errors " +
-            model.string() + " --robot " + (datasets_ / "robots/kr16.yaml").string() + " --out " +
-            out.string(),
+            model.string() + " --robot " + (datasets_ / "robots/kr16.yaml").string() +
+            " --frames " + (cal / "frames.json").string() + " --out " + out.string(),
         tag + "-diagnose");
     const ident::JointErrorLog measured = ident::read_joint_errors_csv(cal / "joint_errors.csv");
     const ident::JointErrorLog modelled = ident::read_joint_errors_csv(model);
@@ -248,7 +250,7 @@ class GapHarnessWide : public test_support::ScratchDirTest {
     const bool alarm = report.at("significant_gap").get<bool>();
     fmt::print("chain-measured control {} seed {}: chain error RMS per joint [rad]{}; cause {}\n",
                program, seed, rms, alarm ? "raised" : "none");
-    if (alarm) fmt::print("  {}\n", report.at("verdict").get<std::string>());
+    fmt::print("  {}\n", report.at("verdict").get<std::string>());
     return alarm;
   }
 };
@@ -256,15 +258,18 @@ class GapHarnessWide : public test_support::ScratchDirTest {
 // The goals on both sets: ranked first >= 90 %, joint located >= 90 %, shrinkage within
 // ±20 pp >= 85 %, every effect of a multi-effect case found >= 80 %, false alarms <= 10 % with
 // the chain-measured controls. Met: the shrinkage (development 22/24, held out 23/24). Missed, and
-// held here at the measured level so that a fall shows (decisions 0050 and 0058 say why): ranked
-// first 20/24 and 18/24, joint located 21/24 and 21/24, multi-effect 4/6 and 2/6 (effects at the
-// noise floor; a member of one joint standing for another's), false alarms 6/6 and 9/9: the chain's
-// error and the chain-like noise hold at rest and move with the pose, which drift, kinematic,
-// IMS-bias and time-offset candidates fit on the training blocks and carry to the held-out ones;
-// telling them from the measurement's own error needs the measurement's error budget as a
-// candidate, not built here.
+// held here at the measured level so that a fall shows (decisions 0050, 0057 and 0058 say why):
+// ranked first 20/24 and 18/24, joint located 21/24 and 21/24, multi-effect 4/6 and 2/6 (effects at
+// the noise floor; a member of one joint standing for another's), false alarms 3/6 and 7/9: the
+// generated controls' chain-like noise holds at rest and moves with the pose, which drift,
+// kinematic, IMS-bias and time-offset candidates fit on the training blocks and carry to the
+// held-out ones (those cases carry no noise floor, so the measurement budget does not test them).
+// The chain-measured controls are tested against the budget with their frames (decision 0057): 5
+// of 6 within; the mixed program on mount 2 stays beyond on A6 (an error after its fast cross move
+// that the budget has no column for).
 void expect_goals_or_the_measured_level(const Tally& development, const Tally& held_out,
-                                        std::vector<double> chain_rms_rad) {
+                                        std::vector<double> chain_rms_rad, int chain_alarms) {
+  EXPECT_LE(chain_alarms, 1);
   EXPECT_GE(pct(development.within, development.effect_cases), 85.0);
   EXPECT_GE(pct(held_out.within, held_out.effect_cases), 85.0);
   EXPECT_GE(development.first, 20);
@@ -294,6 +299,7 @@ TEST_F(GapHarnessWide, ProgramsCasesAndChainMeasuredControlsMeetTheGoals) {
   }
   // Controls through the chain: mount and unit 1 in the development set, 2 held out.
   std::vector<double> chain_rms_rad;
+  int chain_alarms = 0;
   for (int seed : {1, 2}) {
     const auto [frames, unit] = mounting_session(seed);
     if (HasFatalFailure()) return;
@@ -304,6 +310,7 @@ TEST_F(GapHarnessWide, ProgramsCasesAndChainMeasuredControlsMeetTheGoals) {
       Tally& set = seed == 1 ? development : held_out;
       ++set.controls;
       set.alarms += alarm;
+      chain_alarms += alarm;
     }
   }
   for (const auto& [label, t] :
@@ -326,7 +333,8 @@ TEST_F(GapHarnessWide, ProgramsCasesAndChainMeasuredControlsMeetTheGoals) {
                                 pct(t.all_found, t.multi));
     test_support::record_figure(prefix + "false_alarm_percent", pct(t.alarms, t.controls));
   }
-  expect_goals_or_the_measured_level(development, held_out, chain_rms_rad);
+  fmt::print("chain-measured controls raising a cause: {}/6\n", chain_alarms);
+  expect_goals_or_the_measured_level(development, held_out, chain_rms_rad, chain_alarms);
 }
 
 }  // namespace
