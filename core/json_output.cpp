@@ -1,5 +1,7 @@
 #include "core/json_output.hpp"
 
+#include <cmath>
+
 #include <spdlog/spdlog.h>
 
 namespace imscal {
@@ -14,6 +16,10 @@ std::string json_text(const nlohmann::json& value, int indent, const std::string
         target);
     return value.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   }
+}
+
+nlohmann::json json_number_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
 }  // namespace imscal

@@ -12,4 +12,8 @@ namespace imscal {
 // `target`, the file the text is for).
 std::string json_text(const nlohmann::json& value, int indent, const std::string& target);
 
+// v, or null when v is NaN or infinite (JSON has no such numbers; readers take null as NaN,
+// `JsonField::number_or_nan`).
+nlohmann::json json_number_or_null(double v);
+
 }  // namespace imscal

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/input_error.hpp"
+#include "core/json_output.hpp"
 #include "core/numeric_table.hpp"
 #include "core/units.hpp"
 #include "eval/path_deviation.hpp"
@@ -105,23 +106,22 @@ PathEvaluation evaluate_paths(const PathEvaluationOptions& args) {
   double max_dev = 0.0;
   const nlohmann::json per_cycle = per_cycle_deviations(args, commanded, attained, max_dev);
   constexpr double deg = kDegPerRad;
-  auto finite = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
   PathEvaluation e;
   e.document = {{"commanded", args.commanded},
                 {"cycles", r.cycles},
                 {"length_m", r.length_m},
                 {"commanded_speed_m_s", v_c},
                 {"AT_p_mm", r.AT_p_m * 1e3},
-                {"RT_p_mm", finite(r.RT_p_m * 1e3)},
+                {"RT_p_mm", json_number_or_null(r.RT_p_m * 1e3)},
                 {"AT_a_deg", r.AT_abc_rad[0] * deg},
                 {"AT_b_deg", r.AT_abc_rad[1] * deg},
                 {"AT_c_deg", r.AT_abc_rad[2] * deg},
-                {"RT_a_deg", finite(r.RT_abc_rad[0] * deg)},
-                {"RT_b_deg", finite(r.RT_abc_rad[1] * deg)},
-                {"RT_c_deg", finite(r.RT_abc_rad[2] * deg)},
-                {"AV_percent", finite(r.AV_percent)},
-                {"RV_percent", finite(r.RV_percent)},
-                {"FV_m_s", finite(r.FV_m_s)},
+                {"RT_a_deg", json_number_or_null(r.RT_abc_rad[0] * deg)},
+                {"RT_b_deg", json_number_or_null(r.RT_abc_rad[1] * deg)},
+                {"RT_c_deg", json_number_or_null(r.RT_abc_rad[2] * deg)},
+                {"AV_percent", json_number_or_null(r.AV_percent)},
+                {"RV_percent", json_number_or_null(r.RV_percent)},
+                {"FV_m_s", json_number_or_null(r.FV_m_s)},
                 {"max_path_deviation_mm", max_dev * 1e3},
                 {"missed_crossings", r.missed_crossings},
                 {"per_cycle", per_cycle}};

@@ -23,10 +23,6 @@ namespace {
 
 constexpr double kMm = 1e3;
 
-json finite(double v) {
-  return std::isfinite(v) ? json(v) : json(nullptr);
-}
-
 json figures_json(const PathFigures& f) {
   return {{"max_path_deviation_mm", f.max_path_deviation_m * kMm},
           {"rms_path_deviation_mm", f.rms_path_deviation_m * kMm},
@@ -34,17 +30,17 @@ json figures_json(const PathFigures& f) {
           {"systematic_max_mm", f.systematic_max_m * kMm},
           {"about_mean_max_mm", f.about_mean_max_m * kMm},
           {"AT_p_mm", f.AT_p_m * kMm},
-          {"RT_p_mm", finite(f.RT_p_m * kMm)},
+          {"RT_p_mm", json_number_or_null(f.RT_p_m * kMm)},
           {"AT_a_deg", f.AT_abc_rad[0] * kDegPerRad},
           {"AT_b_deg", f.AT_abc_rad[1] * kDegPerRad},
           {"AT_c_deg", f.AT_abc_rad[2] * kDegPerRad},
-          {"RT_a_deg", finite(f.RT_abc_rad[0] * kDegPerRad)},
-          {"RT_b_deg", finite(f.RT_abc_rad[1] * kDegPerRad)},
-          {"RT_c_deg", finite(f.RT_abc_rad[2] * kDegPerRad)},
+          {"RT_a_deg", json_number_or_null(f.RT_abc_rad[0] * kDegPerRad)},
+          {"RT_b_deg", json_number_or_null(f.RT_abc_rad[1] * kDegPerRad)},
+          {"RT_c_deg", json_number_or_null(f.RT_abc_rad[2] * kDegPerRad)},
           {"CO_mm", f.CO_m * kMm},
-          {"CR_mm", finite(f.CR_m * kMm)},
+          {"CR_mm", json_number_or_null(f.CR_m * kMm)},
           {"AV_percent", f.AV_percent},
-          {"RV_percent", finite(f.RV_percent)},
+          {"RV_percent", json_number_or_null(f.RV_percent)},
           {"FV_m_s", f.FV_m_s},
           {"missed_crossings", f.missed_crossings}};
 }

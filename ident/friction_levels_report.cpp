@@ -1,18 +1,14 @@
 #include "ident/friction_levels_report.hpp"
 
-#include <cmath>
+#include "core/json_output.hpp"
 
 namespace imscal::ident {
 namespace {
 
-nlohmann::json number(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
-}
-
 nlohmann::json level_json(const FrictionLevel& level, bool estimated) {
-  return {{"value", estimated ? number(level.value) : nlohmann::json()},
-          {"sigma", estimated ? number(level.sigma) : nlohmann::json()},
-          {"nominal", number(level.nominal)}};
+  return {{"value", estimated ? json_number_or_null(level.value) : nlohmann::json()},
+          {"sigma", estimated ? json_number_or_null(level.sigma) : nlohmann::json()},
+          {"nominal", json_number_or_null(level.nominal)}};
 }
 
 FrictionLevel level_of(const JsonField& f) {
@@ -33,9 +29,9 @@ nlohmann::json friction_levels_json(const std::vector<JointFrictionLevels>& leve
     joint["reflected_inertia_kg_m2"] = level_json(l.reflected_inertia_kg_m2, l.estimated);
     joint["rows"] = l.rows;
     joint["dead_time_cycles"] = l.dead_time_cycles;
-    joint["model_torque_rms_nm"] = number(l.torque_rms_nm);
-    joint["balance_fit_percent"] = number(l.torque_fit_percent);
-    joint["correlation_factor"] = number(l.correlation_factor);
+    joint["model_torque_rms_nm"] = json_number_or_null(l.torque_rms_nm);
+    joint["balance_fit_percent"] = json_number_or_null(l.torque_fit_percent);
+    joint["correlation_factor"] = json_number_or_null(l.correlation_factor);
     joints.push_back(std::move(joint));
   }
   return {{"source", "motor encoders' following error (q_desired - q_internal)"},

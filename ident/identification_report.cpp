@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/json_fields.hpp"
+#include "core/json_output.hpp"
 
 namespace imscal::ident {
 namespace {
@@ -12,10 +13,6 @@ namespace {
 using nlohmann::json;
 
 constexpr const char* kVersionKey = "imscal-identification-report";
-
-json number_or_null(double v) {
-  return std::isfinite(v) ? json(v) : json(nullptr);
-}
 
 json correlation_json(const CorrelationTest& t) {
   json c = json::array();
@@ -41,10 +38,10 @@ json curves_json(const OrderSweepResult& sweep) {
                         {"nb", s.nb},
                         {"dead_time", s.dead_time},
                         {"valid", cand.valid},
-                        {"loss", number_or_null(cand.loss)},
-                        {"aic", number_or_null(cand.aic)},
-                        {"bic", number_or_null(cand.bic)},
-                        {"validation_loss", number_or_null(cand.validation_loss)}};
+                        {"loss", json_number_or_null(cand.loss)},
+                        {"aic", json_number_or_null(cand.aic)},
+                        {"bic", json_number_or_null(cand.bic)},
+                        {"validation_loss", json_number_or_null(cand.validation_loss)}};
     if (s.nb == c.nb && s.dead_time == c.dead_time) curves["over_na"].push_back(point);
     if (s.na == c.na && s.dead_time == c.dead_time) curves["over_nb"].push_back(point);
     if (s.na == c.na && s.nb == c.nb) curves["over_d"].push_back(point);
@@ -94,7 +91,7 @@ json cell_json(const CellIdentification& c, const CellFitFigures& figures) {
         {"samples", v.sample_count},
         {"one_step_fit_percent", v.one_step_fit_percent},
         {"simulation_fit_percent", v.simulation_fit_percent},
-        {"joint_error_fit_percent", number_or_null(figures.joint_error_fit_percent)},
+        {"joint_error_fit_percent", json_number_or_null(figures.joint_error_fit_percent)},
         {"residual_rms_rad", v.residual_rms},
         {"residual_whiteness", correlation_json(v.residual_whiteness)},
         {"input_residual", correlation_json(v.input_residual)}};
@@ -103,17 +100,17 @@ json cell_json(const CellIdentification& c, const CellFitFigures& figures) {
 }
 
 json estimate_json(const StructureEstimate& e) {
-  return {{"value", number_or_null(e.value)}, {"sigma", number_or_null(e.sigma)}};
+  return {{"value", json_number_or_null(e.value)}, {"sigma", json_number_or_null(e.sigma)}};
 }
 
 json structure_json(const IdentifiedStructure& s) {
   return {{"cells", s.cells},
           {"compliance_rad_per_nm", estimate_json(s.compliance_rad_per_nm)},
-          {"nominal_compliance_rad_per_nm", number_or_null(s.nominal_compliance_rad_per_nm)},
+          {"nominal_compliance_rad_per_nm", json_number_or_null(s.nominal_compliance_rad_per_nm)},
           {"stiffness_nm_per_rad", estimate_json(s.stiffness_nm_per_rad)},
           {"direction_offset_rad", estimate_json(s.direction_offset_rad)},
           {"transmission_error_harmonic_per_motor_rev",
-           number_or_null(s.transmission_error_harmonic_per_motor_rev)},
+           json_number_or_null(s.transmission_error_harmonic_per_motor_rev)},
           {"transmission_error_amplitude_rad", estimate_json(s.transmission_error_amplitude_rad)},
           {"transmission_error_phase_rad", estimate_json(s.transmission_error_phase_rad)}};
 }
@@ -123,22 +120,23 @@ json joint_json(const JointIdentification& r, double seconds, const IdentifiedSt
   json cells = json::array();
   for (const auto& c : r.cells)
     cells.push_back(cell_json(c, r.parameters.cells.at(std::size_t(c.cell)).figures));
-  return {{"joint", r.parameters.name},
-          {"seconds", seconds},
-          {"table_joint_error_fit_percent", number_or_null(r.table_fit.joint_error_fit_percent)},
-          {"table_validation_rows", r.table_fit.rows},
-          {"backlash",
-           {{"identified", r.parameters.backlash_identified},
-            {"l_rad", b.l_rad},
-            {"l_sigma_rad", b.l_sigma_rad},
-            {"full_play_rad", 2.0 * r.parameters.backlash_l_rad},
-            {"reversals_found", b.reversals_found},
-            {"reversals_used", b.reversals_used},
-            {"lag_samples", b.lag_samples},
-            {"per_reversal_l_rad", b.per_reversal_rad},
-            {"reason", b.reason}}},
-          {"structure", structure_json(s)},
-          {"cells", cells}};
+  return {
+      {"joint", r.parameters.name},
+      {"seconds", seconds},
+      {"table_joint_error_fit_percent", json_number_or_null(r.table_fit.joint_error_fit_percent)},
+      {"table_validation_rows", r.table_fit.rows},
+      {"backlash",
+       {{"identified", r.parameters.backlash_identified},
+        {"l_rad", b.l_rad},
+        {"l_sigma_rad", b.l_sigma_rad},
+        {"full_play_rad", 2.0 * r.parameters.backlash_l_rad},
+        {"reversals_found", b.reversals_found},
+        {"reversals_used", b.reversals_used},
+        {"lag_samples", b.lag_samples},
+        {"per_reversal_l_rad", b.per_reversal_rad},
+        {"reason", b.reason}}},
+      {"structure", structure_json(s)},
+      {"cells", cells}};
 }
 
 json order_tracking_json(const OrderSearchJoint& j) {
@@ -156,16 +154,16 @@ json order_search_json(const OrderSearchReport& search) {
   json joints = json::array();
   for (const OrderSearchJoint& j : search.joints) {
     json fits = json::array();
-    for (double fit : j.held_out_joint_error_fit_percent) fits.push_back(number_or_null(fit));
+    for (double fit : j.held_out_joint_error_fit_percent) fits.push_back(json_number_or_null(fit));
     joints.push_back(
         {{"name", j.name},
          {"config_harmonic_per_motor_rev", j.config_harmonic_per_motor_rev},
          {"best_harmonic_per_motor_rev", j.best_harmonic_per_motor_rev},
-         {"gain_points", number_or_null(j.gain_points)},
+         {"gain_points", json_number_or_null(j.gain_points)},
          {"chosen_harmonic_per_motor_rev", j.chosen_harmonic_per_motor_rev},
          {"held_out_joint_error_fit_percent", fits},
-         {"second_harmonic_per_motor_rev", number_or_null(j.second_harmonic_per_motor_rev)},
-         {"second_bic", number_or_null(j.second_bic)}});
+         {"second_harmonic_per_motor_rev", json_number_or_null(j.second_harmonic_per_motor_rev)},
+         {"second_bic", json_number_or_null(j.second_bic)}});
     if (j.tracking_windows > 0) joints.back()["order_tracking"] = order_tracking_json(j);
   }
   return {{"candidates_per_motor_rev", search.candidates_per_motor_rev}, {"joints", joints}};

@@ -57,11 +57,6 @@ json units() {
           {"payload", "kg"}, {"position", "rad"}, {"acceleration", "rad/s^2"}};
 }
 
-// NaN/inf figures (e.g. no held-out data) are written as null.
-json number_or_null(double v) {
-  return std::isfinite(v) ? json(v) : json(nullptr);
-}
-
 json cell_json(const CellParameters& c) {
   json j = {{"bands", c.bands},
             {"status", to_string(c.status)},
@@ -76,13 +71,13 @@ json cell_json(const CellParameters& c) {
             {"fit",
              {{"estimation_rows", c.figures.estimation_rows},
               {"validation_rows", c.figures.validation_rows},
-              {"one_step_fit_percent", number_or_null(c.figures.one_step_fit_percent)},
-              {"simulation_fit_percent", number_or_null(c.figures.simulation_fit_percent)},
-              {"joint_error_fit_percent", number_or_null(c.figures.joint_error_fit_percent)},
-              {"residual_rms_rad", number_or_null(c.figures.residual_rms_rad)},
+              {"one_step_fit_percent", json_number_or_null(c.figures.one_step_fit_percent)},
+              {"simulation_fit_percent", json_number_or_null(c.figures.simulation_fit_percent)},
+              {"joint_error_fit_percent", json_number_or_null(c.figures.joint_error_fit_percent)},
+              {"residual_rms_rad", json_number_or_null(c.figures.residual_rms_rad)},
               {"whiteness_passed", c.figures.whiteness_passed},
               {"input_residual_passed", c.figures.input_residual_passed},
-              {"spectral_radius", number_or_null(c.figures.spectral_radius)}}}};
+              {"spectral_radius", json_number_or_null(c.figures.spectral_radius)}}}};
   if (c.status == CellStatus::kFilled) j["filled_from"] = c.filled_from;
   if (c.status != CellStatus::kIdentified) j["reason"] = c.reason;
   return j;
