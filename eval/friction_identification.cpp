@@ -7,13 +7,10 @@
 #include <stdexcept>
 
 namespace imscal::eval {
-namespace {
 
-// Speed and acceleration of x by central differences inside each segment (one-sided at its ends,
-// acceleration 0 there).
-void derivatives(const std::vector<double>& x, double cycle_s,
-                 const std::vector<std::pair<std::size_t, std::size_t>>& segments,
-                 std::vector<double>& speed, std::vector<double>& acceleration) {
+void path_derivatives(const std::vector<double>& x, double cycle_s,
+                      const std::vector<std::pair<std::size_t, std::size_t>>& segments,
+                      std::vector<double>& speed, std::vector<double>& acceleration) {
   speed.assign(x.size(), 0.0);
   acceleration.assign(x.size(), 0.0);
   for (const auto& [begin, end] : segments)
@@ -23,8 +20,6 @@ void derivatives(const std::vector<double>& x, double cycle_s,
       if (hi - lo == 2) acceleration[k] = (x[hi] - 2.0 * x[k] + x[lo]) / (cycle_s * cycle_s);
     }
 }
-
-}  // namespace
 
 std::vector<ident::JointFrictionLevels> identify_friction_levels(
     const ident::JointErrorLog& log, const ModelTorqueSource& nominal,
@@ -54,8 +49,8 @@ std::vector<ident::JointFrictionLevels> identify_friction_levels(
   std::vector<std::vector<double>> speed(joints), acceleration(joints);
   std::vector<double> unused;
   for (std::size_t j = 0; j < joints; ++j) {
-    derivatives(log.q_internal_rad[j], log.cycle_s, segments, speed[j], unused);
-    derivatives(log.q_desired_rad[j], log.cycle_s, segments, unused, acceleration[j]);
+    path_derivatives(log.q_internal_rad[j], log.cycle_s, segments, speed[j], unused);
+    path_derivatives(log.q_desired_rad[j], log.cycle_s, segments, unused, acceleration[j]);
   }
   // One dead time for the controller: the δ with the least Σ_j (1 − fit_j)² over the joints.
   std::vector<ident::JointFrictionLevels> best;

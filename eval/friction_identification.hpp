@@ -6,7 +6,9 @@
 // path's speed and acceleration by central differences within each segment. The nominal robot's
 // drive values are the prior the estimate starts from and is reported beside; the plant is never
 // read.
+#include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "eval/model_torque.hpp"
@@ -20,6 +22,12 @@ namespace imscal::eval {
 std::vector<ident::JointFrictionLevels> identify_friction_levels(
     const ident::JointErrorLog& log, const ModelTorqueSource& nominal,
     const ident::FrictionLevelOptions& options = {});
+
+// Speed and acceleration of x [rad] by central differences inside each segment (one-sided at its
+// ends, acceleration 0 there).
+void path_derivatives(const std::vector<double>& x, double cycle_s,
+                      const std::vector<std::pair<std::size_t, std::size_t>>& segments,
+                      std::vector<double>& speed, std::vector<double>& acceleration);
 
 // One line per joint for the identification's log.
 std::string describe_friction_levels(const ident::JointFrictionLevels& levels);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -58,15 +59,19 @@ FrictionProblem make_problem(const JointFrictionSignals& s, const FrictionLevelO
 }
 
 // The linear regression of the drive's torque balance: rows k, columns
-//   [e(k−i), i = 0..n−1 | Σ_{m<=k} e(m) Δt | 1 | −tanh(q̇/s) | −q̇ | −q̈],
+//   [e(k−i), i = 0..n−1 | Σ_{m<=k} e(m) Δt | 1 | −tanh(q̇/s) | −q̇ | −q̈ | extra(k − δ)],
 // target the model torque τ(k).
 void regression(const FrictionProblem& pb, const FrictionLevelOptions& options,
-                Eigen::MatrixXd& columns, Eigen::VectorXd& target) {
+                std::span<const std::span<const double>> extra, Eigen::MatrixXd& columns,
+                Eigen::VectorXd& target) {
   const std::size_t n = pb.error.size();
   const int lags = pb.na, sum = lags, one = lags + 1, level = lags + 2;
-  // Per-sample signals: e, ∫e, tanh, q̇, q̈ (at k − δ), τ (at k − δ); then each filtered by the
-  // same moving average within its segment (a linear filter keeps the balance exact).
-  std::vector<std::vector<double>> signal(6, std::vector<double>(n, 0.0));
+  // Per-sample signals: e, ∫e, tanh, q̇, q̈ (at k − δ), τ (at k − δ), the extra ones (at k − δ);
+  // then each filtered by the same moving average within its segment (a linear filter keeps the
+  // balance exact).
+  std::vector<std::vector<double>> signal(6 + extra.size(), std::vector<double>(n, 0.0));
+  for (const auto& x : extra)
+    if (x.size() != n) throw std::invalid_argument("friction balance: extra signal's length");
   for (const auto& [begin, end] : pb.signals->segments) {
     double running = 0.0;
     for (std::size_t k = begin + pb.delay; k < std::min(end, n); ++k) {
@@ -74,6 +79,7 @@ void regression(const FrictionProblem& pb, const FrictionLevelOptions& options,
       signal[1][k] = running += pb.error[k] * options.cycle_s;
       for (int m = 0; m < kLevels; ++m) signal[std::size_t(2 + m)][k] = pb.x(m, k);
       signal[5][k] = pb.signals->model_torque_nm[k - pb.delay];
+      for (std::size_t x = 0; x < extra.size(); ++x) signal[6 + x][k] = extra[x][k - pb.delay];
     }
   }
   const auto width = std::size_t(std::max(1, options.smoothing_samples));
@@ -89,7 +95,7 @@ void regression(const FrictionProblem& pb, const FrictionLevelOptions& options,
     }
     x = std::move(smooth);
   }
-  columns.resize(Eigen::Index(pb.rows.size()), lags + 2 + kLevels);
+  columns.resize(Eigen::Index(pb.rows.size()), lags + 2 + kLevels + Eigen::Index(extra.size()));
   target.resize(columns.rows());
   for (std::size_t row = 0; row < pb.rows.size(); ++row) {
     const std::size_t k = pb.rows[row];
@@ -99,6 +105,8 @@ void regression(const FrictionProblem& pb, const FrictionLevelOptions& options,
     columns(i, one) = 1.0;
     for (int m = 0; m < kLevels; ++m) columns(i, level + m) = -signal[std::size_t(2 + m)][k];
     target(i) = signal[5][k];
+    for (std::size_t x = 0; x < extra.size(); ++x)
+      columns(i, level + kLevels + Eigen::Index(x)) = signal[6 + x][k];
   }
 }
 
@@ -150,7 +158,7 @@ JointFrictionLevels estimate_at(const JointFrictionSignals& signals,
   }
   Eigen::MatrixXd columns;
   Eigen::VectorXd target;
-  regression(pb, options, columns, target);
+  regression(pb, options, {}, columns, target);
   const Eigen::MatrixXd inverse = normal_inverse(columns);
   if (inverse.size() == 0) {
     out.not_estimated = "the joint's motion does not separate the friction levels";
@@ -193,6 +201,19 @@ JointFrictionLevels estimate_friction_levels(const JointFrictionSignals& signals
     out.estimated = false;
     out.not_estimated = "the model torque is too small against the friction to fix the scale";
   }
+  return out;
+}
+
+FrictionBalanceRegression friction_balance_regression(
+    const JointFrictionSignals& signals, const FrictionLevelOptions& options, int dead_time_cycles,
+    std::span<const std::span<const double>> extra) {
+  if (dead_time_cycles < 0)
+    throw std::invalid_argument("friction balance: dead time must be >= 0 cycles");
+  const FrictionProblem pb = make_problem(signals, options, dead_time_cycles);
+  FrictionBalanceRegression out;
+  out.drive_columns = pb.parameter_count();
+  regression(pb, options, extra, out.columns, out.target);
+  out.samples = pb.rows;
   return out;
 }
 

@@ -24,11 +24,13 @@
 //
 // References (docs/references.md): [Ljung1999] (least squares and the covariance of its
 // estimates).
+#include <Eigen/Core>
 #include <cstddef>
 #include <limits>
 #include <span>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace imscal::ident {
 
@@ -95,5 +97,20 @@ JointFrictionLevels estimate_friction_levels(const JointFrictionSignals& signals
                                              const FrictionPrior& prior,
                                              const FrictionLevelOptions& options,
                                              int dead_time_cycles);
+
+// The balance's regression at dead time δ, for estimators that add columns to it: per row the
+// drive's columns [e(k−i), i < n | Σ e Δt | 1 | −tanh(q̇_m/s) | −q̇_m | −q̈_d], then one column per
+// extra per-sample signal (taken at k − δ like τ), all through the same moving average; the
+// target τ(k − δ) filtered alike. Throws std::invalid_argument for signals of different lengths
+// or δ < 0.
+struct FrictionBalanceRegression {
+  Eigen::MatrixXd columns;
+  Eigen::VectorXd target;
+  int drive_columns = 0;             // the leading columns that are the drive's
+  std::vector<std::size_t> samples;  // each row's sample index k
+};
+FrictionBalanceRegression friction_balance_regression(
+    const JointFrictionSignals& signals, const FrictionLevelOptions& options, int dead_time_cycles,
+    std::span<const std::span<const double>> extra);
 
 }  // namespace imscal::ident

@@ -10,6 +10,7 @@
 #include "eval/friction_identification.hpp"
 #include "sim/plant_config.hpp"
 #include "sim/plant_simulator.hpp"
+#include "tests/eval/encoder_record.hpp"
 #include "tests/sim/plant_test_paths.hpp"
 
 namespace imscal::eval {
@@ -42,23 +43,7 @@ ident::JointErrorLog record_of(const calib::RobotDescription& plant) {
   const sim::DesiredJointPath path = friction_path();
   const sim::PlantLog run =
       sim::simulate_plant(sim::make_plant_config(plant, nullptr), path, path.cycle_s);
-  ident::JointErrorLog log;
-  log.robot = plant.name;
-  log.cycle_s = path.cycle_s;
-  log.joint_names = {"A1", "A2", "A3", "A4", "A5", "A6"};
-  log.q_desired_rad.assign(6, {});
-  log.q_measured_rad.assign(6, {});
-  log.q_internal_rad.assign(6, {});
-  for (std::size_t k = 0; k < std::min(path.samples.size(), run.samples.size()); ++k) {
-    log.time_s.push_back(path.samples[k].t_s);
-    log.payload_kg.push_back(0.0);
-    for (std::size_t j = 0; j < 6; ++j) {
-      log.q_desired_rad[j].push_back(path.samples[k].q_rad(int(j)));
-      log.q_measured_rad[j].push_back(run.samples[k].q_link_rad(int(j)));
-      log.q_internal_rad[j].push_back(run.samples[k].q_motor_rad(int(j)));
-    }
-  }
-  return log;
+  return test::encoder_record(plant.name, path, run);
 }
 
 calib::RobotDescription with_friction_times(double factor) {
