@@ -266,9 +266,9 @@ class GapHarnessWide : public test_support::ScratchDirTest {
 // beyond on A6 (an error after its fast cross move that the budget has no column for). Every case
 // carries its noise floor (gap_cases.hpp), so the measurement budget tests the generated controls
 // as it tests a record (0/3 and 0/6 alarms there, were 3/3 and 6/6 without it); it calls seven
-// effects below the noise (true shrinkage 4-12 %) within the measurement, one of which was ranked
-// first without it; effects above the noise (true shrinkage >= 30 %) stay ranked first 18/18 and
-// 13/16. The chain-measured controls are tested against the budget with their frames (decision
+// effects below the noise (true shrinkage -4 to 12 %) within the measurement, one of which was
+// ranked first without it; effects above the noise (true shrinkage >= 30 %) stay ranked first 18/18
+// and 13/16. The chain-measured controls are tested against the budget with their frames (decision
 // 0057): 5 of 6 within.
 void expect_goals_or_the_measured_level(const Tally& development, const Tally& held_out,
                                         std::vector<double> chain_rms_rad, int chain_alarms) {
