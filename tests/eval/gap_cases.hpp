@@ -11,11 +11,13 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <Eigen/Geometry>
 
 #include "core/units.hpp"
 #include "eval/gap_candidates.hpp"
 #include "eval/gap_diagnosis.hpp"
+#include "eval/gap_measurement_prior.hpp"
 #include "eval/gap_nominal_plant.hpp"
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table.hpp"
@@ -52,7 +54,9 @@ struct WithheldEffect {
 // `calibrate --frames` -> `model-joint-errors` on a control (test_gap_harness_wide.cpp): per joint
 // an RMS drawn in 5e-5..8e-5 rad, 90 % of its variance a first-order part of 1 s (the chain's
 // error holds at rest and moves with the motions: frames, heading and biases seen from another
-// pose) and 10 % white.
+// pose) and 10 % white; the drawn RMS is the case's noise floor (the header key
+// q_measured_sigma_rms_rad, as calibrate writes the smoother's sigma), which the measurement
+// budget tests the gap against.
 enum class NoiseLevel { kLow, kImsChain };
 
 inline EffectKind expected_kind(const std::string& name) {
@@ -234,13 +238,18 @@ struct GapWorld {
       }
     return int(std::max_element(energy.begin(), energy.end()) - energy.begin());
   }
-  // NoiseLevel::kImsChain: each joint's noise scaled to its drawn RMS over the record.
+  // NoiseLevel::kImsChain: each joint's noise scaled to its drawn RMS over the record. The drawn
+  // RMS is written into the log's header as the noise floor (kNoiseFloorKey), as `imscal
+  // calibrate` writes the smoother's sigma into a measured joint_errors.csv: the diagnosis's
+  // measurement budget then tests the case as it tests a real record.
   static void add_ims_chain_noise(std::mt19937_64& rng, ident::JointErrorLog& log) {
     std::uniform_real_distribution<double> rms_rad(5e-5, 8e-5);
+    std::string floor;
     std::normal_distribution<double> unit(0.0, 1.0);
     const double phi = std::exp(-log.cycle_s / 1.0);
     for (auto& qm : log.q_measured_rad) {
       const double rms = rms_rad(rng);
+      floor += fmt::format("{}{:.17g}", floor.empty() ? "" : ",", rms);
       std::vector<double> slow(qm.size()), fast(qm.size());
       double ar = unit(rng), e_slow = 0.0, e_fast = 0.0;
       for (std::size_t k = 0; k < qm.size(); ++k) {
@@ -252,6 +261,7 @@ struct GapWorld {
       const double a = rms * std::sqrt(0.9 * n / e_slow), b = rms * std::sqrt(0.1 * n / e_fast);
       for (std::size_t k = 0; k < qm.size(); ++k) qm[k] += a * slow[k] + b * fast[k];
     }
+    log.metadata.emplace_back(kNoiseFloorKey, floor);
   }
 
   // One speed dimension per joint: joint `joint` identified up to v_id (the band above filled),

@@ -42,8 +42,11 @@ struct Score {
 inline Score score_case(const GapWorld& world, const HarnessCase& hc,
                         std::map<std::string, std::map<std::string, int>>& confusion) {
   const auto c = world.make_case(hc.effects, hc.seed, hc.noise);
-  const GapSignals signals =
+  GapSignals signals =
       make_gap_signals(c.real, c.sim_joint_error_rad, world.robot, c.table ? &*c.table : nullptr);
+  // The noise floor from the case's header where it has one, as `imscal diagnose` reads it.
+  signals.measurement.noise_floor_rad = noise_floor_from_log(c.real, "the case's joint errors");
+  if (signals.measurement.known()) signals.measurement.source = "the case's noise floor";
   // The joint model refined on the simulator of the nominal model, as the lab has it
   // (eval/gap_refinement.hpp); linear only under the sanitizers (~10 more plant runs a case).
   const Diagnosis d = diagnose_gap(signals, DiagnosisOptions{}, sanitized() ? nullptr : &c.nominal);

@@ -2,7 +2,8 @@
 // program, low noise): three more motion programs (joint and line moves, a shortened ISO 9283 set,
 // the paper's line; tests/data/scenarios/gap-*-program.yaml), effects switched and resized, two
 // and three effects at once, every case at the IMS chain's noise (gap_cases.hpp
-// NoiseLevel::kImsChain: 5e-5..8e-5 rad RMS per joint), and controls measured through the chain
+// NoiseLevel::kImsChain: 5e-5..8e-5 rad RMS per joint, with that floor in the case's header as a
+// record has it), and controls measured through the chain
 // itself (`simulate` -> `calibrate --frames` -> `model-joint-errors` -> `diagnose`, on a plant
 // equal to the nominal model, so that the chain's own error is all the gap there is). The cases
 // are split into a development set and a held-out set, both fixed before either was run (decision
@@ -257,25 +258,31 @@ class GapHarnessWide : public test_support::ScratchDirTest {
 
 // The goals on both sets: ranked first >= 90 %, joint located >= 90 %, shrinkage within
 // ±20 pp >= 85 %, every effect of a multi-effect case found >= 80 %, false alarms <= 10 % with
-// the chain-measured controls. Met: the shrinkage (development 22/24, held out 23/24). Missed, and
-// held here at the measured level so that a fall shows (decisions 0050, 0057 and 0058 say why):
-// ranked first 20/24 and 18/24, joint located 21/24 and 21/24, multi-effect 4/6 and 2/6 (effects at
-// the noise floor; a member of one joint standing for another's), false alarms 3/6 and 7/9: the
-// generated controls' chain-like noise holds at rest and moves with the pose, which drift,
-// kinematic, IMS-bias and time-offset candidates fit on the training blocks and carry to the
-// held-out ones (those cases carry no noise floor, so the measurement budget does not test them).
-// The chain-measured controls are tested against the budget with their frames (decision 0057): 5
-// of 6 within; the mixed program on mount 2 stays beyond on A6 (an error after its fast cross move
-// that the budget has no column for).
+// the chain-measured controls. Met: the shrinkage (development 22/24, held out 23/24) and the
+// false alarms on the development set (0/6). Missed, and held here at the measured level so that
+// a fall shows (decisions 0050, 0057, 0058 and 0064 say why): ranked first 19/24 and 18/24, joint
+// located 20/24 and 20/24, multi-effect 4/6 and 2/6 (effects at the noise floor; a member of one
+// joint standing for another's), false alarms 1/9 held out: the mixed program on mount 2 stays
+// beyond on A6 (an error after its fast cross move that the budget has no column for). Every case
+// carries its noise floor (gap_cases.hpp), so the measurement budget tests the generated controls
+// as it tests a record (0/3 and 0/6 alarms there, were 3/3 and 6/6 without it); it calls seven
+// effects below the noise (true shrinkage -4 to 12 %) within the measurement, one of which was
+// ranked first without it; effects above the noise (true shrinkage >= 30 %) stay ranked first 18/18
+// and 13/16. The chain-measured controls are tested against the budget with their frames (decision
+// 0057): 5 of 6 within.
 void expect_goals_or_the_measured_level(const Tally& development, const Tally& held_out,
                                         std::vector<double> chain_rms_rad, int chain_alarms) {
   EXPECT_LE(chain_alarms, 1);
+  EXPECT_LE(development.alarms, 0);
+  EXPECT_LE(held_out.alarms, 1);
   EXPECT_GE(pct(development.within, development.effect_cases), 85.0);
   EXPECT_GE(pct(held_out.within, held_out.effect_cases), 85.0);
-  EXPECT_GE(development.first, 20);
+  EXPECT_GE(development.first, 19);
   EXPECT_GE(held_out.first, 18);
-  EXPECT_GE(development.located, 21);
-  EXPECT_GE(held_out.located, 21);
+  EXPECT_GE(development.above_noise_first, 18);
+  EXPECT_GE(held_out.above_noise_first, 13);
+  EXPECT_GE(development.located, 20);
+  EXPECT_GE(held_out.located, 20);
   EXPECT_GE(development.all_found, 4);
   EXPECT_GE(held_out.all_found, 2);
   // The chain measured at its level: the median of its error RMS over the 36 joint records within
