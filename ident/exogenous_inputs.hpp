@@ -20,12 +20,18 @@
 // link, and at the joint speed ẋ it oscillates at Ω = f ẋ, where the locked-motor mode
 // H(s) = ω_n² / (s² + 2 ζ ω_n s + ω_n²) turns sin φ into Im(H(jΩ) e^{jφ}) and cos φ into
 // Re(H(jΩ) e^{jφ}). The pair then carries the resonance the inputs' FIR taps cannot follow
-// (decay time 1 / (ζ ω_n) ≈ 0.2 s at 15 Hz, 5 %); ω_n = 0 gives H = 1, the plain pair.
+// (decay time 1 / (ζ ω_n) ≈ 0.2 s at 15 Hz, 5 %); ω_n = 0 gives H = 1, the plain pair. Along a
+// path (the identification's segments, the precontrol's model steps) the pair is the mode as a
+// filter with state instead (ident/gear_mode_filter.hpp, exogenous_values with an
+// ExogenousFilterState), whose steady state is that response: it follows the error's frequency
+// sweeping through the mode faster than the mode's decay, which the steady state does not.
 #include <array>
 #include <cmath>
 #include <complex>
 #include <span>
 #include <string>
+
+#include "ident/gear_mode_filter.hpp"
 
 namespace imscal::ident {
 
@@ -169,6 +175,57 @@ inline double exogenous_value(TableInput input, const ExogenousParameters& p,
 inline void exogenous_values(std::span<const TableInput> inputs, const ExogenousParameters& p,
                              const ExogenousSample& s, double* values) noexcept {
   for (std::size_t e = 0; e < inputs.size(); ++e) values[e] = exogenous_value(inputs[e], p, s);
+}
+
+// The further inputs' state along a path: the gear mode's filter of each transmission-error pair.
+struct ExogenousFilterState {
+  GearModeStep mode;  // Φ for the joint's mode and the path's step
+  GearModeFilterState pair_1, pair_2;
+};
+
+// Sets the mode for a path sampled every step_s and restarts both pairs: the next sample settles
+// them at its own speed.
+inline void restart_exogenous_filter(ExogenousFilterState& state, const ExogenousParameters& p,
+                                     double step_s) noexcept {
+  state.mode =
+      gear_mode_step(p.transmission_error_mode_rad_s, p.transmission_error_mode_damping, step_s);
+  state.pair_1.started = false;
+  state.pair_2.started = false;
+}
+
+// The values of `inputs` of the next sample of a path: with a gear mode, each transmission-error
+// pair through the mode's filter (advanced once per call), otherwise as exogenous_values.
+inline void exogenous_values(std::span<const TableInput> inputs, const ExogenousParameters& p,
+                             const ExogenousSample& s, ExogenousFilterState& state,
+                             double* values) noexcept {
+  if (!(p.transmission_error_mode_rad_s > 0.0)) return exogenous_values(inputs, p, s, values);
+  const double motor_angle_rad = transmission_error_motor_angle(p, s);
+  const double f_1 = p.transmission_error_rad_per_rad, f_2 = p.transmission_error_2_rad_per_rad;
+  std::complex<double> y_1, y_2;
+  if (has_input(inputs, TableInput::kTransmissionErrorSin) ||
+      has_input(inputs, TableInput::kTransmissionErrorCos))
+    y_1 = gear_mode_filter_advance(state.mode, state.pair_1, f_1 * motor_angle_rad,
+                                   f_1 * s.speed_rad_s);
+  if (f_2 != 0.0 && (has_input(inputs, TableInput::kTransmissionError2Sin) ||
+                     has_input(inputs, TableInput::kTransmissionError2Cos)))
+    y_2 = gear_mode_filter_advance(state.mode, state.pair_2, f_2 * motor_angle_rad,
+                                   f_2 * s.speed_rad_s);
+  for (std::size_t e = 0; e < inputs.size(); ++e) switch (inputs[e]) {
+      case TableInput::kTransmissionErrorSin:
+        values[e] = y_1.imag();
+        break;
+      case TableInput::kTransmissionErrorCos:
+        values[e] = y_1.real();
+        break;
+      case TableInput::kTransmissionError2Sin:
+        values[e] = y_2.imag();
+        break;
+      case TableInput::kTransmissionError2Cos:
+        values[e] = y_2.real();
+        break;
+      default:
+        values[e] = exogenous_value(inputs[e], p, s);
+    }
 }
 
 }  // namespace imscal::ident

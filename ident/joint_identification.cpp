@@ -169,7 +169,7 @@ struct FitSignals {
 
 // The further inputs' values at every sample of the segments, input after input, along the
 // path `driver` (its speed over one cycle, 0 at a segment's first sample) with the model torque
-// (0 when not given).
+// (0 when not given). A gear mode's filter restarts at each segment's first sample.
 std::vector<std::vector<double>> exogenous_signals(
     std::span<const TableInput> inputs, const ExogenousParameters& parameters,
     std::span<const double> driver, std::span<const double> model_torque_nm,
@@ -177,15 +177,18 @@ std::vector<std::vector<double>> exogenous_signals(
   const std::size_t n = driver.size();
   std::vector<std::vector<double>> values(inputs.size(), std::vector<double>(n, 0.0));
   std::array<double, kMaxExtraInputs> sample_values{};
-  for (const auto& [begin, end] : segments)
+  ExogenousFilterState filter;
+  for (const auto& [begin, end] : segments) {
+    restart_exogenous_filter(filter, parameters, cycle_s);
     for (std::size_t k = begin; k < end; ++k) {
       ExogenousSample sample;
       sample.angle_rad = driver[k];
       sample.speed_rad_s = k > begin ? (driver[k] - driver[k - 1]) / cycle_s : 0.0;
       sample.model_torque_nm = model_torque_nm.empty() ? 0.0 : model_torque_nm[k];
-      exogenous_values(inputs, parameters, sample, sample_values.data());
+      exogenous_values(inputs, parameters, sample, filter, sample_values.data());
       for (std::size_t e = 0; e < inputs.size(); ++e) values[e][k] = sample_values[e];
     }
+  }
   return values;
 }
 

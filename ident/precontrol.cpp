@@ -218,12 +218,12 @@ int Precontrol::read_events(PrecontrolEvent* out, int capacity) noexcept {
   return n;
 }
 
-std::array<double, kArxStepMaxExtras> Precontrol::extra_values(const JointModel& joint, double x,
+std::array<double, kArxStepMaxExtras> Precontrol::extra_values(JointModel& joint, double x,
                                                                double speed,
                                                                double torque) const noexcept {
   std::array<double, kArxStepMaxExtras> value{};
   exogenous_values(std::span(inputs_.data(), std::size_t(extra_count_)), joint.exogenous,
-                   ExogenousSample{x, speed, torque}, value.data());
+                   ExogenousSample{x, speed, torque}, joint.exogenous_filter, value.data());
   return value;
 }
 
@@ -236,6 +236,8 @@ void Precontrol::restart_models(const std::array<double, kPrecontrolJoints>& q,
   for (int j = 0; j < kPrecontrolJoints; ++j) {
     JointModel& joint = joints_[j];
     joint.u.fill(q[j]);
+    // The gear mode's filter settles at rest on this pose; model steps advance it from here.
+    restart_exogenous_filter(joint.exogenous_filter, joint.exogenous, model_sample_s_);
     const std::array<double, kArxStepMaxExtras> x = extra_values(joint, q[j], 0.0, torque[j]);
     for (int e = 0; e < extra_count_; ++e) joint.x[e].fill(x[e]);
     for (int k = 0; k < joint.cells; ++k) {

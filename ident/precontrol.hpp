@@ -195,7 +195,8 @@ class Precontrol {
     std::array<int, 4> centre_count{};
     std::array<double, 4> lower{}, upper{};  // grid bounds (outside: event)
     double backlash_l_rad = 0.0;
-    ExogenousParameters exogenous;  // the constants of the further inputs
+    ExogenousParameters exogenous;          // the constants of the further inputs
+    ExogenousFilterState exogenous_filter;  // the gear mode's filter along the model steps
     // The identification's direction of motion is the desired velocity `backlash_lag` cycles
     // earlier (ident/backlash_identification.hpp): a ring of past speeds [rad/s].
     int backlash_lag = 0;
@@ -214,9 +215,9 @@ class Precontrol {
   void model_step(JointModel& joint, double q_desired, double speed, double acceleration,
                   double payload, double torque, bool& outside) noexcept;
   // The further inputs' values of a model step at input x [rad] (ident/exogenous_inputs.hpp),
-  // table order.
-  std::array<double, kArxStepMaxExtras> extra_values(const JointModel& joint, double x,
-                                                     double speed, double torque) const noexcept;
+  // table order; advances the joint's gear-mode filter by one model step.
+  std::array<double, kArxStepMaxExtras> extra_values(JointModel& joint, double x, double speed,
+                                                     double torque) const noexcept;
   void restart_models(const std::array<double, kPrecontrolJoints>& q_desired,
                       const std::array<double, kPrecontrolJoints>& torque) noexcept;
   PrecontrolOutput run_cycle(const std::array<double, kPrecontrolJoints>& q_desired_rad,

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <new>
+#include <numbers>
 #include <random>
 #include <string>
 
@@ -41,9 +42,10 @@ constexpr double kTeRadPerRad = 160.0, kTeCompliance = 1.0 / 4.5e5;
 // transmission-error pair with transmission_error); the taps per input vary between cells
 // (1..12 for torque and direction, 1 for the torque sign, 1..8 for the pair), so that every sum
 // has its own length. with_inputs = false: the same table with zero further coefficients.
-// second_pair: also the second transmission-error pair (f_2 = 2.5 x 160 rad/rad).
+// second_pair: also the second transmission-error pair (f_2 = 2.5 x 160 rad/rad). gear_mode: the
+// pairs through a 15 Hz, 5 % gear mode (ident/gear_mode_filter.hpp, a filter with state).
 ParameterTable multi_input_table(bool with_inputs, bool transmission_error = false,
-                                 bool second_pair = false) {
+                                 bool second_pair = false, bool gear_mode = false) {
   std::mt19937_64 rng(61);
   ParameterTable t;
   t.robot = "kr16";
@@ -71,6 +73,10 @@ ParameterTable multi_input_table(bool with_inputs, bool transmission_error = fal
       joint.transmission_error_compliance_rad_per_nm = kTeCompliance;
     }
     if (second_pair) joint.transmission_error_2_rad_per_rad = 2.5 * kTeRadPerRad;
+    if (gear_mode) {
+      joint.transmission_error_mode_rad_s = 2.0 * std::numbers::pi * 15.0;
+      joint.transmission_error_mode_damping = 0.05;
+    }
     for (int c = 0; c < 6; ++c) {
       CellParameters cp;
       cp.bands = {c / 2, c % 2};
@@ -99,8 +105,9 @@ ParameterTable multi_input_table(bool with_inputs, bool transmission_error = fal
   return t;
 }
 
-void expect_same_offsets_as_the_reference(bool transmission_error, bool second_pair = false) {
-  const ParameterTable t = multi_input_table(true, transmission_error, second_pair);
+void expect_same_offsets_as_the_reference(bool transmission_error, bool second_pair = false,
+                                          bool gear_mode = false) {
+  const ParameterTable t = multi_input_table(true, transmission_error, second_pair, gear_mode);
   PrecontrolOptions o;
   o.offset_tolerance_rad.fill(0.05);
   // The offset's rate reaches the joint speed when a move starts (the models lag the command):
@@ -113,7 +120,8 @@ void expect_same_offsets_as_the_reference(bool transmission_error, bool second_p
   ASSERT_TRUE(Precontrol::create(t, "kr16", o, &p, &why)) << why;
   ASSERT_TRUE(test_support::AllCellsPrecontrol::create(t, "kr16", o, &reference, &why)) << why;
   ASSERT_TRUE(test_support::AllCellsPrecontrol::create(
-      multi_input_table(false, transmission_error, second_pair), "kr16", o, &without_inputs, &why))
+      multi_input_table(false, transmission_error, second_pair, gear_mode), "kr16", o,
+      &without_inputs, &why))
       << why;
   ASSERT_TRUE(p.needs_model_torque());
   ASSERT_TRUE(reference.needs_model_torque());
@@ -195,6 +203,12 @@ TEST(PrecontrolFurtherInputs, TheSecondTransmissionErrorPairGivesTheReferenceOff
   expect_same_offsets_as_the_reference(true, true);
 }
 
+// Both pairs through the gear mode's filter: its state restarts with the models (start, each
+// re-activation) and advances once per model step, as in the reference.
+TEST(PrecontrolFurtherInputs, TheGearModeFilterGivesTheReferenceOffsets) {
+  expect_same_offsets_as_the_reference(true, true, true);
+}
+
 // A table with the pair needs each joint's phase rate (> 0), and the compliance the model torque.
 TEST(PrecontrolFurtherInputs, TransmissionErrorWithoutAPhaseRateIsRefused) {
   PrecontrolOptions o;
@@ -216,7 +230,8 @@ TEST(PrecontrolFurtherInputs, TransmissionErrorWithoutAPhaseRateIsRefused) {
 
 // The heaviest table of the precontrol's benchmark (bench/bench_precontrol.cpp, the same motion):
 // order 32 in every cell of a 3 x 2 grid, the model torque and direction with 32 taps, the
-// torque sign with one and the transmission-error pair with 32 each.
+// torque sign with one and the transmission-error pair with 32 each; the odd joints' pair through
+// a gear mode (the filter with state runs inside the cycle too).
 ParameterTable order_32_grid_table() {
   std::mt19937_64 rng(32);
   ParameterTable t;
@@ -233,6 +248,10 @@ ParameterTable order_32_grid_table() {
     joint.torque_sign_scale_nm = 1.0;
     joint.transmission_error_rad_per_rad = kTeRadPerRad;
     joint.transmission_error_compliance_rad_per_nm = kTeCompliance;
+    if (j % 2 == 1) {
+      joint.transmission_error_mode_rad_s = 2.0 * std::numbers::pi * 15.0;
+      joint.transmission_error_mode_damping = 0.05;
+    }
     for (int c = 0; c < 6; ++c) {
       CellParameters cell;
       cell.bands = {c / 2, c % 2};

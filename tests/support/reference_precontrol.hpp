@@ -107,7 +107,8 @@ class AllCellsPrecontrol {
     std::array<int, 4> centre_count{};
     std::array<double, 4> lower{}, upper{};  // grid bounds (outside: event)
     double backlash_l_rad = 0.0;
-    ExogenousParameters exogenous;  // the constants of the further inputs
+    ExogenousParameters exogenous;          // the constants of the further inputs
+    ExogenousFilterState exogenous_filter;  // the gear mode's filter along the model steps
     // The identification's direction of motion is the desired velocity `backlash_lag` cycles
     // earlier (ident/backlash_identification.hpp): a ring of past speeds [rad/s].
     int backlash_lag = 0;
@@ -125,7 +126,7 @@ class AllCellsPrecontrol {
 
   void model_step(JointModel& joint, double q_desired, double speed, double acceleration,
                   double payload, double torque, bool& outside) noexcept;
-  std::array<double, kMaxExtras> extra_values(const JointModel& joint, double x, double speed,
+  std::array<double, kMaxExtras> extra_values(JointModel& joint, double x, double speed,
                                               double torque) const noexcept;
   void restart_models(const std::array<double, kPrecontrolJoints>& q_desired,
                       const std::array<double, kPrecontrolJoints>& torque) noexcept;
@@ -284,10 +285,10 @@ inline int AllCellsPrecontrol::read_events(PrecontrolEvent* out, int capacity) n
 }
 
 inline std::array<double, AllCellsPrecontrol::kMaxExtras> AllCellsPrecontrol::extra_values(
-    const JointModel& joint, double x, double speed, double torque) const noexcept {
+    JointModel& joint, double x, double speed, double torque) const noexcept {
   std::array<double, kMaxExtras> value{};
   exogenous_values(std::span(inputs_.data(), std::size_t(extra_count_)), joint.exogenous,
-                   ExogenousSample{x, speed, torque}, value.data());
+                   ExogenousSample{x, speed, torque}, joint.exogenous_filter, value.data());
   return value;
 }
 
@@ -300,6 +301,7 @@ inline void AllCellsPrecontrol::restart_models(
   for (int j = 0; j < kPrecontrolJoints; ++j) {
     JointModel& joint = joints_[j];
     joint.u.fill(q[j]);
+    restart_exogenous_filter(joint.exogenous_filter, joint.exogenous, model_sample_s_);
     const std::array<double, kMaxExtras> x = extra_values(joint, q[j], 0.0, torque[j]);
     for (int e = 0; e < extra_count_; ++e) joint.x[e].fill(x[e]);
     for (int k = 0; k < joint.cells; ++k) {
