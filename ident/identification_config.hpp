@@ -60,9 +60,9 @@ struct IdentificationConfig {
   // joint has no second order, its model leaves the pair out (zero coefficients in the table).
   std::vector<double> transmission_error_second_harmonic_per_joint;
   // `model.transmission_error_gear_mode:` each joint's transmission-error pairs through its
-  // locked-motor gear mode (ident/exogenous_inputs.hpp), the mode found before identifying
-  // (eval/transmission_error_gear_mode.hpp): per joint its natural frequency [rad/s] and damping
-  // ratio (empty, or 0 for a joint: the plain pair).
+  // locked-motor gear mode as a filter with state along the path (ident/gear_mode_filter.hpp),
+  // the mode found before identifying (eval/transmission_error_gear_mode.hpp): per joint its
+  // natural frequency [rad/s] and damping ratio (empty, or 0 for a joint: the plain pair).
   bool transmission_error_gear_mode = false;
   std::vector<double> transmission_error_mode_rad_s;
   std::vector<double> transmission_error_mode_damping;
