@@ -16,6 +16,7 @@
 #include "eval/gap_filters.hpp"
 #include "eval/gap_joint_stack.hpp"
 #include "eval/gap_normal_equations.hpp"
+#include "eval/gap_shape_choice.hpp"
 #include "eval/gap_validation.hpp"
 
 namespace imscal::eval {
@@ -233,9 +234,6 @@ std::vector<Eigen::MatrixXd> join_columns(const std::vector<Eigen::MatrixXd>& a,
 
 namespace {
 
-// Relative margin within which the shape with fewer parameters wins the validation.
-constexpr double kShapeParsimony = 0.01;
-
 // The size of the effect in words, in the effect's own terms where it has them.
 std::string size_in_words(const CandidateFit& c, const CandidateShape& sh, double own_rms) {
   const auto own_words = effect_definition(c.kind).size_in_words;
@@ -257,28 +255,12 @@ LinearFit fit_bounded(CandidateFit& c, const GapSignals& s, const std::vector<bo
 
 std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, std::size_t joint,
                                           const std::vector<bool>& training) {
-  const std::vector<CandidateShape> shapes = candidate_shapes(kind, s, joint, &training);
-  if (shapes.empty()) return std::nullopt;
-  // The shape is chosen by the 2-fold validation inside the training rows
-  // (eval/gap_validation.hpp). Of shapes within 1 % of the best validation error, the one with the
-  // fewest parameters.
+  // The shape the 2-fold validation inside the training rows chooses (eval/gap_shape_choice.hpp).
   const TrainingFolds folds = training_folds(s, training);
+  const std::optional<CandidateShape> chosen = chosen_shape(kind, s, joint, training, folds);
+  if (!chosen) return std::nullopt;
+  const CandidateShape& sh = *chosen;
   const Eigen::Index n = Eigen::Index(s.sample_count());
-  std::size_t chosen = 0;
-  if (shapes.size() > 1 && folds.usable()) {
-    std::vector<double> score;
-    for (const auto& sh : shapes)
-      score.push_back(cross_validation_sse(sh.columns, s.gap_rad, folds));
-    const double best_score = *std::min_element(score.begin(), score.end());
-    const auto width = [&](std::size_t i) { return shapes[i].parameter_names.size(); };
-    for (std::size_t i = 0; i < shapes.size(); ++i) {
-      if (score[i] > best_score * (1.0 + kShapeParsimony)) continue;
-      if (score[chosen] > best_score * (1.0 + kShapeParsimony) || width(i) < width(chosen) ||
-          (width(i) == width(chosen) && score[i] < score[chosen]))
-        chosen = i;
-    }
-  }
-  const CandidateShape& sh = shapes[chosen];
   CandidateFit c;
   c.kind = kind;
   c.joint = joint;

@@ -22,6 +22,27 @@ const std::vector<Basis>& bases() {
   return b;
 }
 
+// Every time scale and order the bases take.
+std::vector<std::pair<double, int>> basis_scales() {
+  std::vector<std::pair<double, int>> scales;
+  for (const Basis& basis : bases())
+    scales.insert(scales.end(), basis.laguerres.begin(), basis.laguerres.end());
+  return scales;
+}
+
+// A basis's columns side by side (samples x its parameters).
+Eigen::MatrixXd basis_matrix(const Basis& basis, const LaguerreBank& filtered) {
+  Eigen::Index width = 0;
+  for (const auto& [tl, order] : basis.laguerres) width += order;
+  Eigen::MatrixXd m(filtered.first(basis.laguerres.front().first, 1).rows(), width);
+  Eigen::Index c = 0;
+  for (const auto& [tl, order] : basis.laguerres) {
+    m.middleCols(c, order) = filtered.first(tl, order);
+    c += order;
+  }
+  return m;
+}
+
 }  // namespace
 
 CouplingColumns coupling_columns(const GapSignals& s,
@@ -48,23 +69,22 @@ CouplingColumns coupling_columns(const GapSignals& s,
     Column u = Column::Zero(n);
     for (std::size_t j = 0; j < nj; ++j)
       if (j != i && acceleration[j].size() == n)
-        u += to_column(s.mass_matrix_kg_m2[i * nj + j]).cwiseProduct(acceleration[j]);
+        u += Eigen::Map<const Column>(s.mass_matrix_kg_m2[i * nj + j].data(), n)
+                 .cwiseProduct(acceleration[j]);
     if (rms_of(u) == 0.0) continue;
     double none = 0.0;  // the validation error without coupling: the residual itself
     for (const auto& fold : folds.folds)
       for (Eigen::Index k : fold) none += residual[i][std::size_t(k)] * residual[i][std::size_t(k)];
     double best = none * (1.0 - kCouplingMinGain);
     Reach chosen{i, {}, {}, {}};
+    const LaguerreBank filtered(u, basis_scales(), s);
     for (const Basis& basis : bases()) {
-      std::vector<Column> cols;
       std::vector<std::string> names;
-      for (const auto& [tl, order] : basis.laguerres) {
-        for (auto& c : laguerre(u, tl, order, s)) cols.push_back(std::move(c));
+      for (const auto& [tl, order] : basis.laguerres)
         for (int o = 0; o < order; ++o)
           names.push_back(fmt::format("{}_coupling_laguerre{:.0f}ms_{}_rad_per_nm",
                                       s.joint_names[i], 1000.0 * tl, o));
-      }
-      const Eigen::MatrixXd m = matrix_of(cols);
+      const Eigen::MatrixXd m = basis_matrix(basis, filtered);
       const double sse = cross_validation_sse(m, residual[i], folds);
       if (sse < best) {
         best = sse;

@@ -80,6 +80,11 @@ struct EffectDefinition {
   const char* what_to_measure;  // the measurement that pins it down, in plain words
   // Its shapes on a joint (eval/gap_candidates.hpp, candidate_shapes); empty: it does not apply.
   std::vector<CandidateShape> (*shapes)(const ShapeContext& context);
+  // An effect with a large grid of shapes (a resonance's frequencies and dampings): their count
+  // and the i-th of `shapes`, built one at a time so that the validation holds one shape at a time
+  // and keeps only the one it chooses (eval/gap_shape_choice.hpp). Null: all at once.
+  std::size_t (*shape_count)(const ShapeContext& context) = nullptr;
+  CandidateShape (*shape_at)(const ShapeContext& context, std::size_t index) = nullptr;
   // Its size in words from the fit of its chosen shape (`own_rms`: the RMS of its modelled gap on
   // its own joint). Null: the first parameter with its sigma.
   std::string (*size_in_words)(const CandidateFit& fit, const CandidateShape& shape,

@@ -1,6 +1,8 @@
 #include "eval/gap_filters.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace imscal::eval {
 
@@ -64,9 +66,12 @@ std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta
   return {y, r};
 }
 
-std::vector<Column> laguerre(const Column& u, double tau_s, int order, const GapSignals& s) {
+namespace {
+
+// The Laguerre filters of u: filter i's value at sample k goes to out(i, k).
+template <typename Out>
+void laguerre_filters(const Column& u, double tau_s, int order, const GapSignals& s, Out&& out) {
   const double a = std::exp(-s.cycle_s / tau_s), g0 = std::sqrt(1.0 - a * a);
-  std::vector<Column> out(std::size_t(order), Column(u.size()));
   for (const auto& [b, e] : s.runs) {
     if (e <= b) continue;
     const double u0 = u[Eigen::Index(b)];
@@ -80,12 +85,44 @@ std::vector<Column> laguerre(const Column& u, double tau_s, int order, const Gap
         const double next = i == 0 ? a * yi + g0 * x : a * yi + x_previous[std::size_t(i)] - a * x;
         x_previous[std::size_t(i)] = x;
         yi = next;
-        out[std::size_t(i)][Eigen::Index(k)] = next;
+        out(i, Eigen::Index(k)) = next;
         x = next;
       }
     }
   }
+}
+
+}  // namespace
+
+std::vector<Column> laguerre(const Column& u, double tau_s, int order, const GapSignals& s) {
+  std::vector<Column> out(std::size_t(order), Column(u.size()));
+  laguerre_filters(u, tau_s, order, s,
+                   [&](int i, Eigen::Index k) -> double& { return out[std::size_t(i)][k]; });
   return out;
+}
+
+LaguerreBank::LaguerreBank(const Column& u, const std::vector<std::pair<double, int>>& scales,
+                           const GapSignals& s) {
+  std::vector<std::pair<double, int>> highest;  // (time scale, highest order), first asked first
+  for (const auto& [tau_s, order] : scales) {
+    const auto same = [tau_s = tau_s](const auto& h) { return h.first == tau_s; };
+    const auto it = std::find_if(highest.begin(), highest.end(), same);
+    if (it == highest.end())
+      highest.emplace_back(tau_s, order);
+    else
+      it->second = std::max(it->second, order);
+  }
+  for (const auto& [tau_s, order] : highest) {
+    Eigen::MatrixXd m(u.size(), order);
+    laguerre_filters(u, tau_s, order, s, [&](int i, Eigen::Index k) -> double& { return m(k, i); });
+    filters_.emplace_back(tau_s, std::move(m));
+  }
+}
+
+Eigen::Ref<const Eigen::MatrixXd> LaguerreBank::first(double tau_s, int order) const {
+  for (const auto& [scale_s, filters] : filters_)
+    if (scale_s == tau_s && order <= filters.cols()) return filters.leftCols(order);
+  throw std::logic_error("LaguerreBank: a time scale or order not filtered");
 }
 
 Column relay(const Column& z, double h, const GapSignals& s) {

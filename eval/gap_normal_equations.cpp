@@ -11,10 +11,49 @@ namespace {
 // matrix product's packing costs more than it saves for so few.
 constexpr Eigen::Index kDotProductColumns = 4;
 
-}  // namespace
+// From this many columns on, the columns that are zero on every sample (the other joints' blocks
+// of a fit stacked over joints, eval/gap_joint_stack.hpp) are left out of the products: their
+// Gram entries stay as they are. Fewer columns: checking them costs about what it saves.
+constexpr Eigen::Index kSkipZeroColumnsFrom = 8;
 
-void add_augmented_gram(const Eigen::MatrixXd& x, const std::vector<double>& y,
-                        const std::vector<Eigen::Index>& rows, Eigen::MatrixXd& a) {
+// The columns of x with a value other than 0 (NaN counts).
+std::vector<Eigen::Index> nonzero_columns(const Eigen::MatrixXd& x) {
+  std::vector<Eigen::Index> cols;
+  for (Eigen::Index c = 0; c < x.cols(); ++c)
+    for (Eigen::Index k = 0; k < x.rows(); ++k)
+      if (x(k, c) != 0.0) {
+        cols.push_back(c);
+        break;
+      }
+  return cols;
+}
+
+void add_gram_of_runs(const Eigen::MatrixXd& x, const std::vector<double>& y,
+                      const std::vector<Eigen::Index>& rows, Eigen::MatrixXd& a);
+
+// add_augmented_gram of the columns `cols` of x only (ascending): their rows gathered into one
+// run, its Gram matrix added at their places in `a`.
+void add_gram_of_columns(const Eigen::MatrixXd& x, const std::vector<double>& y,
+                         const std::vector<Eigen::Index>& rows,
+                         const std::vector<Eigen::Index>& cols, Eigen::MatrixXd& a) {
+  const Eigen::Index p = x.cols(), k = Eigen::Index(cols.size());
+  const Eigen::MatrixXd gathered = x(rows, cols);
+  std::vector<double> y_gathered(rows.size());
+  std::vector<Eigen::Index> all(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    y_gathered[i] = y[std::size_t(rows[i])], all[i] = Eigen::Index(i);
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(k + 1, k + 1);
+  add_gram_of_runs(gathered, y_gathered, all, g);
+  for (Eigen::Index c = 0; c < k; ++c) {
+    for (Eigen::Index d = 0; d <= c; ++d) a(cols[std::size_t(c)], cols[std::size_t(d)]) += g(c, d);
+    a(p, cols[std::size_t(c)]) += g(k, c);
+  }
+  a(p, p) += g(k, k);
+}
+
+// add_augmented_gram over every column of x, run of consecutive rows by run.
+void add_gram_of_runs(const Eigen::MatrixXd& x, const std::vector<double>& y,
+                      const std::vector<Eigen::Index>& rows, Eigen::MatrixXd& a) {
   const Eigen::Index p = x.cols();
   auto xtx = a.topLeftCorner(p, p);
   for (std::size_t i = 0; i < rows.size();) {
@@ -36,6 +75,17 @@ void add_augmented_gram(const Eigen::MatrixXd& x, const std::vector<double>& y,
     a(p, p) += yb.squaredNorm();
     i = end;
   }
+}
+
+}  // namespace
+
+void add_augmented_gram(const Eigen::MatrixXd& x, const std::vector<double>& y,
+                        const std::vector<Eigen::Index>& rows, Eigen::MatrixXd& a) {
+  if (x.cols() >= kSkipZeroColumnsFrom) {
+    const std::vector<Eigen::Index> cols = nonzero_columns(x);
+    if (Eigen::Index(cols.size()) < x.cols()) return add_gram_of_columns(x, y, rows, cols, a);
+  }
+  add_gram_of_runs(x, y, rows, a);
 }
 
 Eigen::MatrixXd augmented_gram(const Eigen::MatrixXd& x, const std::vector<double>& y,

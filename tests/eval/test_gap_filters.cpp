@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
+#include <utility>
 
 #include "eval/gap_filters.hpp"
 
@@ -44,6 +46,25 @@ TEST(GapFilters, LaguerreImpulseResponsesAreOrthonormal) {
   for (std::size_t i = 0; i < l.size(); ++i)
     for (std::size_t j = 0; j < l.size(); ++j)
       EXPECT_NEAR(l[i].dot(l[j]), i == j ? 1.0 : 0.0, 1e-12) << i << "," << j;
+}
+
+TEST(GapFilters, LaguerreBankGivesTheFiltersOfEveryOrderAsked) {
+  // A lower order's filters are the first of a higher order's: the bank filters each time scale
+  // once, at its highest order, and must give bit for bit what laguerre() gives for each order
+  // asked, over two runs (each restarted at its first input).
+  const GapSignals s = record(400, {{0, 150}, {150, 400}});
+  Column u(400);
+  for (Eigen::Index k = 0; k < 400; ++k) u[k] = std::sin(0.05 * double(k)) + 0.01 * double(k % 7);
+  const LaguerreBank bank(u, {{0.01, 4}, {0.03, 6}, {0.03, 3}, {0.01, 2}}, s);
+  for (const auto& [tau_s, order] :
+       {std::pair{0.01, 4}, std::pair{0.01, 2}, std::pair{0.03, 6}, std::pair{0.03, 3}}) {
+    const std::vector<Column> direct = laguerre(u, tau_s, order, s);
+    const Eigen::MatrixXd banked = bank.first(tau_s, order);
+    ASSERT_EQ(banked.cols(), order);
+    for (int i = 0; i < order; ++i) EXPECT_EQ(banked.col(i), direct[std::size_t(i)]) << tau_s << i;
+  }
+  EXPECT_THROW(bank.first(0.1, 1), std::logic_error);
+  EXPECT_THROW(bank.first(0.01, 5), std::logic_error);
 }
 
 TEST(GapFilters, SecondOrderStepResponseFollowsTheClosedForm) {

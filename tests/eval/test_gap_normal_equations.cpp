@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "eval/gap_candidates.hpp"
@@ -131,6 +133,30 @@ TEST(GapNormalEquations, RefusesIllConditionedOrZeroColumns) {
   Problem zero = p;
   zero.x.col(2).setZero();
   EXPECT_FALSE(solve_normal_equations(augmented_gram(zero.x, zero.y, all)));
+}
+
+TEST(GapNormalEquations, ZeroColumnsOfAWideMatrixLeaveTheirEntriesAlone) {
+  // A stacked fit's columns: this joint's four columns at the middle of twelve, the other joints'
+  // blocks zero (the wide path leaves them out of the products). Truth: [X y]^T [X y] on the
+  // gathered rows, by a plain matrix product. Tolerance 1e-12 of the entries' scale: the same
+  // sums in another order.
+  const Problem p = random_problem(11);
+  Eigen::MatrixXd wide = Eigen::MatrixXd::Zero(kSamples, 12);
+  wide.middleCols(5, 4) = p.x;
+  const std::vector<Eigen::Index> rows = chunked_rows(3, 50, 120);
+  Eigen::MatrixXd xy(Eigen::Index(rows.size()), 13);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    xy.row(Eigen::Index(i)).head(12) = wide.row(rows[i]);
+    xy(Eigen::Index(i), 12) = p.y[std::size_t(rows[i])];
+  }
+  const Eigen::MatrixXd truth = xy.transpose() * xy;
+  Eigen::MatrixXd gram = Eigen::MatrixXd::Constant(13, 13, 0.5);  // added to, as across joints
+  add_augmented_gram(wide, p.y, rows, gram);
+  for (Eigen::Index c = 0; c < 13; ++c)
+    for (Eigen::Index d = 0; d <= c; ++d) {
+      const double scale = std::sqrt(truth(c, c) * truth(d, d));
+      EXPECT_NEAR(gram(c, d) - 0.5, truth(c, d), 1e-12 * std::max(scale, 1.0)) << c << "," << d;
+    }
 }
 
 TEST(GapNormalEquations, CrossValidationMatchesFoldFitsByQr) {
