@@ -1,5 +1,5 @@
-// Transmission error: s, c = sin/cos(h N q_internal), h = 1..3 per motor revolution and the two
-// orders of 1..8 whose raw ripple best fits the training rows: raw, through L_3ms (x3, x4),
+// Transmission error: s, c = sin/cos(h N q_internal), h the order of 1..8 per motor revolution
+// whose raw ripple best fits the training rows (1..3 without them): raw, through L_3ms (x3, x4),
 // L_10ms or L_30ms (x4), or with the ripple torque tau_d s, tau_d c (the gear's virtual work on the
 // motor) through L_100ms x3 beside L_10ms x3 or L_3ms + L_30ms x3 of s, c: below the loop's
 // bandwidth the link follows the error, above the link's mode it does not. In the nominal model:
