@@ -257,10 +257,11 @@ class GapHarnessWide : public test_support::ScratchDirTest {
 
 // The goals on both sets: ranked first >= 90 %, joint located >= 90 %, shrinkage within
 // ±20 pp >= 85 %, every effect of a multi-effect case found >= 80 %, false alarms <= 10 % with
-// the chain-measured controls. Met: the shrinkage (development 22/24, held out 23/24). Missed, and
-// held here at the measured level so that a fall shows (decisions 0050, 0057 and 0058 say why):
-// ranked first 20/24 and 18/24, joint located 21/24 and 21/24, multi-effect 4/6 and 2/6 (effects at
-// the noise floor; a member of one joint standing for another's), false alarms 3/6 and 7/9: the
+// the chain-measured controls. Met: the shrinkage (development 23/24, held out 23/24) and the
+// development set's multi-effect cases (5/6). Missed, and held here at the measured level so that
+// a fall shows (decisions 0050, 0057, 0058 and 0065 say why): ranked first 21/24 and 18/24, joint
+// located 22/24 and 21/24, multi-effect held out 3/6 (effects at the noise floor; a member of one
+// joint standing for another's), false alarms 3/6 and 7/9: the
 // generated controls' chain-like noise holds at rest and moves with the pose, which drift,
 // kinematic, IMS-bias and time-offset candidates fit on the training blocks and carry to the
 // held-out ones (those cases carry no noise floor, so the measurement budget does not test them).
@@ -272,12 +273,12 @@ void expect_goals_or_the_measured_level(const Tally& development, const Tally& h
   EXPECT_LE(chain_alarms, 1);
   EXPECT_GE(pct(development.within, development.effect_cases), 85.0);
   EXPECT_GE(pct(held_out.within, held_out.effect_cases), 85.0);
-  EXPECT_GE(development.first, 20);
+  EXPECT_GE(development.first, 21);
   EXPECT_GE(held_out.first, 18);
-  EXPECT_GE(development.located, 21);
+  EXPECT_GE(development.located, 22);
   EXPECT_GE(held_out.located, 21);
-  EXPECT_GE(development.all_found, 4);
-  EXPECT_GE(held_out.all_found, 2);
+  EXPECT_GE(development.all_found, 5);
+  EXPECT_GE(held_out.all_found, 3);
   // The chain measured at its level: the median of its error RMS over the 36 joint records within
   // 3e-5..1.5e-4 rad (measured 6.2e-5; the lab's chain 5e-5..8e-5, 1.3e-5..3.3e-4 here per joint).
   ASSERT_EQ(chain_rms_rad.size(), 36u);
