@@ -56,8 +56,8 @@ struct LevelBound {
 // The shapes of a candidate on a joint (empty when the candidate does not apply, e.g. the
 // operating point without a table). The columns are computed from the whole record (filters run
 // across training and held-out rows alike: they are known signals).
-// `training`: the rows a transmission error's further orders are searched on (below); null: the
-// orders 1 to 3 only.
+// `training`: the rows a transmission error's order is searched on (one order, chosen by its
+// response's fit; eval/gap_effect_transmission_error.cpp); null: the orders 1 to 3.
 std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& signals,
                                              std::size_t joint,
                                              const std::vector<bool>* training = nullptr);

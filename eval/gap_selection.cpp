@@ -1,5 +1,6 @@
 #include "eval/gap_selection.hpp"
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -171,6 +172,54 @@ struct Trial {
   double p_value = 1.0;
 };
 
+double own_parameters(const Trial& t) {
+  const CandidateFit& added = t.set.back();
+  return double(added.parameters.size() - added.coupling_parameter_count);
+}
+
+// Whether every column of `small` lies in the span of `big`'s columns on the same joint (to 1e-6
+// of its norm): an offset in a drift, a play held on one flank in a drift.
+bool nested_in(const CandidateFit& small, const CandidateFit& big) {
+  if (small.columns.size() != big.columns.size()) return false;
+  for (std::size_t j = 0; j < small.columns.size(); ++j) {
+    const Eigen::MatrixXd& a = small.columns[j];
+    if (a.cols() == 0) continue;
+    const Eigen::MatrixXd& b = big.columns[j];
+    if (b.cols() == 0) return false;
+    const Eigen::MatrixXd coefficients = b.colPivHouseholderQr().solve(a);
+    if ((a - b * coefficients).norm() > 1e-6 * a.norm()) return false;
+  }
+  return true;
+}
+
+// Of the trials on the joint of trials[best] (the forward step's choice) nested in it, the one
+// with the fewest own parameters that adds significantly to the model and that trials[best] does
+// not improve on significantly (the same rule): the extra columns explain nothing the data can
+// show (a drift's slope and curvature, fitted to the chain's slow noise, displaced the offset it
+// nests). trials[best] itself when none is.
+std::size_t fewest_parameters_alike(const Context& x_in, const Refit& model,
+                                    std::vector<Trial>& trials, std::size_t best) {
+  // Its own bootstrap seeds: the selection's other tests draw the same as without this check.
+  std::uint64_t seed = x_in.seed;
+  const Context x{x_in.s,     x_in.o, x_in.candidates, x_in.training, x_in.heldout,
+                  x_in.block, seed,   x_in.e0};
+  const std::size_t joint = x.candidates[trials[best].candidate].fit.joint;
+  std::size_t chosen = best;
+  for (std::size_t i = 0; i < trials.size(); ++i) {
+    Trial& u = trials[i];
+    if (i == best || x.candidates[u.candidate].fit.joint != joint ||
+        own_parameters(u) >= own_parameters(trials[chosen]) ||
+        !nested_in(u.set.back(), trials[best].set.back()))
+      continue;
+    const Gain alone = x.gain(model, u.refit, joint);
+    if (!x.significant(alone) || x.significant(x.gain(u.refit, trials[best].refit, joint)))
+      continue;
+    u.p_value = std::min(alone.p, alone.joint_p);
+    chosen = i;
+  }
+  return chosen;
+}
+
 // The five candidates whose own columns best explain the model's residual, fitted again to it and
 // refitted jointly with the model, tried in the order of their held-out shrinkage less the
 // parsimony charge: the first whose gain is significant, or none.
@@ -194,18 +243,19 @@ std::optional<Trial> forward_step(const Context& x, const std::vector<std::size_
     t.set = set;
     t.set.push_back(refined(x, t.candidate, on_residual));
     t.refit = refit(x.s, t.set, x.training, x.heldout);
-    const CandidateFit& added = t.set.back();
-    const double own = double(added.parameters.size() - added.coupling_parameter_count);
-    t.score = x.shrink(t.refit.energy) - kParsimonyPercentPerParameter * own;
+    t.score = x.shrink(t.refit.energy) - kParsimonyPercentPerParameter * own_parameters(t);
   });
   std::stable_sort(trials.begin(), trials.end(),
                    [](const Trial& a, const Trial& b) { return a.score > b.score; });
-  for (Trial& t : trials) {
+  for (std::size_t i = 0; i < trials.size(); ++i) {
+    Trial& t = trials[i];
     tried[t.candidate] = true;
     const Gain g = x.gain(model, t.refit, x.candidates[t.candidate].fit.joint);
     if (!x.significant(g)) continue;
     t.p_value = std::min(g.p, g.joint_p);
-    return std::move(t);
+    const std::size_t chosen = fewest_parameters_alike(x, model, trials, i);
+    tried[trials[chosen].candidate] = true;
+    return std::move(trials[chosen]);
   }
   return std::nullopt;
 }

@@ -10,7 +10,10 @@
 //             held-out gain is significant (block bootstrap, p < alpha) and adds at
 //             least min_combination_gain_percent of the whole gap or min_shrinkage_percent of its
 //             own joint's remaining gap with at least 0.5 pp of the whole (an effect on a joint
-//             with a small share of the whole gap is still a cause of its own)
+//             with a small share of the whole gap is still a cause of its own); of the trials on
+//             its joint nested in it (an offset in a drift) that it does not improve on
+//             significantly by the same rule, and that add significantly themselves, the one with
+//             the fewest own parameters is added instead
 //   backward  after each addition, drop a member (not the first) whose loss, with the others
 //             refitted without it, is no longer significant by the same rule
 //

@@ -146,13 +146,23 @@ std::string model_in_words(const Diagnosis& d) {
 }
 
 // The gap within what the IMS chain's own error explains (eval/gap_measurement_budget.hpp): no
-// cause is raised; the candidate ranked first is what to look at once the measurement is better.
+// cause is raised; the candidate ranked first is still named, with its evidence, since the
+// floor bounds the chain's error from above (a robot effect near the floor is called within) and
+// it is what to look at once the measurement is better.
 void write_within_measurement_verdict(const GapSignals& s, const std::string& where,
                                       Diagnosis& out) {
   out.verdict = fmt::format(
       "{} {} No robot cause is raised: at this level the candidates fit the IMS chain's own "
       "error.",
       where, measurement_in_words(s, out.measurement));
+  if (!out.candidates.empty()) {
+    const CandidateResult& first = out.candidates.front();
+    out.verdict += fmt::format(
+        " Should part of it lie in the robot, the cause ranked first is {}, which shrinks the "
+        "held-out gap by {:.0f} % (p = {:.3f}{}).",
+        candidate_in_words(s, first.fit), first.shrinkage_percent, first.p_value,
+        first.supported ? "" : ", not significant on its own");
+  }
   if (!out.candidates.empty())
     out.measure_next.push_back(fmt::format(
         "if a gap of {:.3g} rad matters: a better measurement (the floor is the IMS smoother's "

@@ -112,6 +112,13 @@ TEST_F(MeasurementBudgetCli, ControlMeasuredThroughTheChainIsWithinTheMeasuremen
   const std::string verdict = report["verdict"];
   EXPECT_NE(verdict.find("within what the measurement explains"), std::string::npos) << verdict;
   EXPECT_EQ(verdict.find("Most likely cause"), std::string::npos) << verdict;
+  // Within the measurement, the cause ranked first is still named (a robot effect near the floor
+  // is called within): report.json's first candidate.
+  ASSERT_FALSE(report["candidates"].empty());
+  const std::string first = "the cause ranked first is " +
+                            report["candidates"][0]["effect"].get<std::string>() + " on joint " +
+                            report["candidates"][0]["joint"].get<std::string>();
+  EXPECT_NE(verdict.find(first), std::string::npos) << verdict;
   // The floor is the smoother's own sigma, not fitted to the gap: with plant = nominal the gap is
   // the chain's true error (the nominal model reproduces the plant to < 2e-6 rad,
   // tests/eval/test_model_joint_errors_cli.cpp), and it must lie at or below the floor. Measured
