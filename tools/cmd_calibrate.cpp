@@ -11,11 +11,14 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "calib/calibration_session.hpp"
 #include "calib/calibration_session_inputs.hpp"
@@ -39,15 +42,8 @@ struct CalibrateArgs {
   bool force = false;
 };
 
-void write_outputs(const CalibrateArgs& args, OutputFolder& folder,
-                   const calib::LoadedSession& loaded, const calib::SessionResult& session) {
-  const calib::SessionFiles& f = args.files;
-  calib::stage_session_outputs(folder, f, loaded, session);
-  if (session.joint_errors)
-    eval::write_calibration_joint_errors_csv(
-        folder.staged("joint_errors.csv"), *session.joint_errors, loaded.inputs.log,
-        fmt::format("imscal {} calibrate --imu {} --robot-log {}", kVersion, f.imu, f.robot_log));
-  folder.commit();
+bool writes_joint_errors(const std::vector<fs::path>& outputs) {
+  return std::find(outputs.begin(), outputs.end(), fs::path("joint_errors.csv")) != outputs.end();
 }
 
 void run(const CalibrateArgs& args) {
@@ -56,13 +52,21 @@ void run(const CalibrateArgs& args) {
   // whether joint_errors.csv is written.
   const std::vector<fs::path> outputs = calib::session_output_names(args.files);
   const Overwrite overwrite = args.force ? Overwrite::kAllow : Overwrite::kRefuse;
-  { OutputFolder check(args.out, outputs, overwrite); }
+  OutputFolder folder(args.out, outputs, overwrite);
 
   Progress progress;
   // The whole command's share for `imscal run` (one copy: it keeps the highest share reported).
   const calib::SessionProgress share = calib::command_share_progress(progress_channel());
   progress.update("read", 0.0);
-  const calib::LoadedSession loaded = calib::read_session_inputs(args.files);
+  calib::LoadedSession loaded = calib::read_session_inputs(args.files);
+  // joint_errors.csv's rows go to the staged file as they are computed, not held.
+  std::optional<eval::CalibrationJointErrorsCsv> joint_errors;
+  if (writes_joint_errors(outputs)) {
+    joint_errors.emplace(folder.staged("joint_errors.csv"), loaded.inputs.log);
+    loaded.options.joint_error_rows = [&](const calib::JointErrorRow& row) {
+      joint_errors->add(row);
+    };
+  }
   const calib::SessionResult session = calib::calibrate_session(
       loaded.inputs, loaded.options, [&](const std::string& stage, double fraction) {
         progress.update(stage, fraction);
@@ -70,8 +74,13 @@ void run(const CalibrateArgs& args) {
       });
   progress.update("write", 0.0);
   share("write", 0.0);
-  OutputFolder folder(args.out, outputs, overwrite);
-  write_outputs(args, folder, loaded, session);
+  const calib::SessionFiles& f = args.files;
+  calib::stage_session_outputs(folder, f, loaded, session);
+  if (joint_errors && session.joint_errors)
+    joint_errors->commit(
+        *session.joint_errors, loaded.inputs.log,
+        fmt::format("imscal {} calibrate --imu {} --robot-log {}", kVersion, f.imu, f.robot_log));
+  folder.commit();
   progress.finish();
   share("write", 1.0);
   const double seconds =
