@@ -52,18 +52,26 @@ void run(const CalibrateArgs& args) {
   // whether joint_errors.csv is written.
   const std::vector<fs::path> outputs = calib::session_output_names(args.files);
   const Overwrite overwrite = args.force ? Overwrite::kAllow : Overwrite::kRefuse;
-  OutputFolder folder(args.out, outputs, overwrite);
+  { OutputFolder check(args.out, outputs, overwrite); }
 
   Progress progress;
   // The whole command's share for `imscal run` (one copy: it keeps the highest share reported).
   const calib::SessionProgress share = calib::command_share_progress(progress_channel());
   progress.update("read", 0.0);
   calib::LoadedSession loaded = calib::read_session_inputs(args.files);
-  // joint_errors.csv's rows go to the staged file as they are computed, not held.
+  // The staged outputs, made when the first joint-error row comes (or at the end):
+  // joint_errors.csv's rows go there as they are computed, not held.
+  std::optional<OutputFolder> folder;
   std::optional<eval::CalibrationJointErrorsCsv> joint_errors;
+  const auto open_outputs = [&] {
+    if (folder) return;
+    folder.emplace(args.out, outputs, overwrite);
+    if (writes_joint_errors(outputs))
+      joint_errors.emplace(folder->staged("joint_errors.csv"), loaded.inputs.log);
+  };
   if (writes_joint_errors(outputs)) {
-    joint_errors.emplace(folder.staged("joint_errors.csv"), loaded.inputs.log);
     loaded.options.joint_error_rows = [&](const calib::JointErrorRow& row) {
+      open_outputs();
       joint_errors->add(row);
     };
   }
@@ -74,13 +82,14 @@ void run(const CalibrateArgs& args) {
       });
   progress.update("write", 0.0);
   share("write", 0.0);
+  open_outputs();
   const calib::SessionFiles& f = args.files;
-  calib::stage_session_outputs(folder, f, loaded, session);
+  calib::stage_session_outputs(*folder, f, loaded, session);
   if (joint_errors && session.joint_errors)
     joint_errors->commit(
         *session.joint_errors, loaded.inputs.log,
         fmt::format("imscal {} calibrate --imu {} --robot-log {}", kVersion, f.imu, f.robot_log));
-  folder.commit();
+  folder->commit();
   progress.finish();
   share("write", 1.0);
   const double seconds =
