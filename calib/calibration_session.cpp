@@ -107,7 +107,8 @@ FrameCalibrationOptions bundle_options(const SessionInputs& in, const Calibratio
   return bundle;
 }
 
-JointSpaceErrors session_joint_errors(const SessionInputs& in, const SessionResult& out) {
+JointSpaceErrors session_joint_errors(const SessionInputs& in, const SessionResult& out,
+                                      const SessionOptions& options) {
   const FrameCalibrationResult& result = out.frames;
   JointSpaceInput js;
   js.imu = &in.imu;
@@ -120,8 +121,10 @@ JointSpaceErrors session_joint_errors(const SessionInputs& in, const SessionResu
     js.first_rest.q_link_rad += result.joint_deviation_rad.front();
   js.zupt = ims::zupt_options_from_spec(in.sensor);
   js.source = in.source;
-  JointSpaceErrors errors = joint_space_errors(js);
-  spdlog::info("calibrate: joint errors at {} robot samples", errors.t_s.size());
+  JointSpaceOptions joint_space;
+  joint_space.row_sink = options.joint_error_rows;
+  JointSpaceErrors errors = joint_space_errors(js, joint_space);
+  spdlog::info("calibrate: joint errors at {} robot samples", errors.sums.rows);
   return errors;
 }
 
@@ -188,7 +191,7 @@ SessionResult calibrate_session(const SessionInputs& in, const SessionOptions& o
   frame_input.robot = {};  // the joint series, as long as the record: done with
   if (config.joint_errors) {
     report(progress, "joint errors", 0.0);
-    out.joint_errors = session_joint_errors(in, out);
+    out.joint_errors = session_joint_errors(in, out, options);
   }
   return out;
 }

@@ -41,6 +41,9 @@ struct SessionInputs {
 
 struct SessionOptions {
   CalibrationConfig config;
+  // Set: the joint-error rows are handed to it as computed and not kept in
+  // SessionResult::joint_errors' columns (JointSpaceOptions::row_sink).
+  std::function<void(const JointErrorRow&)> joint_error_rows;
 };
 
 struct SessionResult {

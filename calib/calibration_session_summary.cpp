@@ -111,7 +111,7 @@ void joint_error_figures(Lines& line, const JointSpaceErrors& je) {
   line(
       fmt::format("joint errors: {} samples ({} outside the IMS record, {} inverse-kinematics "
                   "failures, {} left out near the wrist singularity)",
-                  je.t_s.size(), je.outside_record, je.ik_failures, je.near_wrist_singularity));
+                  je.sums.rows, je.outside_record, je.ik_failures, je.near_wrist_singularity));
   // The position the smoother could not observe, corrected where the arm stood at a pose
   // again (calib/revisited_poses.hpp) and interpolated at the other standstills.
   const auto returns =
@@ -125,16 +125,12 @@ void joint_error_figures(Lines& line, const JointSpaceErrors& je) {
         "(largest {:.3f} mm)",
         returns, je.revisited_pose_errors.size(), largest * 1e3));
   }
-  if (je.t_s.empty()) return;
+  const JointErrorSums& sums = je.sums;  // the rows may have gone to a file as computed
+  if (sums.rows == 0) return;
   for (int j = 0; j < kJointCount; ++j) {
-    double sum = 0.0, worst = 0.0;
-    for (std::size_t k = 0; k < je.t_s.size(); ++k) {
-      const double e = je.q_desired_rad[k][j] - je.q_measured_rad[k][j];
-      sum += e * e;
-      worst = std::max(worst, std::abs(e));
-    }
     line(fmt::format("  A{}: RMS {:.4f} mrad, max {:.4f} mrad", j + 1,
-                     std::sqrt(sum / double(je.t_s.size())) * 1e3, worst * 1e3));
+                     std::sqrt(sums.error_squared_rad2[j] / double(sums.rows)) * 1e3,
+                     sums.error_max_abs_rad[j] * 1e3));
   }
 }
 

@@ -5,9 +5,11 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <span>
+#include <utility>
 
 #include "core/input_error.hpp"
 #include "ims/earth_model.hpp"
@@ -73,14 +75,18 @@ namespace {
 // The rows of joint_errors_along, one robot sample at a time (in the log's order).
 class JointErrorRows {
  public:
+  // With `sink`, the rows go to it and the columns stay empty.
   JointErrorRows(const RobotLog& log, const KinematicModel& kinematics,
-                 const CalibratedFrames& frames, double min_wrist_sin)
+                 const CalibratedFrames& frames, double min_wrist_sin,
+                 std::function<void(const JointErrorRow&)> sink = {})
       : kinematics_(kinematics),
         frames_(frames),
         min_wrist_sin_(min_wrist_sin),
-        solver_(make_inverse_kinematics(kinematics)) {
+        solver_(make_inverse_kinematics(kinematics)),
+        sink_(std::move(sink)) {
     out.robot = log.robot_name;
     out.cycle_s = log.cycle_s;
+    if (sink_) return;
     // At most one row per sample: reserved, the rows take no more than they hold.
     const std::size_t n = log.samples.size();
     for (auto* column :
@@ -113,19 +119,27 @@ class JointErrorRows {
       ++out.near_wrist_singularity;
       return;
     }
-    out.t_s.push_back(sample.t_s);
-    out.payload_kg.push_back(sample.payload_kg);
-    out.q_desired_rad.push_back(sample.q_desired_rad);
-    out.q_measured_rad.push_back(solution.q);
-    out.q_internal_rad.push_back(sample.q_internal_rad);
     // The smoother's sigmas at the nearest state.
     auto nearest =
         std::lower_bound(trajectory.begin(), trajectory.end(), t_ims,
                          [](const ims::SmoothedState& s, double t) { return s.state.t_s < t; });
     if (nearest == trajectory.end()) --nearest;
     const Eigen::Vector3d r_S_H_W = T_W_S.linear() * frames_.T_S_H.translation();  // S to H in W
-    out.q_measured_sigma_rad.push_back(
-        joint_sigma(kinematics_, solution.q, nearest->sigma, frames_.T_R_W.linear(), r_S_H_W));
+    JointErrorRow row{
+        sample.t_s,
+        sample.payload_kg,
+        sample.q_desired_rad,
+        solution.q,
+        sample.q_internal_rad,
+        joint_sigma(kinematics_, solution.q, nearest->sigma, frames_.T_R_W.linear(), r_S_H_W)};
+    out.sums.add(row);
+    if (sink_) return sink_(row);
+    out.t_s.push_back(row.t_s);
+    out.payload_kg.push_back(row.payload_kg);
+    out.q_desired_rad.push_back(row.q_desired_rad);
+    out.q_measured_rad.push_back(row.q_measured_rad);
+    out.q_internal_rad.push_back(row.q_internal_rad);
+    out.q_measured_sigma_rad.push_back(row.q_measured_sigma_rad);
   }
 
   JointSpaceErrors out;
@@ -135,6 +149,7 @@ class JointErrorRows {
   const CalibratedFrames& frames_;
   double min_wrist_sin_;
   std::unique_ptr<IkSolver> solver_;
+  std::function<void(const JointErrorRow&)> sink_;
 };
 
 // Calls use(block) on consecutive blocks of the trajectory: `first`, then the stream's states
@@ -206,7 +221,8 @@ JointSpaceErrors joint_errors_in_blocks(ims::SmoothedStateStream& stream,
                                         const std::vector<PositionErrorSample>& errors,
                                         const JointSpaceInput& input,
                                         const JointSpaceOptions& options) {
-  JointErrorRows rows(*input.log, input.kinematics, input.frames, options.min_wrist_sin);
+  JointErrorRows rows(*input.log, input.kinematics, input.frames, options.min_wrist_sin,
+                      options.row_sink);
   const std::vector<RobotLogSample>& samples = input.log->samples;
   const double offset_s = input.frames.time_offset_s;
   std::vector<ims::SmoothedState> trajectory;
@@ -311,9 +327,22 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   return out;
 }
 
+void JointErrorSums::add(const JointErrorRow& row) {
+  ++rows;
+  for (int j = 0; j < kJointCount; ++j) {
+    const double e = row.q_desired_rad[j] - row.q_measured_rad[j];
+    error_squared_rad2[j] += e * e;
+    error_max_abs_rad[j] = std::max(error_max_abs_rad[j], std::abs(e));
+  }
+  sigma_squared_rad2 += row.q_measured_sigma_rad.cwiseAbs2();
+}
+
 JointVector q_measured_sigma_rms_rad(const JointSpaceErrors& errors) {
   JointVector sum = JointVector::Zero();
-  if (errors.q_measured_sigma_rad.empty()) return sum;
+  if (errors.q_measured_sigma_rad.empty()) {
+    if (errors.sums.rows == 0) return sum;
+    return (errors.sums.sigma_squared_rad2 / double(errors.sums.rows)).cwiseSqrt();
+  }
   for (const JointVector& sigma : errors.q_measured_sigma_rad) sum += sigma.cwiseAbs2();
   return (sum / double(errors.q_measured_sigma_rad.size())).cwiseSqrt();
 }

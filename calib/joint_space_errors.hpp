@@ -25,6 +25,7 @@
 // identification treats the time gap as a split between runs.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,23 @@ struct JointSpaceInput {
   std::string source;     // for messages
 };
 
+// One row of joint_errors.csv with q_measured's 1-sigma [robot clock, SI].
+struct JointErrorRow {
+  double t_s = 0.0;
+  double payload_kg = 0.0;
+  JointVector q_desired_rad, q_measured_rad, q_internal_rad, q_measured_sigma_rad;
+};
+
+// Running figures over the rows, added in the rows' order (the same sums as over the columns).
+struct JointErrorSums {
+  std::size_t rows = 0;
+  JointVector error_squared_rad2 = JointVector::Zero();  // sum of (q_desired - q_measured)^2
+  JointVector error_max_abs_rad = JointVector::Zero();   // largest |q_desired - q_measured|
+  JointVector sigma_squared_rad2 = JointVector::Zero();  // sum of q_measured_sigma^2
+
+  void add(const JointErrorRow& row);
+};
+
 struct JointSpaceOptions {
   // 1-sigma of the initial state handed to the smoother: attitude [rad] (the first rest's
   // joint-angle uncertainty through the kinematics, plus the frames'), velocity [m/s] (at rest),
@@ -90,6 +108,9 @@ struct JointSpaceOptions {
   bool keep_trajectory = false;
   // Smoothed states per block (160 bytes each; 65536: 10 MB); the rows do not depend on it.
   std::size_t states_per_block = std::size_t(1) << 16;
+  // Set: each row is handed to it as it is computed (in time order) and not kept in
+  // JointSpaceErrors' columns (208 bytes per robot sample; 6.2 MB per recorded minute at 500 Hz).
+  std::function<void(const JointErrorRow&)> row_sink;
 };
 
 // One row per kept robot sample (the joint_errors.csv columns) [robot clock, SI].
@@ -103,6 +124,7 @@ struct JointSpaceErrors {
   std::vector<JointVector> q_internal_rad;
   // 1-sigma of q_measured from the smoother's sigmas (zero along a trajectory without them).
   std::vector<JointVector> q_measured_sigma_rad;
+  JointErrorSums sums;             // over every row, kept in the columns or handed to the row sink
   std::size_t outside_record = 0;  // robot samples without IMS data (before/after the record)
   std::size_t ik_failures = 0;     // robot samples whose inverse kinematics failed
   std::size_t near_wrist_singularity = 0;  // left out: |sin A5| < JointSpaceOptions::min_wrist_sin
@@ -121,7 +143,8 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
                                     const JointSpaceOptions& options = {});
 
 // RMS over the samples of q_measured's 1-sigma per joint [rad]: the IMS noise floor in joint
-// space (the gap diagnosis' measurement budget reads it). Zero without samples.
+// space (the gap diagnosis' measurement budget reads it); from the sums when the rows went to a
+// sink. Zero without samples.
 JointVector q_measured_sigma_rms_rad(const JointSpaceErrors& errors);
 
 // Steps 2-3 alone: the flange poses and inverse kinematics at the robot samples from a given

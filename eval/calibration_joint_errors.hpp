@@ -10,6 +10,7 @@
 
 #include "calib/joint_space_errors.hpp"
 #include "core/atomic_file.hpp"
+#include "ident/joint_error_io.hpp"
 #include "robot/robot_log.hpp"
 
 namespace imscal::eval {
@@ -20,5 +21,24 @@ void write_calibration_joint_errors_csv(const std::filesystem::path& file,
                                         const calib::JointSpaceErrors& errors,
                                         const calib::RobotLog& log, const std::string& source,
                                         Overwrite overwrite = Overwrite::kAllow);
+
+// The same file written as the rows are computed (calib::SessionOptions::joint_error_rows), so
+// that they are never held: the header, whose noise floor is over all rows, is written at commit
+// (the rows wait in a file beside it; ident::JointErrorsCsvWriter). The same bytes.
+class CalibrationJointErrorsCsv {
+ public:
+  // `log`'s joints make the columns. Throws std::runtime_error when the file cannot be made.
+  CalibrationJointErrorsCsv(const std::filesystem::path& file, const calib::RobotLog& log,
+                            Overwrite overwrite = Overwrite::kAllow);
+  // Throws std::invalid_argument for non-finite values.
+  void add(const calib::JointErrorRow& row);
+  // `errors`: the joint-space step's result (its sums give the noise floor), as for
+  // write_calibration_joint_errors_csv.
+  void commit(const calib::JointSpaceErrors& errors, const calib::RobotLog& log,
+              const std::string& source);
+
+ private:
+  ident::JointErrorsCsvWriter out_;
+};
 
 }  // namespace imscal::eval

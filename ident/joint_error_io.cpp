@@ -251,16 +251,16 @@ JointErrorLog read_joint_errors_csv(const std::filesystem::path& path) {
   return log;
 }
 
-JointErrorsCsvWriter::JointErrorsCsvWriter(const std::filesystem::path& file,
-                                           const JointErrorLog& header, bool with_internal,
-                                           Overwrite overwrite)
-    : out_(file, overwrite), joints_(header.joint_count()), with_internal_(with_internal) {
-  if (joints_ == 0) throw std::invalid_argument("write_joint_errors_csv: no joints");
+namespace {
+
+// The header lines of joint_errors.csv up to the column names. Throws std::invalid_argument for
+// no joints, a bad joint name or cycle_s <= 0.
+void write_joint_errors_header(std::ostream& s, const JointErrorLog& header, bool with_internal) {
+  if (header.joint_count() == 0) throw std::invalid_argument("write_joint_errors_csv: no joints");
   if (!(header.cycle_s > 0.0)) throw std::invalid_argument("write_joint_errors_csv: cycle_s <= 0");
   for (const auto& name : header.joint_names)
     if (name.empty() || name.find_first_of(",# \t\n") != std::string::npos)
       throw std::invalid_argument("write_joint_errors_csv: bad joint name '" + name + "'");
-  auto& s = out_.stream();
   s << fmt::format("# imscal-joint-errors: {}\n# robot: {}\n# cycle_s: {}\n", kFormatVersion,
                    header.robot, header.cycle_s);
   if (!header.source.empty()) s << "# source: " << header.source << '\n';
@@ -268,6 +268,37 @@ JointErrorsCsvWriter::JointErrorsCsvWriter(const std::filesystem::path& file,
   const auto names = expected_columns(header.joint_names, with_internal);
   for (std::size_t c = 0; c < names.size(); ++c) s << (c ? "," : "") << names[c];
   s << '\n';
+}
+
+}  // namespace
+
+JointErrorsCsvWriter::JointErrorsCsvWriter(const std::filesystem::path& file,
+                                           const JointErrorLog& header, bool with_internal,
+                                           Overwrite overwrite)
+    : out_(file, overwrite), joints_(header.joint_count()), with_internal_(with_internal) {
+  write_joint_errors_header(out_.stream(), header, with_internal);
+}
+
+JointErrorsCsvWriter::JointErrorsCsvWriter(const std::filesystem::path& file, std::size_t joints,
+                                           bool with_internal, Overwrite overwrite)
+    : out_(file, overwrite),
+      joints_(joints),
+      with_internal_(with_internal),
+      rows_file_(file.string() + ".rows") {
+  if (joints_ == 0) throw std::invalid_argument("write_joint_errors_csv: no joints");
+  rows_out_.open(rows_file_, std::ios::binary | std::ios::trunc);
+  if (!rows_out_) throw std::runtime_error("cannot write " + rows_file_.string());
+}
+
+JointErrorsCsvWriter::~JointErrorsCsvWriter() {
+  if (rows_file_.empty()) return;
+  rows_out_.close();
+  std::error_code ignored;
+  std::filesystem::remove(rows_file_, ignored);
+}
+
+std::ostream& JointErrorsCsvWriter::rows() {
+  return rows_file_.empty() ? static_cast<std::ostream&>(out_.stream()) : rows_out_;
 }
 
 void JointErrorsCsvWriter::add(double t_s, double payload_kg, std::span<const double> q_desired_rad,
@@ -288,11 +319,28 @@ void JointErrorsCsvWriter::add(double t_s, double payload_kg, std::span<const do
     }
   }
   line_ += '\n';
-  out_.stream() << line_;
+  rows() << line_;
   ++samples_;
 }
 
 void JointErrorsCsvWriter::commit() {
+  if (!rows_file_.empty())
+    throw std::logic_error("JointErrorsCsvWriter: the header is given at commit");
+  out_.commit();
+}
+
+void JointErrorsCsvWriter::commit(const JointErrorLog& header) {
+  if (rows_file_.empty()) throw std::logic_error("JointErrorsCsvWriter: the header is written");
+  if (header.joint_count() != joints_)
+    throw std::invalid_argument("write_joint_errors_csv: inconsistent sizes");
+  write_joint_errors_header(out_.stream(), header, with_internal_);
+  rows_out_.close();
+  if (!rows_out_) throw std::runtime_error("cannot write " + rows_file_.string());
+  if (samples_ > 0) {
+    std::ifstream in(rows_file_, std::ios::binary);
+    out_.stream() << in.rdbuf();
+    if (!in || !out_.stream()) throw std::runtime_error("cannot copy " + rows_file_.string());
+  }
   out_.commit();
 }
 

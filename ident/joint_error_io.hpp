@@ -17,6 +17,8 @@
 // an error); a time that does not increase is an error.
 #include <cstddef>
 #include <filesystem>
+#include <fstream>
+#include <ostream>
 #include <span>
 #include <string>
 #include <utility>
@@ -72,18 +74,32 @@ class JointErrorsCsvWriter {
   // joints, a bad joint name or cycle_s <= 0, std::runtime_error when the file cannot be made.
   JointErrorsCsvWriter(const std::filesystem::path& file, const JointErrorLog& header,
                        bool with_internal, Overwrite overwrite = Overwrite::kAllow);
+  // The header given at commit (a header value that depends on all rows): the rows wait in
+  // `file`.rows beside the file (removed at commit or destruction), `joints` values per family.
+  JointErrorsCsvWriter(const std::filesystem::path& file, std::size_t joints, bool with_internal,
+                       Overwrite overwrite = Overwrite::kAllow);
+  JointErrorsCsvWriter(const JointErrorsCsvWriter&) = delete;
+  JointErrorsCsvWriter& operator=(const JointErrorsCsvWriter&) = delete;
+  ~JointErrorsCsvWriter();
   // One sample, a value per joint in each span (q_internal not read without the block). Throws
   // std::invalid_argument for a non-finite value or a span of another size.
   void add(double t_s, double payload_kg, std::span<const double> q_desired_rad,
            std::span<const double> q_measured_rad, std::span<const double> q_internal_rad);
   void commit();
+  // With the header given at commit: writes it (as the first constructor; its joint count must
+  // be `joints`), then the rows, and commits.
+  void commit(const JointErrorLog& header);
 
  private:
+  std::ostream& rows();
+
   AtomicFile out_;
   std::size_t joints_ = 0;
   bool with_internal_ = false;
   std::size_t samples_ = 0;
   std::string line_;
+  std::filesystem::path rows_file_;  // empty: the header is written and rows follow it in out_
+  std::ofstream rows_out_;
 };
 
 // Re-derives segment_starts from the time stamps (gap > 1.5 cycle_s starts a segment).

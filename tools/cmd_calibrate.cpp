@@ -11,11 +11,14 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "calib/calibration_session.hpp"
 #include "calib/calibration_session_inputs.hpp"
@@ -39,15 +42,8 @@ struct CalibrateArgs {
   bool force = false;
 };
 
-void write_outputs(const CalibrateArgs& args, OutputFolder& folder,
-                   const calib::LoadedSession& loaded, const calib::SessionResult& session) {
-  const calib::SessionFiles& f = args.files;
-  calib::stage_session_outputs(folder, f, loaded, session);
-  if (session.joint_errors)
-    eval::write_calibration_joint_errors_csv(
-        folder.staged("joint_errors.csv"), *session.joint_errors, loaded.inputs.log,
-        fmt::format("imscal {} calibrate --imu {} --robot-log {}", kVersion, f.imu, f.robot_log));
-  folder.commit();
+bool writes_joint_errors(const std::vector<fs::path>& outputs) {
+  return std::find(outputs.begin(), outputs.end(), fs::path("joint_errors.csv")) != outputs.end();
 }
 
 void run(const CalibrateArgs& args) {
@@ -62,7 +58,23 @@ void run(const CalibrateArgs& args) {
   // The whole command's share for `imscal run` (one copy: it keeps the highest share reported).
   const calib::SessionProgress share = calib::command_share_progress(progress_channel());
   progress.update("read", 0.0);
-  const calib::LoadedSession loaded = calib::read_session_inputs(args.files);
+  calib::LoadedSession loaded = calib::read_session_inputs(args.files);
+  // The staged outputs, made when the first joint-error row comes (or at the end):
+  // joint_errors.csv's rows go there as they are computed, not held.
+  std::optional<OutputFolder> folder;
+  std::optional<eval::CalibrationJointErrorsCsv> joint_errors;
+  const auto open_outputs = [&] {
+    if (folder) return;
+    folder.emplace(args.out, outputs, overwrite);
+    if (writes_joint_errors(outputs))
+      joint_errors.emplace(folder->staged("joint_errors.csv"), loaded.inputs.log);
+  };
+  if (writes_joint_errors(outputs)) {
+    loaded.options.joint_error_rows = [&](const calib::JointErrorRow& row) {
+      open_outputs();
+      joint_errors->add(row);
+    };
+  }
   const calib::SessionResult session = calib::calibrate_session(
       loaded.inputs, loaded.options, [&](const std::string& stage, double fraction) {
         progress.update(stage, fraction);
@@ -70,8 +82,14 @@ void run(const CalibrateArgs& args) {
       });
   progress.update("write", 0.0);
   share("write", 0.0);
-  OutputFolder folder(args.out, outputs, overwrite);
-  write_outputs(args, folder, loaded, session);
+  open_outputs();
+  const calib::SessionFiles& f = args.files;
+  calib::stage_session_outputs(*folder, f, loaded, session);
+  if (joint_errors && session.joint_errors)
+    joint_errors->commit(
+        *session.joint_errors, loaded.inputs.log,
+        fmt::format("imscal {} calibrate --imu {} --robot-log {}", kVersion, f.imu, f.robot_log));
+  folder->commit();
   progress.finish();
   share("write", 1.0);
   const double seconds =

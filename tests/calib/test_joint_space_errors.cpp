@@ -17,10 +17,12 @@
 // the IMS's noise floor (second test below).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <vector>
 
 #include "calib/joint_space_errors.hpp"
 #include "calib/rest_poses.hpp"
@@ -460,6 +462,42 @@ TEST(JointSpaceErrors, BlocksGiveTheRowsOfTheWholeTrajectory) {
       ASSERT_EQ(e->q_measured_rad[k], along.q_measured_rad[k]) << k;
       ASSERT_EQ(e->q_measured_sigma_rad[k], along.q_measured_sigma_rad[k]) << k;
     }
+  }
+}
+
+TEST(JointSpaceErrors, RowsHandedToASinkAreTheKeptRows) {
+  // The truth is the same run keeping its rows: the sink gets them in order, bit for bit, the
+  // columns stay empty, and the sums (summary.txt's RMS and maximum, the noise floor) are those
+  // over the kept columns, added in the same order.
+  const SimRun& run = seed_line();
+  const JointSpaceErrors kept = joint_space_errors(true_input(run));
+  std::vector<JointErrorRow> handed;
+  JointSpaceOptions sunk;
+  sunk.row_sink = [&](const JointErrorRow& row) { handed.push_back(row); };
+  const JointSpaceErrors streamed = joint_space_errors(true_input(run), sunk);
+  EXPECT_TRUE(streamed.t_s.empty());
+  EXPECT_TRUE(streamed.q_measured_sigma_rad.empty());
+  ASSERT_GT(kept.t_s.size(), 100u);
+  ASSERT_EQ(handed.size(), kept.t_s.size());
+  for (std::size_t k = 0; k < handed.size(); ++k) {
+    ASSERT_EQ(handed[k].t_s, kept.t_s[k]) << k;
+    ASSERT_EQ(handed[k].payload_kg, kept.payload_kg[k]) << k;
+    ASSERT_EQ(handed[k].q_desired_rad, kept.q_desired_rad[k]) << k;
+    ASSERT_EQ(handed[k].q_measured_rad, kept.q_measured_rad[k]) << k;
+    ASSERT_EQ(handed[k].q_internal_rad, kept.q_internal_rad[k]) << k;
+    ASSERT_EQ(handed[k].q_measured_sigma_rad, kept.q_measured_sigma_rad[k]) << k;
+  }
+  EXPECT_EQ(streamed.sums.rows, kept.t_s.size());
+  EXPECT_EQ(q_measured_sigma_rms_rad(streamed), q_measured_sigma_rms_rad(kept));
+  for (int j = 0; j < kJointCount; ++j) {
+    double sum = 0.0, worst = 0.0;
+    for (std::size_t k = 0; k < kept.t_s.size(); ++k) {
+      const double e = kept.q_desired_rad[k][j] - kept.q_measured_rad[k][j];
+      sum += e * e;
+      worst = std::max(worst, std::abs(e));
+    }
+    EXPECT_EQ(streamed.sums.error_squared_rad2[j], sum) << j;
+    EXPECT_EQ(streamed.sums.error_max_abs_rad[j], worst) << j;
   }
 }
 

@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
 #include <random>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "core/input_error.hpp"
 #include "ident/joint_error_io.hpp"
@@ -166,6 +169,43 @@ TEST_F(JointErrorFiles, BadInputsRefused) {
   expect_refused(kHeader, 4, "", "no samples");
   expect_refused(kHeader + row + "0.002,5,0.1,,0.1,0.2,0.1,0.2\n", 6, "q_desired_A2_rad",
                  "is not a number");
+}
+
+TEST_F(JointErrorFiles, HeaderGivenAtCommitWritesTheSameBytes) {
+  // The truth is write_joint_errors_csv's file of the same log; the rows' waiting file is gone
+  // after the commit, and after a writer dropped without one (which leaves no output).
+  const ident::JointErrorLog log = random_log();
+  const auto whole = dir_ / "whole.csv", deferred = dir_ / "deferred.csv";
+  ident::write_joint_errors_csv(whole, log);
+  {
+    ident::JointErrorsCsvWriter out(deferred, log.joint_count(), true);
+    std::vector<double> desired(3), measured(3), internal(3);
+    for (std::size_t k = 0; k < log.sample_count(); ++k) {
+      for (std::size_t j = 0; j < 3; ++j) {
+        desired[j] = log.q_desired_rad[j][k];
+        measured[j] = log.q_measured_rad[j][k];
+        internal[j] = log.q_internal_rad[j][k];
+      }
+      out.add(log.time_s[k], log.payload_kg[k], desired, measured, internal);
+    }
+    EXPECT_THROW(out.commit(), std::logic_error);  // its header is still to come
+    out.commit(log);
+  }
+  const auto bytes = [](const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(bytes(deferred), bytes(whole));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "deferred.csv.rows"));
+  const auto dropped = dir_ / "dropped.csv";
+  {
+    ident::JointErrorsCsvWriter out(dropped, 3, true);
+    const std::vector<double> zero(3, 0.0);
+    out.add(0.0, 5.0, zero, zero, zero);
+    EXPECT_TRUE(std::filesystem::exists(dir_ / "dropped.csv.rows"));
+  }
+  EXPECT_FALSE(std::filesystem::exists(dropped));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "dropped.csv.rows"));
 }
 
 TEST_F(JointErrorFiles, MissingFileRefused) {
