@@ -11,6 +11,18 @@
 // run leaves the completed stages and no visible half-written folder; the next run removes the
 // leftovers and reruns the interrupted stage from scratch. One run at a time per folder (a lock).
 //
+// Concurrency: a stage starts as soon as the earlier stages (in chain order) whose outputs it
+// reads, its declared upstream, have ended, while at most RunOptions::max_parallel_stages stages
+// run at once, each on its own thread (a subcommand stage in its own child process): Stage::run
+// must not touch what another stage's run uses. A stage that gates later stages (validation) and
+// a stage that summarises the run wait for every earlier stage. A stage sees only its declared
+// upstream stages, so the outputs are the bytes a one-at-a-time run writes, and the summary lists
+// the stages in chain order. A failed check keeps the later stages that have not started from
+// starting (except those that summarise); a stage already running completes. A stage's exception
+// starts no other stage, lets the running ones complete (committed) and then propagates. Each
+// stage.json records the stage's own wall and CPU time (its thread plus the children it waited
+// for, from wait4), and the terminal's progress line shows the running stages side by side.
+//
 // Layout:
 //   <run>/run.json          which config made this run folder
 //   <run>/run.log           log of every run in this folder (appended)
