@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 
 namespace imscal {
 
@@ -41,7 +42,10 @@ std::optional<ProgressReport> parse_progress_line(std::string_view line) {
 }
 
 void request_progress_lines_from_children() {
-  ::setenv(kProgressChannelVariable, "1", 1);
+  // Once per process: stages on several threads call this before they fork, and setenv must not
+  // run while another thread forks (the child would copy a half-changed environment).
+  static std::once_flag requested;
+  std::call_once(requested, [] { ::setenv(kProgressChannelVariable, "1", 1); });
 }
 
 }  // namespace imscal

@@ -11,18 +11,23 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <condition_variable>
 #include <cstring>
 #include <ctime>
+#include <exception>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include "core/atomic_file.hpp"
 #include "core/input_error.hpp"
 #include "core/run_record.hpp"
 #include "core/sha256.hpp"
+#include "core/subprocess.hpp"
 
 namespace imscal {
 
@@ -165,18 +170,42 @@ class FolderLock {
   int fd_ = -1;
 };
 
-// Adds <run>/run.log to the default logger for the lifetime of the object.
+// A terminal sink whose lines go above the progress line (Progress::above_line), so that the
+// log of one stage never lands inside another stage's progress figure.
+class AboveProgressSink final : public spdlog::sinks::sink {
+ public:
+  AboveProgressSink(spdlog::sink_ptr terminal, Progress& progress)
+      : terminal_(std::move(terminal)), progress_(progress) {
+    set_level(terminal_->level());
+  }
+  void log(const spdlog::details::log_msg& msg) override {
+    progress_.above_line([&] { terminal_->log(msg); });
+  }
+  void flush() override { terminal_->flush(); }
+  void set_pattern(const std::string& pattern) override { terminal_->set_pattern(pattern); }
+  void set_formatter(std::unique_ptr<spdlog::formatter> formatter) override {
+    terminal_->set_formatter(std::move(formatter));
+  }
+
+ private:
+  spdlog::sink_ptr terminal_;
+  Progress& progress_;
+};
+
+// Adds <run>/run.log to the default logger for the lifetime of the object; the terminal's lines
+// go above the progress line.
 class RunLog {
  public:
-  explicit RunLog(const fs::path& file) : previous_(spdlog::default_logger()) {
+  RunLog(const fs::path& file, Progress& progress) : previous_(spdlog::default_logger()) {
     auto file_sink = std::make_shared<spdlog::sinks::basic_file_sink_mt>(file.string(), false);
     file_sink->set_pattern("%Y-%m-%dT%H:%M:%S.%e %l %v");
     file_sink->set_level(spdlog::level::debug);
-    std::vector<spdlog::sink_ptr> sinks = previous_->sinks();
+    std::vector<spdlog::sink_ptr> sinks;
     // The terminal keeps the level it had; the log file gets debug messages too.
-    for (auto& sink : sinks) {
+    for (const auto& sink : previous_->sinks()) {
       sink_levels_.push_back(sink->level());
       sink->set_level(std::max(sink->level(), previous_->level()));
+      sinks.push_back(std::make_shared<AboveProgressSink>(sink, progress));
     }
     sinks.push_back(file_sink);
     auto logger = std::make_shared<spdlog::logger>("", sinks.begin(), sinks.end());
@@ -196,19 +225,6 @@ class RunLog {
   std::shared_ptr<spdlog::logger> previous_;
   std::vector<spdlog::level::level_enum> sink_levels_;
 };
-
-// CPU time [s] of this process's threads and of its finished, waited-for children (a stage's
-// subprocess), user plus system.
-double cpu_seconds_so_far() {
-  double total = 0.0;
-  for (int who : {RUSAGE_SELF, RUSAGE_CHILDREN}) {
-    rusage usage{};
-    ::getrusage(who, &usage);
-    for (const timeval& t : {usage.ru_utime, usage.ru_stime})
-      total += double(t.tv_sec) + 1e-6 * double(t.tv_usec);
-  }
-  return total;
-}
 
 std::string config_identity(const RunOptions& options) {
   return options.config_file.empty() ? std::string()
@@ -283,6 +299,281 @@ struct Completed {
   json outputs;
 };
 
+// What a stage's thread hands back: its line of the summary and its outputs, or its exception.
+struct Finished {
+  StageRun run;
+  Completed completed{StageStatus::kOk, json::array()};
+  std::exception_ptr error;
+};
+
+// CPU time [s] of the calling thread and of the children it ran and waited for: one stage's,
+// while other stages run on other threads.
+double thread_cpu_seconds() {
+  rusage usage{};
+  ::getrusage(RUSAGE_THREAD, &usage);
+  double total = children_cpu_seconds_of_this_thread();
+  for (const timeval& t : {usage.ru_utime, usage.ru_stime})
+    total += double(t.tv_sec) + 1e-6 * double(t.tv_usec);
+  return total;
+}
+
+json input_record(const StageInputs& declared, json upstream) {
+  json inputs = {
+      {"files", json::array()}, {"upstream", std::move(upstream)}, {"config", declared.config}};
+  for (const auto& [role, file] : declared.files) {
+    inputs["files"].push_back({{"role", role},
+                               {"path", fs::absolute(file).lexically_normal().string()},
+                               {"sha256", sha256_hex_of_file(file)}});
+  }
+  return inputs;
+}
+
+// The recorded result, when the stage's record matches these inputs and its outputs are intact.
+std::optional<Finished> skipped(const std::string& name, const fs::path& stage_dir,
+                                const std::optional<json>& record, const json& inputs,
+                                const RunOptions& options) {
+  if (options.force || !record || record->value("inputs", json()) != inputs ||
+      record->value("tool_version", "") != options.tool_version || !record->contains("outputs") ||
+      !outputs_intact(stage_dir, (*record)["outputs"]))
+    return std::nullopt;
+  Finished f;
+  f.run.name = name;
+  f.run.what = StageRun::What::kSkipped;
+  f.run.status = record->value("status", "") == "ok" ? StageStatus::kOk : StageStatus::kCheckFailed;
+  f.run.message = record->value("message", "");
+  f.completed = {f.run.status, (*record)["outputs"]};
+  spdlog::info("{}: inputs unchanged since {}, skipped ({}{}{})", name,
+               record->value("finished_utc", "?"), to_string(f.run.status),
+               f.run.message.empty() ? "" : ": ", f.run.message);
+  return f;
+}
+
+// A stage that is about to start, with what the scheduler resolved for it.
+struct StageJob {
+  Stage* stage;
+  StageInputs declared;
+  json upstream;  // the inputs' "upstream" entries
+  std::vector<std::string> completed_upstream;
+};
+
+// Runs the stage into its staging folder and commits it; the staging folder is removed when the
+// stage throws.
+Finished execute(const StageJob& job, const json& inputs, const RunOptions& options,
+                 Progress& progress, std::chrono::steady_clock::time_point t0) {
+  const std::string name = job.stage->name();
+  const fs::path& run_dir = options.folder;
+  const fs::path stage_dir = run_dir / name;
+  const fs::path staging = run_dir / (kStagingPrefix + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(staging);
+  fs::create_directories(staging);
+  const std::string started = utc_now();
+  const double cpu0 = thread_cpu_seconds();
+  StageOutcome outcome;
+  try {
+    StageWorkspace workspace(staging, run_dir, job.completed_upstream, name, &progress);
+    outcome = job.stage->run(workspace);
+    progress.finish(name);
+  } catch (...) {
+    progress.finish(name);
+    std::error_code ignored;
+    fs::remove_all(staging, ignored);
+    spdlog::error("{}: failed; nothing of it was kept", name);
+    throw;
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const json outputs = output_checksums(staging);
+  const json stage_record = {{"schema", "imscal-stage-record"},
+                             {"schema_version", 1},
+                             {"stage", name},
+                             {"status", to_string(outcome.status)},
+                             {"message", outcome.message},
+                             {"tool_version", options.tool_version},
+                             {"started_utc", started},
+                             {"finished_utc", utc_now()},
+                             {"seconds", seconds},
+                             {"cpu_seconds", thread_cpu_seconds() - cpu0},
+                             {"inputs", inputs},
+                             {"outputs", outputs},
+                             {"summary", outcome.summary}};
+  write_file_atomically(staging / kStageRecordName,
+                        json_text(stage_record, 1, (stage_dir / kStageRecordName).string()));
+  commit_stage_folder(staging, stage_dir,
+                      run_dir / (kOldPrefix + name + "-" + std::to_string(::getpid())));
+  spdlog::info("{}: {} in {:.2f} s{}{}", name, to_string(outcome.status), seconds,
+               outcome.message.empty() ? "" : ": ", outcome.message);
+  Finished f;
+  f.run = {name, StageRun::What::kRan, outcome.status, outcome.message, 0.0};
+  f.completed = {outcome.status, outputs};
+  return f;
+}
+
+// One stage on its thread: skipped when unchanged, else run and committed.
+Finished process_stage(const StageJob& job, const RunOptions& options, Progress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string name = job.stage->name();
+  const json inputs = input_record(job.declared, job.upstream);
+  const fs::path stage_dir = options.folder / name;
+  const std::optional<json> record = read_json_file(stage_dir / kStageRecordName);
+  std::optional<Finished> result = skipped(name, stage_dir, record, inputs, options);
+  if (!result) {
+    spdlog::info("{}: {}", name,
+                 options.force ? "rerun (--force)"
+                 : record      ? "inputs, version or outputs changed: rerun"
+                               : "no record: run");
+    result = execute(job, inputs, options, progress, t0);
+  }
+  result->run.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return std::move(*result);
+}
+
+}  // namespace
+
+namespace {
+
+// Starts each stage on its own thread once the earlier stages it waits for have ended, at most
+// `max_parallel` at a time; collects the results in chain order.
+class StageScheduler {
+ public:
+  StageScheduler(const std::vector<std::unique_ptr<Stage>>& stages, const RunOptions& options,
+                 Progress& progress)
+      : stages_(stages), options_(options), progress_(progress), state_(stages.size(), kWaiting) {
+    max_parallel_ = options.max_parallel_stages != 0
+                        ? options.max_parallel_stages
+                        : std::max(1u, std::thread::hardware_concurrency());
+    for (const auto& stage : stages) {
+      StageRun not_run;
+      not_run.name = stage->name();
+      summary_.stages.push_back(not_run);
+    }
+  }
+  StageScheduler(const StageScheduler&) = delete;
+  StageScheduler& operator=(const StageScheduler&) = delete;
+  // A throw on this thread still waits for the stages running (their threads use this object).
+  ~StageScheduler() {
+    for (std::thread& t : threads_) t.join();
+  }
+
+  RunSummary run() {
+    for (;;) {
+      if (!error_) start_ready_stages();
+      if (running_ == 0) break;
+      std::vector<std::pair<std::size_t, Finished>> ended;
+      {
+        std::unique_lock lock(mutex_);
+        ended_cv_.wait(lock, [&] { return !ended_.empty(); });
+        ended.swap(ended_);
+      }
+      for (auto& [index, finished] : ended) record(index, std::move(finished));
+    }
+    if (error_) std::rethrow_exception(error_);
+    return summary_;
+  }
+
+ private:
+  enum State { kWaiting, kRunning, kDone };
+
+  bool check_failed_before(std::size_t index) const {
+    for (std::size_t j = 0; j < index; ++j)
+      if (state_[j] == kDone && summary_.stages[j].what != StageRun::What::kNotRun &&
+          summary_.stages[j].status == StageStatus::kCheckFailed)
+        return true;
+    return false;
+  }
+
+  // Whether every earlier stage this one waits for has ended.
+  bool may_start(std::size_t index, const StageInputs& declared) const {
+    const Stage& stage = *stages_[index];
+    for (std::size_t j = 0; j < index; ++j) {
+      const std::string& earlier = summary_.stages[j].name;
+      const bool waits = stage.runs_after_failed_check() || stages_[j]->gates_later_stages() ||
+                         std::find(declared.upstream.begin(), declared.upstream.end(), earlier) !=
+                             declared.upstream.end();
+      if (waits && state_[j] != kDone) return false;
+    }
+    return true;
+  }
+
+  void start_ready_stages() {
+    for (std::size_t i = 0; i < stages_.size() && running_ < max_parallel_; ++i) {
+      if (state_[i] != kWaiting) continue;
+      if (check_failed_before(i) && !stages_[i]->runs_after_failed_check()) {
+        spdlog::info("{}: not run (an earlier check failed)", summary_.stages[i].name);
+        state_[i] = kDone;
+        continue;
+      }
+      StageInputs declared = stages_[i]->inputs();
+      if (may_start(i, declared)) start(i, std::move(declared));
+    }
+  }
+
+  // The inputs' upstream entries: the earlier stages' output checksums, or "not run".
+  StageJob job_for(std::size_t index, StageInputs declared) const {
+    StageJob job{stages_[index].get(), std::move(declared), json::array(), {}};
+    for (const std::string& up : job.declared.upstream) {
+      const auto found = completed_.find(up);
+      if (found == completed_.end()) {
+        job.upstream.push_back({{"stage", up}, {"status", "not run"}});
+      } else {
+        job.completed_upstream.push_back(up);
+        job.upstream.push_back({{"stage", up},
+                                {"status", to_string(found->second.status)},
+                                {"outputs", found->second.outputs}});
+      }
+    }
+    return job;
+  }
+
+  void start(std::size_t index, StageInputs declared) {
+    state_[index] = kRunning;
+    ++running_;
+    threads_.emplace_back([this, index, job = job_for(index, std::move(declared))] {
+      Finished finished;
+      try {
+        finished = process_stage(job, options_, progress_);
+      } catch (...) {
+        finished.error = std::current_exception();
+      }
+      const std::lock_guard lock(mutex_);
+      ended_.emplace_back(index, std::move(finished));
+      ended_cv_.notify_one();
+    });
+  }
+
+  void record(std::size_t index, Finished finished) {
+    --running_;
+    state_[index] = kDone;
+    if (finished.error) {
+      // The first stage in chain order that threw is the one reported.
+      if (!error_ || index < error_index_) {
+        error_ = finished.error;
+        error_index_ = index;
+      }
+      return;
+    }
+    completed_[summary_.stages[index].name] = finished.completed;
+    summary_.stages[index] = std::move(finished.run);
+  }
+
+  const std::vector<std::unique_ptr<Stage>>& stages_;
+  const RunOptions& options_;
+  Progress& progress_;
+  unsigned max_parallel_ = 1;
+  std::vector<State> state_;
+  RunSummary summary_;
+  // Only the stages that completed (ran or skipped) earlier in this run; a stage started reads
+  // nothing else, and they are all earlier in the chain (upstream stages are never later ones).
+  std::map<std::string, Completed> completed_;
+  unsigned running_ = 0;
+  std::exception_ptr error_;
+  std::size_t error_index_ = 0;
+  std::mutex mutex_;  // guards ended_
+  std::condition_variable ended_cv_;
+  std::vector<std::pair<std::size_t, Finished>> ended_;
+  std::vector<std::thread> threads_;
+};
+
 }  // namespace
 
 RunSummary run_stages(const std::vector<std::unique_ptr<Stage>>& stages,
@@ -300,115 +591,13 @@ RunSummary run_stages(const std::vector<std::unique_ptr<Stage>>& stages,
   fs::create_directories(run_dir);
   FolderLock lock(run_dir);
   if (run_record_needed(options)) record_run_folder(options);
-  RunLog log(run_dir / "run.log");
+  Progress progress(Progress::Stages::kConcurrent);
+  RunLog log(run_dir / "run.log", progress);
   spdlog::info("run in {} ({}, config {}){}", run_dir.string(), options.tool_version,
                options.config_file.string(), options.force ? ", --force: every stage reruns" : "");
   remove_leftovers(run_dir);
-
-  Progress progress;
-  RunSummary summary;
-  std::map<std::string, Completed> completed;
-  bool check_failed = false;
-  for (const auto& stage : stages) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const std::string name = stage->name();
-    StageRun result;
-    result.name = name;
-    if (check_failed && !stage->runs_after_failed_check()) {
-      spdlog::info("{}: not run (an earlier check failed)", name);
-      summary.stages.push_back(result);
-      continue;
-    }
-    const StageInputs declared = stage->inputs();
-    json inputs = {
-        {"files", json::array()}, {"upstream", json::array()}, {"config", declared.config}};
-    for (const auto& [role, file] : declared.files) {
-      inputs["files"].push_back({{"role", role},
-                                 {"path", fs::absolute(file).lexically_normal().string()},
-                                 {"sha256", sha256_hex_of_file(file)}});
-    }
-    std::vector<std::string> completed_upstream;
-    for (const std::string& up : declared.upstream) {
-      const auto found = completed.find(up);
-      if (found == completed.end()) {
-        inputs["upstream"].push_back({{"stage", up}, {"status", "not run"}});
-      } else {
-        completed_upstream.push_back(up);
-        inputs["upstream"].push_back({{"stage", up},
-                                      {"status", to_string(found->second.status)},
-                                      {"outputs", found->second.outputs}});
-      }
-    }
-
-    const fs::path stage_dir = run_dir / name;
-    const std::optional<json> record = read_json_file(stage_dir / kStageRecordName);
-    const bool unchanged = !options.force && record && record->value("inputs", json()) == inputs &&
-                           record->value("tool_version", "") == options.tool_version &&
-                           record->contains("outputs") &&
-                           outputs_intact(stage_dir, (*record)["outputs"]);
-    if (unchanged) {
-      result.what = StageRun::What::kSkipped;
-      result.status =
-          record->value("status", "") == "ok" ? StageStatus::kOk : StageStatus::kCheckFailed;
-      result.message = record->value("message", "");
-      completed[name] = {result.status, (*record)["outputs"]};
-      spdlog::info("{}: inputs unchanged since {}, skipped ({}{}{})", name,
-                   record->value("finished_utc", "?"), to_string(result.status),
-                   result.message.empty() ? "" : ": ", result.message);
-    } else {
-      spdlog::info("{}: {}", name,
-                   options.force ? "rerun (--force)"
-                   : record      ? "inputs, version or outputs changed: rerun"
-                                 : "no record: run");
-      const fs::path staging = run_dir / (kStagingPrefix + name + "-" + std::to_string(::getpid()));
-      fs::remove_all(staging);
-      fs::create_directories(staging);
-      const std::string started = utc_now();
-      const double cpu0 = cpu_seconds_so_far();
-      StageOutcome outcome;
-      try {
-        StageWorkspace workspace(staging, run_dir, completed_upstream, name, &progress);
-        outcome = stage->run(workspace);
-        progress.finish();
-      } catch (...) {
-        progress.finish();
-        std::error_code ignored;
-        fs::remove_all(staging, ignored);
-        spdlog::error("{}: failed; nothing of it was kept", name);
-        throw;
-      }
-      const double seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      const json outputs = output_checksums(staging);
-      const json stage_record = {{"schema", "imscal-stage-record"},
-                                 {"schema_version", 1},
-                                 {"stage", name},
-                                 {"status", to_string(outcome.status)},
-                                 {"message", outcome.message},
-                                 {"tool_version", options.tool_version},
-                                 {"started_utc", started},
-                                 {"finished_utc", utc_now()},
-                                 {"seconds", seconds},
-                                 {"cpu_seconds", cpu_seconds_so_far() - cpu0},
-                                 {"inputs", inputs},
-                                 {"outputs", outputs},
-                                 {"summary", outcome.summary}};
-      write_file_atomically(staging / kStageRecordName,
-                            json_text(stage_record, 1, (stage_dir / kStageRecordName).string()));
-      commit_stage_folder(staging, stage_dir,
-                          run_dir / (kOldPrefix + name + "-" + std::to_string(::getpid())));
-      result.what = StageRun::What::kRan;
-      result.status = outcome.status;
-      result.message = outcome.message;
-      completed[name] = {outcome.status, outputs};
-      spdlog::info("{}: {} in {:.2f} s{}{}", name, to_string(outcome.status), seconds,
-                   outcome.message.empty() ? "" : ": ", outcome.message);
-    }
-    if (result.status == StageStatus::kCheckFailed) check_failed = true;
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    summary.stages.push_back(result);
-  }
-  return summary;
+  StageScheduler scheduler(stages, options, progress);
+  return scheduler.run();
 }
 
 }  // namespace imscal

@@ -11,6 +11,18 @@
 // run leaves the completed stages and no visible half-written folder; the next run removes the
 // leftovers and reruns the interrupted stage from scratch. One run at a time per folder (a lock).
 //
+// Concurrency: a stage starts as soon as the earlier stages (in chain order) whose outputs it
+// reads, its declared upstream, have ended, while at most RunOptions::max_parallel_stages stages
+// run at once, each on its own thread (a subcommand stage in its own child process): Stage::run
+// must not touch what another stage's run uses. A stage that gates later stages (validation) and
+// a stage that summarises the run wait for every earlier stage. A stage sees only its declared
+// upstream stages, so the outputs are the bytes a one-at-a-time run writes, and the summary lists
+// the stages in chain order. A failed check keeps the later stages that have not started from
+// starting (except those that summarise); a stage already running completes. A stage's exception
+// starts no other stage, lets the running ones complete (committed) and then propagates. Each
+// stage.json records the stage's own wall and CPU time (its thread plus the children it waited
+// for, from wait4), and the terminal's progress line shows the running stages side by side.
+//
 // Layout:
 //   <run>/run.json          which config made this run folder
 //   <run>/run.log           log of every run in this folder (appended)
@@ -77,7 +89,8 @@ class Stage {
   virtual ~Stage() = default;
   // The stage's folder name in the run folder: lower-case letters, digits, '_' and '-'.
   virtual std::string name() const = 0;
-  // Called just before the stage would run (so it sees the files as they are now).
+  // Called before the stage would run, the last time just before it starts (so it sees the
+  // files as they are then); its upstream list also orders the stages.
   virtual StageInputs inputs() const = 0;
   // Writes the outputs into workspace.output_dir(). Throws InputError for bad input (nothing is
   // committed); returns kCheckFailed when the data were read but a check on them failed (the
@@ -85,6 +98,9 @@ class Stage {
   virtual StageOutcome run(StageWorkspace& workspace) = 0;
   // True for stages that summarise the run (the report): they run even after a failed check.
   virtual bool runs_after_failed_check() const { return false; }
+  // True for a stage whose failure must keep every later stage from starting (a validation of
+  // the raw files): later stages wait for it even when they do not read its outputs.
+  virtual bool gates_later_stages() const { return false; }
 };
 
 struct RunOptions {
@@ -92,6 +108,7 @@ struct RunOptions {
   std::filesystem::path config_file;  // the config that defines this run (recorded in run.json)
   std::string tool_version;           // "imscal 0.1.0": a new version reruns every stage
   bool force = false;  // rerun every stage; accept a folder made by another config or by no run
+  unsigned max_parallel_stages = 0;  // stages running at once; 0: the hardware threads
 };
 
 struct StageRun {
@@ -110,9 +127,10 @@ struct RunSummary {
   std::optional<std::string> failed_check() const;
 };
 
-// Runs the chain in order. Throws InputError when the folder cannot be used (another config's
-// run folder or a non-empty folder that is no run folder, without force; another run holds it)
-// and lets a stage's exceptions through (that stage leaves nothing visible).
+// Runs the chain (concurrently where the stages allow, see above). Throws InputError when the
+// folder cannot be used (another config's run folder or a non-empty folder that is no run folder,
+// without force; another run holds it) and lets a stage's exceptions through (that stage leaves
+// nothing visible).
 RunSummary run_stages(const std::vector<std::unique_ptr<Stage>>& stages, const RunOptions& options);
 
 // The name of the record file in every stage folder.

@@ -4,6 +4,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -15,6 +16,15 @@
 namespace imscal {
 
 namespace {
+thread_local double children_cpu_s = 0.0;
+
+double cpu_seconds_of(const rusage& usage) {
+  double total = 0.0;
+  for (const timeval& t : {usage.ru_utime, usage.ru_stime})
+    total += double(t.tv_sec) + 1e-6 * double(t.tv_usec);
+  return total;
+}
+
 void write_all(int fd, std::string_view text) {
   while (!text.empty()) {
     const ssize_t n = ::write(fd, text.data(), text.size());
@@ -23,6 +33,10 @@ void write_all(int fd, std::string_view text) {
   }
 }
 }  // namespace
+
+double children_cpu_seconds_of_this_thread() {
+  return children_cpu_s;
+}
 
 SubprocessResult run_subprocess(const std::vector<std::string>& argv,
                                 const SubprocessOptions& options) {
@@ -108,8 +122,9 @@ SubprocessResult run_subprocess(const std::vector<std::string>& argv,
   ::close(pipe_fds[0]);
   // The output may close before the child ends: wait for it, still within the time limit.
   int status = 0;
+  rusage usage{};  // of the child alone (and its waited-for children), not of a sibling's child
   for (;;) {
-    const pid_t done = ::waitpid(child, &status, result.timed_out ? 0 : WNOHANG);
+    const pid_t done = ::wait4(child, &status, result.timed_out ? 0 : WNOHANG, &usage);
     if (done == child) break;
     if (done < 0 && errno != EINTR) break;
     if (done == 0) {
@@ -121,6 +136,8 @@ SubprocessResult run_subprocess(const std::vector<std::string>& argv,
       }
     }
   }
+  result.cpu_seconds = cpu_seconds_of(usage);
+  children_cpu_s += result.cpu_seconds;
   if (WIFEXITED(status)) {
     result.exit_code = WEXITSTATUS(status);
   } else if (WIFSIGNALED(status)) {

@@ -12,9 +12,10 @@
 namespace imscal {
 
 struct SubprocessResult {
-  int exit_code = -1;      // the child's exit status; 128 + signal when killed by a signal
-  bool timed_out = false;  // killed because the time limit passed
-  std::string output;      // stdout and stderr, merged, as the child wrote them
+  int exit_code = -1;        // the child's exit status; 128 + signal when killed by a signal
+  bool timed_out = false;    // killed because the time limit passed
+  std::string output;        // stdout and stderr, merged, as the child wrote them
+  double cpu_seconds = 0.0;  // the child's CPU time, user plus system (wait4's rusage)
 };
 
 struct SubprocessOptions {
@@ -28,5 +29,10 @@ struct SubprocessOptions {
 // reason in `output`. Throws std::runtime_error only when no child can be created at all.
 SubprocessResult run_subprocess(const std::vector<std::string>& argv,
                                 const SubprocessOptions& options = {});
+
+// CPU time [s] of every child the calling thread has run through run_subprocess so far (each
+// one's threads and its own waited-for children): a stage's CPU time when several stages of one
+// process run at once (getrusage's RUSAGE_CHILDREN mixes them).
+double children_cpu_seconds_of_this_thread();
 
 }  // namespace imscal

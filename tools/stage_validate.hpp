@@ -15,6 +15,8 @@ class ValidateStage : public Stage {
   std::string name() const override { return "validate"; }
   StageInputs inputs() const override;
   StageOutcome run(StageWorkspace& workspace) override;
+  // Files that fail validation must not reach calibrate, which does not read validate's outputs.
+  bool gates_later_stages() const override { return true; }
 
  private:
   const RunConfig& config_;
