@@ -1,5 +1,5 @@
-// Transmission error: s, c = sin/cos(h N q_internal), h the order of 1..8 per motor revolution
-// whose response best fits the training rows (1..3 without them): raw, through L_3ms (x3, x4),
+// Transmission error: s, c = sin/cos(h N q_internal), h = 1..3 per motor revolution and the two
+// orders of 1..8 whose raw ripple best fits the training rows: raw, through L_3ms (x3, x4),
 // L_10ms or L_30ms (x4), or with the ripple torque tau_d s, tau_d c (the gear's virtual work on the
 // motor) through L_100ms x3 beside L_10ms x3 or L_3ms + L_30ms x3 of s, c: below the loop's
 // bandwidth the link follows the error, above the link's mode it does not. In the nominal model:
@@ -40,9 +40,7 @@ Named joined(Named a, const Named& b) {
   return a;
 }
 
-// The shapes of order h per motor revolution; the one at kResponseShape (ripple through 10 ms x3,
-// torque ripple through 100 ms x3) ranks the orders.
-constexpr std::size_t kResponseShape = 5;
+// The shapes of order h per motor revolution.
 void add_order(const ShapeContext& x, double h, std::vector<CandidateShape>& out) {
   const Column q = to_column(x.s.q_internal_rad[x.joint]);
   const Column tau_d = to_column(x.s.torque_nm[x.joint]);
@@ -91,27 +89,11 @@ void add_order(const ShapeContext& x, double h, std::vector<CandidateShape>& out
 std::vector<CandidateShape> shapes(const ShapeContext& x) {
   std::vector<CandidateShape> out;
   if (x.joint >= x.s.q_internal_rad.size()) return out;  // the motor angle is not known
-  // The order is the gear's own period: the one whose response (its ripple through 10 ms x3 and
-  // its torque ripple through 100 ms x3, the same parameters for every order) fits the training
-  // rows best; then only that order's responses compete in the shape's validation. With five
-  // orders of seven responses each, a two-fold validation on a few seconds of motion paired a
-  // wrong order with a flexible response (an A3 order-1 error fitted as order 2.5, -8 % held out
-  // against 57 %); the raw ripple alone ranks the orders by chance where the loop's response
-  // dominates (an order-3 error ranked 3.5 first).
   std::vector<double> orders = {1.0, 2.0, 3.0};
-  if (x.training) {
-    const std::vector<double> searched =
-        transmission_orders_by_fit(x.s, x.joint, x.s.gap_rad[x.joint], *x.training);
-    double best_rms = -1.0;
-    for (double h : searched) {
-      std::vector<CandidateShape> of_order;
-      add_order(x, h, of_order);
-      const double rms =
-          fit_columns(of_order[kResponseShape].columns[x.joint], x.s.gap_rad[x.joint], *x.training)
-              .rms;
-      if (best_rms < 0.0 || rms < best_rms) best_rms = rms, orders = {h};
-    }
-  }
+  if (x.training)  // two further orders from the search on the training rows
+    for (double h : transmission_orders_by_fit(x.s, x.joint, x.s.gap_rad[x.joint], *x.training))
+      if (orders.size() < 5 && std::find(orders.begin(), orders.end(), h) == orders.end())
+        orders.push_back(h);
   for (double h : orders) add_order(x, h, out);
   return out;
 }
