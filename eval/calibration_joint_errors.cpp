@@ -1,7 +1,5 @@
 #include "eval/calibration_joint_errors.hpp"
 
-#include <fmt/format.h>
-
 #include <span>
 
 #include "eval/gap_measurement_prior.hpp"
@@ -10,6 +8,10 @@
 namespace imscal::eval {
 
 namespace {
+
+std::span<const double> values(const calib::JointVector& q) {
+  return {q.data(), std::size_t(q.size())};
+}
 
 // The header of a calibration's joint_errors.csv, with the IMS noise floor in joint space.
 ident::JointErrorLog calibration_header(const calib::JointSpaceErrors& errors,
@@ -21,16 +23,9 @@ ident::JointErrorLog calibration_header(const calib::JointSpaceErrors& errors,
   header.joint_names.assign(log.joint_names.begin(), log.joint_names.end());
   if (!errors.q_measured_sigma_rad.empty() || errors.sums.rows > 0) {
     const calib::JointVector floor_rad = calib::q_measured_sigma_rms_rad(errors);
-    std::string value;
-    for (int j = 0; j < calib::kJointCount; ++j)
-      value += fmt::format("{}{:.6g}", j ? "," : "", floor_rad[j]);
-    header.metadata.emplace_back(kNoiseFloorKey, value);
+    header.metadata.emplace_back(kNoiseFloorKey, noise_floor_header_value(values(floor_rad)));
   }
   return header;
-}
-
-std::span<const double> values(const calib::JointVector& q) {
-  return {q.data(), std::size_t(q.size())};
 }
 
 }  // namespace

@@ -43,6 +43,13 @@ std::size_t frames_index(const JsonField& names, const std::string& name) {
 
 }  // namespace
 
+std::string noise_floor_header_value(std::span<const double> floor_rad) {
+  std::string value;
+  for (std::size_t j = 0; j < floor_rad.size(); ++j)
+    value += fmt::format("{}{:.6g}", j ? "," : "", floor_rad[j]);
+  return value;
+}
+
 std::vector<double> noise_floor_from_log(const ident::JointErrorLog& log, const std::string& file) {
   for (const auto& [key, value] : log.metadata) {
     if (key != kNoiseFloorKey) continue;

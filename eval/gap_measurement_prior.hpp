@@ -36,6 +36,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,10 @@ struct MeasurementPrior {
 // separated, > 0); empty when the log has no such key. InputError naming `file` and the key when
 // it is not one finite positive number per joint.
 std::vector<double> noise_floor_from_log(const ident::JointErrorLog& log, const std::string& file);
+
+// The header value of kNoiseFloorKey that noise_floor_from_log reads: the floors [rad], comma
+// separated, 6 significant digits (the floor is an RMS of sigmas; more digits carry no meaning).
+std::string noise_floor_header_value(std::span<const double> floor_rad);
 
 // The frames' covariance in the budget's parameters, from calibrate's frames.json; the deflection
 // scales of the joints `joint_names` (windup_scale_deviation.<name>, play_scale_deviation.<name>)

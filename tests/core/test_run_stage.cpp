@@ -24,6 +24,7 @@
 #include "core/run_stage.hpp"
 #include "core/sha256.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/stage_outcome.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -35,6 +36,7 @@ using imscal::StageOutcome;
 using imscal::StageRun;
 using imscal::StageStatus;
 using imscal::StageWorkspace;
+using imscal::test_support::stage_outcome;
 
 std::string read_text(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -168,12 +170,6 @@ class RunStageTest : public imscal::test_support::ScratchDirTest {
     o.force = force;
     return o;
   }
-  static StageRun::What what(const RunSummary& s, const std::string& name) {
-    for (const auto& stage : s.stages)
-      if (stage.name == name) return stage.what;
-    ADD_FAILURE() << name << " not in the summary";
-    return StageRun::What::kNotRun;
-  }
   // Every file of the run folder except records, the log and the lock: name -> bytes.
   static std::map<std::string, std::string> outputs(const fs::path& folder) {
     std::map<std::string, std::string> files;
@@ -198,7 +194,7 @@ TEST_F(RunStageTest, UnchangedInputsAreSkippedWithRecordsUntouched) {
   const double first_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (const char* s : {"upper", "count", "summary"})
-    EXPECT_EQ(what(first, s), StageRun::What::kRan);
+    EXPECT_EQ(stage_outcome(first, s), StageRun::What::kRan);
   EXPECT_FALSE(first.failed_check());
   EXPECT_EQ(read_text(run / "upper" / "part1.txt") + read_text(run / "upper" / "sub" / "part2.txt"),
             "HELLO RUN FOLDER\n");
@@ -217,7 +213,7 @@ TEST_F(RunStageTest, UnchangedInputsAreSkippedWithRecordsUntouched) {
   const double second_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   for (const char* s : {"upper", "count", "summary"}) {
-    EXPECT_EQ(what(second, s), StageRun::What::kSkipped) << s;
+    EXPECT_EQ(stage_outcome(second, s), StageRun::What::kSkipped) << s;
     EXPECT_EQ(read_text(run / s / "stage.json"), records[s]) << s;  // started/finished times too
     EXPECT_EQ(fs::last_write_time(run / s / "stage.json"), times[s]) << s;
   }
@@ -231,7 +227,7 @@ TEST_F(RunStageTest, UnchangedInputsAreSkippedWithRecordsUntouched) {
   // --force reruns everything.
   const RunSummary forced = imscal::run_stages(c.stages, options(run, /*force=*/true));
   for (const char* s : {"upper", "count", "summary"})
-    EXPECT_EQ(what(forced, s), StageRun::What::kRan);
+    EXPECT_EQ(stage_outcome(forced, s), StageRun::What::kRan);
 }
 
 TEST_F(RunStageTest, ChangedInputRerunsTheStageAndDownstreamOnlyIfItsOutputsChanged) {
@@ -242,25 +238,25 @@ TEST_F(RunStageTest, ChangedInputRerunsTheStageAndDownstreamOnlyIfItsOutputsChan
   // count and summary (whose inputs are upper's output checksums) stay skipped.
   write_text(input_, "HELLO run FOLDER\n");
   RunSummary s = imscal::run_stages(c.stages, options(run));
-  EXPECT_EQ(what(s, "upper"), StageRun::What::kRan);
-  EXPECT_EQ(what(s, "count"), StageRun::What::kSkipped);
-  EXPECT_EQ(what(s, "summary"), StageRun::What::kSkipped);
+  EXPECT_EQ(stage_outcome(s, "upper"), StageRun::What::kRan);
+  EXPECT_EQ(stage_outcome(s, "count"), StageRun::What::kSkipped);
+  EXPECT_EQ(stage_outcome(s, "summary"), StageRun::What::kSkipped);
   // A longer text: upper's outputs change, so everything downstream reruns.
   write_text(input_, "hello longer run folder\n");
   s = imscal::run_stages(c.stages, options(run));
   for (const char* name : {"upper", "count", "summary"})
-    EXPECT_EQ(what(s, name), StageRun::What::kRan);
+    EXPECT_EQ(stage_outcome(s, name), StageRun::What::kRan);
   EXPECT_EQ(read_text(run / "count" / "count.txt"), "24\n");
   // A changed config subtree reruns the stage too.
   auto reversed = chain("reverse");
   s = imscal::run_stages(reversed.stages, options(run));
-  EXPECT_EQ(what(s, "upper"), StageRun::What::kRan);
+  EXPECT_EQ(stage_outcome(s, "upper"), StageRun::What::kRan);
   EXPECT_EQ(read_text(run / "upper" / "part1.txt"), "\nREDLOF NUR ");
   // An output changed by hand is detected: its stage reruns and restores it.
   write_text(run / "count" / "count.txt", "3\n");
   s = imscal::run_stages(reversed.stages, options(run));
-  EXPECT_EQ(what(s, "upper"), StageRun::What::kSkipped);
-  EXPECT_EQ(what(s, "count"), StageRun::What::kRan);
+  EXPECT_EQ(stage_outcome(s, "upper"), StageRun::What::kSkipped);
+  EXPECT_EQ(stage_outcome(s, "count"), StageRun::What::kRan);
   EXPECT_EQ(read_text(run / "count" / "count.txt"), "24\n");
 }
 
@@ -315,7 +311,7 @@ TEST_F(RunStageTest, KilledMidStageResumesToTheSameBytesAsAnUninterruptedRun) {
   auto resumed = chain();
   const RunSummary s = imscal::run_stages(resumed.stages, options(run));
   for (const char* name : {"upper", "count", "summary"})
-    EXPECT_EQ(what(s, name), StageRun::What::kRan);
+    EXPECT_EQ(stage_outcome(s, name), StageRun::What::kRan);
   for (const auto& e : fs::directory_iterator(run))
     EXPECT_NE(e.path().filename().string().rfind(".staging-", 0), 0u) << "leftover " << e.path();
   EXPECT_EQ(outputs(run), outputs(reference));
@@ -333,7 +329,7 @@ TEST_F(RunStageTest, AFailedCheckStopsTheChainButTheSummaryRuns) {
   EXPECT_EQ(read_text(run / "summary" / "summary.txt"), "upper present\ncount present\n");
   // Skipped the second time, and the failure is reported again.
   const RunSummary again = imscal::run_stages(c.stages, options(run));
-  EXPECT_EQ(what(again, "count"), StageRun::What::kSkipped);
+  EXPECT_EQ(stage_outcome(again, "count"), StageRun::What::kSkipped);
   ASSERT_TRUE(again.failed_check());
 }
 

@@ -19,6 +19,7 @@
 #include "core/run_stage.hpp"
 #include "core/subprocess.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/stage_outcome.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -30,6 +31,7 @@ using imscal::StageOutcome;
 using imscal::StageRun;
 using imscal::StageStatus;
 using imscal::StageWorkspace;
+using imscal::test_support::stage_outcome;
 using namespace std::chrono_literals;
 
 std::string read_text(const fs::path& file) {
@@ -135,12 +137,6 @@ class RunStageConcurrent : public imscal::test_support::ScratchDirTest {
     o.tool_version = "imscal test";
     o.max_parallel_stages = max_parallel;
     return o;
-  }
-  static StageRun::What what(const RunSummary& s, const std::string& name) {
-    for (const auto& stage : s.stages)
-      if (stage.name == name) return stage.what;
-    ADD_FAILURE() << name << " not in the summary";
-    return StageRun::What::kNotRun;
   }
   // The stage outputs (everything but records, log and lock): name -> bytes.
   static std::map<std::string, std::string> outputs(const fs::path& folder) {
@@ -248,11 +244,11 @@ TEST_F(RunStageConcurrent, AFailedCheckLetsTheRunningSiblingCompleteAndStartsNoL
   const RunSummary s = imscal::run_stages(stages, options(dir_ / "run", 2));
   ASSERT_TRUE(s.failed_check());
   EXPECT_EQ(*s.failed_check(), "left: left failed");
-  EXPECT_EQ(what(s, "right"), StageRun::What::kRan);
+  EXPECT_EQ(stage_outcome(s, "right"), StageRun::What::kRan);
   EXPECT_TRUE(fs::exists(dir_ / "run" / "right" / "stage.json"));
-  EXPECT_EQ(what(s, "join"), StageRun::What::kNotRun);
+  EXPECT_EQ(stage_outcome(s, "join"), StageRun::What::kNotRun);
   EXPECT_FALSE(fs::exists(dir_ / "run" / "join"));
-  EXPECT_EQ(what(s, "summary"), StageRun::What::kRan);
+  EXPECT_EQ(stage_outcome(s, "summary"), StageRun::What::kRan);
   EXPECT_EQ(read_text(dir_ / "run" / "summary" / "summary.txt"),
             "summary source:source join:absent");
 }
@@ -300,7 +296,8 @@ TEST_F(RunStageConcurrent, AGatingStageHoldsBackEveryLaterStage) {
     stages.push_back(std::make_unique<ScriptedStage>("free", std::vector<std::string>{}, ok));
     const fs::path run = dir_ / (gates ? "gated" : "free");
     const RunSummary s = imscal::run_stages(stages, options(run, 2));
-    EXPECT_EQ(what(s, "free"), gates ? StageRun::What::kNotRun : StageRun::What::kRan) << gates;
+    EXPECT_EQ(stage_outcome(s, "free"), gates ? StageRun::What::kNotRun : StageRun::What::kRan)
+        << gates;
   }
 }
 

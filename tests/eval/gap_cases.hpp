@@ -244,12 +244,12 @@ struct GapWorld {
   // measurement budget then tests the case as it tests a real record.
   static void add_ims_chain_noise(std::mt19937_64& rng, ident::JointErrorLog& log) {
     std::uniform_real_distribution<double> rms_rad(5e-5, 8e-5);
-    std::string floor;
+    std::vector<double> floor_rad;
     std::normal_distribution<double> unit(0.0, 1.0);
     const double phi = std::exp(-log.cycle_s / 1.0);
     for (auto& qm : log.q_measured_rad) {
       const double rms = rms_rad(rng);
-      floor += fmt::format("{}{:.17g}", floor.empty() ? "" : ",", rms);
+      floor_rad.push_back(rms);
       std::vector<double> slow(qm.size()), fast(qm.size());
       double ar = unit(rng), e_slow = 0.0, e_fast = 0.0;
       for (std::size_t k = 0; k < qm.size(); ++k) {
@@ -261,7 +261,7 @@ struct GapWorld {
       const double a = rms * std::sqrt(0.9 * n / e_slow), b = rms * std::sqrt(0.1 * n / e_fast);
       for (std::size_t k = 0; k < qm.size(); ++k) qm[k] += a * slow[k] + b * fast[k];
     }
-    log.metadata.emplace_back(kNoiseFloorKey, floor);
+    log.metadata.emplace_back(kNoiseFloorKey, noise_floor_header_value(floor_rad));
   }
 
   // One speed dimension per joint: joint `joint` identified up to v_id (the band above filled),
