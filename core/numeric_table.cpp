@@ -4,7 +4,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -36,19 +35,6 @@ std::size_t NumericTable::meta_line(const std::string& key) const {
 }
 
 namespace {
-
-// The lines left in `in` (at most; counted, then `in` put back), to reserve the rows.
-std::size_t lines_left(std::istream& in) {
-  const std::istream::pos_type here = in.tellg();
-  if (here == std::istream::pos_type(-1)) return 0;
-  std::size_t lines = 1;
-  std::array<char, 1 << 16> buffer{};
-  while (in.read(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0)
-    lines += std::size_t(std::count(buffer.data(), buffer.data() + in.gcount(), '\n'));
-  in.clear();
-  in.seekg(here);
-  return lines;
-}
 
 // The metadata line `text` ('#' first) into the table, if it holds a key.
 void add_metadata(std::string_view text, std::size_t line_number, NumericTable& table) {
@@ -124,7 +110,7 @@ void read_numeric_rows(const std::filesystem::path& path, const NumericHeaderUse
         continue;
       }
       read_header_line(text, line_number, table);
-      if (header) header(table, lines_left(in));
+      if (header) header(table, csv::lines_left(in));
       continue;
     }
     read_data_line(text, line_number, table, values);
