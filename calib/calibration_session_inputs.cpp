@@ -67,12 +67,11 @@ void read_imu_record(const SessionFiles& files, LoadedSession& s) {
   if (spec.acc.range > 0.0) read_options.acc_range_m_s2 = spec.acc.range;
   ims::ImuSeries& imu = s.inputs.imu;
   imu = ims::read_imu_file(files.imu, read_options);
-  if (imu.quantity == ims::ImuQuantity::kRates) imu = ims::rates_to_increments(std::move(imu));
+  if (imu.quantity == ims::ImuQuantity::kRates) imu = ims::rates_to_increments(imu);
   s.unit_calibration_file = s.options.config.unit_calibration_file;
   if (!files.unit_calibration.empty()) s.unit_calibration_file = fs::path(files.unit_calibration);
   if (s.unit_calibration_file) {
-    const ims::SensorErrorModel unit = ims::load_sensor_error_model(*s.unit_calibration_file);
-    imu = ims::correct(std::move(imu), unit);
+    imu = ims::correct(imu, ims::load_sensor_error_model(*s.unit_calibration_file));
     spdlog::info("calibrate: corrected {} with the unit calibration {}", files.imu,
                  s.unit_calibration_file->string());
   }

@@ -275,11 +275,9 @@ TimeOffsetResult estimate_initial_time_offset(const ims::ImuSeries& imu, const R
     }
     earth_rate_S /= static_cast<double>(initial_rest.last_sample - initial_rest.first_sample + 1);
   }
-  // The joint series only while the flange rate is computed (both grow with the log).
-  const RateMagnitudeSeries robot_rate = [&] {
-    const RobotJointSeries joints = robot_joint_series(log);
-    return flange_rate_magnitude(kinematics, joints.t_robot_s, joints.q_rad, "robot log");
-  }();
+  const RobotJointSeries joints = robot_joint_series(log);
+  const RateMagnitudeSeries robot_rate =
+      flange_rate_magnitude(kinematics, joints.t_robot_s, joints.q_rad, "robot log");
   const RateMagnitudeSeries ims_rate = ims_rate_magnitude(imu, earth_rate_S);
   return estimate_time_offset(robot_rate, ims_rate, options);
 }

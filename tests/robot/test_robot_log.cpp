@@ -114,10 +114,10 @@ TEST(RobotLogBadInputs, EveryCaseIsRefusedWithFileLineAndField) {
   EXPECT_EQ(cases, 23);  // make_cases.py writes 23: none may go missing silently
 }
 
-// Two faults in one file: the rows are read as they come, but the log's own checks speak only
-// once the file's structure is checked to its end, so the first error is the one a whole table
-// read first gave. The line and field of each are known from the file written here.
-TEST_F(RobotLogTest, TheFirstOfTwoFaultsIsTheOneTheTableGave) {
+// Two faults in one file: the file's structure (fields, numbers) is checked to its end before
+// the log's own checks speak, and of those the header's and then the earlier row's come first.
+// The line and field of each are known from the file written here.
+TEST_F(RobotLogTest, TheFirstOfTwoFaultsIsTheStructureThenTheEarlierRow) {
   const auto write = [&](const std::string& name, const std::string& robot,
                          const std::vector<std::string>& rows) {
     std::ofstream out(dir_ / name);
