@@ -8,14 +8,15 @@
 #include <stdexcept>
 
 #include "core/input_error.hpp"
-#include "core/record_file.hpp"
 #include "ims/error_state_model.hpp"
 #include "ims/sensor_error_model.hpp"
 #include "ims/so3.hpp"
 #include "ims/strapdown.hpp"
+#include "ims/zupt_smoother_records.hpp"
 
 namespace imscal::ims {
 using namespace error_state;
+using namespace zupt_records;
 
 namespace {
 
@@ -60,51 +61,6 @@ void check_options(const ImuSamples& imu, const ZuptOptions& o) {
   if (!(o.propagation_interval_s > 0.0)) refuse("propagation_interval_s", "must be positive");
   if (!(o.innovation_gate_chi2 > 0.0)) refuse("innovation_gate_chi2", "must be positive");
 }
-
-// What the forward pass keeps per propagation instant k (k = 0: the initial state).
-struct Epoch {
-  std::size_t last_sample = 0;  // sample index ending the interval (k - 1, k]; unused for k = 0
-  double t_s = 0.0;
-  ErrorVector correction = ErrorVector::Zero();         // error estimate fed back at k
-  Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();  // estimates after the updates at k
-  Eigen::Vector3d acc_bias = Eigen::Vector3d::Zero();
-};
-
-// The matrices of instant k, which only the backward pass needs: 5.4 kB per instant (32 MB
-// per minute at 100 Hz), so they go to a temporary file (CovarianceFile) instead of memory.
-struct EpochCovariances {
-  ErrorMatrix transition;     // from k - 1 to k
-  ErrorMatrix predicted_cov;  // at k before the updates
-  ErrorMatrix filtered_cov;   // at k after the updates
-};
-
-// The forward pass' EpochCovariances, one record per instant, written in order and read back
-// by the backward pass in reverse, bit for bit.
-class CovarianceFile {
- public:
-  static constexpr std::size_t kValues = 3 * kSize * kSize;
-  // 512 instants per block: 2.8 MB of buffer.
-  CovarianceFile() : file_(kValues, 512, "the smoother's covariances") {}
-  void append(const EpochCovariances& c) {
-    std::copy_n(c.transition.data(), kSize * kSize, values_.data());
-    std::copy_n(c.predicted_cov.data(), kSize * kSize, values_.data() + kSize * kSize);
-    std::copy_n(c.filtered_cov.data(), kSize * kSize, values_.data() + 2 * kSize * kSize);
-    file_.append(values_.data());
-  }
-  EpochCovariances read(std::size_t k) {
-    const double* v = file_.record(k);
-    EpochCovariances c;
-    c.transition = Eigen::Map<const ErrorMatrix>(v);
-    c.predicted_cov = Eigen::Map<const ErrorMatrix>(v + kSize * kSize);
-    c.filtered_cov = Eigen::Map<const ErrorMatrix>(v + 2 * kSize * kSize);
-    return c;
-  }
-  std::size_t size() const { return file_.size(); }
-
- private:
-  RecordFile file_;
-  std::vector<double> values_ = std::vector<double>(kValues);
-};
 
 struct UpdateTally {
   std::size_t accepted = 0, rejected = 0, above95 = 0;
@@ -205,38 +161,30 @@ Epoch initial_epoch(const NavState& initial, const ZuptOptions& options) {
   return first;
 }
 
-struct SmoothedErrors {
-  // after[k]: smoothed error relative to the fed-back (post-update) nominal at k;
-  // before[k] = after[k] + correction[k]: relative to the nominal before the updates at k,
-  // i.e. the end of the mechanised interval (k - 1, k].
-  std::vector<ErrorVector> after, before;
-  std::vector<ErrorVector> variance;  // diagonal of the smoothed covariance
-};
-
 // Rauch-Tung-Striebel on the error state. With the estimates fed back, the filtered error is
-// zero after every update and so is its prediction: x_s(k) = C_k x_s^before(k + 1).
-SmoothedErrors rts_backward_pass(const std::vector<Epoch>& epochs, CovarianceFile& covariances) {
+// zero after every update and so is its prediction: x_s(k) = C_k x_s^before(k + 1). Appends
+// each instant's smoothed errors to `out`, from the last instant to the first.
+void rts_backward_pass(EpochFile& epochs, CovarianceFile& covariances, SmoothedErrorFile& out) {
   const std::size_t last = epochs.size() - 1;
-  SmoothedErrors s;
-  s.after.resize(epochs.size());
-  s.before.resize(epochs.size());
-  s.variance.resize(epochs.size());
-  s.after[last].setZero();
+  SmoothedError s;
+  s.after.setZero();
   EpochCovariances next = covariances.read(last);
   ErrorMatrix smoothed_cov = next.filtered_cov;
-  s.variance[last] = smoothed_cov.diagonal();
-  s.before[last] = epochs[last].correction;
+  s.variance = smoothed_cov.diagonal();
+  s.before = epochs.read(last).correction;
+  out.append_before(s);
   for (std::size_t k = last; k-- > 0;) {
     EpochCovariances current = covariances.read(k);
     const ErrorMatrix C = smoother_gain(current.filtered_cov, next.transition, next.predicted_cov);
-    s.after[k] = C * s.before[k + 1];
+    const ErrorVector before_next = s.before;
+    s.after = C * before_next;
     smoothed_cov = current.filtered_cov + C * (smoothed_cov - next.predicted_cov) * C.transpose();
     smoothed_cov = 0.5 * (smoothed_cov + smoothed_cov.transpose());
-    s.variance[k] = smoothed_cov.diagonal().cwiseMax(0.0);
-    s.before[k] = s.after[k] + epochs[k].correction;
+    s.variance = smoothed_cov.diagonal().cwiseMax(0.0);
+    s.before = s.after + epochs.read(k).correction;
+    out.append_before(s);
     next = std::move(current);
   }
-  return s;
 }
 
 // Sample i without the biases estimated at the instant before its interval.
@@ -294,23 +242,34 @@ bool aid_velocity_at(const SmootherAids& aids, double t, std::size_t& cursor, Ei
 
 struct SmoothedStateStream::Record {
   Strapdown initial;
-  std::vector<Epoch> epochs;
-  SmoothedErrors smoothed;
+  EpochFile epochs;
+  SmoothedErrorFile smoothed;
 };
 
 // Where the stream stands: the strapdown after sample `sample` - 1, in the interval ending at
-// instant `instant`.
+// instant `instant`, with what the record holds for the instants before and at its end.
 struct SmoothedStateStream::Cursor {
   Strapdown strapdown;
   std::size_t instant = 1;
   std::size_t sample = 0;
+  Epoch start, end;
+  SmoothedError smoothed_start, smoothed_end;
+
+  // Reads the instants around the interval `instant` ends, when the record has it.
+  void load(Record& record) {
+    if (instant >= record.epochs.size()) return;
+    start = record.epochs.read(instant - 1);
+    end = record.epochs.read(instant);
+    smoothed_start = record.smoothed.read(instant - 1);
+    smoothed_end = record.smoothed.read(instant);
+  }
 };
 
 SmoothedStateStream::SmoothedStateStream() = default;
-SmoothedStateStream::SmoothedStateStream(std::unique_ptr<const Record> record, ImuSamples imu)
-    : imu_(std::move(imu)),
-      record_(std::move(record)),
-      cursor_(std::make_unique<Cursor>(Cursor{record_->initial})) {}
+SmoothedStateStream::SmoothedStateStream(std::unique_ptr<Record> record, ImuSamples imu)
+    : imu_(std::move(imu)), record_(std::move(record)) {
+  rewind();
+}
 SmoothedStateStream::~SmoothedStateStream() = default;
 SmoothedStateStream::SmoothedStateStream(SmoothedStateStream&&) noexcept = default;
 SmoothedStateStream& SmoothedStateStream::operator=(SmoothedStateStream&&) noexcept = default;
@@ -323,7 +282,26 @@ bool SmoothedStateStream::done() const {
   return !record_ || cursor_->instant >= record_->epochs.size();
 }
 void SmoothedStateStream::rewind() {
-  if (record_) *cursor_ = Cursor{record_->initial};
+  if (!record_) return;
+  cursor_ = std::make_unique<Cursor>(Cursor{record_->initial, 1, 0, {}, {}, {}, {}});
+  cursor_->load(*record_);
+}
+
+std::vector<SmoothedBias> SmoothedStateStream::biases() {
+  std::vector<SmoothedBias> out;
+  if (!record_) return out;
+  out.resize(record_->epochs.size());
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const Epoch epoch = record_->epochs.read(k);
+    const SmoothedError smoothed = record_->smoothed.read(k);
+    SmoothedBias& b = out[k];
+    b.t_s = epoch.t_s;
+    b.gyro_rad_s = epoch.gyro_bias + smoothed.after.segment<3>(kGyroBias);
+    b.acc_m_s2 = epoch.acc_bias + smoothed.after.segment<3>(kAccBias);
+    b.gyro_sigma_rad_s = smoothed.variance.segment<3>(kGyroBias).cwiseSqrt();
+    b.acc_sigma_m_s2 = smoothed.variance.segment<3>(kAccBias).cwiseSqrt();
+  }
+  return out;
 }
 
 // The nominal state of every sample corrected by the smoothed error, interpolated linearly in
@@ -332,27 +310,25 @@ void SmoothedStateStream::rewind() {
 // kept per sample or per instant.
 std::size_t SmoothedStateStream::next(std::vector<SmoothedState>& out, std::size_t max_states) {
   if (!record_) return 0;
-  const std::vector<Epoch>& epochs = record_->epochs;
-  const SmoothedErrors& smoothed = record_->smoothed;
   Cursor& c = *cursor_;
   std::size_t given = 0;
-  while (c.instant < epochs.size() && given < max_states) {
-    const std::size_t k = c.instant;
-    const double t0 = epochs[k - 1].t_s, t1 = epochs[k].t_s;
-    for (; c.sample <= epochs[k].last_sample && given < max_states; ++c.sample, ++given) {
-      c.strapdown.step(bias_corrected(imu_, c.sample, epochs[k - 1]));
+  while (c.instant < record_->epochs.size() && given < max_states) {
+    const double t0 = c.start.t_s, t1 = c.end.t_s;
+    for (; c.sample <= c.end.last_sample && given < max_states; ++c.sample, ++given) {
+      c.strapdown.step(bias_corrected(imu_, c.sample, c.start));
       const NavState& nominal = c.strapdown.state();
       const double alpha = (nominal.t_s - t0) / (t1 - t0);
-      const ErrorVector e = (1.0 - alpha) * smoothed.after[k - 1] + alpha * smoothed.before[k];
+      const ErrorVector e = (1.0 - alpha) * c.smoothed_start.after + alpha * c.smoothed_end.before;
       const ErrorVector var =
-          (1.0 - alpha) * smoothed.variance[k - 1] + alpha * smoothed.variance[k];
+          (1.0 - alpha) * c.smoothed_start.variance + alpha * c.smoothed_end.variance;
       SmoothedState& state = out.emplace_back();
       state.state = apply_error(nominal, e);
       state.sigma = var.head<9>().cwiseSqrt();
     }
-    if (c.sample > epochs[k].last_sample) {
-      feed_back(c.strapdown, epochs[k].correction);
+    if (c.sample > c.end.last_sample) {
+      feed_back(c.strapdown, c.end.correction);
       ++c.instant;
+      c.load(*record_);
     }
   }
   return given;
@@ -367,7 +343,7 @@ ZuptSmootherResult smooth_with_zupt(const ImuSamples& imu, const EarthModel& ear
   ZuptSmootherResult result;
   result.states.reserve(imu.samples.size() + 1);  // room for a caller's initial state
   smoothing.states.next(result.states, imu.samples.size());
-  result.biases = std::move(smoothing.biases);
+  result.biases = smoothing.states.biases();
   result.summary = std::move(smoothing.summary);
   return result;
 }
@@ -413,10 +389,10 @@ ZuptSmoothing smooth_with_zupt_streamed(const ImuSamples& imu, const EarthModel&
   const std::vector<bool> epoch_zero_velocity = rest_interior(options.zero_velocity_edge_margin_s);
 
   // ---- forward pass ----
-  std::vector<Epoch> epochs;
+  EpochFile epochs;
   CovarianceFile covariances;
-  epochs.reserve(epoch_count + 1);
-  epochs.push_back(initial_epoch(initial, options));
+  Epoch previous = initial_epoch(initial, options);
+  epochs.append(previous);
   const EpochCovariances first_covariances = initial_covariances(initial_sigma, options);
   covariances.append(first_covariances);
   ErrorMatrix previous_filtered_cov = first_covariances.filtered_cov;
@@ -441,7 +417,6 @@ ZuptSmoothing smooth_with_zupt_streamed(const ImuSamples& imu, const EarthModel&
   for (std::size_t k = 1; k <= epoch_count; ++k) {
     const std::size_t begin = (k - 1) * samples_per_epoch;
     const std::size_t end = std::min(n, begin + samples_per_epoch);
-    const Epoch& previous = epochs.back();
     Eigen::Matrix3d sum_R = Eigen::Matrix3d::Zero();
     Eigen::Vector3d sum_dv_W = Eigen::Vector3d::Zero();
     Eigen::Vector3d sum_raw_dtheta = Eigen::Vector3d::Zero();
@@ -534,24 +509,17 @@ ZuptSmoothing smooth_with_zupt_streamed(const ImuSamples& imu, const EarthModel&
     cov.filtered_cov = P;
     previous_filtered_cov = P;
     epoch.correction = x;
-    epochs.push_back(std::move(epoch));
+    epochs.append(epoch);
     covariances.append(cov);
+    previous = epoch;
   }
   result.summary.zero_velocity = zupt_tally.statistics();
   result.summary.zero_angular_rate = zaru_tally.statistics();
   result.summary.velocity_aid = aid_tally.statistics();
   result.summary.propagation_steps = epoch_count;
 
-  SmoothedErrors smoothed = rts_backward_pass(epochs, covariances);
-  result.biases.resize(epochs.size());
-  for (std::size_t k = 0; k < epochs.size(); ++k) {
-    SmoothedBias& b = result.biases[k];
-    b.t_s = epochs[k].t_s;
-    b.gyro_rad_s = epochs[k].gyro_bias + smoothed.after[k].segment<3>(kGyroBias);
-    b.acc_m_s2 = epochs[k].acc_bias + smoothed.after[k].segment<3>(kAccBias);
-    b.gyro_sigma_rad_s = smoothed.variance[k].segment<3>(kGyroBias).cwiseSqrt();
-    b.acc_sigma_m_s2 = smoothed.variance[k].segment<3>(kAccBias).cwiseSqrt();
-  }
+  SmoothedErrorFile smoothed;
+  rts_backward_pass(epochs, covariances, smoothed);
   result.states =
       SmoothedStateStream(std::make_unique<SmoothedStateStream::Record>(SmoothedStateStream::Record{
                               initial_strapdown, std::move(epochs), std::move(smoothed)}),

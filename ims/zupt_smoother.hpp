@@ -76,15 +76,15 @@ struct ZuptSummary {
 
 // The smoothed states one block at a time, in sample order: mechanised again from the initial
 // state with the forward pass' bias estimates and feedbacks and corrected by the smoothed
-// errors of the propagation instants around each sample. It keeps per instant what the states
-// are built from (about 600 bytes per 10 ms, against 160 bytes per sample for the states), so
-// a caller that uses the trajectory block by block holds memory that does not grow with the
-// record's rate. Holds a view of the IMS record it was smoothed from, which must outlive it.
+// errors of the propagation instants around each sample. What the states are built from (about
+// 550 bytes per 10 ms) waits in temporary files (ims/zupt_smoother_records.hpp), so a caller
+// that uses the trajectory block by block holds memory that does not grow with the record.
+// Holds a view of the IMS record it was smoothed from, which must outlive it.
 class SmoothedStateStream {
  public:
   struct Record;  // the forward and backward passes' per-instant results (zupt_smoother.cpp)
   SmoothedStateStream();  // no states
-  SmoothedStateStream(std::unique_ptr<const Record> record, ImuSamples imu);
+  SmoothedStateStream(std::unique_ptr<Record> record, ImuSamples imu);
   ~SmoothedStateStream();
   SmoothedStateStream(SmoothedStateStream&&) noexcept;
   SmoothedStateStream& operator=(SmoothedStateStream&&) noexcept;
@@ -95,17 +95,18 @@ class SmoothedStateStream {
   // Starts again at the first sample (for a second pass over the trajectory).
   void rewind();
   std::size_t size() const;  // states in all: one per IMS sample
+  // The smoothed biases, one per propagation instant (read from the files; the cursor stays).
+  std::vector<SmoothedBias> biases();
 
  private:
   struct Cursor;
   ImuSamples imu_;  // a view of the record smoothed
-  std::unique_ptr<const Record> record_;
+  std::unique_ptr<Record> record_;
   std::unique_ptr<Cursor> cursor_;
 };
 
 struct ZuptSmoothing {
-  SmoothedStateStream states;
-  std::vector<SmoothedBias> biases;  // one per propagation instant
+  SmoothedStateStream states;  // and the smoothed biases (SmoothedStateStream::biases)
   ZuptSummary summary;
 };
 

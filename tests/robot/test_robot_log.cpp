@@ -8,6 +8,9 @@
 #include <cmath>
 #include <fstream>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/input_error.hpp"
 #include "tests/support/scratch_dir.hpp"
@@ -109,6 +112,42 @@ TEST(RobotLogBadInputs, EveryCaseIsRefusedWithFileLineAndField) {
     }
   }
   EXPECT_EQ(cases, 23);  // make_cases.py writes 23: none may go missing silently
+}
+
+// Two faults in one file: the file's structure (fields, numbers) is checked to its end before
+// the log's own checks speak, and of those the header's and then the earlier row's come first.
+// The line and field of each are known from the file written here.
+TEST_F(RobotLogTest, TheFirstOfTwoFaultsIsTheStructureThenTheEarlierRow) {
+  const auto write = [&](const std::string& name, const std::string& robot,
+                         const std::vector<std::string>& rows) {
+    std::ofstream out(dir_ / name);
+    out << "# imscal-robot-log: 1\n# robot: " << robot << "\n# cycle_s: 0.002\nt_s,payload_kg";
+    for (const char* p : {"q_desired", "q_internal"})
+      for (int j = 1; j <= 6; ++j) out << "," << p << "_A" << j << "_rad";
+    out << "\n";  // header on line 4, rows from line 5
+    for (const std::string& row : rows) out << row << ",0,0,0,0,0,0,0,0,0,0,0,0\n";
+    return dir_ / name;
+  };
+  const auto refusal = [](const fs::path& file) {
+    try {
+      read_robot_log_csv(file, "kr16");
+    } catch (const InputError& e) {
+      return std::pair(e.line(), e.field());
+    }
+    return std::pair(std::size_t{0}, std::string("accepted"));
+  };
+  // Another robot (header) and a word in a later row (structure): the structure first.
+  EXPECT_EQ(refusal(write("robot_then_word.csv", "kr6", {"0,0", "0.002,x", "0.004,0"})),
+            std::pair(std::size_t{6}, std::string("payload_kg")));
+  // A negative payload on line 6 and a gap on line 8: the earlier row's.
+  EXPECT_EQ(refusal(write("payload_then_gap.csv", "kr16", {"0,0", "0.002,-1", "0.004,0", "0.1,0"})),
+            std::pair(std::size_t{6}, std::string("payload_kg")));
+  // A gap on line 7 and a word on line 8: the word (structure) first.
+  EXPECT_EQ(refusal(write("gap_then_word.csv", "kr16", {"0,0", "0.002,0", "0.1,0", "0.102,y"})),
+            std::pair(std::size_t{8}, std::string("payload_kg")));
+  // Another robot alone: the header's error, on its line.
+  EXPECT_EQ(refusal(write("robot.csv", "kr6", {"0,0", "0.002,0"})),
+            std::pair(std::size_t{2}, std::string("robot")));
 }
 
 TEST(RobotLogBadInputs, MissingFileIsAnInputError) {
