@@ -9,9 +9,8 @@
 // The normal equations square the columns' condition number (the error of theta grows as
 // eps kappa², against eps kappa for a QR, Higham 2002 ch. 20). A solution is only given when the
 // condition number of the scaled Gram matrix is at most kMaxGramCondition (kappa(X) <= 1e4: theta
-// within ~1e-8 of the QR's, relative); otherwise the fits fall back to their column-pivoted QR,
-// which also handles a rank-deficient set of columns, and the cross-validation truncates the
-// directions beyond that bound (eval/gap_validation.hpp).
+// within ~1e-8 of the QR's, relative); otherwise the caller falls back to its column-pivoted QR,
+// which also handles a rank-deficient set of columns.
 //
 // References (docs/references.md): [Higham2002], [Bjorck1996].
 #include <Eigen/Core>

@@ -1,8 +1,9 @@
 #include "eval/gap_validation.hpp"
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "eval/gap_joint_stack.hpp"
 #include "eval/gap_normal_equations.hpp"
@@ -13,8 +14,8 @@ namespace {
 
 // Chunks of 1 s (the training blocks' length, eval/gap_diagnosis.hpp) dealt to two folds: each fit
 // is judged on motion it did not see.
-constexpr std::size_t kFoldCount = 2;
 constexpr double kFoldChunkS = 1.0;
+constexpr std::size_t kFoldCount = 2;
 
 }  // namespace
 
@@ -36,44 +37,45 @@ TrainingFolds training_folds(const GapSignals& s, const std::vector<bool>& train
   return f;
 }
 
-Eigen::VectorXd truncated_fit(const Eigen::MatrixXd& fit, const Eigen::MatrixXd& whole) {
-  const Eigen::Index p = fit.rows() - 1;
-  // 1 / the columns' norms on all rows; a column zero there stays out (its parameter 0).
-  Eigen::VectorXd inverse_scale = Eigen::VectorXd::Zero(p);
-  for (Eigen::Index c = 0; c < p; ++c)
-    if (whole(c, c) > 0.0) inverse_scale[c] = 1.0 / std::sqrt(whole(c, c));
-  const Eigen::MatrixXd g =
-      inverse_scale.asDiagonal() *
-      Eigen::MatrixXd(fit.topLeftCorner(p, p).selfadjointView<Eigen::Lower>()) *
-      inverse_scale.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(g);
-  Eigen::VectorXd theta = Eigen::VectorXd::Zero(p);
-  if (p == 0 || eigen.info() != Eigen::Success) return theta;
-  const Eigen::VectorXd& lambda = eigen.eigenvalues();  // ascending
-  const Eigen::VectorXd projected =
-      eigen.eigenvectors().transpose() * inverse_scale.cwiseProduct(fit.row(p).head(p).transpose());
-  Eigen::VectorXd z = Eigen::VectorXd::Zero(p);
-  for (Eigen::Index k = 0; k < p; ++k)
-    if (lambda[k] * kMaxGramCondition > lambda[p - 1]) z[k] = projected[k] / lambda[k];
-  theta = (eigen.eigenvectors() * z).cwiseProduct(inverse_scale);
-  return theta;
-}
-
 namespace {
 
-// The validation error of fold `i`: the truncated fit on the other folds' Gram matrices, judged
-// on fold i's.
-double fold_sse(const std::vector<Eigen::MatrixXd>& grams, std::size_t i) {
+// The validation error by the column-pivoted QR on the rows `fit` (the fallback of the normal
+// equations: ill-conditioned or rank-deficient columns).
+double qr_validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
+                         const std::vector<Eigen::Index>& fit,
+                         const std::vector<Eigen::Index>& check) {
+  const Eigen::Index p = columns.cols();
+  // Gathered column by column (a column-major matrix's rows are strided).
+  Eigen::MatrixXd x = columns(fit, Eigen::all);
+  Eigen::VectorXd b(x.rows());
+  for (std::size_t i = 0; i < fit.size(); ++i) b[Eigen::Index(i)] = y[std::size_t(fit[i])];
+  // Column scaling keeps the QR well conditioned for columns of very different sizes.
+  Eigen::VectorXd scale(p);
+  for (Eigen::Index c = 0; c < p; ++c) {
+    scale[c] = x.col(c).norm() > 0.0 ? x.col(c).norm() : 1.0;
+    x.col(c) /= scale[c];
+  }
+  // Decomposed in place: x is not used after.
+  const Eigen::ColPivHouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(x);
+  const Eigen::VectorXd theta = qr.solve(b).cwiseQuotient(scale);
+  // Each check row's residual, the columns summed in their order (the terms of an
+  // ill-conditioned fit may cancel: no quadratic form).
+  double sse = 0.0;
+  for (std::size_t i = 0; i < check.size(); ++i) {
+    double predicted = 0.0;
+    for (Eigen::Index c = 0; c < p; ++c) predicted += columns(check[i], c) * theta[c];
+    const double r = y[std::size_t(check[i])] - predicted;
+    sse += r * r;
+  }
+  return sse;
+}
+
+// The fit on all folds but `i`, from the folds' Gram matrices; nullopt when ill-conditioned.
+std::optional<GramSolution> fold_fit(const std::vector<Eigen::MatrixXd>& grams, std::size_t i) {
   Eigen::MatrixXd fit = Eigen::MatrixXd::Zero(grams[i].rows(), grams[i].cols());
   for (std::size_t j = 0; j < grams.size(); ++j)
     if (j != i) fit += grams[j];
-  return sse_of_gram(grams[i], truncated_fit(fit, fit + grams[i]));
-}
-
-double folds_sse(const std::vector<Eigen::MatrixXd>& grams) {
-  double sse = 0.0;
-  for (std::size_t i = 0; i < grams.size(); ++i) sse += fold_sse(grams, i);
-  return sse;
+  return solve_normal_equations(fit);
 }
 
 }  // namespace
@@ -81,14 +83,23 @@ double folds_sse(const std::vector<Eigen::MatrixXd>& grams) {
 double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                       const std::vector<Eigen::Index>& fit,
                       const std::vector<Eigen::Index>& check) {
-  return fold_sse({augmented_gram(columns, y, check), augmented_gram(columns, y, fit)}, 0);
+  if (const auto solution = solve_normal_equations(augmented_gram(columns, y, fit)))
+    return sse_of_gram(augmented_gram(columns, y, check), solution->theta);
+  return qr_validation_sse(columns, y, fit, check);
 }
 
 double cross_validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                             const TrainingFolds& folds) {
   std::vector<Eigen::MatrixXd> grams;
   for (const auto& fold : folds.folds) grams.push_back(augmented_gram(columns, y, fold));
-  return folds_sse(grams);
+  double sse = 0.0;
+  for (std::size_t i = 0; i < folds.folds.size(); ++i) {
+    if (const auto solution = fold_fit(grams, i))
+      sse += sse_of_gram(grams[i], solution->theta);
+    else
+      sse += qr_validation_sse(columns, y, folds.complements[i], folds.folds[i]);
+  }
+  return sse;
 }
 
 double cross_validation_sse(const std::vector<Eigen::MatrixXd>& columns,
@@ -102,7 +113,20 @@ double cross_validation_sse(const std::vector<Eigen::MatrixXd>& columns,
     for (std::size_t j : joints) add_augmented_gram(columns[j], y[j], fold, a);
     grams.push_back(std::move(a));
   }
-  return folds_sse(grams);
+  double sse = 0.0;
+  std::optional<StackedJoints> stacked;  // for the QR, only when needed
+  for (std::size_t i = 0; i < folds.folds.size(); ++i) {
+    if (const auto solution = fold_fit(grams, i)) {
+      sse += sse_of_gram(grams[i], solution->theta);
+      continue;
+    }
+    if (!stacked) stacked = stack_joints(columns, y);
+    const Eigen::Index n = columns[joints.front()].rows();
+    sse += qr_validation_sse(stacked->x, stacked->y,
+                             stacked_rows(folds.complements[i], joints.size(), n),
+                             stacked_rows(folds.folds[i], joints.size(), n));
+  }
+  return sse;
 }
 
 }  // namespace imscal::eval

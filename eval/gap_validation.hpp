@@ -20,19 +20,11 @@ struct TrainingFolds {
 };
 TrainingFolds training_folds(const GapSignals& signals, const std::vector<bool>& training);
 
-// The parameters of the LS fit held in the augmented Gram matrix `fit`
-// (eval/gap_normal_equations.hpp, lower triangle), truncated: the columns scaled by their norms
-// over the rows of `whole` (the fit rows and the rows it is judged on), the scaled Gram matrix's
-// eigen-directions with an eigenvalue below 1 / kMaxGramCondition of the largest left out (their
-// component 0). A direction the fit rows do not determine (columns collinear there, or a column
-// that is nearly zero on the fit rows and not on the others) then predicts nothing on the check
-// rows instead of extrapolating a noise-sized fit by orders of magnitude; on well-determined
-// columns it is the LS fit. References (docs/references.md): [Hansen1987] (truncated SVD).
-Eigen::VectorXd truncated_fit(const Eigen::MatrixXd& fit, const Eigen::MatrixXd& whole);
-
-// Sum of squared residuals on the rows `check` of the truncated LS fit of columns to y on the rows
-// `fit` (parameters only: no sigma is needed to choose a shape), from the two row sets' Gram
-// matrices: each fold's Gram matrix is formed once and the folds' fits are summed from them.
+// Sum of squared residuals on the rows `check` of the LS fit of columns to y on the rows `fit`
+// (parameters only: no sigma is needed to choose a shape). Solved by the normal equations of the
+// scaled columns when they are well conditioned, by the column-pivoted QR otherwise
+// (eval/gap_normal_equations.hpp): each fold's Gram matrix is formed once and the folds' fits
+// are summed from them.
 double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                       const std::vector<Eigen::Index>& fit, const std::vector<Eigen::Index>& check);
 

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/QR>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -203,67 +202,9 @@ TEST(GapNormalEquations, IllConditionedFitFallsBackToTheQr) {
   const Eigen::VectorXd theta = qr_theta(p.x, p.y, rows);
   const double rms = std::sqrt(direct_sse(p.x, p.y, rows, theta) / double(rows.size()));
   EXPECT_NEAR(fit.rms, rms, 1e-9 * rms);
-}
-
-// The truncated fit by the SVD of the gathered fit rows, the columns scaled by their norms on the
-// fit and check rows, singular values below 1 / sqrt(kMaxGramCondition) of the largest left out
-// (the eigenvalues of the Gram matrix are their squares): independent of the Gram matrices.
-Eigen::VectorXd svd_truncated_theta(const Eigen::MatrixXd& x, const std::vector<double>& y,
-                                    const std::vector<Eigen::Index>& fit,
-                                    const std::vector<Eigen::Index>& check) {
-  std::vector<Eigen::Index> all = fit;
-  all.insert(all.end(), check.begin(), check.end());
-  const Eigen::VectorXd scale = x(all, Eigen::all).colwise().norm().transpose();
-  Eigen::MatrixXd xs = x(fit, Eigen::all);
-  Eigen::VectorXd b(xs.rows());
-  for (std::size_t i = 0; i < fit.size(); ++i) b[Eigen::Index(i)] = y[std::size_t(fit[i])];
-  for (Eigen::Index c = 0; c < xs.cols(); ++c)
-    xs.col(c) =
-        scale[c] > 0.0 ? Eigen::VectorXd(xs.col(c) / scale[c]) : Eigen::VectorXd::Zero(xs.rows());
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(xs, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const Eigen::VectorXd& sv = svd.singularValues();  // descending
-  Eigen::VectorXd z = Eigen::VectorXd::Zero(sv.size());
-  const Eigen::VectorXd ub = svd.matrixU().transpose() * b;
-  for (Eigen::Index k = 0; k < sv.size(); ++k)
-    if (sv[k] > sv[0] / std::sqrt(kMaxGramCondition)) z[k] = ub[k] / sv[k];
-  Eigen::VectorXd theta = svd.matrixV() * z;
-  for (Eigen::Index c = 0; c < theta.size(); ++c)
-    theta[c] = scale[c] > 0.0 ? theta[c] / scale[c] : 0.0;
-  return theta;
-}
-
-TEST(GapNormalEquations, IllConditionedFoldFitIsTruncated) {
-  // Column 3 = column 1 within 1e-7: kappa(X) ~ 1e7 after scaling, past the normal equations'
-  // bound, so the direction of their difference is left out of each fold's fit.
-  Problem p = random_problem(7);
-  std::mt19937_64 rng(8);
-  std::normal_distribution<double> normal(0.0, 1e-7);
-  for (Eigen::Index k = 0; k < kSamples; ++k) p.x(k, 3) = p.x(k, 1) * (1.0 + normal(rng));
   const TrainingFolds folds = two_folds(30, 60);
-  double truth = 0.0;
-  for (std::size_t i = 0; i < 2; ++i)
-    truth += direct_sse(p.x, p.y, folds.folds[i],
-                        svd_truncated_theta(p.x, p.y, folds.complements[i], folds.folds[i]));
-  // The quadratic form's error, ~eps y'y / sse (as above), against an SVD's ~eps kappa.
-  EXPECT_NEAR(cross_validation_sse(p.x, p.y, folds), truth, 1e-7 * truth);
-}
-
-TEST(GapNormalEquations, ColumnAbsentFromTheFitRowsPredictsNothing) {
-  // Column 2 is zero on fold 0's complement (the fit rows) and large on fold 0: no fit can know
-  // its parameter, so fold 0's error is that of the fit without it (truth: the QR on the other
-  // three columns). A full-rank solve on the fit rows alone would scale this column up to unit
-  // norm and give its parameter any size.
-  Problem p = random_problem(12);
-  const TrainingFolds folds = two_folds(30, 60);
-  for (Eigen::Index k : folds.complements[0]) p.x(k, 2) = 1e-30 * p.x(k, 2);
-  const Eigen::MatrixXd three = p.x(Eigen::all, std::vector<Eigen::Index>{0, 1, 3});
-  const double truth =
-      direct_sse(three, p.y, folds.folds[0], qr_theta(three, p.y, folds.complements[0]));
-  const double sse = validation_sse(p.x, p.y, folds.complements[0], folds.folds[0]);
-  EXPECT_NEAR(sse, truth, 1e-7 * truth);  // as above
-  // Left out altogether (zero on every row), the column is not fitted either.
-  p.x.col(2).setZero();
-  EXPECT_NEAR(validation_sse(p.x, p.y, folds.complements[0], folds.folds[0]), truth, 1e-7 * truth);
+  const double truth = qr_cross_validation_sse(p, folds);
+  EXPECT_NEAR(cross_validation_sse(p.x, p.y, folds), truth, 1e-9 * truth);
 }
 
 TEST(GapNormalEquations, FitSigmaMatchesTheQrCovariance) {
