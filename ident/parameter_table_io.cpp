@@ -462,6 +462,27 @@ void read_version_6_gear_mode_pairs(ParameterTable& t) {
   t.schema_version = kParameterTableSchemaVersion;
 }
 
+// The joints of a table whose header (version, sample time, inputs) is read.
+void read_joints(const Node& joints, ParameterTable& t) {
+  std::set<std::string> names;
+  const auto has = [&](TableInput input) { return has_input(t.extra_inputs, input); };
+  using enum TableInput;
+  const bool plain = has(kTransmissionErrorSin) || has(kTransmissionErrorCos);
+  const bool filtered = has(kTransmissionErrorModeSin) || has(kTransmissionErrorModeCos);
+  const bool second = has(kTransmissionError2Sin) || has(kTransmissionError2Cos) ||
+                      has(kTransmissionError2ModeSin) || has(kTransmissionError2ModeCos);
+  for (const Node& j : joints.items()) {
+    t.joints.push_back(read_joint(j, t.sample_time_s, t.schema_version,
+                                  t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1,
+                                  has(kTorqueSign), plain || filtered, second,
+                                  t.schema_version < 7 ? plain : filtered));
+    if (!names.insert(t.joints.back().name).second)
+      j.child("name").fail("joint '" + t.joints.back().name + "' given twice");
+  }
+  if (t.joints.empty()) joints.fail("no joint");
+  if (t.schema_version < 7) read_version_6_gear_mode_pairs(t);
+}
+
 }  // namespace
 
 nlohmann::json model_torque_links_json(const std::vector<LinkMassParameters>& links) {
@@ -657,26 +678,7 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
   t.source.sha256 = src.child("sha256").string();
   t.source.samples = src.child("samples").count();
   t.source.description = src.child("description").string();
-  const Node joints = r.child("joints");
-  std::set<std::string> names;
-  const auto has = [&](TableInput input) {
-    return std::find(t.extra_inputs.begin(), t.extra_inputs.end(), input) != t.extra_inputs.end();
-  };
-  using enum TableInput;
-  const bool plain = has(kTransmissionErrorSin) || has(kTransmissionErrorCos);
-  const bool filtered = has(kTransmissionErrorModeSin) || has(kTransmissionErrorModeCos);
-  const bool second = has(kTransmissionError2Sin) || has(kTransmissionError2Cos) ||
-                      has(kTransmissionError2ModeSin) || has(kTransmissionError2ModeCos);
-  for (const Node& j : joints.items()) {
-    t.joints.push_back(read_joint(j, t.sample_time_s, t.schema_version,
-                                  t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1,
-                                  has(kTorqueSign), plain || filtered, second,
-                                  t.schema_version < 7 ? plain : filtered));
-    if (!names.insert(t.joints.back().name).second)
-      j.child("name").fail("joint '" + t.joints.back().name + "' given twice");
-  }
-  if (t.joints.empty()) joints.fail("no joint");
-  if (t.schema_version < 7) read_version_6_gear_mode_pairs(t);
+  read_joints(r.child("joints"), t);
   t.model_torque_links = read_model_torque_links(r, t.schema_version, t.joints.size());
   return t;
 }
