@@ -22,7 +22,7 @@ namespace imscal::ident {
 
 inline constexpr int kArxStepLanes = 8;
 inline constexpr int kArxStepMaxTerms = 64;  // longest sum (na, nb, nx_e), after rounding
-inline constexpr int kArxStepMaxExtras = 7;
+inline constexpr int kArxStepMaxExtras = 11;
 static_assert(kArxStepMaxTerms % kArxStepLanes == 0);
 
 // One cell's model, fixed after construction. The coefficients live here, not behind pointers,

@@ -21,7 +21,7 @@
 
 namespace imscal::ident {
 
-inline constexpr int kMaxExtraInputs = 7;
+inline constexpr int kMaxExtraInputs = 11;
 
 struct ArxStructure {
   int na = 1;            // number of autoregressive coefficients a_1..a_na

@@ -38,6 +38,10 @@ bool has_input(std::span<const TableInput> inputs, TableInput input) {
   return std::find(inputs.begin(), inputs.end(), input) != inputs.end();
 }
 
+bool has_pair(std::span<const TableInput> inputs, TableInput sin_kind, TableInput cos_kind) {
+  return has_input(inputs, sin_kind) || has_input(inputs, cos_kind);
+}
+
 std::string exogenous_inputs_problem(std::span<const TableInput> inputs) {
   for (const TableInput input : inputs)
     if (kind_of(input).needs_model_torque_input && !has_input(inputs, TableInput::kModelTorque))
@@ -54,26 +58,30 @@ std::string exogenous_parameters_problem(std::span<const TableInput> inputs,
     return "the transmission error's compliance must be finite and >= 0";
   if (compliance > 0.0 && !has_input(inputs, TableInput::kModelTorque))
     return "the transmission error's compliance needs the model torque input";
-  const bool transmission_error = has_input(inputs, TableInput::kTransmissionErrorSin) ||
-                                  has_input(inputs, TableInput::kTransmissionErrorCos);
+  using enum TableInput;
+  const bool plain = has_pair(inputs, kTransmissionErrorSin, kTransmissionErrorCos);
+  const bool filtered = has_pair(inputs, kTransmissionErrorModeSin, kTransmissionErrorModeCos);
+  const bool transmission_error = plain || filtered;
   const double f = p.transmission_error_rad_per_rad;
   if (transmission_error && !(f > 0.0 && std::isfinite(f)))
     return "the transmission-error inputs need a phase rate > 0";
-  const bool second = has_input(inputs, TableInput::kTransmissionError2Sin) ||
-                      has_input(inputs, TableInput::kTransmissionError2Cos);
+  const bool second = has_pair(inputs, kTransmissionError2Sin, kTransmissionError2Cos) ||
+                      has_pair(inputs, kTransmissionError2ModeSin, kTransmissionError2ModeCos);
   const double f2 = p.transmission_error_2_rad_per_rad;
   if (second && !(f2 >= 0.0 && std::isfinite(f2) && f2 != f))
     return "the second transmission-error inputs need a phase rate >= 0 other than the first's "
            "(0: no second order on the joint)";
-  if (second && !transmission_error)
+  if (has_pair(inputs, kTransmissionError2Sin, kTransmissionError2Cos) && !plain)
     return "the second transmission-error inputs need the first transmission-error inputs";
+  if (has_pair(inputs, kTransmissionError2ModeSin, kTransmissionError2ModeCos) && !filtered)
+    return "the second gear-mode transmission-error inputs need the first gear-mode inputs";
   const double mode = p.transmission_error_mode_rad_s, damping = p.transmission_error_mode_damping;
   if (!(mode >= 0.0 && std::isfinite(mode) && damping >= 0.0 && std::isfinite(damping)))
     return "the transmission error's gear mode needs a finite frequency and damping >= 0";
   if (mode > 0.0 && !(damping > 0.0))
     return "the transmission error's gear mode needs a damping ratio > 0";
-  if (mode > 0.0 && !transmission_error)
-    return "the transmission error's gear mode needs the transmission-error inputs";
+  if (mode > 0.0 && !filtered)
+    return "the transmission error's gear mode needs the gear-mode transmission-error inputs";
   return {};
 }
 

@@ -14,17 +14,20 @@
 //    sin(f (x + τ / k)), cos(f (x + τ / k)), f = harmonic per motor revolution x gear ratio,
 //    1 / k the gear's compliance (the motor angle the deflected gear sits at);
 //  * transmission_error_2_sin / _cos: the same pair at a second harmonic f_2 (a gear's error
-//    repeats at several of its stages' tooth and lobe counts over the motor revolution).
-// With a gear mode (natural frequency ω_n > 0, damping ratio ζ) each pair is the error's
-// steady-state response through that mode instead: the error is a displacement between motor and
-// link, and at the joint speed ẋ it oscillates at Ω = f ẋ, where the locked-motor mode
-// H(s) = ω_n² / (s² + 2 ζ ω_n s + ω_n²) turns sin φ into Im(H(jΩ) e^{jφ}) and cos φ into
-// Re(H(jΩ) e^{jφ}). The pair then carries the resonance the inputs' FIR taps cannot follow
-// (decay time 1 / (ζ ω_n) ≈ 0.2 s at 15 Hz, 5 %); ω_n = 0 gives H = 1, the plain pair. Along a
-// path (the identification's segments, the precontrol's model steps) the pair is the mode as a
-// filter with state instead (ident/gear_mode_filter.hpp, exogenous_values with an
-// ExogenousFilterState), whose steady state is that response: it follows the error's frequency
-// sweeping through the mode faster than the mode's decay, which the steady state does not.
+//    repeats at several of its stages' tooth and lobe counts over the motor revolution);
+//  * transmission_error_mode_sin / _cos, transmission_error_2_mode_sin / _cos: the same pairs
+//    through the joint's locked-motor gear mode (natural frequency ω_n > 0, damping ratio ζ),
+//    beside the plain pairs or instead of them. The error is a displacement between motor and
+//    link, and at the joint speed ẋ it oscillates at Ω = f ẋ, where the mode
+//    H(s) = ω_n² / (s² + 2 ζ ω_n s + ω_n²) turns sin φ into Im(H(jΩ) e^{jφ}) and cos φ into
+//    Re(H(jΩ) e^{jφ}): the resonance the plain pair's FIR taps cannot follow (decay time
+//    1 / (ζ ω_n) ≈ 0.2 s at 15 Hz, 5 %). Along a path (the identification's segments, the
+//    precontrol's model steps) each is the mode as a filter with state (ident/gear_mode_filter.hpp,
+//    exogenous_values with an ExogenousFilterState), which follows the error's frequency sweeping
+//    through the mode faster than the mode's decay; a single sample (exogenous_value) gets the
+//    filter's steady state H(jΩ) e^{jφ}. Without a mode (ω_n = 0) they equal the plain pairs.
+//    Tables before version 7 filtered the plain pairs' kinds of joints with a mode; they are read
+//    as these kinds (ident/parameter_table_io.hpp).
 #include <array>
 #include <cmath>
 #include <complex>
@@ -45,7 +48,11 @@ enum class TableInput {
   kTransmissionErrorSin,
   kTransmissionErrorCos,
   kTransmissionError2Sin,
-  kTransmissionError2Cos
+  kTransmissionError2Cos,
+  kTransmissionErrorModeSin,
+  kTransmissionErrorModeCos,
+  kTransmissionError2ModeSin,
+  kTransmissionError2ModeCos
 };
 
 // One input kind: how parameters.json names it, the words errors use for it, the first table
@@ -67,11 +74,19 @@ inline constexpr ExogenousInputKind kExogenousInputKinds[] = {
      false},
     {TableInput::kTransmissionError2Cos, "transmission_error_2_cos", "second transmission-error", 4,
      false},
+    {TableInput::kTransmissionErrorModeSin, "transmission_error_mode_sin",
+     "gear-mode transmission-error", 7, false},
+    {TableInput::kTransmissionErrorModeCos, "transmission_error_mode_cos",
+     "gear-mode transmission-error", 7, false},
+    {TableInput::kTransmissionError2ModeSin, "transmission_error_2_mode_sin",
+     "second gear-mode transmission-error", 7, false},
+    {TableInput::kTransmissionError2ModeCos, "transmission_error_2_mode_cos",
+     "second gear-mode transmission-error", 7, false},
 };
 inline constexpr int kExogenousInputKindCount = int(std::size(kExogenousInputKinds));
 const ExogenousInputKind& kind_of(TableInput input);
 // "model_torque", "direction", "torque_sign", "transmission_error_sin", "transmission_error_cos",
-// "transmission_error_2_sin", "transmission_error_2_cos"
+// "transmission_error_2_sin", "transmission_error_2_cos", "transmission_error_mode_sin", ...
 const char* to_string(TableInput input);
 
 // The joint state of one sample the inputs are computed from: the model's input path x (the
@@ -91,13 +106,16 @@ struct ExogenousParameters {
   // The second harmonic's phase rate (0: the joint has no second order, the pair's inputs are 0).
   double transmission_error_2_rad_per_rad = 0.0;
   double transmission_error_compliance_rad_per_nm = 0.0;
-  // The joint's locked-motor gear mode the error passes through (0: none, the plain pair).
+  // The joint's locked-motor gear mode of the gear-mode pairs (0: none, they equal the plain
+  // pairs).
   double transmission_error_mode_rad_s = 0.0;
   double transmission_error_mode_damping = 0.0;
 };
 // A table's constants for one of its joints.
 ExogenousParameters exogenous_parameters(const ParameterTable& table, const JointParameters& joint);
 bool has_input(std::span<const TableInput> inputs, TableInput input);
+// Whether `inputs` has either kind of a pair (its sin or its cos).
+bool has_pair(std::span<const TableInput> inputs, TableInput sin_kind, TableInput cos_kind);
 // Why the list `inputs` cannot be computed (an input needs another that is missing); empty when
 // it can.
 std::string exogenous_inputs_problem(std::span<const TableInput> inputs);
@@ -132,20 +150,31 @@ inline std::complex<double> gear_mode_response(const ExogenousParameters& p,
                               2.0 * p.transmission_error_mode_damping * w * omega);
 }
 
-// The pair (Im, Re) of H(jΩ) e^{jφ}: the response of sin φ and of cos φ through the gear mode.
+// The pair (Im, Re) of H(jΩ) e^{jφ}: the response of sin φ and of cos φ through the gear mode
+// (the plain pair without a mode, or with filtered false).
 inline double transmission_error_pair_value(const ExogenousParameters& p,
                                             double phase_rate_rad_per_rad, const ExogenousSample& s,
-                                            bool sine) noexcept {
+                                            bool sine, bool filtered) noexcept {
   const double phase = phase_rate_rad_per_rad * transmission_error_motor_angle(p, s);
   const double sin_phase = std::sin(phase), cos_phase = std::cos(phase);
-  if (!(p.transmission_error_mode_rad_s > 0.0)) return sine ? sin_phase : cos_phase;
+  if (!filtered || !(p.transmission_error_mode_rad_s > 0.0)) return sine ? sin_phase : cos_phase;
   const std::complex<double> h = gear_mode_response(p, phase_rate_rad_per_rad, s.speed_rad_s);
   return sine ? h.real() * sin_phase + h.imag() * cos_phase
               : h.real() * cos_phase - h.imag() * sin_phase;
 }
 
+// The second order's pair; 0 on a joint without a second order (phase rate 0), so that its zero
+// coefficients are not needed for the pair to do nothing.
+inline double second_transmission_error_pair_value(const ExogenousParameters& p,
+                                                   const ExogenousSample& s, bool sine,
+                                                   bool filtered) noexcept {
+  const double f_2 = p.transmission_error_2_rad_per_rad;
+  return f_2 == 0.0 ? 0.0 : transmission_error_pair_value(p, f_2, s, sine, filtered);
+}
+
 inline double exogenous_value(TableInput input, const ExogenousParameters& p,
                               const ExogenousSample& s) noexcept {
+  const double f_1 = p.transmission_error_rad_per_rad;
   switch (input) {
     case TableInput::kModelTorque:
       return s.model_torque_nm;
@@ -154,19 +183,21 @@ inline double exogenous_value(TableInput input, const ExogenousParameters& p,
     case TableInput::kTorqueSign:
       return std::tanh(s.model_torque_nm / p.torque_sign_scale_nm);
     case TableInput::kTransmissionErrorSin:
-      return transmission_error_pair_value(p, p.transmission_error_rad_per_rad, s, true);
+      return transmission_error_pair_value(p, f_1, s, true, false);
     case TableInput::kTransmissionErrorCos:
-      return transmission_error_pair_value(p, p.transmission_error_rad_per_rad, s, false);
-    // A joint without a second order (phase rate 0) has both inputs 0, so that its zero
-    // coefficients are not needed for the pair to do nothing.
+      return transmission_error_pair_value(p, f_1, s, false, false);
     case TableInput::kTransmissionError2Sin:
-      return p.transmission_error_2_rad_per_rad == 0.0
-                 ? 0.0
-                 : transmission_error_pair_value(p, p.transmission_error_2_rad_per_rad, s, true);
+      return second_transmission_error_pair_value(p, s, true, false);
     case TableInput::kTransmissionError2Cos:
-      return p.transmission_error_2_rad_per_rad == 0.0
-                 ? 0.0
-                 : transmission_error_pair_value(p, p.transmission_error_2_rad_per_rad, s, false);
+      return second_transmission_error_pair_value(p, s, false, false);
+    case TableInput::kTransmissionErrorModeSin:
+      return transmission_error_pair_value(p, f_1, s, true, true);
+    case TableInput::kTransmissionErrorModeCos:
+      return transmission_error_pair_value(p, f_1, s, false, true);
+    case TableInput::kTransmissionError2ModeSin:
+      return second_transmission_error_pair_value(p, s, true, true);
+    case TableInput::kTransmissionError2ModeCos:
+      return second_transmission_error_pair_value(p, s, false, true);
   }
   return 0.0;
 }
@@ -193,8 +224,8 @@ inline void restart_exogenous_filter(ExogenousFilterState& state, const Exogenou
   state.pair_2.started = false;
 }
 
-// The values of `inputs` of the next sample of a path: with a gear mode, each transmission-error
-// pair through the mode's filter (advanced once per call), otherwise as exogenous_values.
+// The values of `inputs` of the next sample of a path: with a gear mode, each gear-mode pair
+// through the mode's filter (advanced once per call), otherwise as exogenous_values.
 inline void exogenous_values(std::span<const TableInput> inputs, const ExogenousParameters& p,
                              const ExogenousSample& s, ExogenousFilterState& state,
                              double* values) noexcept {
@@ -202,25 +233,25 @@ inline void exogenous_values(std::span<const TableInput> inputs, const Exogenous
   const double motor_angle_rad = transmission_error_motor_angle(p, s);
   const double f_1 = p.transmission_error_rad_per_rad, f_2 = p.transmission_error_2_rad_per_rad;
   std::complex<double> y_1, y_2;
-  if (has_input(inputs, TableInput::kTransmissionErrorSin) ||
-      has_input(inputs, TableInput::kTransmissionErrorCos))
+  if (has_pair(inputs, TableInput::kTransmissionErrorModeSin,
+               TableInput::kTransmissionErrorModeCos))
     y_1 = gear_mode_filter_advance(state.mode, state.pair_1, f_1 * motor_angle_rad,
                                    f_1 * s.speed_rad_s);
-  if (f_2 != 0.0 && (has_input(inputs, TableInput::kTransmissionError2Sin) ||
-                     has_input(inputs, TableInput::kTransmissionError2Cos)))
+  if (f_2 != 0.0 && has_pair(inputs, TableInput::kTransmissionError2ModeSin,
+                             TableInput::kTransmissionError2ModeCos))
     y_2 = gear_mode_filter_advance(state.mode, state.pair_2, f_2 * motor_angle_rad,
                                    f_2 * s.speed_rad_s);
   for (std::size_t e = 0; e < inputs.size(); ++e) switch (inputs[e]) {
-      case TableInput::kTransmissionErrorSin:
+      case TableInput::kTransmissionErrorModeSin:
         values[e] = y_1.imag();
         break;
-      case TableInput::kTransmissionErrorCos:
+      case TableInput::kTransmissionErrorModeCos:
         values[e] = y_1.real();
         break;
-      case TableInput::kTransmissionError2Sin:
+      case TableInput::kTransmissionError2ModeSin:
         values[e] = y_2.imag();
         break;
-      case TableInput::kTransmissionError2Cos:
+      case TableInput::kTransmissionError2ModeCos:
         values[e] = y_2.real();
         break;
       default:

@@ -67,6 +67,24 @@ double duration_instead_of_count(const ConfigNode& parent, const std::string& pa
   return seconds;
 }
 
+// Where the gear mode's pairs go (model.transmission_error_gear_mode_pairs, instead of the plain
+// pairs by default) and their taps beside them.
+void load_gear_mode_pairs(const ConfigNode& model, IdentificationConfig& c) {
+  JointIdentificationOptions& o = c.options;
+  GearModePairs pairs = GearModePairs::kInstead;
+  if (const auto n = model.optional_child("transmission_error_gear_mode_pairs")) {
+    if (n->as_string() == "beside")
+      pairs = GearModePairs::kBeside;
+    else if (n->as_string() != "instead")
+      n->fail("expected 'instead' (of the plain pairs) or 'beside' (them)");
+  }
+  o.transmission_error_mode_pairs = c.transmission_error_gear_mode ? pairs : GearModePairs::kNone;
+  o.transmission_error_mode_taps =
+      int(model.get_int("transmission_error_gear_mode_taps", o.transmission_error_mode_taps));
+  if (o.transmission_error_mode_taps < 1 || o.transmission_error_mode_taps > 64)
+    model.child("transmission_error_gear_mode_taps").fail("must be in 1..64 coefficients");
+}
+
 // `robot:` and `cycle_s:`, the record the config is for.
 void load_record_keys(const ConfigNode& root, IdentificationConfig& c) {
   c.file = root.file();
@@ -127,6 +145,11 @@ JointIdentificationOptions IdentificationConfig::joint_options(std::size_t joint
       o.transmission_error_mode_rad_s = transmission_error_mode_rad_s[joint];
       o.transmission_error_mode_damping = transmission_error_mode_damping[joint];
     }
+    // Beside the plain pairs, a joint without a mode would repeat them: it is identified without
+    // the gear-mode pairs (zero coefficients in the table, as for an absent second order).
+    if (o.transmission_error_mode_pairs == GearModePairs::kBeside &&
+        !(o.transmission_error_mode_rad_s > 0.0))
+      o.transmission_error_mode_pairs = GearModePairs::kNone;
   }
   return o;
 }
@@ -194,12 +217,27 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
         cells->get_double("min_rms_speed_deg_s", o.min_rms_speed_rad_s / kRadPerDeg) * kRadPerDeg;
   }
   if (auto model = root.optional_child("model")) {
-    model->require_only_keys(
-        {"form", "preview_cycles", "preview_s", "model_torque", "direction",
-         "direction_speed_scale_deg_s", "torque_sign", "torque_sign_scale_fraction", "input_taps",
-         "input_history_s", "torque_sign_taps", "torque_sign_history_s", "transmission_error",
-         "transmission_error_harmonic_per_motor_rev", "transmission_error_taps",
-         "transmission_error_history_s", "transmission_error_gear_mode", "refine_mass_parameters"});
+    model->require_only_keys({"form",
+                              "preview_cycles",
+                              "preview_s",
+                              "model_torque",
+                              "direction",
+                              "direction_speed_scale_deg_s",
+                              "torque_sign",
+                              "torque_sign_scale_fraction",
+                              "input_taps",
+                              "input_history_s",
+                              "torque_sign_taps",
+                              "torque_sign_history_s",
+                              "transmission_error",
+                              "transmission_error_harmonic_per_motor_rev",
+                              "transmission_error_taps",
+                              "transmission_error_history_s",
+                              "transmission_error_gear_mode",
+                              "transmission_error_gear_mode_pairs",
+                              "transmission_error_gear_mode_taps",
+                              "transmission_error_gear_mode_history_s",
+                              "refine_mass_parameters"});
     ConfigDurations& d = c.durations;
     d.preview_s = duration_instead_of_count(*model, "model", "preview_s", "preview_cycles", c);
     d.input_history_s =
@@ -208,6 +246,9 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
         duration_instead_of_count(*model, "model", "torque_sign_history_s", "torque_sign_taps", c);
     d.transmission_error_history_s = duration_instead_of_count(
         *model, "model", "transmission_error_history_s", "transmission_error_taps", c);
+    d.transmission_error_gear_mode_history_s =
+        duration_instead_of_count(*model, "model", "transmission_error_gear_mode_history_s",
+                                  "transmission_error_gear_mode_taps", c);
     if (auto n = model->optional_child("form")) {
       try {
         o.form = arx_model_form_from_string(n->as_string());
@@ -261,6 +302,7 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
           .fail(
               "the gear mode is the transmission error's, its inertia the rigid-body model's: "
               "needs transmission_error: true and model_torque: true");
+    load_gear_mode_pairs(*model, c);
     // One harmonic for every joint, or a list with one per joint.
     if (const auto harmonic = model->optional_child("transmission_error_harmonic_per_motor_rev")) {
       if (harmonic->is_sequence()) {
@@ -280,8 +322,9 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
     if (o.transmission_error_taps < 1 || o.transmission_error_taps > 64)
       model->child("transmission_error_taps").fail("must be in 1..64 coefficients");
     if (extra_input_count(o) > kMaxExtraInputs)
-      model->fail(fmt::format("at most {} further inputs (the transmission error counts twice)",
-                              kMaxExtraInputs));
+      model->fail(
+          fmt::format("at most {} further inputs (each transmission-error pair counts twice)",
+                      kMaxExtraInputs));
   }
   if (auto order = root.optional_child("order")) {
     order->require_only_keys({"na", "nb", "dead_time", "criterion"});
@@ -311,7 +354,10 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
   if (o.model_torque_input || o.direction_input || o.transmission_error_input) {
     const int taps = std::max({o.model_torque_input || o.direction_input ? o.input_taps : 0,
                                o.torque_sign_input ? o.torque_sign_taps : 0,
-                               o.transmission_error_input ? o.transmission_error_taps : 0});
+                               o.transmission_error_input ? o.transmission_error_taps : 0,
+                               o.transmission_error_mode_pairs == GearModePairs::kBeside
+                                   ? o.transmission_error_mode_taps
+                                   : 0});
     const int longest = taps + o.grid.dead_time_max;
     if (longest > kMaxPrecontrolOrder) {
       const ConfigNode at =

@@ -23,13 +23,15 @@ struct ExtraDimension {
 // The durations a config may state in seconds instead of cycles (NaN: given as a count, or not
 // at all), by key path: model.preview_s (preview_cycles), model.input_history_s (input_taps),
 // model.torque_sign_history_s (torque_sign_taps), model.transmission_error_history_s
-// (transmission_error_taps), cells.min_estimation_s (min_rows).
+// (transmission_error_taps), model.transmission_error_gear_mode_history_s
+// (transmission_error_gear_mode_taps), cells.min_estimation_s (min_rows).
 struct ConfigDurations {
   static constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
   double preview_s = kNone;
   double input_history_s = kNone;
   double torque_sign_history_s = kNone;
   double transmission_error_history_s = kNone;
+  double transmission_error_gear_mode_history_s = kNone;
   double min_estimation_s = kNone;
 };
 
@@ -63,6 +65,9 @@ struct IdentificationConfig {
   // locked-motor gear mode as a filter with state along the path (ident/gear_mode_filter.hpp),
   // the mode found before identifying (eval/transmission_error_gear_mode.hpp): per joint its
   // natural frequency [rad/s] and damping ratio (empty, or 0 for a joint: the plain pair).
+  // `model.transmission_error_gear_mode_pairs: instead | beside` (options.
+  // transmission_error_mode_pairs): the filtered pairs instead of the plain ones (their taps), or
+  // beside them with `transmission_error_gear_mode_taps` each.
   bool transmission_error_gear_mode = false;
   std::vector<double> transmission_error_mode_rad_s;
   std::vector<double> transmission_error_mode_damping;

@@ -43,7 +43,10 @@ void check_precontrol_capacity(const IdentificationConfig& config, double cycle_
   const JointIdentificationOptions& o = config.options;
   const int taps = std::max({o.model_torque_input || o.direction_input ? o.input_taps : 0,
                              o.torque_sign_input ? o.torque_sign_taps : 0,
-                             o.transmission_error_input ? o.transmission_error_taps : 0});
+                             o.transmission_error_input ? o.transmission_error_taps : 0,
+                             o.transmission_error_mode_pairs == GearModePairs::kBeside
+                                 ? o.transmission_error_mode_taps
+                                 : 0});
   if (taps + o.grid.dead_time_max <= kMaxPrecontrolOrder) return;
   refuse(config, given(config.durations.input_history_s) ? "model.input_history_s" : "model",
          fmt::format("at {} s per cycle the further inputs take {} coefficients, plus the largest "
@@ -69,12 +72,16 @@ void apply_durations(IdentificationConfig& config, double cycle_s,
   if (given(d.transmission_error_history_s))
     o.transmission_error_taps = cycles_of(config, "model.transmission_error_history_s",
                                           d.transmission_error_history_s, cycle_s, 1, 64, warnings);
+  if (given(d.transmission_error_gear_mode_history_s))
+    o.transmission_error_mode_taps =
+        cycles_of(config, "model.transmission_error_gear_mode_history_s",
+                  d.transmission_error_gear_mode_history_s, cycle_s, 1, 64, warnings);
   if (given(d.min_estimation_s))
     o.min_rows_per_cell = std::size_t(cycles_of(config, "cells.min_estimation_s",
                                                 d.min_estimation_s, cycle_s, 1, 1 << 30, warnings));
   // Counts alone were checked on loading; durations give other counts at every cycle.
   if (given(d.input_history_s) || given(d.torque_sign_history_s) ||
-      given(d.transmission_error_history_s))
+      given(d.transmission_error_history_s) || given(d.transmission_error_gear_mode_history_s))
     check_precontrol_capacity(config, cycle_s);
   config.resolved_cycle_s = cycle_s;
 }

@@ -106,8 +106,14 @@ IdentifiedStructure structure_of_gains(const StaticGains& g, std::span<const Tab
     s.stiffness_nm_per_rad = {1.0 / c, s.compliance_rad_per_nm.sigma / (c * c)};
   }
   s.direction_offset_rad = gain_estimate(g, direction);
-  set_transmission_error(s, g, index_of(inputs, TableInput::kTransmissionErrorSin),
-                         index_of(inputs, TableInput::kTransmissionErrorCos));
+  // The plain pair's gains; with the gear-mode pair instead of it, that pair's (the mode's gain
+  // is 1 at rest).
+  const bool plain = has_input(inputs, TableInput::kTransmissionErrorSin);
+  set_transmission_error(s, g,
+                         index_of(inputs, plain ? TableInput::kTransmissionErrorSin
+                                                : TableInput::kTransmissionErrorModeSin),
+                         index_of(inputs, plain ? TableInput::kTransmissionErrorCos
+                                                : TableInput::kTransmissionErrorModeCos));
   return s;
 }
 

@@ -18,8 +18,11 @@ IdentifiedStructure structure_beside_config(const JointIdentification& result,
                                             const IdentificationConfig& config, std::size_t joint) {
   // The joint's own inputs: a joint without a second transmission-error order was fitted
   // without that pair.
-  IdentifiedStructure s =
-      identified_structure(result, extra_inputs_of(config.joint_options(joint)));
+  JointIdentificationOptions options = config.joint_options(joint);
+  if (options.transmission_error_mode_pairs == GearModePairs::kBeside &&
+      !(result.parameters.transmission_error_mode_rad_s > 0.0))  // fitted without them
+    options.transmission_error_mode_pairs = GearModePairs::kNone;
+  IdentifiedStructure s = identified_structure(result, extra_inputs_of(options));
   if (joint < config.gear_stiffness_nm_per_rad.size())
     s.nominal_compliance_rad_per_nm = 1.0 / config.gear_stiffness_nm_per_rad[joint];
   if (config.options.transmission_error_input)
@@ -27,19 +30,36 @@ IdentifiedStructure structure_beside_config(const JointIdentification& result,
   return s;
 }
 
-// A joint identified without the second transmission-error pair in a table that has it: each of
-// its cells gets the pair as two further inputs of one zero coefficient each, as a neutral cell
-// gets every input (the pair is last among the inputs, extra_inputs_of).
-void pad_absent_second_transmission_error(JointParameters& joint) {
-  for (CellParameters& cell : joint.cells) {
-    for (int e = 0; e < 2; ++e) {
-      if (cell.structure.extra_inputs >= kMaxExtraInputs)
-        throw std::logic_error("pad_absent_second_transmission_error: too many further inputs");
-      cell.structure.nx[std::size_t(cell.structure.extra_inputs++)] = 1;
-      cell.c.push_back(0.0);
-    }
+// One joint's identification, padded to the table's inputs. Beside the plain pairs, a joint
+// whose data leave the gear-mode pairs in the plain pairs' span (every candidate rank deficient:
+// where the error's frequency stays well below the mode, H(jΩ) e^{jφ} is the plain pair through
+// a short FIR, which the plain pairs' taps already are) is identified without them.
+JointIdentification identify_one_joint(
+    const JointErrorLog& log, const IdentificationConfig& config, std::size_t j,
+    std::span<const std::pair<std::size_t, std::size_t>> segments) {
+  const std::span<const double> torque =
+      log.model_torque_nm.empty() ? std::span<const double>() : log.model_torque_nm[j];
+  JointIdentificationOptions options = config.joint_options(j);
+  const auto identify = [&] {
+    return identify_joint(log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j],
+                          log.payload_kg, segments, log.cycle_s, config.joint_grid(j), options,
+                          torque);
+  };
+  JointIdentification result;
+  try {
+    result = identify();
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::runtime_error&) {
+    if (options.transmission_error_mode_pairs != GearModePairs::kBeside) throw;
+    options.transmission_error_mode_pairs = GearModePairs::kNone;
+    result = identify();
   }
-  joint.transmission_error_2_rad_per_rad = 0.0;
+  const std::vector<TableInput> joint_inputs = extra_inputs_of(options);
+  const std::vector<TableInput> table_inputs = extra_inputs_of(config.options);
+  if (joint_inputs != table_inputs)
+    pad_absent_inputs(result.parameters, joint_inputs, table_inputs);
+  return result;
 }
 
 // The config with its durations in counts of the log's cycle (ident/
@@ -50,6 +70,37 @@ IdentificationConfig for_log(const IdentificationConfig& config, const JointErro
 }
 
 }  // namespace
+
+void pad_absent_inputs(JointParameters& joint, std::span<const TableInput> joint_inputs,
+                       std::span<const TableInput> table_inputs) {
+  if (table_inputs.size() > std::size_t(kMaxExtraInputs))
+    throw std::logic_error("pad_absent_inputs: too many further inputs");
+  for (CellParameters& cell : joint.cells) {
+    ArxStructure padded = cell.structure;
+    padded.extra_inputs = int(table_inputs.size());
+    padded.nx.fill(0);
+    std::vector<double> c;
+    std::size_t from = 0;
+    for (std::size_t e = 0; e < table_inputs.size(); ++e) {
+      const bool present = from < joint_inputs.size() && joint_inputs[from] == table_inputs[e];
+      const int nx = present ? cell.structure.nx[from] : 1;
+      const auto first = cell.c.begin() + (present ? cell.structure.extra_offset(int(from)) : 0);
+      if (present)
+        c.insert(c.end(), first, first + nx);
+      else
+        c.push_back(0.0);
+      padded.nx[e] = nx;
+      from += present ? 1 : 0;
+    }
+    if (from != joint_inputs.size())
+      throw std::logic_error("pad_absent_inputs: the joint's inputs are not the table's");
+    cell.structure = padded;
+    cell.c = std::move(c);
+  }
+  if (!has_input(joint_inputs, TableInput::kTransmissionError2Sin) &&
+      !has_input(joint_inputs, TableInput::kTransmissionError2ModeSin))
+    joint.transmission_error_2_rad_per_rad = 0.0;
+}
 
 ParameterTable parameter_table_header(const JointErrorLog& log,
                                       const IdentificationConfig& given_config, DataSource source) {
@@ -86,15 +137,7 @@ std::vector<JointOutcome> identify_joints(const JointErrorLog& log,
     for (std::size_t j = next++; j < joints; j = next++) {
       const auto start = std::chrono::steady_clock::now();
       try {
-        const std::span<const double> torque =
-            log.model_torque_nm.empty() ? std::span<const double>() : log.model_torque_nm[j];
-        const JointIdentificationOptions joint_options = config.joint_options(j);
-        outcomes[j].result = identify_joint(
-            log.joint_names[j], log.q_desired_rad[j], log.q_measured_rad[j], log.payload_kg,
-            segments, log.cycle_s, config.joint_grid(j), joint_options, torque);
-        if (config.options.second_transmission_error_input &&
-            !joint_options.second_transmission_error_input)
-          pad_absent_second_transmission_error(outcomes[j].result.parameters);
+        outcomes[j].result = identify_one_joint(log, config, j, segments);
       } catch (const InputError&) {
         errors[j] = std::current_exception();
       } catch (const std::runtime_error& e) {

@@ -5,6 +5,7 @@
 // sequential run: no joint's arithmetic depends on another's or on the thread).
 #include <cstddef>
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,14 @@ struct JointOutcome {
 // creating tool's version, the data source) without its joints.
 ParameterTable parameter_table_header(const JointErrorLog& log, const IdentificationConfig& config,
                                       DataSource source);
+
+// A joint identified without some of the table's inputs (the second transmission-error pair
+// where the joint has no second order, the gear-mode pairs where it has no mode): each of its
+// cells gets each missing input with one zero coefficient, as a neutral cell gets every input,
+// and a joint without either second pair the second phase rate 0. joint_inputs must be a
+// subsequence of table_inputs (extra_inputs_of keeps one order): std::logic_error otherwise.
+void pad_absent_inputs(JointParameters& joint, std::span<const TableInput> joint_inputs,
+                       std::span<const TableInput> table_inputs);
 
 using JointDoneCallback = std::function<void(std::size_t joint, std::size_t joints_done)>;
 std::vector<JointOutcome> identify_joints(const JointErrorLog& log,

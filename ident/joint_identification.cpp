@@ -259,6 +259,26 @@ const char* to_string(ArxModelForm form) {
   return "?";
 }
 
+const char* to_string(GearModePairs pairs) {
+  switch (pairs) {
+    case GearModePairs::kNone:
+      return "none";
+    case GearModePairs::kInstead:
+      return "instead";
+    case GearModePairs::kBeside:
+      return "beside";
+  }
+  return "?";
+}
+
+GearModePairs gear_mode_pairs_from_string(const std::string& text) {
+  for (const GearModePairs pairs :
+       {GearModePairs::kNone, GearModePairs::kInstead, GearModePairs::kBeside})
+    if (text == to_string(pairs)) return pairs;
+  throw std::invalid_argument("gear-mode pairs '" + text +
+                              "' unknown; expected none, instead or beside");
+}
+
 ArxModelForm arx_model_form_from_string(const std::string& text) {
   for (const ArxModelForm form :
        {ArxModelForm::kJointError, ArxModelForm::kAngle, ArxModelForm::kInverse})
@@ -297,13 +317,17 @@ std::vector<TableInput> extra_inputs_of(const JointIdentificationOptions& option
   if (options.model_torque_input) inputs.push_back(TableInput::kModelTorque);
   if (options.direction_input) inputs.push_back(TableInput::kDirection);
   if (options.torque_sign_input) inputs.push_back(TableInput::kTorqueSign);
-  if (options.transmission_error_input) {
-    inputs.push_back(TableInput::kTransmissionErrorSin);
-    inputs.push_back(TableInput::kTransmissionErrorCos);
-    if (options.second_transmission_error_input) {
-      inputs.push_back(TableInput::kTransmissionError2Sin);
-      inputs.push_back(TableInput::kTransmissionError2Cos);
-    }
+  if (!options.transmission_error_input) return inputs;
+  const bool second = options.second_transmission_error_input;
+  using enum TableInput;
+  if (options.transmission_error_mode_pairs != GearModePairs::kInstead) {
+    inputs.insert(inputs.end(), {kTransmissionErrorSin, kTransmissionErrorCos});
+    if (second) inputs.insert(inputs.end(), {kTransmissionError2Sin, kTransmissionError2Cos});
+  }
+  if (options.transmission_error_mode_pairs != GearModePairs::kNone) {
+    inputs.insert(inputs.end(), {kTransmissionErrorModeSin, kTransmissionErrorModeCos});
+    if (second)
+      inputs.insert(inputs.end(), {kTransmissionError2ModeSin, kTransmissionError2ModeCos});
   }
   return inputs;
 }
@@ -324,6 +348,13 @@ int extra_input_taps(TableInput input, const JointIdentificationOptions& options
     case TableInput::kTransmissionError2Sin:
     case TableInput::kTransmissionError2Cos:
       return options.transmission_error_taps;
+    case TableInput::kTransmissionErrorModeSin:
+    case TableInput::kTransmissionErrorModeCos:
+    case TableInput::kTransmissionError2ModeSin:
+    case TableInput::kTransmissionError2ModeCos:
+      return options.transmission_error_mode_pairs == GearModePairs::kBeside
+                 ? options.transmission_error_mode_taps
+                 : options.transmission_error_taps;
   }
   return options.input_taps;
 }
@@ -337,8 +368,10 @@ ExogenousParameters exogenous_parameters(const JointIdentificationOptions& optio
   p.transmission_error_2_rad_per_rad =
       options.second_transmission_error_input ? options.transmission_error_2_rad_per_rad : 0.0;
   p.transmission_error_compliance_rad_per_nm = options.transmission_error_compliance_rad_per_nm;
-  p.transmission_error_mode_rad_s = options.transmission_error_mode_rad_s;
-  p.transmission_error_mode_damping = options.transmission_error_mode_damping;
+  if (options.transmission_error_mode_pairs != GearModePairs::kNone) {
+    p.transmission_error_mode_rad_s = options.transmission_error_mode_rad_s;
+    p.transmission_error_mode_damping = options.transmission_error_mode_damping;
+  }
   return p;
 }
 
@@ -487,8 +520,10 @@ JointIdentification identify_joint(const std::string& name, std::span<const doub
     out.parameters.transmission_error_rad_per_rad = options.transmission_error_rad_per_rad;
     out.parameters.transmission_error_compliance_rad_per_nm =
         options.transmission_error_compliance_rad_per_nm;
-    out.parameters.transmission_error_mode_rad_s = options.transmission_error_mode_rad_s;
-    out.parameters.transmission_error_mode_damping = options.transmission_error_mode_damping;
+    if (options.transmission_error_mode_pairs != GearModePairs::kNone) {
+      out.parameters.transmission_error_mode_rad_s = options.transmission_error_mode_rad_s;
+      out.parameters.transmission_error_mode_damping = options.transmission_error_mode_damping;
+    }
     if (options.second_transmission_error_input) {
       if (!(options.transmission_error_2_rad_per_rad > 0.0) ||
           options.transmission_error_2_rad_per_rad == options.transmission_error_rad_per_rad)

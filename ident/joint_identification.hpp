@@ -76,6 +76,12 @@ const char* to_string(ArxModelForm form);
 // "joint-error", "angle", "inverse"; std::invalid_argument otherwise.
 ArxModelForm arx_model_form_from_string(const std::string& text);
 
+// Where the gear mode's pairs go among the further inputs (JointIdentificationOptions).
+enum class GearModePairs { kNone, kInstead, kBeside };
+// "none", "instead", "beside"; std::invalid_argument otherwise.
+const char* to_string(GearModePairs pairs);
+GearModePairs gear_mode_pairs_from_string(const std::string& text);
+
 struct JointIdentificationOptions {
   ArxModelForm form = ArxModelForm::kJointError;
   int preview_cycles = 0;  // P of the inverse form (>= 0; only with kInverse)
@@ -117,13 +123,19 @@ struct JointIdentificationOptions {
   // The gear's compliance 1 / k [rad/(N m)]: the motor sits τ / k ahead of the link under the
   // model torque τ, so the error's phase is f (q + τ / k) (0: the link angle alone).
   double transmission_error_compliance_rad_per_nm = 0.0;
-  // The joint's locked-motor gear mode the error passes through (ident/exogenous_inputs.hpp):
-  // natural frequency [rad/s] and damping ratio; 0: none, the plain pair.
+  // The pairs through the joint's locked-motor gear mode (the gear-mode kinds of
+  // ident/exogenous_inputs.hpp): none, instead of the plain pairs (with their taps), or beside
+  // them with transmission_error_mode_taps each (the plain pairs keep the loop's response at the
+  // error's frequency, the filtered ones the mode's transient; the filtered pair is narrow-band,
+  // so many taps of it are nearly collinear). The mode: natural frequency [rad/s] and damping
+  // ratio; 0: none (the gear-mode pairs equal the plain ones).
+  GearModePairs transmission_error_mode_pairs = GearModePairs::kNone;
   double transmission_error_mode_rad_s = 0.0;
   double transmission_error_mode_damping = 0.0;
   int input_taps = 32;
   int torque_sign_taps = 1;
   int transmission_error_taps = 8;
+  int transmission_error_mode_taps = 4;
   OrderGrid grid{1, 32, 1, 32, 0, 4};
   OrderCriterion criterion = OrderCriterion::kBic;
   double validation_fraction = 0.3;  // of every segment (or block), held out (its end)
@@ -180,7 +192,8 @@ JointIdentification neutral_joint_identification(const std::string& name, double
                                                  const std::string& reason, int extra_inputs = 0);
 
 // The further inputs the options switch on (ident/exogenous_inputs.hpp), in the order of the
-// table and of the fit: model torque, direction, torque sign, transmission-error sin and cos.
+// table and of the fit: model torque, direction, torque sign, transmission-error sin and cos
+// (then the second order's), then the gear-mode pairs (first, second order).
 std::vector<TableInput> extra_inputs_of(const JointIdentificationOptions& options);
 // The number of them (the transmission error counts twice).
 int extra_input_count(const JointIdentificationOptions& options);

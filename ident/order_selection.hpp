@@ -45,7 +45,7 @@ struct OrderGrid {
   // Coefficients of each further input (multi-input form; fixed, not swept: the further inputs
   // are the model torque, the direction of motion and the torque's sign, whose responses share
   // the poles of A(z)). The first as many as the data carry are used; each >= 1.
-  std::array<int, kMaxExtraInputs> extra_taps{8, 8, 8, 8, 8, 8, 8};
+  std::array<int, kMaxExtraInputs> extra_taps{8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8};
 };
 
 enum class OrderCriterion { kAic, kBic, kValidation };

@@ -23,8 +23,12 @@ namespace imscal::ident {
 // transmission_error_2_sin / _cos, the joints' transmission_error_2_rad_per_rad). Version 5
 // added the model torque's link masses refined from the identification data (model_torque_links,
 // optional). Version 6 added the joints' gear mode the transmission error passes through
-// (transmission_error_gear_mode, optional: natural frequency and damping ratio).
-inline constexpr int kParameterTableSchemaVersion = 6;
+// (transmission_error_gear_mode, optional: natural frequency and damping ratio), which filtered
+// the plain pairs. Version 7 added the gear-mode pairs as inputs of their own
+// (transmission_error_mode_sin / _cos, transmission_error_2_mode_sin / _cos), beside the plain
+// pairs or instead of them, and the mode acts on those only; a version 6 table with a gear mode
+// is read as version 7 with its pairs as the gear-mode kinds (the same values).
+inline constexpr int kParameterTableSchemaVersion = 7;
 
 // What the cells' models are (ident/joint_identification.hpp): forward error models of the
 // loop (paper, eq. 2: the predicted error Δq̂ from q_d), or inverse models (the offset that makes

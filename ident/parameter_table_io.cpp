@@ -280,12 +280,13 @@ TableInput read_input(const Node& n) {
   n.fail("expected " + expected + ", got '" + name + "'");
 }
 
-// The gear mode the transmission error passes through (version 6 on, optional): natural
-// frequency > 0 and damping ratio > 0.
-void read_gear_mode_key(const Node& n, JointParameters& j, bool transmission_error) {
+// The gear mode of the gear-mode transmission-error pairs (version 6 on, optional): natural
+// frequency > 0 and damping ratio > 0. gear_mode_inputs: whether the table has inputs it acts on
+// (version 6: the plain pairs, read as the gear-mode kinds; version 7: the gear-mode kinds).
+void read_gear_mode_key(const Node& n, JointParameters& j, bool gear_mode_inputs) {
   if (!n.has("transmission_error_gear_mode")) return;
   const Node mode = n.child("transmission_error_gear_mode");
-  if (!transmission_error) mode.fail("the table has no transmission-error input");
+  if (!gear_mode_inputs) mode.fail("the table has no gear-mode transmission-error input");
   mode.only_keys({"natural_frequency_rad_s", "damping_ratio"});
   j.transmission_error_mode_rad_s = mode.child("natural_frequency_rad_s").number();
   j.transmission_error_mode_damping = mode.child("damping_ratio").number();
@@ -298,7 +299,7 @@ void read_gear_mode_key(const Node& n, JointParameters& j, bool transmission_err
 
 // The transmission-error keys of a joint (version 3 on): the phase rates and the compliance.
 void read_transmission_error_keys(const Node& n, JointParameters& j, bool transmission_error,
-                                  bool second_transmission_error) {
+                                  bool second_transmission_error, bool gear_mode_inputs) {
   const Node te = n.child("transmission_error_rad_per_rad");
   j.transmission_error_rad_per_rad = te.number();
   if (transmission_error ? !(j.transmission_error_rad_per_rad > 0.0)
@@ -318,7 +319,7 @@ void read_transmission_error_keys(const Node& n, JointParameters& j, bool transm
     n.child("transmission_error_2_rad_per_rad")
         .fail("the table has no second transmission-error input");
   }
-  read_gear_mode_key(n, j, transmission_error);
+  read_gear_mode_key(n, j, gear_mode_inputs);
   const Node compliance = n.child("transmission_error_compliance_rad_per_nm");
   j.transmission_error_compliance_rad_per_nm = compliance.number();
   if (!(j.transmission_error_compliance_rad_per_nm >= 0.0) ||
@@ -329,10 +330,11 @@ void read_transmission_error_keys(const Node& n, JointParameters& j, bool transm
 
 // extra_inputs: the table's further inputs (-1: schema version 1); torque_sign: whether one of
 // them is the torque's sign (the joint then needs its scale); transmission_error: whether the
-// transmission-error pair is (the joint then needs its phase rate; the key from version 3 on).
+// transmission-error pair is (the joint then needs its phase rate; the key from version 3 on);
+// gear_mode_inputs: whether a joint may carry a gear mode (read_gear_mode_key).
 JointParameters read_joint(const Node& n, double sample_time_s, int schema_version,
                            int extra_inputs, bool torque_sign, bool transmission_error,
-                           bool second_transmission_error) {
+                           bool second_transmission_error, bool gear_mode_inputs) {
   if (extra_inputs < 0)
     n.only_keys({"name", "backlash", "dimensions", "cells"});
   else if (schema_version < 3)
@@ -361,7 +363,8 @@ JointParameters read_joint(const Node& n, double sample_time_s, int schema_versi
           .fail(torque_sign ? "the table has the torque-sign input: the scale must be > 0"
                             : "the table has no torque-sign input: the scale must be 0");
     if (schema_version >= 3)
-      read_transmission_error_keys(n, j, transmission_error, second_transmission_error);
+      read_transmission_error_keys(n, j, transmission_error, second_transmission_error,
+                                   gear_mode_inputs);
     for (const auto& [key, value] :
          {std::pair{"offset_envelope_rad", &j.offset_envelope_rad},
           std::pair{"offset_rate_envelope_rad_s", &j.offset_rate_envelope_rad_s}}) {
@@ -442,6 +445,44 @@ std::vector<LinkMassParameters> read_model_torque_links(const Node& r, int schem
   return out;
 }
 
+// Version 6 filtered the plain pairs of the joints with a gear mode: such a table's pairs are
+// the gear-mode kinds, which equal the plain pairs on joints without a mode (the values and
+// coefficients unchanged); the table is then one of this version.
+void read_version_6_gear_mode_pairs(ParameterTable& t) {
+  const bool any_mode = std::ranges::any_of(
+      t.joints, [](const JointParameters& j) { return j.transmission_error_mode_rad_s > 0.0; });
+  if (!any_mode) return;
+  for (TableInput& input : t.extra_inputs) {
+    using enum TableInput;
+    if (input == kTransmissionErrorSin) input = kTransmissionErrorModeSin;
+    if (input == kTransmissionErrorCos) input = kTransmissionErrorModeCos;
+    if (input == kTransmissionError2Sin) input = kTransmissionError2ModeSin;
+    if (input == kTransmissionError2Cos) input = kTransmissionError2ModeCos;
+  }
+  t.schema_version = kParameterTableSchemaVersion;
+}
+
+// The joints of a table whose header (version, sample time, inputs) is read.
+void read_joints(const Node& joints, ParameterTable& t) {
+  std::set<std::string> names;
+  const auto has = [&](TableInput input) { return has_input(t.extra_inputs, input); };
+  using enum TableInput;
+  const bool plain = has(kTransmissionErrorSin) || has(kTransmissionErrorCos);
+  const bool filtered = has(kTransmissionErrorModeSin) || has(kTransmissionErrorModeCos);
+  const bool second = has(kTransmissionError2Sin) || has(kTransmissionError2Cos) ||
+                      has(kTransmissionError2ModeSin) || has(kTransmissionError2ModeCos);
+  for (const Node& j : joints.items()) {
+    t.joints.push_back(read_joint(j, t.sample_time_s, t.schema_version,
+                                  t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1,
+                                  has(kTorqueSign), plain || filtered, second,
+                                  t.schema_version < 7 ? plain : filtered));
+    if (!names.insert(t.joints.back().name).second)
+      j.child("name").fail("joint '" + t.joints.back().name + "' given twice");
+  }
+  if (t.joints.empty()) joints.fail("no joint");
+  if (t.schema_version < 7) read_version_6_gear_mode_pairs(t);
+}
+
 }  // namespace
 
 nlohmann::json model_torque_links_json(const std::vector<LinkMassParameters>& links) {
@@ -460,7 +501,10 @@ nlohmann::json model_torque_links_json(const std::vector<LinkMassParameters>& li
 
 std::string parameters_json_text(const ParameterTable& t) {
   const bool second_transmission_error =
-      std::ranges::find(t.extra_inputs, TableInput::kTransmissionError2Sin) != t.extra_inputs.end();
+      has_pair(t.extra_inputs, TableInput::kTransmissionError2Sin,
+               TableInput::kTransmissionError2Cos) ||
+      has_pair(t.extra_inputs, TableInput::kTransmissionError2ModeSin,
+               TableInput::kTransmissionError2ModeCos);
   json joints = json::array();
   for (const JointParameters& j : t.joints) {
     json dims = json::array();
@@ -489,7 +533,7 @@ std::string parameters_json_text(const ParameterTable& t) {
     }
     if (second_transmission_error)  // version 4, with the second pair only
       joint["transmission_error_2_rad_per_rad"] = j.transmission_error_2_rad_per_rad;
-    if (j.transmission_error_mode_rad_s > 0.0)  // version 6, with a gear mode only
+    if (j.transmission_error_mode_rad_s > 0.0)  // version 6 on, with a gear mode only
       joint["transmission_error_gear_mode"] = {
           {"natural_frequency_rad_s", j.transmission_error_mode_rad_s},
           {"damping_ratio", j.transmission_error_mode_damping}};
@@ -634,21 +678,7 @@ ParameterTable parse_parameters_json(const std::string& text, const std::string&
   t.source.sha256 = src.child("sha256").string();
   t.source.samples = src.child("samples").count();
   t.source.description = src.child("description").string();
-  const Node joints = r.child("joints");
-  std::set<std::string> names;
-  const auto has = [&](TableInput input) {
-    return std::find(t.extra_inputs.begin(), t.extra_inputs.end(), input) != t.extra_inputs.end();
-  };
-  for (const Node& j : joints.items()) {
-    t.joints.push_back(read_joint(
-        j, t.sample_time_s, t.schema_version,
-        t.schema_version >= 2 ? int(t.extra_inputs.size()) : -1, has(TableInput::kTorqueSign),
-        has(TableInput::kTransmissionErrorSin) || has(TableInput::kTransmissionErrorCos),
-        has(TableInput::kTransmissionError2Sin) || has(TableInput::kTransmissionError2Cos)));
-    if (!names.insert(t.joints.back().name).second)
-      j.child("name").fail("joint '" + t.joints.back().name + "' given twice");
-  }
-  if (t.joints.empty()) joints.fail("no joint");
+  read_joints(r.child("joints"), t);
   t.model_torque_links = read_model_torque_links(r, t.schema_version, t.joints.size());
   return t;
 }

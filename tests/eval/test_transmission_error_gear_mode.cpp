@@ -59,7 +59,7 @@ TEST(TransmissionErrorGearMode, PairIsTheModesSteadyStateResponse) {
       const ident::ExogenousSample s{x0 + speed * t, speed, 0.0};
       for (const bool sine : {true, false}) {
         const TableInput input =
-            sine ? TableInput::kTransmissionErrorSin : TableInput::kTransmissionErrorCos;
+            sine ? TableInput::kTransmissionErrorModeSin : TableInput::kTransmissionErrorModeCos;
         // Tolerance: 1e-3 of the response's amplitude (transient ~6e-6, RK4 with Ω dt ≤ 3e-3
         // far below).
         EXPECT_NEAR(ident::exogenous_value(input, p, s), simulated_response(speed, x0, t, sine),
@@ -87,11 +87,18 @@ TEST(TransmissionErrorGearMode, WithoutAModeThePairIsPlainAndTheSecondOrderHasIt
   p.transmission_error_mode_damping = kDamping;
   const std::complex<double> h2 = ident::gear_mode_response(p, 2.0 * kPhaseRate, 0.4);
   const double phase2 = 2.0 * kPhaseRate * 0.37;
-  EXPECT_NEAR(ident::exogenous_value(TableInput::kTransmissionError2Cos, p, s),
+  EXPECT_NEAR(ident::exogenous_value(TableInput::kTransmissionError2ModeCos, p, s),
               (h2 * std::polar(1.0, phase2)).real(), 1e-12);
-  // The plain pair's constants pass the check; a mode without damping does not.
-  const TableInput pair[] = {TableInput::kTransmissionErrorSin, TableInput::kTransmissionErrorCos};
+  // The plain pairs stay plain beside a mode.
+  EXPECT_EQ(ident::exogenous_value(TableInput::kTransmissionError2Cos, p, s), std::cos(phase2));
+  // The gear-mode pair's constants pass the check; a mode without damping does not, nor a mode
+  // without a gear-mode pair.
+  const TableInput pair[] = {TableInput::kTransmissionErrorModeSin,
+                             TableInput::kTransmissionErrorModeCos};
+  const TableInput plain_pair[] = {TableInput::kTransmissionErrorSin,
+                                   TableInput::kTransmissionErrorCos};
   EXPECT_EQ(ident::exogenous_parameters_problem(pair, p), "");
+  EXPECT_NE(ident::exogenous_parameters_problem(plain_pair, p), "");
   p.transmission_error_mode_damping = 0.0;
   EXPECT_NE(ident::exogenous_parameters_problem(pair, p), "");
 }

@@ -47,8 +47,12 @@ TEST(ExogenousInputs, DescriptorsNameEveryKindInEnumOrder) {
                          "transmission_error_sin",
                          "transmission_error_cos",
                          "transmission_error_2_sin",
-                         "transmission_error_2_cos"};
-  ASSERT_EQ(kExogenousInputKindCount, 7);
+                         "transmission_error_2_cos",
+                         "transmission_error_mode_sin",
+                         "transmission_error_mode_cos",
+                         "transmission_error_2_mode_sin",
+                         "transmission_error_2_mode_cos"};
+  ASSERT_EQ(kExogenousInputKindCount, 11);
   for (int k = 0; k < kExogenousInputKindCount; ++k) {
     EXPECT_EQ(int(kExogenousInputKinds[k].input), k);
     EXPECT_STREQ(to_string(TableInput(k)), names[k]);

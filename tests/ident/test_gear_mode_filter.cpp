@@ -74,8 +74,8 @@ std::array<double, 2> sweep_errors(double acceleration_rad_s2, double t_end_s) {
   auto frequency = [&](double t) { return kPhaseRate * acceleration_rad_s2 * t; };
   const std::vector<Complex> truth = ode_response(phase, frequency, t_end_s);
   const ident::ExogenousParameters p = mode_parameters();
-  const std::array<TableInput, 2> inputs{TableInput::kTransmissionErrorSin,
-                                         TableInput::kTransmissionErrorCos};
+  const std::array<TableInput, 2> inputs{TableInput::kTransmissionErrorModeSin,
+                                         TableInput::kTransmissionErrorModeCos};
   ident::ExogenousFilterState state;
   ident::restart_exogenous_filter(state, p, kStep_s);
   double filter_error = 0.0, steady_error = 0.0;
@@ -112,8 +112,8 @@ TEST(GearModeFilter, SteadyStateIsTheModesResponseAndAtRestThePlainPair) {
   // At a constant speed from its steady state the filter stays on H(jΩ) e^{jφ}: the discretization
   // is exact for a complex exponential at a constant frequency (rounding only, 1e-9).
   const ident::ExogenousParameters p = mode_parameters();
-  const std::array<TableInput, 2> inputs{TableInput::kTransmissionErrorSin,
-                                         TableInput::kTransmissionErrorCos};
+  const std::array<TableInput, 2> inputs{TableInput::kTransmissionErrorModeSin,
+                                         TableInput::kTransmissionErrorModeCos};
   for (const double ratio : {0.0, 0.5, 1.0, -1.3, 3.0}) {
     const double speed = ratio * kMode_rad_s / kPhaseRate;
     ident::ExogenousFilterState state;
@@ -147,8 +147,8 @@ TEST(GearModeFilter, SecondPairRunsItsOwnFilterAndIsZeroWithoutAnOrder) {
   ident::ExogenousParameters doubled = mode_parameters();
   doubled.transmission_error_rad_per_rad = 2.0 * kPhaseRate;
   const std::array<TableInput, 4> inputs{
-      TableInput::kTransmissionErrorSin, TableInput::kTransmissionErrorCos,
-      TableInput::kTransmissionError2Sin, TableInput::kTransmissionError2Cos};
+      TableInput::kTransmissionErrorModeSin, TableInput::kTransmissionErrorModeCos,
+      TableInput::kTransmissionError2ModeSin, TableInput::kTransmissionError2ModeCos};
   ident::ExogenousFilterState both, reference;
   ident::restart_exogenous_filter(both, p, kStep_s);
   ident::restart_exogenous_filter(reference, doubled, kStep_s);

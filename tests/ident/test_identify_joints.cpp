@@ -85,5 +85,39 @@ TEST(IdentifyJoints, ThreadsGiveTheSequentialResultInJointOrder) {
   EXPECT_EQ(parallel[3].result.cells[0].status, CellStatus::kNeutral);
 }
 
+// A joint fitted without some of the table's inputs (no second order, no gear mode) gets each
+// missing input with one zero coefficient in its place, its own coefficients unchanged.
+TEST(IdentifyJoints, AbsentInputsArePaddedInTheirPlaceWithZeros) {
+  using enum TableInput;
+  JointParameters joint;
+  joint.transmission_error_2_rad_per_rad = 400.0;
+  CellParameters cell;
+  cell.structure = {1, 1, 0, 5, {2, 3, 1, 2, 1}};
+  cell.c = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+  joint.cells = {cell};
+  const std::vector<TableInput> own{kModelTorque, kTransmissionErrorSin, kTransmissionErrorCos,
+                                    kTransmissionErrorModeSin, kTransmissionErrorModeCos};
+  const std::vector<TableInput> table{kModelTorque,
+                                      kTransmissionErrorSin,
+                                      kTransmissionErrorCos,
+                                      kTransmissionError2Sin,
+                                      kTransmissionError2Cos,
+                                      kTransmissionErrorModeSin,
+                                      kTransmissionErrorModeCos,
+                                      kTransmissionError2ModeSin,
+                                      kTransmissionError2ModeCos};
+  pad_absent_inputs(joint, own, table);
+  const CellParameters& padded = joint.cells[0];
+  EXPECT_EQ(padded.structure.extra_inputs, 9);
+  EXPECT_EQ(padded.structure.nx,
+            (std::array<int, kMaxExtraInputs>{2, 3, 1, 1, 1, 2, 1, 1, 1, 0, 0}));
+  EXPECT_EQ(padded.c, (std::vector<double>{1, 2, 3, 4, 5, 6, 0, 0, 7, 8, 9, 0, 0}));
+  EXPECT_NO_THROW(padded.structure.validate());
+  EXPECT_EQ(joint.transmission_error_2_rad_per_rad, 0.0);
+  // Inputs out of the table's order are a programming error.
+  const std::vector<TableInput> swapped{kTransmissionErrorCos, kTransmissionErrorSin};
+  EXPECT_THROW(pad_absent_inputs(joint, swapped, table), std::logic_error);
+}
+
 }  // namespace
 }  // namespace imscal::ident

@@ -165,7 +165,8 @@ TEST(OrderSelection, RejectsBadGridAndMissingValidation) {
     select_arx_order(data, options);
     ADD_FAILURE() << "accepted a zero tap count";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("further inputs' taps 4,1,1,0,0,0,0"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("further inputs' taps 4,1,1,0,0,0,0,0,0,0,0"),
+              std::string::npos)
         << e.what();
   }
   options.grid = {1, 2, 1, 2, 0, 1};
@@ -186,7 +187,7 @@ TEST(OrderSelection, MultiInputSweepEqualsDirectFitsAndFindsTheTrueStructure) {
   const std::vector<IoSegment> estimation{est.view()}, validation{val.view()};
   OrderSelectionOptions options;
   options.grid = {0, 4, 1, 4, 0, 3};
-  options.grid.extra_taps = {4, 1, 1, 1, 1, 1, 1};
+  options.grid.extra_taps = {4, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
   const auto result = select_arx_order(estimation, options, validation);
   ASSERT_EQ(result.candidates.size(), 5u * 4u * 4u);
   const int first_row = std::max(4, 3 + 4 - 1);  // largest lag of the grid (u and x: d + n - 1)
@@ -194,7 +195,7 @@ TEST(OrderSelection, MultiInputSweepEqualsDirectFitsAndFindsTheTrueStructure) {
     ASSERT_TRUE(c.valid) << to_string(c.structure);
     EXPECT_EQ(c.structure.extra_inputs, 2);
     EXPECT_EQ(c.structure.nx,
-              (std::array<int, imscal::ident::kMaxExtraInputs>{4, 1, 0, 0, 0, 0, 0}));
+              (std::array<int, imscal::ident::kMaxExtraInputs>{4, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0}));
     const std::size_t skip = std::size_t(first_row - c.structure.max_lag());
     const std::vector<IoSegment> rows{estimation[0].subspan(skip)};
     const auto fit = fit_arx(rows, c.structure);

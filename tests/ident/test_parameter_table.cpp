@@ -175,29 +175,40 @@ TEST_F(ParameterTableFiles, ModelTorqueLinksRoundTripAndAreChecked) {
   refused(short_com, "/model_torque_links/0/com_sigma_m");
 }
 
-// Schema 6's gear mode of the transmission error: exact round trip; a joint without one writes
-// no key and reads 0 (as every older table); frequency and damping > 0; not in a version 5 table,
-// nor in a table without the transmission-error inputs.
+// The gear mode of the gear-mode pairs (version 6's key, version 7's inputs): exact round trip; a
+// joint without one writes no key and reads 0 (as every older table); frequency and damping > 0;
+// not in a version 5 table, nor in a table without gear-mode inputs.
 TEST_F(ParameterTableFiles, GearModeRoundTripsAndIsChecked) {
+  using ident::TableInput;
   ident::ParameterTable table = sample_table();
+  table.extra_inputs[2] = TableInput::kTransmissionErrorModeSin;  // instead of the plain pair
+  table.extra_inputs[3] = TableInput::kTransmissionErrorModeCos;
   table.joints[0].transmission_error_mode_rad_s = 94.28090415820634;
   table.joints[0].transmission_error_mode_damping = 0.050677;
   const auto file = dir_ / "parameters.json";
   ident::write_parameters_json(file, table);
   EXPECT_TRUE(ident::read_parameters_json(file) == table);
   const json good = json::parse(ident::parameters_json_text(table));
-  EXPECT_EQ(good["schema_version"], 6);
+  EXPECT_EQ(good["schema_version"], 7);
   EXPECT_EQ(good["joints"][1].count("transmission_error_gear_mode"), 0u);
-  json old = good;
+  // Version 6 filtered its plain pairs: read as the gear-mode kinds, the same table.
+  json version_6 = good;
+  version_6["schema_version"] = 6;
+  version_6["extra_inputs"][2] = "transmission_error_sin";
+  version_6["extra_inputs"][3] = "transmission_error_cos";
+  EXPECT_TRUE(ident::parse_parameters_json(version_6.dump(), "parameters.json") == table);
+  json kinds_too_new = good;  // the gear-mode kinds are version 7's
+  kinds_too_new["schema_version"] = 6;
+  refused(kinds_too_new, "/extra_inputs");
+  json old = version_6;
   old["schema_version"] = 5;
   refused(old, "/joints/0/transmission_error_gear_mode");
-  json still = good;  // a version 5 table without the key reads as before: no mode
+  json still = version_6;  // a version 5 table without the key reads as before: no mode
   still["schema_version"] = 5;
   still["joints"][0].erase("transmission_error_gear_mode");
-  EXPECT_EQ(ident::parse_parameters_json(still.dump(), "parameters.json")
-                .joints[0]
-                .transmission_error_mode_rad_s,
-            0.0);
+  const ident::ParameterTable plain = ident::parse_parameters_json(still.dump(), "parameters.json");
+  EXPECT_EQ(plain.joints[0].transmission_error_mode_rad_s, 0.0);
+  EXPECT_EQ(plain.extra_inputs[2], TableInput::kTransmissionErrorSin);
   json zero = good;
   zero["joints"][0]["transmission_error_gear_mode"]["natural_frequency_rad_s"] = 0.0;
   refused(zero, "/joints/0/transmission_error_gear_mode/natural_frequency_rad_s");
@@ -208,6 +219,26 @@ TEST_F(ParameterTableFiles, GearModeRoundTripsAndIsChecked) {
   without["joints"][0]["transmission_error_gear_mode"] =
       good["joints"][0]["transmission_error_gear_mode"];
   refused(without, "/joints/0/transmission_error_gear_mode");
+  // Version 7 with the plain pairs only: the mode has nothing to act on.
+  json plain_7 = json::parse(ident::parameters_json_text(sample_table()));
+  plain_7["joints"][0]["transmission_error_gear_mode"] =
+      good["joints"][0]["transmission_error_gear_mode"];
+  refused(plain_7, "/joints/0/transmission_error_gear_mode");
+}
+
+// Version 7's gear-mode pairs beside the plain pairs: exact round trip.
+TEST_F(ParameterTableFiles, GearModePairsBesideThePlainPairsRoundTrip) {
+  ident::ParameterTable table = sample_table(true, true);
+  table.extra_inputs[4] = ident::TableInput::kTransmissionErrorModeSin;
+  table.extra_inputs[5] = ident::TableInput::kTransmissionErrorModeCos;
+  for (ident::JointParameters& j : table.joints) {
+    j.transmission_error_2_rad_per_rad = 0.0;
+    j.transmission_error_mode_rad_s = 101.5;
+    j.transmission_error_mode_damping = 0.05;
+  }
+  const auto file = dir_ / "parameters.json";
+  ident::write_parameters_json(file, table);
+  EXPECT_TRUE(ident::read_parameters_json(file) == table);
 }
 
 TEST(ParameterTable, Version1TablesReadAsForwardModelsWithoutPreview) {
@@ -284,8 +315,8 @@ TEST_P(LoaderRefuses, WithPathAndMessage) {
 INSTANTIATE_TEST_SUITE_P(
     BadTables, LoaderRefuses,
     ::testing::Values(
-        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 7; }, "/schema_version",
-                "unknown schema version 7"},
+        Refusal{"UnknownVersion", [](json& j) { j["schema_version"] = 8; }, "/schema_version",
+                "unknown schema version 8"},
         Refusal{"CountsForTheFurtherInputs",
                 [](json& j) { j["joints"][0]["cells"][0]["nx"] = json::array({3}); },
                 "/joints/0/cells/0/nx", "1 counts for the table's 4 further inputs"},

@@ -59,6 +59,14 @@ ParameterTable multi_input_table(bool with_inputs, bool transmission_error = fal
     t.extra_inputs.push_back(TableInput::kTransmissionError2Sin);
     t.extra_inputs.push_back(TableInput::kTransmissionError2Cos);
   }
+  if (gear_mode) {  // the gear-mode pairs beside the plain ones
+    t.extra_inputs.push_back(TableInput::kTransmissionErrorModeSin);
+    t.extra_inputs.push_back(TableInput::kTransmissionErrorModeCos);
+    if (second_pair) {
+      t.extra_inputs.push_back(TableInput::kTransmissionError2ModeSin);
+      t.extra_inputs.push_back(TableInput::kTransmissionError2ModeCos);
+    }
+  }
   const int inputs = static_cast<int>(t.extra_inputs.size());
   for (int j = 0; j < 6; ++j) {
     JointParameters joint;
@@ -85,14 +93,17 @@ ParameterTable multi_input_table(bool with_inputs, bool transmission_error = fal
       cp.structure.extra_inputs = inputs;
       cp.structure.nx = {1 + (5 * c + j) % 12, 1 + (7 * c + 3 * j) % 12, 1,
                          1 + (3 * c + j) % 8,  1 + (c + 5 * j) % 8,      1 + (2 * c + j) % 8,
-                         1 + (c + 3 * j) % 8};
+                         1 + (c + 3 * j) % 8,  1 + (c + j) % 4,          1 + (2 * c + j) % 4,
+                         1 + (c + 2 * j) % 4,  1 + (3 * c + j) % 4};
+      for (int e = inputs; e < kMaxExtraInputs; ++e) cp.structure.nx[std::size_t(e)] = 0;
       const Eigen::VectorXd a =
           test_support::polynomial_from_poles(test_support::random_poles(na, rng));
       const double a_sum = 1.0 + a.sum();  // A(1): coefficients / A(1) give the static gains
       cp.a.assign(a.data(), a.data() + na);
       cp.b.assign(static_cast<std::size_t>(nb), a_sum * (1.0 + 0.002 * c) / nb);  // gains 1..1.01
-      const std::array<double, 7> gain{kTorqueGain, kDirectionGain, kSignGain, kTeGain,
-                                       kTeGain,     kTeGain,        kTeGain};
+      const std::array<double, 11> gain{kTorqueGain, kDirectionGain, kSignGain, kTeGain,
+                                        kTeGain,     kTeGain,        kTeGain,   kTeGain,
+                                        kTeGain,     kTeGain,        kTeGain};
       for (int e = 0; e < inputs; ++e) {
         const int nx = cp.structure.nx[std::size_t(e)];
         for (int i = 0; i < nx; ++i)
@@ -203,8 +214,9 @@ TEST(PrecontrolFurtherInputs, TheSecondTransmissionErrorPairGivesTheReferenceOff
   expect_same_offsets_as_the_reference(true, true);
 }
 
-// Both pairs through the gear mode's filter: its state restarts with the models (start, each
-// re-activation) and advances once per model step, as in the reference.
+// Both pairs through the gear mode's filter, beside the plain pairs: the filter's state restarts
+// with the models (start, each re-activation) and advances once per model step, as in the
+// reference.
 TEST(PrecontrolFurtherInputs, TheGearModeFilterGivesTheReferenceOffsets) {
   expect_same_offsets_as_the_reference(true, true, true);
 }
@@ -230,15 +242,20 @@ TEST(PrecontrolFurtherInputs, TransmissionErrorWithoutAPhaseRateIsRefused) {
 
 // The heaviest table of the precontrol's benchmark (bench/bench_precontrol.cpp, the same motion):
 // order 32 in every cell of a 3 x 2 grid, the model torque and direction with 32 taps, the
-// torque sign with one and the transmission-error pair with 32 each; the odd joints' pair through
-// a gear mode (the filter with state runs inside the cycle too).
+// torque sign with one and the transmission-error pair with 32 each, the gear-mode pair beside it
+// with 4 each; the odd joints have a mode (the filter with state runs inside the cycle too).
 ParameterTable order_32_grid_table() {
   std::mt19937_64 rng(32);
   ParameterTable t;
   t.robot = "kr16";
   t.sample_time_s = kCycle;
-  t.extra_inputs = {TableInput::kModelTorque, TableInput::kDirection, TableInput::kTorqueSign,
-                    TableInput::kTransmissionErrorSin, TableInput::kTransmissionErrorCos};
+  t.extra_inputs = {TableInput::kModelTorque,
+                    TableInput::kDirection,
+                    TableInput::kTorqueSign,
+                    TableInput::kTransmissionErrorSin,
+                    TableInput::kTransmissionErrorCos,
+                    TableInput::kTransmissionErrorModeSin,
+                    TableInput::kTransmissionErrorModeCos};
   for (int j = 0; j < 6; ++j) {
     JointParameters joint;
     joint.name = "A" + std::to_string(j + 1);
@@ -256,13 +273,13 @@ ParameterTable order_32_grid_table() {
       CellParameters cell;
       cell.bands = {c / 2, c % 2};
       cell.structure = {32, 32, 2};
-      cell.structure.extra_inputs = 5;
-      cell.structure.nx = {32, 32, 1, 32, 32};
+      cell.structure.extra_inputs = 7;
+      cell.structure.nx = {32, 32, 1, 32, 32, 4, 4};
       const Eigen::VectorXd a =
           test_support::polynomial_from_poles(test_support::random_poles(32, rng));
       cell.a.assign(a.data(), a.data() + a.size());
       cell.b.assign(32, (1.0 + a.sum()) / 32.0);  // static gain 1
-      cell.c.assign(129, 1e-7);
+      cell.c.assign(137, 1e-7);
       joint.cells.push_back(cell);
     }
     t.joints.push_back(joint);
