@@ -78,13 +78,31 @@ Torques torques_of(const ModelTorqueSource& model, const DecimatedRecord& r) {
   return out;
 }
 
+// The record at rest in its poses (speeds and accelerations 0): its torques are gravity's.
+DecimatedRecord at_rest(DecimatedRecord r) {
+  for (auto* signal : {&r.qd, &r.qdd})
+    for (calib::JointVector& v : *signal) v.setZero();
+  return r;
+}
+
 // ∂τ/∂π_p [row] for every parameter: the torque is linear in a link's mass (its centre of
 // mass and inertia fixed), so the mass's difference quotient is exact; 1 mm for the centre of
-// mass (the parallel-axis term is quadratic in it).
+// mass (the parallel-axis term is quadratic in it). Gravity only (gravity_first_moments): the
+// static torque's derivatives by the centres of mass, exact (gravity is linear in them), and
+// zero columns for the masses, which then keep their nominal values.
 std::vector<Torques> torque_jacobian(const ModelTorqueSource& nominal, const Parameters& p,
-                                     const DecimatedRecord& r, const Torques& at_p) {
+                                     const DecimatedRecord& moving, const Torques& at_p_moving,
+                                     const MassRefinementOptions& o) {
+  const DecimatedRecord rest = o.gravity_first_moments ? at_rest(moving) : DecimatedRecord{};
+  const DecimatedRecord& r = o.gravity_first_moments ? rest : moving;
+  const Torques at_p =
+      o.gravity_first_moments ? torques_of(with_parameters(nominal, p), r) : at_p_moving;
   std::vector<Torques> out;
   for (int k = 0; k < kParameters; ++k) {
+    if (o.gravity_first_moments && k % kPerLink == 0) {
+      out.emplace_back(r.q.size(), calib::JointVector::Zero());
+      continue;
+    }
     const double step = k % kPerLink == 0 ? std::max(0.01 * p(k), 0.01) : 1e-3;
     Parameters moved = p;
     moved(k) += step;
@@ -175,11 +193,33 @@ Eigen::MatrixXd projected_columns(int j, const JointFit& fit, const std::vector<
   return z - fit.basis * (fit.basis.transpose() * z);
 }
 
-Parameters prior_precision(const Parameters& nominal, const MassRefinementOptions& o) {
+// Gravity only: the 1σ of link i's centre of mass [m] that covers its first moment's prior,
+// its own centre of mass and mass, and the masses beyond it acting as its first moment over the
+// DH offsets of its two joints (mass_prior_fraction of each).
+double gravity_com_prior_m(const calib::RobotDescription& robot, int i,
+                           const MassRefinementOptions& o) {
+  const auto& joints = robot.joints;
+  const double mass_kg = std::max(joints[std::size_t(i)].link.mass_kg, 1e-3);
+  double beyond_kg = 0.0;
+  for (std::size_t l = std::size_t(i) + 1; l < joints.size(); ++l)
+    beyond_kg += joints[l].link.mass_kg;
+  double lever_m = 0.0;
+  for (std::size_t l = std::size_t(i); l <= std::size_t(i) + 1 && l < robot.kinematics.dh.size();
+       ++l)
+    lever_m += std::abs(robot.kinematics.dh[l].a_m) + std::abs(robot.kinematics.dh[l].d_m);
+  const double own_m = joints[std::size_t(i)].link.com_m.norm();
+  return o.com_prior_m + o.mass_prior_fraction * (own_m + beyond_kg / mass_kg * lever_m);
+}
+
+Parameters prior_precision(const calib::RobotDescription& robot, const Parameters& nominal,
+                           const MassRefinementOptions& o) {
   Parameters precision;
   for (int k = 0; k < kParameters; ++k) {
+    const int link = k / kPerLink;
+    const double com_sigma_m =
+        o.gravity_first_moments ? gravity_com_prior_m(robot, link, o) : o.com_prior_m;
     const double sigma =
-        k % kPerLink == 0 ? std::max(o.mass_prior_fraction * nominal(k), 1e-3) : o.com_prior_m;
+        k % kPerLink == 0 ? std::max(o.mass_prior_fraction * nominal(k), 1e-3) : com_sigma_m;
     precision(k) = 1.0 / (sigma * sigma);
   }
   return precision;
@@ -307,9 +347,9 @@ MassRefinement refine_mass_parameters(const ident::JointErrorLog& log,
   if (rows.size() < std::size_t(10 * kParameters))
     throw std::invalid_argument("refine_mass_parameters: the record is too short");
   const Parameters p0 = parameters_of(nominal.robot);
-  const Parameters precision = prior_precision(p0, options);
+  const Parameters precision = prior_precision(nominal.robot, p0, options);
   const Torques tau0 = torques_of(nominal, record);
-  const std::vector<Torques> jac0 = torque_jacobian(nominal, p0, record, tau0);
+  const std::vector<Torques> jac0 = torque_jacobian(nominal, p0, record, tau0, options);
   MassRefinement out;
   const HeldOutTest test = held_out_test(record, tau0, jac0, rows, precision, p0, options);
   const std::array<bool, calib::kJointCount> accepted = accepted_links(test, options);
@@ -327,7 +367,7 @@ MassRefinement refine_mass_parameters(const ident::JointErrorLog& log,
     if (out.iterations >= std::max(options.iterations, 1)) break;
     const Torques tau = torques_of(with_parameters(nominal, p), record);
     step = prior_step(
-        information(record, tau, torque_jacobian(nominal, p, record, tau), rows, options),
+        information(record, tau, torque_jacobian(nominal, p, record, tau, options), rows, options),
         precision, p0, p, accepted);
   }
   out.model = with_parameters(nominal, p);

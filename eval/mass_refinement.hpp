@@ -58,6 +58,15 @@ struct MassRefinementOptions {
   // Rows per block of the folds (2 s at 8 ms): longer than the residual's correlation time, so
   // the folds' residuals are nearly independent.
   int held_out_block_rows = 250;
+  // Gravity only: the links' first moments m c (masses fixed, centres of mass free), each
+  // joint's columns the static gravity torque's derivatives ∂τ_g,j/∂c (no speeds, no
+  // accelerations: gravity dominates the deflection and is linear in c). A link's mass acts on
+  // gravity as first moments of the links before it (standard DH: a mass at o_i is one at
+  // o_{i-1} plus first moments along d_i and a_i), so these columns span the gravity's base
+  // parameters; the prior is widened to the first moment that the masses' prior moves
+  // (gravity_prior_m). Each joint's torque coefficients turn the columns into its deflection
+  // per parameter, c_jk = π_k / K_j.
+  bool gravity_first_moments = false;
 };
 
 // A link's estimate from all rows with its 1σ (its mass and centre of mass), whether the model

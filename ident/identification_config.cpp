@@ -199,7 +199,8 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
          "direction_speed_scale_deg_s", "torque_sign", "torque_sign_scale_fraction", "input_taps",
          "input_history_s", "torque_sign_taps", "torque_sign_history_s", "transmission_error",
          "transmission_error_harmonic_per_motor_rev", "transmission_error_taps",
-         "transmission_error_history_s", "transmission_error_gear_mode", "refine_mass_parameters"});
+         "transmission_error_history_s", "transmission_error_gear_mode", "refine_mass_parameters",
+         "refine_gravity"});
     ConfigDurations& d = c.durations;
     d.preview_s = duration_instead_of_count(*model, "model", "preview_s", "preview_cycles", c);
     d.input_history_s =
@@ -238,6 +239,11 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
     c.refine_mass_parameters = model->get_bool("refine_mass_parameters", false);
     if (c.refine_mass_parameters && !o.model_torque_input)
       model->child("refine_mass_parameters").fail("refines the model torque: needs model_torque");
+    c.refine_gravity = model->get_bool("refine_gravity", false);
+    if (c.refine_gravity && !o.model_torque_input)
+      model->child("refine_gravity").fail("refines the model torque: needs model_torque");
+    if (c.refine_gravity && c.refine_mass_parameters)
+      model->child("refine_gravity").fail("refine_mass_parameters refines the gravity already");
     o.input_taps = int(model->get_int("input_taps", o.input_taps));
     if (o.input_taps < 1 || o.input_taps > 64)
       model->child("input_taps").fail("must be in 1..64 coefficients per further input");
