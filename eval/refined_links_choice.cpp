@@ -62,6 +62,17 @@ ModelTorqueSource refined_and_chosen_model(const ident::JointErrorLog& log,
                                            const std::string& who) {
   MassRefinementOptions options;
   options.gravity_first_moments = config.refine_gravity;
+  if (config.refine_gravity) {  // the drive model takes the identification's further inputs
+    options.further_inputs = ident::extra_inputs_of(config.options);
+    options.torque_sign_scale_fraction = config.options.torque_sign_scale_fraction;
+    // Rests and slow moves only, where the deflection is the static one: one tap of each input.
+    options.gravity_max_speed_rad_s = 0.05;
+    options.input_taps = 1;
+    options.further_input_taps = 1;
+    options.payload_centre_free = true;
+    for (std::size_t j = 0; j < options.further_parameters.size(); ++j)
+      options.further_parameters[j] = ident::exogenous_parameters(config.joint_options(j), 0.0);
+  }
   spdlog::info("{}: refining the model torque's {} from the record", who,
                config.refine_gravity ? "gravity (the links' first moments)" : "link masses");
   const MassRefinement refinement = refine_mass_parameters(log, nominal, options);
