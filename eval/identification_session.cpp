@@ -44,11 +44,14 @@ std::vector<ident::LinkMassParameters> attach_session_model_torques(
   check_joint_error_limits(log, options.joint_errors, model.robot);
   nominal = model;
   std::vector<ident::LinkMassParameters> links;
-  if (config.refine_mass_parameters) {
+  if (config.refine_mass_parameters || config.refine_gravity) {
     try {
       model = refined_and_chosen_model(log, config, model, links, "identify");
     } catch (const std::invalid_argument& e) {
-      throw InputError(options.joint_errors, 0, "model.refine_mass_parameters", e.what());
+      throw InputError(
+          options.joint_errors, 0,
+          config.refine_gravity ? "model.refine_gravity" : "model.refine_mass_parameters",
+          e.what());
     }
   }
   spdlog::info("identify: model torques of {} along the {} path", model.robot.name,

@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "sim/rigid_body_dynamics.hpp"
+
 namespace imscal::eval {
 namespace {
 
@@ -43,6 +45,8 @@ struct DecimatedRecord {
   std::vector<calib::JointVector> q, qd, qdd, error;
   std::vector<double> payload_kg;
   std::vector<std::pair<std::size_t, std::size_t>> runs;
+  // With payload_centre_free: payload_centre_columns (else empty).
+  std::array<Torques, 3> payload_centre;
 };
 
 DecimatedRecord decimated(const ident::JointErrorLog& log, int decimation) {
@@ -78,13 +82,31 @@ Torques torques_of(const ModelTorqueSource& model, const DecimatedRecord& r) {
   return out;
 }
 
+// The record at rest in its poses (speeds and accelerations 0): its torques are gravity's.
+DecimatedRecord at_rest(DecimatedRecord r) {
+  for (auto* signal : {&r.qd, &r.qdd})
+    for (calib::JointVector& v : *signal) v.setZero();
+  return r;
+}
+
 // ∂τ/∂π_p [row] for every parameter: the torque is linear in a link's mass (its centre of
 // mass and inertia fixed), so the mass's difference quotient is exact; 1 mm for the centre of
-// mass (the parallel-axis term is quadratic in it).
+// mass (the parallel-axis term is quadratic in it). Gravity only (gravity_first_moments): the
+// static torque's derivatives by the centres of mass, exact (gravity is linear in them), and
+// zero columns for the masses, which then keep their nominal values.
 std::vector<Torques> torque_jacobian(const ModelTorqueSource& nominal, const Parameters& p,
-                                     const DecimatedRecord& r, const Torques& at_p) {
+                                     const DecimatedRecord& moving, const Torques& at_p_moving,
+                                     const MassRefinementOptions& o) {
+  const DecimatedRecord rest = o.gravity_first_moments ? at_rest(moving) : DecimatedRecord{};
+  const DecimatedRecord& r = o.gravity_first_moments ? rest : moving;
+  const Torques at_p =
+      o.gravity_first_moments ? torques_of(with_parameters(nominal, p), r) : at_p_moving;
   std::vector<Torques> out;
   for (int k = 0; k < kParameters; ++k) {
+    if (o.gravity_first_moments && k % kPerLink == 0) {
+      out.emplace_back(r.q.size(), calib::JointVector::Zero());
+      continue;
+    }
     const double step = k % kPerLink == 0 ? std::max(0.01 * p(k), 0.01) : 1e-3;
     Parameters moved = p;
     moved(k) += step;
@@ -97,10 +119,18 @@ std::vector<Torques> torque_jacobian(const ModelTorqueSource& nominal, const Par
 
 // The rows the ARX models use: those with their whole history inside their run.
 std::vector<std::size_t> model_rows(const DecimatedRecord& r, const MassRefinementOptions& o) {
-  const std::size_t history = std::size_t(std::max(o.error_lags, o.input_taps - 1));
+  const std::size_t history =
+      std::size_t(std::max({o.error_lags, o.input_taps - 1, o.further_input_taps - 1}));
   std::vector<std::size_t> rows;
+  const double slow = o.gravity_first_moments ? o.gravity_max_speed_rad_s : 0.0;
+  const auto is_slow = [&](std::size_t i) {
+    for (std::size_t l = 0; l <= history; ++l)
+      if (r.qd[i - l].cwiseAbs().maxCoeff() >= slow) return false;
+    return true;
+  };
   for (const auto& [begin, end] : r.runs)
-    for (std::size_t i = begin + history; i < end; ++i) rows.push_back(i);
+    for (std::size_t i = begin + history; i < end; ++i)
+      if (!(slow > 0.0) || is_slow(i)) rows.push_back(i);
   return rows;
 }
 
@@ -128,10 +158,92 @@ double correlation_time(const Eigen::VectorXd& r) {
   return sum;
 }
 
+// The static gravity torque's derivative by the payload's centre of mass along T's axes
+// [N m / m], [axis][row] (zero on rows without payload); exact, gravity is linear in it.
+std::array<Torques, 3> payload_centre_columns(const ModelTorqueSource& model,
+                                              const DecimatedRecord& r) {
+  sim::RigidBodyDynamics dynamics(model.robot, std::nullopt, model.gravity_in_base_m_s2);
+  std::array<Torques, 3> out;
+  for (auto& column : out) column.assign(r.q.size(), calib::JointVector::Zero());
+  constexpr double kStepM = 0.01;
+  for (std::size_t i = 0; i < r.q.size(); ++i) {
+    if (!(r.payload_kg[i] > 0.0)) continue;
+    calib::RigidBodyParameters payload;
+    payload.mass_kg = r.payload_kg[i];
+    dynamics.set_payload(payload);
+    const calib::JointVector at_origin = dynamics.gravity_torque(r.q[i]);
+    for (int a = 0; a < 3; ++a) {
+      payload.com_m = kStepM * Eigen::Vector3d::Unit(a);
+      dynamics.set_payload(payload);
+      out[std::size_t(a)][i] = (dynamics.gravity_torque(r.q[i]) - at_origin) / kStepM;
+    }
+  }
+  return out;
+}
+
+// The distinct payload masses of the rows (at most a few per program), positive ones only.
+std::vector<double> payload_masses(const DecimatedRecord& r, const std::vector<std::size_t>& rows) {
+  std::vector<double> masses;
+  for (const std::size_t i : rows)
+    if (r.payload_kg[i] > 0.0 && std::ranges::find(masses, r.payload_kg[i]) == masses.end())
+      masses.push_back(r.payload_kg[i]);
+  return masses;
+}
+
+// The taps the drive model gives a further input (0: not taken; the torque and the direction
+// have their own columns).
+int further_taps(ident::TableInput input, const MassRefinementOptions& o) {
+  switch (input) {
+    case ident::TableInput::kModelTorque:
+    case ident::TableInput::kDirection:
+      return 0;
+    case ident::TableInput::kTorqueSign:
+      return 1;
+    default:
+      return o.further_input_taps;
+  }
+}
+
+// The further inputs' columns of joint j from column `first` on: each input's value at the
+// row's sample and its earlier ones (the plain pairs, no gear mode).
+void fill_further_columns(int j, const DecimatedRecord& r, const Torques& tau,
+                          const std::vector<std::size_t>& rows, const MassRefinementOptions& o,
+                          Eigen::MatrixXd& x, int first) {
+  ident::ExogenousParameters p = o.further_parameters[std::size_t(j)];
+  p.transmission_error_mode_rad_s = 0.0;
+  int column = first;
+  for (const ident::TableInput input : o.further_inputs) {
+    const int taps = further_taps(input, o);
+    for (int l = 0; l < taps; ++l, ++column)
+      for (std::size_t n = 0; n < rows.size(); ++n) {
+        const std::size_t i = rows[n] - std::size_t(l);
+        x(Eigen::Index(n), column) =
+            ident::exogenous_value(input, p, {r.q[i](j), r.qd[i](j), tau[i](j)});
+      }
+  }
+}
+
+// Joint j's payload-centre columns from column `first` on: three per payload mass of the rows.
+void fill_payload_centre_columns(int j, const DecimatedRecord& r,
+                                 const std::vector<std::size_t>& rows,
+                                 const std::vector<double>& masses, Eigen::MatrixXd& x, int first) {
+  for (std::size_t m = 0; m < masses.size(); ++m)
+    for (std::size_t a = 0; a < 3; ++a)
+      for (std::size_t n = 0; n < rows.size(); ++n) {
+        const std::size_t i = rows[n];
+        x(Eigen::Index(n), Eigen::Index(first + 3 * m + a)) =
+            r.payload_kg[i] == masses[m] ? r.payload_centre[a][i](j) : 0.0;
+      }
+}
+
 JointFit fit_joint(int j, const DecimatedRecord& r, const Torques& tau,
                    const std::vector<std::size_t>& rows, const MassRefinementOptions& o) {
   const int na = o.error_lags, nb = o.input_taps;
-  const int columns = na + 2 * nb + 2;
+  int further = 0;
+  for (const ident::TableInput input : o.further_inputs) further += further_taps(input, o);
+  const std::vector<double> masses =
+      r.payload_centre[0].empty() ? std::vector<double>{} : payload_masses(r, rows);
+  const int columns = na + 2 * nb + 2 + further + 3 * int(masses.size());
   Eigen::MatrixXd x(Eigen::Index(rows.size()), columns);
   Eigen::VectorXd y(Eigen::Index(rows.size()));
   for (std::size_t n = 0; n < rows.size(); ++n) {
@@ -146,6 +258,8 @@ JointFit fit_joint(int j, const DecimatedRecord& r, const Torques& tau,
     x(row, na + 2 * nb) = std::tanh(r.qd[i](j) / o.direction_speed_scale_rad_s);
     x(row, na + 2 * nb + 1) = 1.0;
   }
+  fill_further_columns(j, r, tau, rows, o, x, na + 2 * nb + 2);
+  fill_payload_centre_columns(j, r, rows, masses, x, na + 2 * nb + 2 + further);
   // Columns scaled to unit RMS: torques [N m] and errors [rad] differ by ~1e8.
   const Eigen::VectorXd scale =
       (x.colwise().norm().array() / std::sqrt(double(rows.size()))).max(1e-300).matrix();
@@ -175,11 +289,33 @@ Eigen::MatrixXd projected_columns(int j, const JointFit& fit, const std::vector<
   return z - fit.basis * (fit.basis.transpose() * z);
 }
 
-Parameters prior_precision(const Parameters& nominal, const MassRefinementOptions& o) {
+// Gravity only: the 1σ of link i's centre of mass [m] that covers its first moment's prior,
+// its own centre of mass and mass, and the masses beyond it acting as its first moment over the
+// DH offsets of its two joints (mass_prior_fraction of each).
+double gravity_com_prior_m(const calib::RobotDescription& robot, int i,
+                           const MassRefinementOptions& o) {
+  const auto& joints = robot.joints;
+  const double mass_kg = std::max(joints[std::size_t(i)].link.mass_kg, 1e-3);
+  double beyond_kg = 0.0;
+  for (std::size_t l = std::size_t(i) + 1; l < joints.size(); ++l)
+    beyond_kg += joints[l].link.mass_kg;
+  double lever_m = 0.0;
+  for (std::size_t l = std::size_t(i); l <= std::size_t(i) + 1 && l < robot.kinematics.dh.size();
+       ++l)
+    lever_m += std::abs(robot.kinematics.dh[l].a_m) + std::abs(robot.kinematics.dh[l].d_m);
+  const double own_m = joints[std::size_t(i)].link.com_m.norm();
+  return o.com_prior_m + o.mass_prior_fraction * (own_m + beyond_kg / mass_kg * lever_m);
+}
+
+Parameters prior_precision(const calib::RobotDescription& robot, const Parameters& nominal,
+                           const MassRefinementOptions& o) {
   Parameters precision;
   for (int k = 0; k < kParameters; ++k) {
+    const int link = k / kPerLink;
+    const double com_sigma_m =
+        o.gravity_first_moments ? gravity_com_prior_m(robot, link, o) : o.com_prior_m;
     const double sigma =
-        k % kPerLink == 0 ? std::max(o.mass_prior_fraction * nominal(k), 1e-3) : o.com_prior_m;
+        k % kPerLink == 0 ? std::max(o.mass_prior_fraction * nominal(k), 1e-3) : com_sigma_m;
     precision(k) = 1.0 / (sigma * sigma);
   }
   return precision;
@@ -295,21 +431,36 @@ std::array<bool, calib::kJointCount> accepted_links(const HeldOutTest& test,
   return out;
 }
 
+// The torque-sign scale of each joint: the options' fraction of its RMS model torque.
+MassRefinementOptions with_torque_sign_scales(MassRefinementOptions o, const Torques& tau) {
+  for (int j = 0; j < calib::kJointCount; ++j) {
+    double sum = 0.0;
+    for (const calib::JointVector& t : tau) sum += t(j) * t(j);
+    const double rms = std::sqrt(sum / double(std::max<std::size_t>(tau.size(), 1)));
+    o.further_parameters[std::size_t(j)].torque_sign_scale_nm =
+        std::max(o.torque_sign_scale_fraction * rms, 1e-9);
+  }
+  return o;
+}
+
 }  // namespace
 
 MassRefinement refine_mass_parameters(const ident::JointErrorLog& log,
                                       const ModelTorqueSource& nominal,
-                                      const MassRefinementOptions& options) {
+                                      const MassRefinementOptions& given) {
   if (log.joint_count() != std::size_t(calib::kJointCount))
     throw std::invalid_argument("refine_mass_parameters: the record needs the robot's 6 joints");
-  const DecimatedRecord record = decimated(log, std::max(options.decimation, 1));
-  const std::vector<std::size_t> rows = model_rows(record, options);
+  DecimatedRecord record = decimated(log, std::max(given.decimation, 1));
+  if (given.gravity_first_moments && given.payload_centre_free)
+    record.payload_centre = payload_centre_columns(nominal, record);
+  const std::vector<std::size_t> rows = model_rows(record, given);
   if (rows.size() < std::size_t(10 * kParameters))
     throw std::invalid_argument("refine_mass_parameters: the record is too short");
   const Parameters p0 = parameters_of(nominal.robot);
-  const Parameters precision = prior_precision(p0, options);
+  const Parameters precision = prior_precision(nominal.robot, p0, given);
   const Torques tau0 = torques_of(nominal, record);
-  const std::vector<Torques> jac0 = torque_jacobian(nominal, p0, record, tau0);
+  const MassRefinementOptions options = with_torque_sign_scales(given, tau0);
+  const std::vector<Torques> jac0 = torque_jacobian(nominal, p0, record, tau0, options);
   MassRefinement out;
   const HeldOutTest test = held_out_test(record, tau0, jac0, rows, precision, p0, options);
   const std::array<bool, calib::kJointCount> accepted = accepted_links(test, options);
@@ -327,7 +478,7 @@ MassRefinement refine_mass_parameters(const ident::JointErrorLog& log,
     if (out.iterations >= std::max(options.iterations, 1)) break;
     const Torques tau = torques_of(with_parameters(nominal, p), record);
     step = prior_step(
-        information(record, tau, torque_jacobian(nominal, p, record, tau), rows, options),
+        information(record, tau, torque_jacobian(nominal, p, record, tau, options), rows, options),
         precision, p0, p, accepted);
   }
   out.model = with_parameters(nominal, p);

@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "eval/model_torque.hpp"
+#include "ident/exogenous_inputs.hpp"
 #include "ident/joint_error_io.hpp"
 
 namespace imscal::eval {
@@ -58,6 +59,32 @@ struct MassRefinementOptions {
   // Rows per block of the folds (2 s at 8 ms): longer than the residual's correlation time, so
   // the folds' residuals are nearly independent.
   int held_out_block_rows = 250;
+  // Gravity only: the links' first moments m c (masses fixed, centres of mass free), each
+  // joint's columns the static gravity torque's derivatives ∂τ_g,j/∂c (no speeds, no
+  // accelerations: gravity dominates the deflection and is linear in c). A link's mass acts on
+  // gravity as first moments of the links before it (standard DH: a mass at o_i is one at
+  // o_{i-1} plus first moments along d_i and a_i), so these columns span the gravity's base
+  // parameters; the prior is widened to the first moment that the masses' prior moves
+  // (gravity_prior_m). Each joint's torque coefficients turn the columns into its deflection
+  // per parameter, c_jk = π_k / K_j.
+  bool gravity_first_moments = false;
+  // Gravity only: the rows where every joint's desired speed stays below this [rad/s] over the
+  // drive model's history (rests and slow moves: the gravity's deflection without the gear's
+  // and the loop's dynamics, which the drive model does not hold; decision 0063); 0: all rows.
+  double gravity_max_speed_rad_s = 0.0;
+  // Gravity only: each logged payload mass's centre of mass in T (the log has the mass only)
+  // free in every joint's drive model, three columns per mass on the rows carrying it, so that a
+  // payload off T's origin is not read as the links' first moments.
+  bool payload_centre_free = false;
+  // The identification's further inputs beside the torque and the direction (empty: none), of
+  // each joint with its constants (the torque-sign scale is set here, torque_sign_scale_fraction
+  // of the joint's RMS model torque): the drive model takes them too, further_input_taps taps of
+  // the transmission-error pairs and one of the torque sign, so that what the joint error carries
+  // beside the torque (the gear's error, its flank under load) is not read as gravity.
+  std::vector<ident::TableInput> further_inputs;
+  std::array<ident::ExogenousParameters, calib::kJointCount> further_parameters{};
+  double torque_sign_scale_fraction = 0.01;
+  int further_input_taps = 16;
 };
 
 // A link's estimate from all rows with its 1σ (its mass and centre of mass), whether the model

@@ -34,7 +34,8 @@ RefinedLinksChoice choose_refined_links(const ident::JointErrorLog& log,
                                         const std::vector<ident::LinkMassParameters>& links) {
   RefinedLinksChoice choice;
   int parameters = 0;
-  for (const ident::LinkMassParameters& l : links) parameters += l.refined ? 4 : 0;
+  const int per_link = config.refine_gravity ? 3 : 4;  // gravity: the centre of mass only
+  for (const ident::LinkMassParameters& l : links) parameters += l.refined ? per_link : 0;
   if (parameters == 0 || !config.options.model_torque_input) return choice;
   const std::vector<ident::TableFit> before = table_fits(log, config, nominal);
   const std::vector<ident::TableFit> after = table_fits(log, config, refined);
@@ -59,8 +60,22 @@ ModelTorqueSource refined_and_chosen_model(const ident::JointErrorLog& log,
                                            const ModelTorqueSource& nominal,
                                            std::vector<ident::LinkMassParameters>& links,
                                            const std::string& who) {
-  spdlog::info("{}: refining the model torque's link masses from the record", who);
-  const MassRefinement refinement = refine_mass_parameters(log, nominal);
+  MassRefinementOptions options;
+  options.gravity_first_moments = config.refine_gravity;
+  if (config.refine_gravity) {  // the drive model takes the identification's further inputs
+    options.further_inputs = ident::extra_inputs_of(config.options);
+    options.torque_sign_scale_fraction = config.options.torque_sign_scale_fraction;
+    // Rests and slow moves only, where the deflection is the static one: one tap of each input.
+    options.gravity_max_speed_rad_s = 0.05;
+    options.input_taps = 1;
+    options.further_input_taps = 1;
+    options.payload_centre_free = true;
+    for (std::size_t j = 0; j < options.further_parameters.size(); ++j)
+      options.further_parameters[j] = ident::exogenous_parameters(config.joint_options(j), 0.0);
+  }
+  spdlog::info("{}: refining the model torque's {} from the record", who,
+               config.refine_gravity ? "gravity (the links' first moments)" : "link masses");
+  const MassRefinement refinement = refine_mass_parameters(log, nominal, options);
   links = table_links(refinement);
   for (std::size_t i = 0; i < links.size(); ++i)
     spdlog::info("{}: link {}: {}", who, i + 1, describe_link(links[i]));

@@ -6,10 +6,10 @@
 // information criterion on those rows prefers it:
 //   BIC change = Σ_j n_j ln(RSS_j,refined / RSS_j,nominal) + k ln n < 0,
 // n_j the joint's held-out rows, RSS_j = spread_j (1 − fit_j / 100)² (the same spread for both),
-// k = 4 parameters per refined link, n the rows of one joint. The refinement's own drive model
-// (a FIR of the error) is an approximation, and its held-out score also passes where the
-// nominal model is the plant's (measured: decision 0054); the tables' held-out fit judges the
-// torque by what uses it.
+// k = 4 parameters per refined link (3, its centre of mass, with the gravity only), n the rows of
+// one joint. The refinement's own drive model (a FIR of the error) is an approximation, and its
+// held-out score also passes where the nominal model is the plant's (measured: decision 0054); the
+// tables' held-out fit judges the torque by what uses it.
 //
 // References (docs/references.md): [Schwarz1978] (BIC), [Ljung1999] (validation on held-out data).
 #include <string>

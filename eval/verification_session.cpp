@@ -150,7 +150,7 @@ std::vector<NamedTable> prepare_tables(const VerificationSessionOptions& options
   }
   std::vector<ident::LinkMassParameters> links;
   const ModelTorqueSource refined =
-      config && config->refine_mass_parameters
+      config && (config->refine_mass_parameters || config->refine_gravity)
           ? refined_and_chosen_model(*source.log, *config, torque_model, links, "verify")
           : torque_model;
   return session_tables(options, source, config, refined, links, folders);

@@ -237,7 +237,8 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
                               "transmission_error_gear_mode_pairs",
                               "transmission_error_gear_mode_taps",
                               "transmission_error_gear_mode_history_s",
-                              "refine_mass_parameters"});
+                              "refine_mass_parameters",
+                              "refine_gravity"});
     ConfigDurations& d = c.durations;
     d.preview_s = duration_instead_of_count(*model, "model", "preview_s", "preview_cycles", c);
     d.input_history_s =
@@ -279,6 +280,11 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
     c.refine_mass_parameters = model->get_bool("refine_mass_parameters", false);
     if (c.refine_mass_parameters && !o.model_torque_input)
       model->child("refine_mass_parameters").fail("refines the model torque: needs model_torque");
+    c.refine_gravity = model->get_bool("refine_gravity", false);
+    if (c.refine_gravity && !o.model_torque_input)
+      model->child("refine_gravity").fail("refines the model torque: needs model_torque");
+    if (c.refine_gravity && c.refine_mass_parameters)
+      model->child("refine_gravity").fail("refine_mass_parameters refines the gravity already");
     o.input_taps = int(model->get_int("input_taps", o.input_taps));
     if (o.input_taps < 1 || o.input_taps > 64)
       model->child("input_taps").fail("must be in 1..64 coefficients per further input");

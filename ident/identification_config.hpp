@@ -79,6 +79,10 @@ struct IdentificationConfig {
   // `model.refine_mass_parameters:` the model torque's link masses and centres of mass refined
   // from the record before the tables are identified (eval/mass_refinement.hpp).
   bool refine_mass_parameters = false;
+  // `model.refine_gravity:` the same refinement with the gravity's columns only: the links'
+  // first moments from the static gravity torque's derivatives, the masses nominal
+  // (eval::MassRefinementOptions::gravity_first_moments). Not with refine_mass_parameters.
+  bool refine_gravity = false;
 
   // Speed × payload (× extra dimensions) of one joint, in SI. Throws std::invalid_argument for
   // a joint without a maximum speed.
