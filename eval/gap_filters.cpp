@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 namespace imscal::eval {
 
@@ -101,28 +100,10 @@ std::vector<Column> laguerre(const Column& u, double tau_s, int order, const Gap
   return out;
 }
 
-LaguerreBank::LaguerreBank(const Column& u, const std::vector<std::pair<double, int>>& scales,
-                           const GapSignals& s) {
-  std::vector<std::pair<double, int>> highest;  // (time scale, highest order), first asked first
-  for (const auto& [tau_s, order] : scales) {
-    const auto same = [tau_s = tau_s](const auto& h) { return h.first == tau_s; };
-    const auto it = std::find_if(highest.begin(), highest.end(), same);
-    if (it == highest.end())
-      highest.emplace_back(tau_s, order);
-    else
-      it->second = std::max(it->second, order);
-  }
-  for (const auto& [tau_s, order] : highest) {
-    Eigen::MatrixXd m(u.size(), order);
-    laguerre_filters(u, tau_s, order, s, [&](int i, Eigen::Index k) -> double& { return m(k, i); });
-    filters_.emplace_back(tau_s, std::move(m));
-  }
-}
-
-Eigen::Ref<const Eigen::MatrixXd> LaguerreBank::first(double tau_s, int order) const {
-  for (const auto& [scale_s, filters] : filters_)
-    if (scale_s == tau_s && order <= filters.cols()) return filters.leftCols(order);
-  throw std::logic_error("LaguerreBank: a time scale or order not filtered");
+void laguerre_into(const Column& u, double tau_s, const GapSignals& s,
+                   Eigen::Ref<Eigen::MatrixXd> out) {
+  laguerre_filters(u, tau_s, int(out.cols()), s,
+                   [&](int i, Eigen::Index k) -> double& { return out(k, i); });
 }
 
 Column relay(const Column& z, double h, const GapSignals& s) {

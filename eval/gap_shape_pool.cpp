@@ -1,0 +1,106 @@
+#include "eval/gap_shape_pool.hpp"
+
+#include <optional>
+
+#include "eval/gap_normal_equations.hpp"
+
+namespace imscal::eval {
+namespace {
+
+Eigen::Index width_of(const PooledShape& shape) {
+  return Eigen::Index(shape.parameter_names.size());
+}
+
+// The pool columns of `shape` on `joint` (empty where it does not act).
+const std::vector<Eigen::Index>& columns_on(const PooledShape& shape, std::size_t joint) {
+  static const std::vector<Eigen::Index> none;
+  return joint < shape.pool_columns.size() ? shape.pool_columns[joint] : none;
+}
+
+// The shape's augmented Gram matrix on one fold (lower triangle) from the pool's full ones
+// ([joint], empty where the pool has no columns).
+Eigen::MatrixXd shape_gram(const PooledShape& shape, const std::vector<Eigen::MatrixXd>& pool) {
+  const Eigen::Index p = width_of(shape);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(p + 1, p + 1);
+  for (std::size_t j = 0; j < pool.size(); ++j) {
+    const std::vector<Eigen::Index>& cols = columns_on(shape, j);
+    if (cols.empty()) continue;
+    const Eigen::MatrixXd& g = pool[j];
+    const Eigen::Index y = g.rows() - 1, first = shape.first_parameter[j];
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      const Eigen::Index row = first + Eigen::Index(c);
+      for (std::size_t d = 0; d <= c; ++d) a(row, first + Eigen::Index(d)) += g(cols[c], cols[d]);
+      a(p, row) += g(y, cols[c]);
+    }
+    a(p, p) += g(y, y);
+  }
+  return a;
+}
+
+// The validation error from the shape's fold Gram matrices; nullopt when a fold's fit is
+// ill-conditioned (eval/gap_validation.cpp then takes the QR on the columns).
+std::optional<double> gram_validation_sse(const std::vector<Eigen::MatrixXd>& folds) {
+  double sse = 0.0;
+  for (std::size_t i = 0; i < folds.size(); ++i) {
+    Eigen::MatrixXd fit = Eigen::MatrixXd::Zero(folds[i].rows(), folds[i].cols());
+    for (std::size_t j = 0; j < folds.size(); ++j)
+      if (j != i) fit += folds[j];
+    const std::optional<GramSolution> solution = solve_normal_equations(fit);
+    if (!solution) return std::nullopt;
+    sse += sse_of_gram(folds[i], solution->theta);
+  }
+  return sse;
+}
+
+}  // namespace
+
+CandidateShape shape_from_pool(const ShapePool& pool, std::size_t index) {
+  const PooledShape& shape = pool.shapes[index];
+  const Eigen::Index p = width_of(shape);
+  CandidateShape out;
+  out.label = shape.label;
+  out.parameter_names = shape.parameter_names;
+  out.columns.assign(pool.columns.size(), Eigen::MatrixXd());
+  for (std::size_t j = 0; j < pool.columns.size(); ++j) {
+    const std::vector<Eigen::Index>& cols = columns_on(shape, j);
+    if (cols.empty()) continue;
+    const Eigen::MatrixXd& from = pool.columns[j];
+    // Zero where the shape's other joints' parameters are.
+    Eigen::MatrixXd m = Eigen::Index(cols.size()) == p ? Eigen::MatrixXd(from.rows(), p)
+                                                       : Eigen::MatrixXd::Zero(from.rows(), p);
+    for (std::size_t c = 0; c < cols.size(); ++c)
+      m.col(shape.first_parameter[j] + Eigen::Index(c)) = from.col(cols[c]);
+    out.columns[j] = std::move(m);
+  }
+  return out;
+}
+
+std::vector<CandidateShape> shapes_from_pool(const ShapePool& pool) {
+  std::vector<CandidateShape> out;
+  for (std::size_t i = 0; i < pool.shapes.size(); ++i) out.push_back(shape_from_pool(pool, i));
+  return out;
+}
+
+std::vector<double> pooled_cross_validation_sse(const ShapePool& pool,
+                                                const std::vector<std::vector<double>>& y,
+                                                const TrainingFolds& folds) {
+  // [fold][joint]: the pool's augmented Gram matrix, both triangles.
+  std::vector<std::vector<Eigen::MatrixXd>> grams(folds.folds.size());
+  for (std::size_t f = 0; f < folds.folds.size(); ++f) {
+    grams[f].resize(pool.columns.size());
+    for (std::size_t j = 0; j < pool.columns.size(); ++j)
+      if (pool.columns[j].size() > 0)
+        grams[f][j] =
+            augmented_gram(pool.columns[j], y[j], folds.folds[f]).selfadjointView<Eigen::Lower>();
+  }
+  std::vector<double> out;
+  for (std::size_t i = 0; i < pool.shapes.size(); ++i) {
+    std::vector<Eigen::MatrixXd> shape_folds;
+    for (const auto& fold : grams) shape_folds.push_back(shape_gram(pool.shapes[i], fold));
+    const std::optional<double> sse = gram_validation_sse(shape_folds);
+    out.push_back(sse ? *sse : cross_validation_sse(shape_from_pool(pool, i).columns, y, folds));
+  }
+  return out;
+}
+
+}  // namespace imscal::eval
