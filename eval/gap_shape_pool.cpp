@@ -1,5 +1,6 @@
 #include "eval/gap_shape_pool.hpp"
 
+#include <algorithm>
 #include <optional>
 
 #include "eval/gap_normal_equations.hpp"
@@ -52,15 +53,10 @@ std::optional<double> gram_validation_sse(const std::vector<Eigen::MatrixXd>& fo
   return sse;
 }
 
-}  // namespace
-
-CandidateShape shape_from_pool(const ShapePool& pool, std::size_t index) {
-  const PooledShape& shape = pool.shapes[index];
+// The shape's columns per joint (samples x its parameters where it acts, else empty).
+std::vector<Eigen::MatrixXd> columns_of(const ShapePool& pool, const PooledShape& shape) {
   const Eigen::Index p = width_of(shape);
-  CandidateShape out;
-  out.label = shape.label;
-  out.parameter_names = shape.parameter_names;
-  out.columns.assign(pool.columns.size(), Eigen::MatrixXd());
+  std::vector<Eigen::MatrixXd> out(pool.columns.size());
   for (std::size_t j = 0; j < pool.columns.size(); ++j) {
     const std::vector<Eigen::Index>& cols = columns_on(shape, j);
     if (cols.empty()) continue;
@@ -70,8 +66,61 @@ CandidateShape shape_from_pool(const ShapePool& pool, std::size_t index) {
                                                        : Eigen::MatrixXd::Zero(from.rows(), p);
     for (std::size_t c = 0; c < cols.size(); ++c)
       m.col(shape.first_parameter[j] + Eigen::Index(c)) = from.col(cols[c]);
-    out.columns[j] = std::move(m);
+    out[j] = std::move(m);
   }
+  return out;
+}
+
+// A shape whose joints each have parameters of their own (the payload's) is that many separate
+// least-squares problems: its fold Gram matrices are block-diagonal, so its fits and validation
+// error are the sums of each joint's. Split into one shape per joint, with its own parameters
+// from 0; any other shape as it is. Each part is solved alone: the blocks' scales do not mix in
+// one condition number, and a block that needs the QR takes it on its own joint's rows only.
+std::vector<PooledShape> independent_parts(const PooledShape& shape) {
+  std::vector<PooledShape> parts;
+  std::vector<int> taken(std::size_t(width_of(shape)), 0);  // joints per parameter
+  for (std::size_t j = 0; j < shape.pool_columns.size(); ++j) {
+    const std::vector<Eigen::Index>& cols = shape.pool_columns[j];
+    if (cols.empty()) continue;
+    for (std::size_t c = 0; c < cols.size(); ++c)
+      ++taken[std::size_t(shape.first_parameter[j]) + c];
+    PooledShape part;
+    part.parameter_names.assign(
+        shape.parameter_names.begin() + shape.first_parameter[j],
+        shape.parameter_names.begin() + shape.first_parameter[j] + Eigen::Index(cols.size()));
+    part.pool_columns.assign(shape.pool_columns.size(), {});
+    part.pool_columns[j] = cols;
+    part.first_parameter.assign(shape.pool_columns.size(), 0);
+    parts.push_back(std::move(part));
+  }
+  // Parameters shared between joints: one problem.
+  const bool each_once = std::all_of(taken.begin(), taken.end(), [](int t) { return t == 1; });
+  if (parts.size() < 2 || !each_once) return {shape};
+  return parts;
+}
+
+// The validation error of one shape of the pool (grams: [fold][joint]).
+double shape_validation_sse(const ShapePool& pool, const PooledShape& shape,
+                            const std::vector<std::vector<double>>& y, const TrainingFolds& folds,
+                            const std::vector<std::vector<Eigen::MatrixXd>>& grams) {
+  double sse = 0.0;
+  for (const PooledShape& part : independent_parts(shape)) {
+    std::vector<Eigen::MatrixXd> part_folds;
+    for (const auto& fold : grams) part_folds.push_back(shape_gram(part, fold));
+    const std::optional<double> gram_sse = gram_validation_sse(part_folds);
+    sse += gram_sse ? *gram_sse : cross_validation_sse(columns_of(pool, part), y, folds);
+  }
+  return sse;
+}
+
+}  // namespace
+
+CandidateShape shape_from_pool(const ShapePool& pool, std::size_t index) {
+  const PooledShape& shape = pool.shapes[index];
+  CandidateShape out;
+  out.label = shape.label;
+  out.parameter_names = shape.parameter_names;
+  out.columns = columns_of(pool, shape);
   return out;
 }
 
@@ -94,12 +143,8 @@ std::vector<double> pooled_cross_validation_sse(const ShapePool& pool,
             augmented_gram(pool.columns[j], y[j], folds.folds[f]).selfadjointView<Eigen::Lower>();
   }
   std::vector<double> out;
-  for (std::size_t i = 0; i < pool.shapes.size(); ++i) {
-    std::vector<Eigen::MatrixXd> shape_folds;
-    for (const auto& fold : grams) shape_folds.push_back(shape_gram(pool.shapes[i], fold));
-    const std::optional<double> sse = gram_validation_sse(shape_folds);
-    out.push_back(sse ? *sse : cross_validation_sse(shape_from_pool(pool, i).columns, y, folds));
-  }
+  for (const PooledShape& shape : pool.shapes)
+    out.push_back(shape_validation_sse(pool, shape, y, folds, grams));
   return out;
 }
 
