@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <optional>
+#include <utility>
 
 #include "eval/gap_normal_equations.hpp"
 
@@ -121,7 +122,22 @@ CandidateShape shape_from_pool(const ShapePool& pool, std::size_t index) {
   out.label = shape.label;
   out.parameter_names = shape.parameter_names;
   out.columns = columns_of(pool, shape);
+  if (shape.level_column >= 0)
+    out.level_signal = pool.columns[shape.level_joint].col(shape.level_column);
+  out.level_lower = shape.level_lower;
+  out.constant_on_own_joint = shape.constant_on_own_joint;
   return out;
+}
+
+PooledShape local_pooled_shape(std::size_t joints, std::size_t joint, std::string label,
+                               std::vector<Eigen::Index> cols, std::vector<std::string> names) {
+  PooledShape shape;
+  shape.label = std::move(label);
+  shape.parameter_names = std::move(names);
+  shape.pool_columns.assign(joints, {});
+  shape.pool_columns[joint] = std::move(cols);
+  shape.first_parameter.assign(joints, 0);
+  return shape;
 }
 
 std::vector<CandidateShape> shapes_from_pool(const ShapePool& pool) {

@@ -24,7 +24,17 @@ struct PooledShape {
   // parameters are zero columns there).
   std::vector<std::vector<Eigen::Index>> pool_columns;
   std::vector<Eigen::Index> first_parameter;
+  // CandidateShape::level_signal: pool column `level_column` of joint `level_joint` (-1: none),
+  // with its lower bound; and CandidateShape::constant_on_own_joint.
+  Eigen::Index level_column = -1;
+  std::size_t level_joint = 0;
+  double level_lower = 0.0;
+  bool constant_on_own_joint = false;
 };
+
+// A shape on `joint` only of the pool columns `cols` of that joint (pool of `joints` joints).
+PooledShape local_pooled_shape(std::size_t joints, std::size_t joint, std::string label,
+                               std::vector<Eigen::Index> cols, std::vector<std::string> names);
 
 struct ShapePool {
   std::vector<Eigen::MatrixXd> columns;  // [joint]: samples x pool width, or empty
