@@ -1,6 +1,7 @@
 #include "eval/gap_filters.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace imscal::eval {
@@ -67,26 +68,48 @@ std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta
 
 namespace {
 
+// The Laguerre filters of u over the run [b, e): filter i's value at sample k goes to out(i, k).
+// Stages holds the stages' states: a std::array for the orders used (its elements stay in
+// registers, the cascade's stages overlap), a std::vector for any other.
+template <typename Stages, typename Out>
+void laguerre_run(const Column& u, double a, double g0, std::size_t b, std::size_t e, Stages y,
+                  Out& out) {
+  const int order = int(y.size());
+  const double u0 = u[Eigen::Index(b)];
+  for (auto& yi : y) yi = g0 / (1.0 - a) * u0;
+  Stages x_previous = y;  // each stage's previous input
+  x_previous[0] = u0;
+  for (std::size_t k = b; k < e; ++k) {
+    double x = u[Eigen::Index(k)];
+    for (int i = 0; i < order; ++i) {
+      double& yi = y[std::size_t(i)];
+      const double next = i == 0 ? a * yi + g0 * x : a * yi + x_previous[std::size_t(i)] - a * x;
+      x_previous[std::size_t(i)] = x;
+      yi = next;
+      out(i, Eigen::Index(k)) = next;
+      x = next;
+    }
+  }
+}
+
 // The Laguerre filters of u: filter i's value at sample k goes to out(i, k).
 template <typename Out>
 void laguerre_filters(const Column& u, double tau_s, int order, const GapSignals& s, Out&& out) {
   const double a = std::exp(-s.cycle_s / tau_s), g0 = std::sqrt(1.0 - a * a);
   for (const auto& [b, e] : s.runs) {
     if (e <= b) continue;
-    const double u0 = u[Eigen::Index(b)];
-    std::vector<double> y(std::size_t(order), g0 / (1.0 - a) * u0);
-    std::vector<double> x_previous = y;  // each stage's previous input
-    x_previous[0] = u0;
-    for (std::size_t k = b; k < e; ++k) {
-      double x = u[Eigen::Index(k)];
-      for (int i = 0; i < order; ++i) {
-        double& yi = y[std::size_t(i)];
-        const double next = i == 0 ? a * yi + g0 * x : a * yi + x_previous[std::size_t(i)] - a * x;
-        x_previous[std::size_t(i)] = x;
-        yi = next;
-        out(i, Eigen::Index(k)) = next;
-        x = next;
-      }
+    switch (order) {
+      case 3:
+        laguerre_run(u, a, g0, b, e, std::array<double, 3>{}, out);
+        break;
+      case 4:
+        laguerre_run(u, a, g0, b, e, std::array<double, 4>{}, out);
+        break;
+      case 6:
+        laguerre_run(u, a, g0, b, e, std::array<double, 6>{}, out);
+        break;
+      default:
+        laguerre_run(u, a, g0, b, e, std::vector<double>(std::size_t(order)), out);
     }
   }
 }
