@@ -279,16 +279,16 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
                                           const std::vector<bool>& training) {
   // The shape the 2-fold validation inside the training rows chooses (eval/gap_shape_choice.hpp).
   const TrainingFolds folds = training_folds(s, training);
-  const std::optional<CandidateShape> chosen = chosen_shape(kind, s, joint, training, folds);
+  std::optional<CandidateShape> chosen = chosen_shape(kind, s, joint, training, folds);
   if (!chosen) return std::nullopt;
-  const CandidateShape& sh = *chosen;
+  CandidateShape& sh = *chosen;
   const Eigen::Index n = Eigen::Index(s.sample_count());
   CandidateFit c;
   c.kind = kind;
   c.joint = joint;
   c.shape = sh.label;
   c.parameter_names = sh.parameter_names;
-  c.columns = sh.columns;
+  c.columns = std::move(sh.columns);  // the fit holds them from here on (no copy)
   if (sh.level_signal.size() > 0)
     c.bound = {joint, 0, Eigen::Index(sh.parameter_names.size()), sh.level_signal, sh.level_lower};
   LinearFit f = fit_bounded(c, s, training);

@@ -136,8 +136,8 @@ std::vector<CandidateShape> shapes(const ShapeContext& x) {
 // joint's modelled gap where the shape's first column (the flank) is positive and negative,
 // half their difference (the Laguerre columns' landing transients left aside; samples between
 // the flanks, where a smooth sign is near zero, left out). One flank only: the modelled offset.
-double half_play(const CandidateFit& c, const CandidateShape& sh) {
-  const Eigen::MatrixXd& cols = sh.columns[c.joint];
+double half_play(const CandidateFit& c) {
+  const Eigen::MatrixXd& cols = c.columns[c.joint];  // the shape's first
   std::vector<double> up, down;
   for (Eigen::Index k = 0; k < cols.rows(); ++k) {
     if (std::abs(cols(k, 0)) < 0.5) continue;  // between the flanks (a smooth sign near zero)
@@ -153,7 +153,7 @@ double half_play(const CandidateFit& c, const CandidateShape& sh) {
 }
 
 std::string size_in_words(const CandidateFit& c, const CandidateShape& sh, double) {
-  const double l = half_play(c, sh);
+  const double l = half_play(c);
   if (sh.constant_on_own_joint)
     return fmt::format(
         "a constant offset of {:.3g} rad ({:.2f} arcsec): half the play if all of it is the "

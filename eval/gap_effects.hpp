@@ -91,7 +91,8 @@ struct EffectDefinition {
   // shapes one by one.
   std::vector<ShapePool> (*shape_pools)(const ShapeContext& context) = nullptr;
   // Its size in words from the fit of its chosen shape (`own_rms`: the RMS of its modelled gap on
-  // its own joint). Null: the first parameter with its sigma.
+  // its own joint; the shape's columns are the fit's `columns`, the shape's first, not the
+  // shape's own, which the fit took). Null: the first parameter with its sigma.
   std::string (*size_in_words)(const CandidateFit& fit, const CandidateShape& shape,
                                double own_rms) = nullptr;
   // The measurement that separates it from `other` on the same joint (`joint_name`) where that
