@@ -6,6 +6,7 @@
 
 #include <Eigen/QR>
 #include <cmath>
+#include <cstddef>
 #include <random>
 #include <string>
 #include <vector>
@@ -22,7 +23,8 @@ GapSignals record(std::size_t joints) {
   s.cycle_s = 0.002;
   s.runs = {{0, 1400}, {1400, kSamples}};
   for (std::size_t k = 0; k < kSamples; ++k) s.time_s.push_back(double(k) * s.cycle_s);
-  for (std::size_t j = 0; j < joints; ++j) s.joint_names.push_back("A" + std::to_string(j + 1));
+  const std::vector<std::string> names = {"A1", "A2", "A3"};
+  s.joint_names.assign(names.begin(), names.begin() + std::ptrdiff_t(joints));
   return s;
 }
 
