@@ -21,35 +21,6 @@
 
 namespace imscal::eval {
 
-// The fewest periods a searched order's ripple must complete over the joint's motion.
-constexpr double kMinRipplePeriods = 10.0;
-
-std::vector<double> transmission_orders_by_fit(const GapSignals& s, std::size_t joint,
-                                               const std::vector<double>& gap,
-                                               const std::vector<bool>& use) {
-  const std::size_t n = s.sample_count();
-  const auto [lowest, highest] =
-      std::minmax_element(s.q_internal_rad[joint].begin(), s.q_internal_rad[joint].end());
-  const double motor_range_rad = n > 0 ? s.gear_ratio[joint] * (*highest - *lowest) : 0.0;
-  std::vector<std::pair<double, double>> scored;  // (rms, order)
-  for (int twice = 2; twice <= 16; ++twice) {
-    const double h = 0.5 * twice;
-    // A ripple of fewer periods over the motion is a slow drift to the data, not an order.
-    if (h * motor_range_rad < kMinRipplePeriods * 2.0 * M_PI) continue;
-    Eigen::MatrixXd columns(Eigen::Index(n), 2);
-    for (std::size_t k = 0; k < n; ++k) {
-      const double angle = h * s.gear_ratio[joint] * s.q_internal_rad[joint][k];
-      columns(Eigen::Index(k), 0) = std::sin(angle);
-      columns(Eigen::Index(k), 1) = std::cos(angle);
-    }
-    scored.emplace_back(fit_columns(columns, gap, use).rms, h);
-  }
-  std::sort(scored.begin(), scored.end());
-  std::vector<double> orders;
-  for (const auto& [rms, h] : scored) orders.push_back(h);
-  return orders;
-}
-
 std::vector<CandidateShape> candidate_shapes(EffectKind kind, const GapSignals& s,
                                              std::size_t joint, const std::vector<bool>* training) {
   return effect_definition(kind).shapes(ShapeContext(s, joint, training));
@@ -146,6 +117,24 @@ struct JointRows {
   const std::vector<double>& y;
 };
 
+// The residual y - x theta on the rows `use_rows` of every joint of `joints`, stacked joint after
+// joint.
+Eigen::VectorXd stacked_residual(const std::vector<JointRows>& joints,
+                                 const std::vector<Eigen::Index>& use_rows,
+                                 const Eigen::VectorXd& theta) {
+  const Eigen::Index m = Eigen::Index(use_rows.size());
+  Eigen::VectorXd r(m * Eigen::Index(joints.size()));
+  const auto runs = consecutive_runs(use_rows);
+  for (std::size_t i = 0; i < joints.size(); ++i)
+    for (const auto& [begin, end] : runs) {
+      const Eigen::Index first = use_rows[std::size_t(begin)], length = end - begin;
+      r.segment(Eigen::Index(i) * m + begin, length) =
+          Eigen::Map<const Eigen::VectorXd>(joints[i].y.data() + first, length) -
+          joints[i].x.middleRows(first, length) * theta;
+    }
+  return r;
+}
+
 // The fit of one parameter vector to the rows `use_rows` of every joint of `joints` (stacked joint
 // after joint: row i * samples + k) by the normal equations; nullopt when they are
 // ill-conditioned.
@@ -156,16 +145,7 @@ std::optional<LinearFit> gram_fit(const std::vector<JointRows>& joints,
   for (const JointRows& j : joints) add_augmented_gram(j.x, j.y, use_rows, a);
   const std::optional<GramSolution> solution = solve_normal_equations(a, true);
   if (!solution) return std::nullopt;
-  const Eigen::Index m = Eigen::Index(use_rows.size());
-  Eigen::VectorXd r(m * Eigen::Index(joints.size()));
-  const auto runs = consecutive_runs(use_rows);
-  for (std::size_t i = 0; i < joints.size(); ++i)
-    for (const auto& [begin, end] : runs) {
-      const Eigen::Index first = use_rows[std::size_t(begin)], length = end - begin;
-      r.segment(Eigen::Index(i) * m + begin, length) =
-          Eigen::Map<const Eigen::VectorXd>(joints[i].y.data() + first, length) -
-          joints[i].x.middleRows(first, length) * solution->theta;
-    }
+  const Eigen::VectorXd r = stacked_residual(joints, use_rows, solution->theta);
   return finished_fit(solution->theta, r, stacked_rows(use_rows, joints.size(), n),
                       solution->inverse_scaled_gram, solution->scale);
 }
@@ -177,7 +157,49 @@ std::vector<Eigen::Index> rows_of(const std::vector<bool>& use) {
   return rows;
 }
 
+// fit_columns(columns, y, use).rms, without the parameters' covariance (an order search needs
+// the residual RMS only); `rows`: the rows flagged in `use`.
+double fit_rms(const Eigen::MatrixXd& columns, const std::vector<double>& y,
+               const std::vector<bool>& use, const std::vector<Eigen::Index>& rows) {
+  if (rows.empty()) return fit_columns(columns, y, use).rms;
+  const std::optional<GramSolution> solution =
+      solve_normal_equations(augmented_gram(columns, y, rows));
+  if (!solution) return fit_columns(columns, y, use).rms;
+  const Eigen::VectorXd r = stacked_residual({{columns, y}}, rows, solution->theta);
+  return std::sqrt(r.squaredNorm() / double(r.size()));
+}
+
 }  // namespace
+
+// The fewest periods a searched order's ripple must complete over the joint's motion.
+constexpr double kMinRipplePeriods = 10.0;
+
+std::vector<double> transmission_orders_by_fit(const GapSignals& s, std::size_t joint,
+                                               const std::vector<double>& gap,
+                                               const std::vector<bool>& use) {
+  const std::size_t n = s.sample_count();
+  const auto [lowest, highest] =
+      std::minmax_element(s.q_internal_rad[joint].begin(), s.q_internal_rad[joint].end());
+  const double motor_range_rad = n > 0 ? s.gear_ratio[joint] * (*highest - *lowest) : 0.0;
+  std::vector<std::pair<double, double>> scored;  // (rms, order)
+  const std::vector<Eigen::Index> rows = rows_of(use);
+  for (int twice = 2; twice <= 16; ++twice) {
+    const double h = 0.5 * twice;
+    // A ripple of fewer periods over the motion is a slow drift to the data, not an order.
+    if (h * motor_range_rad < kMinRipplePeriods * 2.0 * M_PI) continue;
+    Eigen::MatrixXd columns(Eigen::Index(n), 2);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double angle = h * s.gear_ratio[joint] * s.q_internal_rad[joint][k];
+      columns(Eigen::Index(k), 0) = std::sin(angle);
+      columns(Eigen::Index(k), 1) = std::cos(angle);
+    }
+    scored.emplace_back(fit_rms(columns, gap, use, rows), h);
+  }
+  std::sort(scored.begin(), scored.end());
+  std::vector<double> orders;
+  for (const auto& [rms, h] : scored) orders.push_back(h);
+  return orders;
+}
 
 LinearFit fit_columns(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                       const std::vector<bool>& use) {
@@ -257,16 +279,16 @@ std::optional<CandidateFit> fit_candidate(EffectKind kind, const GapSignals& s, 
                                           const std::vector<bool>& training) {
   // The shape the 2-fold validation inside the training rows chooses (eval/gap_shape_choice.hpp).
   const TrainingFolds folds = training_folds(s, training);
-  const std::optional<CandidateShape> chosen = chosen_shape(kind, s, joint, training, folds);
+  std::optional<CandidateShape> chosen = chosen_shape(kind, s, joint, training, folds);
   if (!chosen) return std::nullopt;
-  const CandidateShape& sh = *chosen;
+  CandidateShape& sh = *chosen;
   const Eigen::Index n = Eigen::Index(s.sample_count());
   CandidateFit c;
   c.kind = kind;
   c.joint = joint;
   c.shape = sh.label;
   c.parameter_names = sh.parameter_names;
-  c.columns = sh.columns;
+  c.columns = std::move(sh.columns);  // the fit holds them from here on (no copy)
   if (sh.level_signal.size() > 0)
     c.bound = {joint, 0, Eigen::Index(sh.parameter_names.size()), sh.level_signal, sh.level_lower};
   LinearFit f = fit_bounded(c, s, training);

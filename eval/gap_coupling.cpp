@@ -2,9 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <utility>
 
 #include "eval/gap_filters.hpp"
+#include "eval/gap_shape_pool.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -22,25 +24,51 @@ const std::vector<Basis>& bases() {
   return b;
 }
 
-// Every time scale and order the bases take.
-std::vector<std::pair<double, int>> basis_scales() {
-  std::vector<std::pair<double, int>> scales;
-  for (const Basis& basis : bases())
-    scales.insert(scales.end(), basis.laguerres.begin(), basis.laguerres.end());
-  return scales;
-}
+// The pool of one reached joint (eval/gap_shape_pool.hpp): u through each time scale once, at the
+// highest order the bases take of it, and the bases as its column subsets.
+struct BasisPool {
+  ShapePool pool;
+  std::vector<std::string> shapes;  // the bases' labels
+};
 
-// A basis's columns side by side (samples x its parameters).
-Eigen::MatrixXd basis_matrix(const Basis& basis, const LaguerreBank& filtered) {
+BasisPool basis_pool(const Column& u, std::size_t joint, const GapSignals& s) {
+  std::vector<std::pair<double, int>> highest;  // (time scale, highest order), first taken first
+  for (const Basis& basis : bases())
+    for (const auto& [tl, order] : basis.laguerres) {
+      const auto same = [tl = tl](const auto& h) { return h.first == tl; };
+      const auto it = std::find_if(highest.begin(), highest.end(), same);
+      if (it == highest.end())
+        highest.emplace_back(tl, order);
+      else
+        it->second = std::max(it->second, order);
+    }
+  std::vector<Eigen::Index> first;  // of each time scale in the pool
   Eigen::Index width = 0;
-  for (const auto& [tl, order] : basis.laguerres) width += order;
-  Eigen::MatrixXd m(filtered.first(basis.laguerres.front().first, 1).rows(), width);
-  Eigen::Index c = 0;
-  for (const auto& [tl, order] : basis.laguerres) {
-    m.middleCols(c, order) = filtered.first(tl, order);
-    c += order;
+  for (const auto& [tl, order] : highest) first.push_back(width), width += order;
+  BasisPool out;
+  out.pool.columns.assign(s.joint_count(), Eigen::MatrixXd());
+  Eigen::MatrixXd& m = out.pool.columns[joint];
+  m.resize(u.size(), width);
+  for (std::size_t i = 0; i < highest.size(); ++i)
+    laguerre_into(u, highest[i].first, s, m.middleCols(first[i], highest[i].second));
+  for (const Basis& basis : bases()) {
+    PooledShape shape;
+    shape.pool_columns.assign(s.joint_count(), {});
+    shape.first_parameter.assign(s.joint_count(), 0);
+    for (const auto& [tl, order] : basis.laguerres) {
+      const auto same = [tl = tl](const auto& h) { return h.first == tl; };
+      const Eigen::Index f =
+          first[std::size_t(std::find_if(highest.begin(), highest.end(), same) - highest.begin())];
+      for (int o = 0; o < order; ++o) {
+        shape.pool_columns[joint].push_back(f + o);
+        shape.parameter_names.push_back(fmt::format("{}_coupling_laguerre{:.0f}ms_{}_rad_per_nm",
+                                                    s.joint_names[joint], 1000.0 * tl, o));
+      }
+    }
+    out.pool.shapes.push_back(std::move(shape));
+    out.shapes.push_back(basis.label);
   }
-  return m;
+  return out;
 }
 
 }  // namespace
@@ -77,20 +105,14 @@ CouplingColumns coupling_columns(const GapSignals& s,
       for (Eigen::Index k : fold) none += residual[i][std::size_t(k)] * residual[i][std::size_t(k)];
     double best = none * (1.0 - kCouplingMinGain);
     Reach chosen{i, {}, {}, {}};
-    const LaguerreBank filtered(u, basis_scales(), s);
-    for (const Basis& basis : bases()) {
-      std::vector<std::string> names;
-      for (const auto& [tl, order] : basis.laguerres)
-        for (int o = 0; o < order; ++o)
-          names.push_back(fmt::format("{}_coupling_laguerre{:.0f}ms_{}_rad_per_nm",
-                                      s.joint_names[i], 1000.0 * tl, o));
-      const Eigen::MatrixXd m = basis_matrix(basis, filtered);
-      const double sse = cross_validation_sse(m, residual[i], folds);
-      if (sse < best) {
-        best = sse;
-        chosen = {i, m, basis.label, names};
+    const BasisPool pool = basis_pool(u, i, s);
+    const std::vector<double> sse = pooled_cross_validation_sse(pool.pool, residual, folds);
+    for (std::size_t b = 0; b < sse.size(); ++b)
+      if (sse[b] < best) {
+        best = sse[b];
+        CandidateShape shape = shape_from_pool(pool.pool, b);
+        chosen = {i, std::move(shape.columns[i]), pool.shapes[b], std::move(shape.parameter_names)};
       }
-    }
     if (chosen.columns.size() > 0) reached.push_back(std::move(chosen));
   }
   if (reached.empty()) return out;

@@ -10,6 +10,7 @@
 
 #include "eval/gap_effect_shapes.hpp"
 #include "eval/gap_nominal_plant.hpp"
+#include "eval/gap_shape_pool.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -22,29 +23,32 @@ Column unit_torque(const ShapeContext& x, std::size_t j) {
   return to_column(internal ? x.s.unit_payload_internal_nm_kg[j] : x.s.unit_payload_nm_kg[j]);
 }
 
-// A shape of `width` parameters per loaded joint, its columns `columns_of(j)` on joint j.
-template <typename ColumnsOf>
-CandidateShape per_joint(const ShapeContext& x, const std::vector<std::size_t>& loaded,
-                         std::string label, int width, const ColumnsOf& columns_of,
-                         const std::string& stem) {
-  CandidateShape sh;
+// The pool's columns per loaded joint (eval/gap_shape_pool.hpp): u_j, L_30ms,0..3 u_j,
+// L_100ms,0..5 u_j.
+constexpr Eigen::Index kPoolWidth = 11;
+
+// A shape of `width` parameters per loaded joint, pool columns from `first` on: joint i of
+// `loaded` takes parameters [i width, (i + 1) width).
+PooledShape per_joint(const ShapeContext& x, const std::vector<std::size_t>& loaded,
+                      std::string label, int width, Eigen::Index first, const std::string& stem) {
+  PooledShape sh;
   sh.label = std::move(label);
-  sh.columns.assign(x.nj, Eigen::MatrixXd());
-  const Eigen::Index p = Eigen::Index(width * int(loaded.size()));
+  sh.pool_columns.assign(x.nj, {});
+  sh.first_parameter.assign(x.nj, 0);
   for (std::size_t i = 0; i < loaded.size(); ++i) {
     const std::size_t j = loaded[i];
-    Eigen::MatrixXd c = Eigen::MatrixXd::Zero(x.n, p);
-    c.middleCols(Eigen::Index(i) * width, width) = matrix_of(columns_of(j));
-    sh.columns[j] = c;
-    for (int w = 0; w < width; ++w)
+    sh.first_parameter[j] = Eigen::Index(i) * width;
+    for (int w = 0; w < width; ++w) {
+      sh.pool_columns[j].push_back(first + w);
       sh.parameter_names.push_back(
           width == 1 ? fmt::format("dm_over_k_{}_rad_per_kg", x.s.joint_names[j])
                      : fmt::format("{}{}_{}_rad_per_kg", stem, w, x.s.joint_names[j]));
+    }
   }
   return sh;
 }
 
-std::vector<CandidateShape> shapes(const ShapeContext& x) {
+std::vector<ShapePool> shape_pools(const ShapeContext& x) {
   if (x.joint != 0) return {};  // one candidate for all joints, as the IMS chain's errors
   // Every joint the payload loads (d tau / d m above 1e-6 N m/kg), each with its own
   // parameters: the same mass error acts on each through that joint's own compliance and loop.
@@ -52,31 +56,37 @@ std::vector<CandidateShape> shapes(const ShapeContext& x) {
   for (std::size_t j = 0; j < x.nj; ++j)
     if (rms_of(to_column(x.s.unit_payload_nm_kg[j])) > 1e-6) loaded.push_back(j);
   if (loaded.empty()) return {};
-  std::vector<CandidateShape> out;
-  out.push_back(per_joint(
-      x, loaded, "d tau / d m / k on every loaded joint", 1,
-      [&](std::size_t j) { return std::vector<Column>{unit_torque(x, j)}; }, ""));
-  for (const auto& [scale, count] : {std::pair{0.03, 4}, std::pair{0.1, 6}}) {
-    // Plain copies: clang 14 does not let a lambda capture structured bindings.
-    const double tl = scale;
-    const int order = count;
-    const int ms = int(std::lround(1000.0 * tl));
-    out.push_back(per_joint(
-        x, loaded,
-        fmt::format("d tau / d m through Laguerre {} ms x{} on every loaded joint", ms, order),
-        order, [&](std::size_t j) { return laguerre(unit_torque(x, j), tl, order, x.s); },
-        fmt::format("laguerre{}ms_", ms)));
+  ShapePool pool;
+  pool.columns.assign(x.nj, Eigen::MatrixXd());
+  for (std::size_t j : loaded) {
+    const Column u = unit_torque(x, j);
+    Eigen::MatrixXd m(x.n, kPoolWidth);
+    m.col(0) = u;
+    laguerre_into(u, 0.03, x.s, m.middleCols(1, 4));
+    laguerre_into(u, 0.1, x.s, m.middleCols(5, 6));
+    pool.columns[j] = std::move(m);
   }
+  pool.shapes.push_back(per_joint(x, loaded, "d tau / d m / k on every loaded joint", 1, 0, ""));
+  pool.shapes.push_back(per_joint(x, loaded,
+                                  "d tau / d m through Laguerre 30 ms x4 on every loaded joint", 4,
+                                  1, "laguerre30ms_"));
+  pool.shapes.push_back(per_joint(x, loaded,
+                                  "d tau / d m through Laguerre 100 ms x6 on every loaded joint", 6,
+                                  5, "laguerre100ms_"));
   // Both time scales: the loop's fast reaction to the inertia part and its slow one (the PI
   // working off the static part).
-  out.push_back(per_joint(
-      x, loaded, "d tau / d m through Laguerre 30 ms x4 + 100 ms x6 on every loaded joint", 10,
-      [&](std::size_t j) {
-        std::vector<Column> cols = laguerre(unit_torque(x, j), 0.03, 4, x.s);
-        for (auto& c : laguerre(unit_torque(x, j), 0.1, 6, x.s)) cols.push_back(std::move(c));
-        return cols;
-      },
+  pool.shapes.push_back(per_joint(
+      x, loaded, "d tau / d m through Laguerre 30 ms x4 + 100 ms x6 on every loaded joint", 10, 1,
       "laguerre30ms100ms_"));
+  std::vector<ShapePool> pools;
+  pools.push_back(std::move(pool));
+  return pools;
+}
+
+std::vector<CandidateShape> shapes(const ShapeContext& x) {
+  std::vector<CandidateShape> out;
+  for (const ShapePool& pool : shape_pools(x))
+    for (auto& shape : shapes_from_pool(pool)) out.push_back(std::move(shape));
   return out;
 }
 
@@ -112,6 +122,7 @@ const EffectDefinition kPayloadMismatchEffect{
     .acts_through_dynamics = true,
     .what_to_measure = "the path with and without a known extra mass",
     .shapes = shapes,
+    .shape_pools = shape_pools,
     .nominal = &kNominal,
 };
 

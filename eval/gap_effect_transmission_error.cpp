@@ -8,76 +8,106 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/units.hpp"
 #include "eval/gap_effect_shapes.hpp"
 #include "eval/gap_nominal_plant.hpp"
+#include "eval/gap_shape_pool.hpp"
 
 namespace imscal::eval {
 namespace {
 
-using Named = std::pair<std::vector<Column>, std::vector<std::string>>;
-
-// The inputs through Laguerre bases of time scale tl and `order`, named after `stems`.
-Named through(const ShapeContext& x, const std::vector<Column>& inputs, double tl, int order,
-              const std::vector<std::string>& stems) {
-  std::vector<Column> cols;
-  std::vector<std::string> names;
-  const int ms = int(std::lround(1000.0 * tl));
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
-    for (auto& c : laguerre(inputs[i], tl, order, x.s)) cols.push_back(std::move(c));
-    for (auto& nm : numbered(fmt::format("{}_laguerre{}ms_", stems[i], ms), order))
-      names.push_back(std::move(nm));
-  }
-  return {cols, names};
+// One order's pool of columns (eval/gap_shape_pool.hpp): s, c; s, c through L_3ms, L_10ms and
+// L_30ms x4 each; the ripple torque's s, c through L_100ms x3.
+constexpr Eigen::Index kPoolWidth = 32;
+constexpr Eigen::Index kRippleFirst = 26;
+// The first pool column of s through Laguerre time scale `scale` (c follows 4 columns on).
+Eigen::Index laguerre_first(int scale) {
+  return 2 + 8 * Eigen::Index(scale);
 }
 
-// a's columns and names followed by b's.
-Named joined(Named a, const Named& b) {
-  a.first.insert(a.first.end(), b.first.begin(), b.first.end());
-  a.second.insert(a.second.end(), b.second.begin(), b.second.end());
-  return a;
+// `count` columns from pool column `first` on, named "<stem>0_rad", "<stem>1_rad", ...
+struct Block {
+  Eigen::Index first;
+  int count;
+  std::string stem;
+};
+
+// s and c through Laguerre time scale `scale` (0: 3 ms, 1: 10 ms, 2: 30 ms) of `order`.
+std::vector<Block> through(int scale, int order) {
+  const int ms = std::array{3, 10, 30}[std::size_t(scale)];
+  const Eigen::Index first = laguerre_first(scale);
+  return {{first, order, fmt::format("sin_laguerre{}ms_", ms)},
+          {first + 4, order, fmt::format("cos_laguerre{}ms_", ms)}};
 }
 
-// The shapes of order h per motor revolution.
-void add_order(const ShapeContext& x, double h, std::vector<CandidateShape>& out) {
+// The ripple torque's s and c through Laguerre 100 ms x3.
+std::vector<Block> ripple() {
+  return {{kRippleFirst, 3, "tau_sin_laguerre100ms_"},
+          {kRippleFirst + 3, 3, "tau_cos_laguerre100ms_"}};
+}
+
+void add_shape(ShapePool& pool, std::size_t joint, std::string label,
+               const std::vector<std::vector<Block>>& parts) {
+  PooledShape shape;
+  shape.label = std::move(label);
+  shape.pool_columns.assign(pool.columns.size(), {});
+  shape.first_parameter.assign(pool.columns.size(), 0);
+  for (const auto& part : parts)
+    for (const Block& b : part) {
+      for (int i = 0; i < b.count; ++i) shape.pool_columns[joint].push_back(b.first + i);
+      for (auto& name : numbered(b.stem, b.count)) shape.parameter_names.push_back(std::move(name));
+    }
+  pool.shapes.push_back(std::move(shape));
+}
+
+// The shapes of order h per motor revolution, from one pool.
+ShapePool order_pool(const ShapeContext& x, double h) {
   const Column q = to_column(x.s.q_internal_rad[x.joint]);
   const Column tau_d = to_column(x.s.torque_nm[x.joint]);
   const double tau_d_rms = std::max(rms_of(tau_d), 1e-12);
   const Column phase = h * x.s.gear_ratio[x.joint] * q;
   const Column sn = phase.array().sin().matrix(), cs = phase.array().cos().matrix();
-  out.push_back(
-      x.local(fmt::format("harmonic {} of the motor angle", h), {sn, cs}, {"sin_rad", "cos_rad"}));
-  for (const auto& [tl, order] :
-       {std::pair{0.003, 3}, std::pair{0.003, 4}, std::pair{0.01, 4}, std::pair{0.03, 4}}) {
-    auto [cols, names] = through(x, {sn, cs}, tl, order, {"sin", "cos"});
-    out.push_back(
-        x.local(fmt::format("harmonic {} of the motor angle through Laguerre {:.0f} ms x{}", h,
-                            1000.0 * tl, order),
-                cols, names));
-  }
   // The ripple torque through the loop's slower response (its PI integrates it): tau_d (the
   // desired motion's torque: the actual one carries the ripple's own oscillation).
   const Column ts = tau_d.cwiseProduct(sn) / tau_d_rms;
   const Column tc = tau_d.cwiseProduct(cs) / tau_d_rms;
-  const Named ripple = through(x, {ts, tc}, 0.1, 3, {"tau_sin", "tau_cos"});
-  {
-    auto [cols, names] = joined(through(x, {sn, cs}, 0.01, 3, {"sin", "cos"}), ripple);
-    out.push_back(x.local(fmt::format("harmonic {} of the motor angle through Laguerre 10 ms x3 "
-                                      "and its torque ripple through Laguerre 100 ms x3",
-                                      h),
-                          cols, names));
+  Eigen::MatrixXd m(x.n, kPoolWidth);
+  m.col(0) = sn;
+  m.col(1) = cs;
+  for (int scale = 0; scale < 3; ++scale) {
+    const double tl = std::array{0.003, 0.01, 0.03}[std::size_t(scale)];
+    laguerre_into(sn, tl, x.s, m.middleCols(laguerre_first(scale), 4));
+    laguerre_into(cs, tl, x.s, m.middleCols(laguerre_first(scale) + 4, 4));
   }
-  {
-    auto [cols, names] = joined(joined(through(x, {sn, cs}, 0.003, 3, {"sin", "cos"}),
-                                       through(x, {sn, cs}, 0.03, 3, {"sin", "cos"})),
-                                ripple);
-    out.push_back(x.local(fmt::format("harmonic {} of the motor angle through Laguerre 3 and 30 "
-                                      "ms x3 and its torque ripple through Laguerre 100 ms x3",
-                                      h),
-                          cols, names));
-  }
+  laguerre_into(ts, 0.1, x.s, m.middleCols(kRippleFirst, 3));
+  laguerre_into(tc, 0.1, x.s, m.middleCols(kRippleFirst + 3, 3));
+  ShapePool pool;
+  pool.columns.assign(x.nj, Eigen::MatrixXd());
+  pool.columns[x.joint] = std::move(m);
+  const std::size_t j = x.joint;
+  add_shape(pool, j, fmt::format("harmonic {} of the motor angle", h), {});
+  pool.shapes.back().pool_columns[j] = {0, 1};
+  pool.shapes.back().parameter_names = {"sin_rad", "cos_rad"};
+  for (const auto& [scale, order] :
+       {std::pair{0, 3}, std::pair{0, 4}, std::pair{1, 4}, std::pair{2, 4}})
+    add_shape(pool, j,
+              fmt::format("harmonic {} of the motor angle through Laguerre {} ms x{}", h,
+                          std::array{3, 10, 30}[std::size_t(scale)], order),
+              {through(scale, order)});
+  add_shape(pool, j,
+            fmt::format("harmonic {} of the motor angle through Laguerre 10 ms x3 and its torque "
+                        "ripple through Laguerre 100 ms x3",
+                        h),
+            {through(1, 3), ripple()});
+  add_shape(pool, j,
+            fmt::format("harmonic {} of the motor angle through Laguerre 3 and 30 ms x3 and its "
+                        "torque ripple through Laguerre 100 ms x3",
+                        h),
+            {through(0, 3), through(2, 3), ripple()});
+  return pool;
 }
 
 // te(theta) = A sin(h N theta + phi) between motor and link, theta the motor angle / N: the link
@@ -86,15 +116,22 @@ void add_order(const ShapeContext& x, double h, std::vector<CandidateShape>& out
 // is a linear response to sin, cos (and tau sin, tau cos) of h N theta, whose frequency h N qd
 // sweeps through those modes. Raw, or through Laguerre bases of 3, 10 or 30 ms (the response
 // without knowing the loop's poles), with the ripple through 100 ms.
-std::vector<CandidateShape> shapes(const ShapeContext& x) {
-  std::vector<CandidateShape> out;
-  if (x.joint >= x.s.q_internal_rad.size()) return out;  // the motor angle is not known
+std::vector<ShapePool> shape_pools(const ShapeContext& x) {
+  std::vector<ShapePool> pools;
+  if (x.joint >= x.s.q_internal_rad.size()) return pools;  // the motor angle is not known
   std::vector<double> orders = {1.0, 2.0, 3.0};
   if (x.training)  // two further orders from the search on the training rows
     for (double h : transmission_orders_by_fit(x.s, x.joint, x.s.gap_rad[x.joint], *x.training))
       if (orders.size() < 5 && std::find(orders.begin(), orders.end(), h) == orders.end())
         orders.push_back(h);
-  for (double h : orders) add_order(x, h, out);
+  for (double h : orders) pools.push_back(order_pool(x, h));
+  return pools;
+}
+
+std::vector<CandidateShape> shapes(const ShapeContext& x) {
+  std::vector<CandidateShape> out;
+  for (const ShapePool& pool : shape_pools(x))
+    for (auto& shape : shapes_from_pool(pool)) out.push_back(std::move(shape));
   return out;
 }
 
@@ -140,6 +177,7 @@ const EffectDefinition kTransmissionErrorEffect{
         "a slow constant-speed move of the joint over several motor revolutions "
         "(the error is periodic in the motor angle)",
     .shapes = shapes,
+    .shape_pools = shape_pools,
     .size_in_words = size_in_words,
     .nominal = &kNominal,
 };

@@ -41,6 +41,7 @@ inline constexpr int kEffectKindCount = 15;
 struct CandidateShape;    // eval/gap_candidates.hpp
 struct CandidateFit;      // eval/gap_candidates.hpp
 struct ShapeContext;      // eval/gap_effect_shapes.hpp
+struct ShapePool;         // eval/gap_shape_pool.hpp
 struct NominalPlant;      // eval/gap_nominal_plant.hpp
 struct NominalParameter;  // eval/gap_nominal_plant.hpp
 
@@ -85,8 +86,13 @@ struct EffectDefinition {
   // and keeps only the one it chooses (eval/gap_shape_choice.hpp). Null: all at once.
   std::size_t (*shape_count)(const ShapeContext& context) = nullptr;
   CandidateShape (*shape_at)(const ShapeContext& context, std::size_t index) = nullptr;
+  // An effect whose shapes are column subsets of a few pools (eval/gap_shape_pool.hpp): the pools,
+  // their shapes in the order of `shapes`, validated from each pool's Gram matrices. Null: the
+  // shapes one by one.
+  std::vector<ShapePool> (*shape_pools)(const ShapeContext& context) = nullptr;
   // Its size in words from the fit of its chosen shape (`own_rms`: the RMS of its modelled gap on
-  // its own joint). Null: the first parameter with its sigma.
+  // its own joint; the shape's columns are the fit's `columns`, the shape's first, not the
+  // shape's own, which the fit took). Null: the first parameter with its sigma.
   std::string (*size_in_words)(const CandidateFit& fit, const CandidateShape& shape,
                                double own_rms) = nullptr;
   // The measurement that separates it from `other` on the same joint (`joint_name`) where that

@@ -1,8 +1,8 @@
 #include "eval/gap_filters.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <stdexcept>
 
 namespace imscal::eval {
 
@@ -68,26 +68,48 @@ std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta
 
 namespace {
 
+// The Laguerre filters of u over the run [b, e): filter i's value at sample k goes to out(i, k).
+// Stages holds the stages' states: a std::array for the orders used (its elements stay in
+// registers, the cascade's stages overlap), a std::vector for any other.
+template <typename Stages, typename Out>
+void laguerre_run(const Column& u, double a, double g0, std::size_t b, std::size_t e, Stages y,
+                  Out& out) {
+  const int order = int(y.size());
+  const double u0 = u[Eigen::Index(b)];
+  for (auto& yi : y) yi = g0 / (1.0 - a) * u0;
+  Stages x_previous = y;  // each stage's previous input
+  x_previous[0] = u0;
+  for (std::size_t k = b; k < e; ++k) {
+    double x = u[Eigen::Index(k)];
+    for (int i = 0; i < order; ++i) {
+      double& yi = y[std::size_t(i)];
+      const double next = i == 0 ? a * yi + g0 * x : a * yi + x_previous[std::size_t(i)] - a * x;
+      x_previous[std::size_t(i)] = x;
+      yi = next;
+      out(i, Eigen::Index(k)) = next;
+      x = next;
+    }
+  }
+}
+
 // The Laguerre filters of u: filter i's value at sample k goes to out(i, k).
 template <typename Out>
 void laguerre_filters(const Column& u, double tau_s, int order, const GapSignals& s, Out&& out) {
   const double a = std::exp(-s.cycle_s / tau_s), g0 = std::sqrt(1.0 - a * a);
   for (const auto& [b, e] : s.runs) {
     if (e <= b) continue;
-    const double u0 = u[Eigen::Index(b)];
-    std::vector<double> y(std::size_t(order), g0 / (1.0 - a) * u0);
-    std::vector<double> x_previous = y;  // each stage's previous input
-    x_previous[0] = u0;
-    for (std::size_t k = b; k < e; ++k) {
-      double x = u[Eigen::Index(k)];
-      for (int i = 0; i < order; ++i) {
-        double& yi = y[std::size_t(i)];
-        const double next = i == 0 ? a * yi + g0 * x : a * yi + x_previous[std::size_t(i)] - a * x;
-        x_previous[std::size_t(i)] = x;
-        yi = next;
-        out(i, Eigen::Index(k)) = next;
-        x = next;
-      }
+    switch (order) {
+      case 3:
+        laguerre_run(u, a, g0, b, e, std::array<double, 3>{}, out);
+        break;
+      case 4:
+        laguerre_run(u, a, g0, b, e, std::array<double, 4>{}, out);
+        break;
+      case 6:
+        laguerre_run(u, a, g0, b, e, std::array<double, 6>{}, out);
+        break;
+      default:
+        laguerre_run(u, a, g0, b, e, std::vector<double>(std::size_t(order)), out);
     }
   }
 }
@@ -101,28 +123,10 @@ std::vector<Column> laguerre(const Column& u, double tau_s, int order, const Gap
   return out;
 }
 
-LaguerreBank::LaguerreBank(const Column& u, const std::vector<std::pair<double, int>>& scales,
-                           const GapSignals& s) {
-  std::vector<std::pair<double, int>> highest;  // (time scale, highest order), first asked first
-  for (const auto& [tau_s, order] : scales) {
-    const auto same = [tau_s = tau_s](const auto& h) { return h.first == tau_s; };
-    const auto it = std::find_if(highest.begin(), highest.end(), same);
-    if (it == highest.end())
-      highest.emplace_back(tau_s, order);
-    else
-      it->second = std::max(it->second, order);
-  }
-  for (const auto& [tau_s, order] : highest) {
-    Eigen::MatrixXd m(u.size(), order);
-    laguerre_filters(u, tau_s, order, s, [&](int i, Eigen::Index k) -> double& { return m(k, i); });
-    filters_.emplace_back(tau_s, std::move(m));
-  }
-}
-
-Eigen::Ref<const Eigen::MatrixXd> LaguerreBank::first(double tau_s, int order) const {
-  for (const auto& [scale_s, filters] : filters_)
-    if (scale_s == tau_s && order <= filters.cols()) return filters.leftCols(order);
-  throw std::logic_error("LaguerreBank: a time scale or order not filtered");
+void laguerre_into(const Column& u, double tau_s, const GapSignals& s,
+                   Eigen::Ref<Eigen::MatrixXd> out) {
+  laguerre_filters(u, tau_s, int(out.cols()), s,
+                   [&](int i, Eigen::Index k) -> double& { return out(k, i); });
 }
 
 Column relay(const Column& z, double h, const GapSignals& s) {

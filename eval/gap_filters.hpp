@@ -33,21 +33,12 @@ std::pair<Column, Column> second_order(const Column& u, double f_hz, double zeta
 // knowing its poles.
 std::vector<Column> laguerre(const Column& u, double tau_s, int order, const GapSignals& s);
 
-// One input's Laguerre filters at several time scales, each filtered once up to the highest order
-// asked of it: a lower order's filters are the first ones of a higher order's (the stages are a
-// cascade), so the bases that take several orders of one time scale share them.
-class LaguerreBank {
- public:
-  // (time scale [s], order) pairs; a time scale may appear with several orders.
-  LaguerreBank(const Column& u, const std::vector<std::pair<double, int>>& scales,
-               const GapSignals& s);
-  // The first `order` filters of time scale tau_s (samples x order; asked for at the
-  // construction, with at least that order), without a copy.
-  Eigen::Ref<const Eigen::MatrixXd> first(double tau_s, int order) const;
-
- private:
-  std::vector<std::pair<double, Eigen::MatrixXd>> filters_;  // (time scale, samples x order)
-};
+// The first out.cols() Laguerre filters of u with time scale tau, written into out's columns
+// (samples x order), bit for bit those of `laguerre`: a lower order's filters are the first ones
+// of a higher order's (the stages are a cascade), so shapes that take several orders of one time
+// scale share one call at the highest.
+void laguerre_into(const Column& u, double tau_s, const GapSignals& s,
+                   Eigen::Ref<Eigen::MatrixXd> out);
 
 // Relay with memory: +1 once z > h, -1 once z < -h, the last value while |z| <= h (the link of a
 // gear with play stays on the flank it was pushed to until the torque really reverses: the

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "eval/gap_effect_shapes.hpp"
+#include "eval/gap_shape_pool.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -36,6 +37,29 @@ ShapeScore score_of(const CandidateShape& shape, const GapSignals& s, const Trai
   return {cross_validation_sse(shape.columns, s.gap_rad, folds), shape.parameter_names.size()};
 }
 
+// The chosen shape of an effect whose shapes are drawn from pools (EffectDefinition::shape_pools).
+std::optional<CandidateShape> chosen_pooled_shape(const EffectDefinition& effect,
+                                                  const ShapeContext& context, const GapSignals& s,
+                                                  const TrainingFolds& folds) {
+  const std::vector<ShapePool> pools = effect.shape_pools(context);
+  std::size_t count = 0;
+  for (const ShapePool& pool : pools) count += pool.shapes.size();
+  if (count == 0) return std::nullopt;
+  std::vector<ShapeScore> scores;
+  if (count > 1 && folds.usable())
+    for (const ShapePool& pool : pools) {
+      const std::vector<double> sse = pooled_cross_validation_sse(pool, s.gap_rad, folds);
+      for (std::size_t i = 0; i < sse.size(); ++i)
+        scores.push_back({sse[i], pool.shapes[i].parameter_names.size()});
+    }
+  std::size_t chosen = choose(scores);
+  for (const ShapePool& pool : pools) {
+    if (chosen < pool.shapes.size()) return shape_from_pool(pool, chosen);
+    chosen -= pool.shapes.size();
+  }
+  return std::nullopt;  // not reached: chosen < count
+}
+
 }  // namespace
 
 std::optional<CandidateShape> chosen_shape(EffectKind kind, const GapSignals& s, std::size_t joint,
@@ -43,6 +67,7 @@ std::optional<CandidateShape> chosen_shape(EffectKind kind, const GapSignals& s,
                                            const TrainingFolds& folds) {
   const EffectDefinition& effect = effect_definition(kind);
   const ShapeContext context(s, joint, &training);
+  if (effect.shape_pools) return chosen_pooled_shape(effect, context, s, folds);
   std::vector<ShapeScore> scores;
   if (!effect.shape_at) {
     std::vector<CandidateShape> shapes = effect.shapes(context);
