@@ -62,9 +62,10 @@ TEST(FrameCovarianceLayout, SameRecordGivesTheSameBitsAfterAnyHeapHistory) {
   const FrameCalibrationResult first = calibrate_frames(in, options);
   ASSERT_TRUE(first.converged) << first.solver_brief_report;
   ASSERT_GT(first.covariance.size(), 0);
-  // Hole sizes around the blocks' (3 and 6 doubles, one per rest: 24 to 400 bytes).
+  // Holes of the blocks' sizes (3 and 6 doubles per rest: 192 and 384 bytes for 8 rests) and
+  // others, so that a block allocated on its own would land below or above its neighbours.
   const std::vector<std::vector<std::size_t>> histories = {
-      {24}, {48, 24}, {200, 24, 400}, {400, 200, 48, 24, 16}, {1000, 24, 24, 48}};
+      {24}, {384}, {192}, {192, 384}, {384, 24, 192, 48}, {1000, 200, 400, 16}};
   for (std::size_t h = 0; h < histories.size(); ++h) {
     const auto held = punch_holes(histories[h], 5 + int(h));
     const FrameCalibrationResult again = calibrate_frames(in, options);
