@@ -141,8 +141,8 @@ void FrameUnknowns::allocate(std::size_t rest_count, std::size_t acc_bias_count)
   dq.clear();
   b_a.clear();
   b_a_blocks.clear();
-  for (std::size_t i = 0; i < rest_count; ++i) dq.push_back(take(6));
   for (std::size_t i = 0; i < acc_bias_count; ++i) b_a.push_back(take(3));
+  for (std::size_t i = 0; i < rest_count; ++i) dq.push_back(take(6));
   q_W_R = take(4);
   q_S_H = take(4);
   p_S_H = take(3);

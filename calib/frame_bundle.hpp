@@ -48,8 +48,8 @@ namespace imscal::calib {
 // columns by the blocks' addresses (it sorts the parameter pointers, covariance_impl.cc), and
 // its sparse QR rounds by that order: blocks in separate allocations would make the covariance's
 // last bits follow the heap's layout (what was allocated and freed before, down to the output
-// folder's name). In one buffer the order is fixed: the joint deviations, the accelerometer
-// biases, then the named blocks in their declaration order below.
+// folder's name). In one buffer the order is fixed: the accelerometer biases, the joint
+// deviations, then the named blocks in their declaration order below.
 struct FrameUnknowns {
   FrameUnknowns() = default;
   FrameUnknowns(const FrameUnknowns&) = delete;  // the pointers below point into storage_
