@@ -71,14 +71,13 @@ void set_quaternion(double* q, const Eigen::Matrix3d& R) {
 
 void set_initial_unknowns(FrameBundle& b) {
   FrameUnknowns& x = b.x;
+  x.allocate(b.rests.size(), b.acc_bias_drifts ? b.rests.size() : 1);
+  for (std::size_t i = 0; i < b.rests.size(); ++i)
+    x.b_a_blocks.push_back(x.b_a[b.acc_bias_drifts ? i : 0]);
   set_quaternion(x.q_W_R, b.init.T_R_W.linear().transpose());
   set_quaternion(x.q_S_H, b.init.T_S_H.linear());
   Eigen::Map<Eigen::Vector3d>(x.p_S_H) = b.init.T_S_H.translation();
   x.dt[0] = b.init.time_offset_s;
-  x.dq.assign(b.rests.size(), std::array<double, 6>{0, 0, 0, 0, 0, 0});
-  x.b_a.assign(b.acc_bias_drifts ? b.rests.size() : 1, std::array<double, 3>{0, 0, 0});
-  for (std::size_t i = 0; i < b.rests.size(); ++i)
-    x.b_a_blocks.push_back(x.b_a[b.acc_bias_drifts ? i : 0].data());
   x.rests = &b.input.rests;
 }
 
@@ -130,6 +129,34 @@ void check_heading_reference(const std::optional<HeadingReference>& heading,
                                  heading->source, heading->yaw_rad, heading->sigma_rad));
 }
 
+void FrameUnknowns::allocate(std::size_t rest_count, std::size_t acc_bias_count) {
+  constexpr std::size_t kNamedSize = 4 + 4 + 3 + 3 + 1 + 1 + 3 + 3 + 6 + 6;
+  storage_.assign(6 * rest_count + 3 * acc_bias_count + kNamedSize, 0.0);
+  double* next = storage_.data();
+  const auto take = [&next](std::size_t size) {
+    double* block = next;
+    next += size;
+    return block;
+  };
+  dq.clear();
+  b_a.clear();
+  b_a_blocks.clear();
+  for (std::size_t i = 0; i < acc_bias_count; ++i) b_a.push_back(take(3));
+  for (std::size_t i = 0; i < rest_count; ++i) dq.push_back(take(6));
+  q_W_R = take(4);
+  q_S_H = take(4);
+  p_S_H = take(3);
+  b_g = take(3);
+  dt = take(1);
+  link_share = take(1);
+  s_g = take(3);
+  s_a = take(3);
+  m_w = take(6);
+  m_p = take(6);
+  q_W_R[3] = 1.0;  // identity, Eigen order x, y, z, w
+  q_S_H[3] = 1.0;
+}
+
 Eigen::Matrix3d FrameUnknowns::R_W_R() const {
   return Eigen::Map<const Eigen::Quaterniond>(q_W_R).toRotationMatrix();
 }
@@ -147,7 +174,7 @@ ImuBiases FrameUnknowns::biases() const {
 
 JointVector FrameUnknowns::joint_deviation(std::size_t i) const {
   const RestObservation& r = (*rests)[i];
-  return rest_deviation<double>(dq[i].data(), m_w, m_p, r.q_windup_rad, r.q_play_rad);
+  return rest_deviation<double>(dq[i], m_w, m_p, r.q_windup_rad, r.q_play_rad);
 }
 
 FrameBundle::FrameBundle(const FrameCalibrationInput& input_,

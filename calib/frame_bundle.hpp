@@ -44,22 +44,35 @@
 
 namespace imscal::calib {
 
-// The unknowns as Ceres parameter blocks.
+// The unknowns as Ceres parameter blocks, all in one buffer. ceres::Covariance orders its
+// columns by the blocks' addresses (it sorts the parameter pointers, covariance_impl.cc), and
+// its sparse QR rounds by that order: blocks in separate allocations would make the covariance's
+// last bits follow the heap's layout (what was allocated and freed before, down to the output
+// folder's name). In one buffer the order is fixed: the accelerometer biases, the joint
+// deviations, then the named blocks in their declaration order below.
 struct FrameUnknowns {
-  double q_W_R[4] = {0, 0, 0, 1};  // Eigen order x, y, z, w
-  double q_S_H[4] = {0, 0, 0, 1};
-  double p_S_H[3] = {0, 0, 0};
-  double b_g[3] = {0, 0, 0};
-  // Accelerometer bias per rest (one shared block without drift: b_a_blocks all point to it).
-  std::vector<std::array<double, 3>> b_a;
+  FrameUnknowns() = default;
+  FrameUnknowns(const FrameUnknowns&) = delete;  // the pointers below point into storage_
+  FrameUnknowns& operator=(const FrameUnknowns&) = delete;
+
+  // Lays the buffer out for `rest_count` rests and `acc_bias_count` accelerometer-bias blocks
+  // (1, or one per rest when it drifts) and sets the initial values (identity rotations, zeros).
+  void allocate(std::size_t rest_count, std::size_t acc_bias_count);
+
+  double* q_W_R = nullptr;  // 4, Eigen order x, y, z, w
+  double* q_S_H = nullptr;  // 4
+  double* p_S_H = nullptr;  // 3
+  double* b_g = nullptr;    // 3
+  // Accelerometer bias blocks (3 each); b_a_blocks per rest (without drift all the one block).
+  std::vector<double*> b_a;
   std::vector<double*> b_a_blocks;
-  double dt[1] = {0};
-  double link_share[1] = {0};
-  double s_g[3] = {0, 0, 0};
-  double s_a[3] = {0, 0, 0};
-  double m_w[6] = {0, 0, 0, 0, 0, 0};  // 1 - k_w (estimate_deflection_scale)
-  double m_p[6] = {0, 0, 0, 0, 0, 0};  // 1 - k_p
-  std::vector<std::array<double, 6>> dq;
+  double* dt = nullptr;          // 1
+  double* link_share = nullptr;  // 1
+  double* s_g = nullptr;         // 3
+  double* s_a = nullptr;         // 3
+  double* m_w = nullptr;         // 6: 1 - k_w (estimate_deflection_scale)
+  double* m_p = nullptr;         // 6: 1 - k_p
+  std::vector<double*> dq;       // 6 per rest
   const std::vector<RestObservation>* rests = nullptr;
 
   Eigen::Matrix3d R_W_R() const;
@@ -67,6 +80,9 @@ struct FrameUnknowns {
   ImuBiases biases() const;  // the accelerometer bias of the first rest
   // dq_i plus the scaled wind-up and play of rest i.
   JointVector joint_deviation(std::size_t i) const;
+
+ private:
+  std::vector<double> storage_;  // every block above, allocated once
 };
 
 // The deflection-scale model: per joint, estimated only where some rest has a modelled wind-up /

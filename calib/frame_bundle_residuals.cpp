@@ -82,12 +82,12 @@ void add_frame_and_bias_blocks(FrameBundle& b, ceres::Problem& problem) {
   problem.AddParameterBlock(x.q_S_H, 4, new ceres::EigenQuaternionManifold);
   problem.AddParameterBlock(x.p_S_H, 3);
   problem.AddParameterBlock(x.b_g, 3);
-  for (auto& block : x.b_a) problem.AddParameterBlock(block.data(), 3);
+  for (double* block : x.b_a) problem.AddParameterBlock(block, 3);
 }
 
 void add_joint_deviations(FrameBundle& b, ceres::Problem& problem) {
   for (std::size_t i = 0; i < b.rests.size(); ++i) {
-    double* dq = b.x.dq[i].data();
+    double* dq = b.x.dq[i];
     const JointVector& sigma = b.input.rests[i].q_link_sigma_rad;
     problem.AddParameterBlock(dq, 6);
     std::vector<int> fixed;
@@ -165,8 +165,8 @@ void add_rest_residuals(FrameBundle& b, FrameStage& stage, const std::vector<Eig
     stage.problem->AddResidualBlock(
         new ceres::AutoDiffCostFunction<RestResidual, 6, 4, 4, 6, 3, 3, 3, 3, 6, 6>(
             new RestResidual(f)),
-        new ceres::HuberLoss(options.huber_scale_sigma * std::sqrt(6.0)), x.q_W_R, x.q_S_H,
-        x.dq[i].data(), x.b_g, x.b_a_blocks[i], x.s_g, x.s_a, x.m_w, x.m_p);
+        new ceres::HuberLoss(options.huber_scale_sigma * std::sqrt(6.0)), x.q_W_R, x.q_S_H, x.dq[i],
+        x.b_g, x.b_a_blocks[i], x.s_g, x.s_a, x.m_w, x.m_p);
   }
 }
 
@@ -189,14 +189,14 @@ void add_motion_residuals(FrameBundle& b, FrameStage& stage,
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<MotionResidual, 9, 4, 4, 3, 6, 6, 3, 3, 3, 6, 6>(
               new MotionResidual(f)),
-          new ceres::HuberLoss(huber), x.q_W_R, x.q_S_H, x.p_S_H, x.dq[i].data(),
-          x.dq[i + 1].data(), x.b_g, x.b_a_blocks[i], x.b_a_blocks[i + 1], x.m_w, x.m_p);
+          new ceres::HuberLoss(huber), x.q_W_R, x.q_S_H, x.p_S_H, x.dq[i], x.dq[i + 1], x.b_g,
+          x.b_a_blocks[i], x.b_a_blocks[i + 1], x.m_w, x.m_p);
     } else {
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<MotionResidualConstantBias, 9, 4, 4, 3, 6, 6, 3, 3, 6, 6>(
               new MotionResidualConstantBias{f}),
-          new ceres::HuberLoss(huber), x.q_W_R, x.q_S_H, x.p_S_H, x.dq[i].data(),
-          x.dq[i + 1].data(), x.b_g, x.b_a_blocks[i], x.m_w, x.m_p);
+          new ceres::HuberLoss(huber), x.q_W_R, x.q_S_H, x.p_S_H, x.dq[i], x.dq[i + 1], x.b_g,
+          x.b_a_blocks[i], x.m_w, x.m_p);
     }
   }
 }

@@ -240,8 +240,7 @@ void report_rest_residuals(const FrameBundle& b, const FrameStage& stage,
   for (std::size_t i = 0; i < b.rests.size(); ++i) {
     const RestResidual& f = stage.rest_functors[i];
     Eigen::Matrix<double, 6, 1> r;
-    f(x.q_W_R, x.q_S_H, x.dq[i].data(), x.b_g, x.b_a_blocks[i], x.s_g, x.s_a, x.m_w, x.m_p,
-      r.data());
+    f(x.q_W_R, x.q_S_H, x.dq[i], x.b_g, x.b_a_blocks[i], x.s_g, x.s_a, x.m_w, x.m_p, r.data());
     PoseResidual p;
     p.label = b.input.rests[i].label;
     p.normalised = std::sqrt(r.squaredNorm() / 6.0);
@@ -264,8 +263,8 @@ void report_motion_residuals(const FrameBundle& b, const FrameStage& stage,
   for (std::size_t i = 0; i + 1 < b.rests.size(); ++i) {
     const MotionResidual& f = stage.motion_functors[i];
     Eigen::Matrix<double, 9, 1> r;
-    f(x.q_W_R, x.q_S_H, x.p_S_H, x.dq[i].data(), x.dq[i + 1].data(), x.b_g, x.b_a_blocks[i],
-      x.b_a_blocks[i + 1], x.m_w, x.m_p, r.data());
+    f(x.q_W_R, x.q_S_H, x.p_S_H, x.dq[i], x.dq[i + 1], x.b_g, x.b_a_blocks[i], x.b_a_blocks[i + 1],
+      x.m_w, x.m_p, r.data());
     const Eigen::Matrix<double, 9, 1> raw = stage.motion_covariance_factor[i] * r;
     PoseResidual p;
     p.label = fmt::format("{} -> {}", rests[i].label, rests[i + 1].label);
