@@ -11,6 +11,7 @@
 #include "calib/mounting_report_json.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "tests/support/refused_file.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal::calib {
@@ -159,14 +160,8 @@ TEST_F(MountingReportTest, RefusalsNameTheFileAndTheField) {
   with("/imscal-mounting-report"_json_pointer, 2, "imscal-mounting-report");
   for (const Case& c : cases) {
     SCOPED_TRACE(c.field);
-    std::ofstream(file, std::ios::trunc) << c.document.dump();
-    try {
-      read_mounting_report(file);
-      ADD_FAILURE() << "accepted";
-    } catch (const InputError& e) {
-      EXPECT_EQ(e.file(), file.string());
-      EXPECT_EQ(e.field(), c.field) << e.what();
-    }
+    test_support::expect_refused_naming_field(read_mounting_report, file, c.document.dump(),
+                                              c.field);
   }
 }
 
