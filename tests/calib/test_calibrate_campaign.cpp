@@ -46,6 +46,7 @@
 #include "sim/simulation.hpp"
 #include "sim/simulation_output.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal::calib {
 namespace {
@@ -400,8 +401,7 @@ using CalibrateCampaignScratch = test_support::ScratchDirTest;
 TEST_F(CalibrateCampaignScratch, MountingWithoutBacklash) {
   // The shipped scenario with the backlash off, paths made absolute for the scratch copy.
   const fs::path datasets = fs::path(IMSCAL_SOURCE_DIR) / "datasets";
-  std::ifstream in(datasets / "scenarios" / "mounting.yaml");
-  std::string text((std::istreambuf_iterator<char>(in)), {});
+  std::string text = test_support::read_text(datasets / "scenarios" / "mounting.yaml");
   // Every occurrence: the scenario names the robot twice (the plant and the nominal robot).
   auto replace = [&](const std::string& from, const std::string& to) {
     ASSERT_NE(text.find(from), std::string::npos) << from;

@@ -27,6 +27,7 @@
 #include "tests/support/frames_json.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal {
 namespace {
@@ -43,8 +44,8 @@ const fs::path kConfig = kSource / "datasets" / "calibration" / "calibrate-defau
 
 constexpr auto* run = &imscal::test_support::run_imscal;
 
-constexpr auto* read = &imscal::test_support::read_file_text;
 using imscal::test_support::quaternion_of;
+using imscal::test_support::read_text;
 
 std::string calibrate_arguments(const fs::path& sim, const fs::path& out,
                                 const fs::path& unit_calibration) {
@@ -59,7 +60,7 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
   ASSERT_EQ(
       run("simulate --scenario " + kScenario.string() + " --out " + sim.string(), dir_ / "sim.log"),
       0)
-      << read(dir_ / "sim.log");
+      << read_text(dir_ / "sim.log");
   // The unit's lab calibration: its scale factors and misalignments (a lab's file carries no
   // turn-on biases: they change from run to run).
   ims::SensorErrorModel lab = ims::load_sensor_error_model(sim / "truth" / "sensor_errors.yaml");
@@ -73,13 +74,13 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
   ::setenv(kProgressChannelVariable, "1", 1);
   const int status = run(calibrate_arguments(sim, out, unit), dir_ / "cal.log");
   ::unsetenv(kProgressChannelVariable);
-  ASSERT_TRUE(status == 0 || status == 1) << status << "\n" << read(dir_ / "cal.log");
+  ASSERT_TRUE(status == 0 || status == 1) << status << "\n" << read_text(dir_ / "cal.log");
   // Its steps through the channel, in order, never going back, the last at 1.
   std::vector<double> fractions;
-  std::istringstream lines(read(dir_ / "cal.log"));
+  std::istringstream lines(read_text(dir_ / "cal.log"));
   for (std::string line; std::getline(lines, line);)
     if (const auto report = parse_progress_line(line)) fractions.push_back(report->fraction);
-  ASSERT_GE(fractions.size(), 5u) << read(dir_ / "cal.log");
+  ASSERT_GE(fractions.size(), 5u) << read_text(dir_ / "cal.log");
   EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
   EXPECT_EQ(fractions.back(), 1.0);
   for (const char* file :
@@ -87,9 +88,9 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
     SCOPED_TRACE(file);
     ASSERT_TRUE(fs::is_regular_file(out / file));
   }
-  const json frames = json::parse(read(out / "frames.json"));
-  const json report = json::parse(read(out / "mounting_report.json"));
-  const json truth = json::parse(read(sim / "truth" / "frames.json"));
+  const json frames = json::parse(read_text(out / "frames.json"));
+  const json report = json::parse(read_text(out / "mounting_report.json"));
+  const json truth = json::parse(read_text(sim / "truth" / "frames.json"));
 
   // The verdict and the exit code agree; reasons in words.
   const std::string verdict = report.at("verdict");
@@ -145,23 +146,23 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
   EXPECT_GT(joint_errors.sample_count(), 10000u);
 
   // Again without --force: refused (exit 2) before any work, outputs untouched.
-  const std::string before = read(out / "frames.json");
+  const std::string before = read_text(out / "frames.json");
   EXPECT_EQ(run(calibrate_arguments(sim, out, unit), dir_ / "again.log"), 2);
-  EXPECT_NE(read(dir_ / "again.log").find("--force"), std::string::npos)
-      << read(dir_ / "again.log");
-  EXPECT_EQ(read(out / "frames.json"), before);
+  EXPECT_NE(read_text(dir_ / "again.log").find("--force"), std::string::npos)
+      << read_text(dir_ / "again.log");
+  EXPECT_EQ(read_text(out / "frames.json"), before);
 
   // --out naming an existing file: bad input (exit 2, as `imscal run` gives), before any work.
   std::ofstream(dir_ / "a_file") << "not a folder\n";
   EXPECT_EQ(run(calibrate_arguments(sim, dir_ / "a_file", unit), dir_ / "file_out.log"), 2)
-      << read(dir_ / "file_out.log");
-  EXPECT_NE(read(dir_ / "file_out.log").find("is a file, not a folder"), std::string::npos)
-      << read(dir_ / "file_out.log");
+      << read_text(dir_ / "file_out.log");
+  EXPECT_NE(read_text(dir_ / "file_out.log").find("is a file, not a folder"), std::string::npos)
+      << read_text(dir_ / "file_out.log");
 
   // Bad input: a robot log with a non-numeric joint angle on line 10 -> exit 2 naming the file,
   // the line and the column; nothing written.
   {
-    std::istringstream lines(read(sim / "robot.csv"));
+    std::istringstream lines(read_text(sim / "robot.csv"));
     std::ofstream bad(dir_ / "bad_robot.csv");
     std::string line;
     for (int n = 1; std::getline(lines, line); ++n) {
@@ -178,7 +179,7 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
                     " --sensor " + kSensor.string() + " --out " + bad_out.string(),
                 dir_ / "bad.log"),
             2);
-  const std::string bad_log = read(dir_ / "bad.log");
+  const std::string bad_log = read_text(dir_ / "bad.log");
   EXPECT_NE(bad_log.find("bad_robot.csv:10"), std::string::npos) << bad_log;
   EXPECT_NE(bad_log.find("q_desired_A1_rad"), std::string::npos) << bad_log;
   EXPECT_FALSE(fs::exists(bad_out / "frames.json"));
@@ -191,7 +192,7 @@ TEST_F(CalibrateCli, WritesTheFilesNearTheTruthRefusesOverwriteAndBadInput) {
                     bad_out.string(),
                 dir_ / "bad_config.log"),
             2);
-  const std::string config_log = read(dir_ / "bad_config.log");
+  const std::string config_log = read_text(dir_ / "bad_config.log");
   EXPECT_NE(config_log.find("bad.yaml:3"), std::string::npos) << config_log;
   EXPECT_NE(config_log.find("max_iteration"), std::string::npos) << config_log;
 }

@@ -63,6 +63,7 @@
 #include "tests/support/record_figure.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal {
 namespace {
@@ -71,7 +72,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using CalibrateTwoSessions = test_support::ScratchDirTest;
 constexpr auto* run = &imscal::test_support::run_imscal;
-constexpr auto* read = &imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 
 const fs::path kSource(IMSCAL_SOURCE_DIR);
 const fs::path kScenarios = fs::path(IMSCAL_TEST_DATA_DIR) / "scenarios";
@@ -124,15 +125,15 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
         run("simulate --scenario " + (kScenarios / scenario).string() + " --out " + out.string(),
             log),
         0)
-        << read(log);
+        << read_text(log);
   }
   // Same robot, base, mount and unit: the premise of --frames (the scenarios' seed).
-  const json cal_truth = json::parse(read(cal_sim / "truth" / "frames.json"));
-  const json id_truth = json::parse(read(id_sim / "truth" / "frames.json"));
+  const json cal_truth = json::parse(read_text(cal_sim / "truth" / "frames.json"));
+  const json id_truth = json::parse(read_text(id_sim / "truth" / "frames.json"));
   ASSERT_EQ(cal_truth.at("T_S_H"), id_truth.at("T_S_H"));
   ASSERT_EQ(cal_truth.at("T_R_W"), id_truth.at("T_R_W"));
-  ASSERT_EQ(read(cal_sim / "truth" / "sensor_errors.yaml"),
-            read(id_sim / "truth" / "sensor_errors.yaml"));
+  ASSERT_EQ(read_text(cal_sim / "truth" / "sensor_errors.yaml"),
+            read_text(id_sim / "truth" / "sensor_errors.yaml"));
 
   // The unit's lab calibration: scale factors and misalignments; biases left to the bundle.
   ims::SensorErrorModel lab =
@@ -145,24 +146,25 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
   // Session 1: the frames. 0 = pass/warn, 1 = verdict fail with the outputs written.
   const fs::path cal = dir_ / "cal";
   int status = run(calibrate_arguments(cal_sim, unit, cal), dir_ / "cal.log");
-  ASSERT_TRUE(status == 0 || status == 1) << read(dir_ / "cal.log");
+  ASSERT_TRUE(status == 0 || status == 1) << read_text(dir_ / "cal.log");
   // Session 2 alone has too few rests for the frames: refused (exit 2).
   EXPECT_EQ(run(calibrate_arguments(id_sim, unit, dir_ / "refused"), dir_ / "refused.log"), 2);
-  EXPECT_NE(read(dir_ / "refused.log").find("at least 3"), std::string::npos)
-      << read(dir_ / "refused.log");
+  EXPECT_NE(read_text(dir_ / "refused.log").find("at least 3"), std::string::npos)
+      << read_text(dir_ / "refused.log");
   // With the frames of session 1.
   const fs::path id = dir_ / "id";
   status =
       run(calibrate_arguments(id_sim, unit, id) + " --frames " + (cal / "frames.json").string(),
           dir_ / "id.log");
-  ASSERT_TRUE(status == 0 || status == 1) << read(dir_ / "id.log");
-  std::printf("%s", read(id / "summary.txt").c_str());
+  ASSERT_TRUE(status == 0 || status == 1) << read_text(dir_ / "id.log");
+  std::printf("%s", read_text(id / "summary.txt").c_str());
   // The identification program returns home after every single-joint move and every fourth mixed
   // move: the summary says where the positions were corrected (calib/revisited_poses.hpp).
-  EXPECT_NE(read(id / "summary.txt").find("returns to a pose stood at before"), std::string::npos);
-  const json cal_frames = json::parse(read(cal / "frames.json"));
-  const json id_frames = json::parse(read(id / "frames.json"));
-  const json report = json::parse(read(id / "mounting_report.json"));
+  EXPECT_NE(read_text(id / "summary.txt").find("returns to a pose stood at before"),
+            std::string::npos);
+  const json cal_frames = json::parse(read_text(cal / "frames.json"));
+  const json id_frames = json::parse(read_text(id / "frames.json"));
+  const json report = json::parse(read_text(id / "mounting_report.json"));
   // Where the frames came from, and the frames themselves with their sigma, unchanged.
   EXPECT_EQ(id_frames.at("frames_from").at("path"), (cal / "frames.json").string());
   EXPECT_EQ(id_frames.at("frames_from").at("sha256"), sha256_hex_of_file(cal / "frames.json"));
@@ -247,8 +249,8 @@ TEST_F(CalibrateTwoSessions, IdentificationSessionWithTheMountingSessionsFrames)
                     gravity.str() + " --out " + ident_out.string(),
                 dir_ / "ident.log"),
             0)
-      << read(dir_ / "ident.log");
-  const json ident_report = json::parse(read(ident_out / "identification_report.json"));
+      << read_text(dir_ / "ident.log");
+  const json ident_report = json::parse(read_text(ident_out / "identification_report.json"));
   std::map<std::string, double> fit, table_fits;
   for (const auto& joint : ident_report.at("joints")) {
     double sum = 0.0, rows = 0.0;
@@ -406,7 +408,7 @@ TEST_F(CalibrateTwoSessions, FramesOfAnotherRobotVersionOrWithNaNAreRefused) {
                 kSensor.string() + " --frames " + file.string() + " --out " + out.string(),
             log),
         2);
-    const std::string text = read(log);
+    const std::string text = read_text(log);
     EXPECT_NE(text.find(file.string()), std::string::npos) << text;
     EXPECT_NE(text.find(std::string("field '") + c.field + "'"), std::string::npos) << text;
     EXPECT_NE(text.find(c.words), std::string::npos) << text;

@@ -11,6 +11,8 @@
 #include "calib/mounting_report_json.hpp"
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
+#include "tests/support/json_edit.hpp"
+#include "tests/support/refused_file.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal::calib {
@@ -133,41 +135,23 @@ TEST_F(MountingReportTest, WhatIsWrittenIsReadBack) {
 TEST_F(MountingReportTest, RefusalsNameTheFileAndTheField) {
   const auto file = dir_ / "mounting_report.json";
   const json good = mounting_report_json(sample_report(), nullptr, nullptr);
-  struct Case {
-    json document;
-    std::string field;
+  const auto refused = [&](const json::json_pointer& at, const json& value,
+                           const std::string& field) {
+    SCOPED_TRACE(field);
+    test_support::expect_refused_naming_field(read_mounting_report, file,
+                                              test_support::edited(good, at, value).dump(), field);
   };
-  std::vector<Case> cases;
-  const auto with = [&](const json::json_pointer& at, const json& value, std::string field) {
-    json j = good;
-    if (value.is_discarded())
-      j[at.parent_pointer()].erase(at.back());
-    else
-      j[at] = value;
-    cases.push_back({j, std::move(field)});
-  };
-  const json removed(json::value_t::discarded);
-  with("/verdict"_json_pointer, "maybe", "verdict");
-  with("/checks/1/level"_json_pointer, 2, "checks[1].level");
-  with("/combined/T_S_H/quaternion_wxyz"_json_pointer, {1.0, 0.1, 0.0, 0.0},
-       "combined.T_S_H.quaternion_wxyz");
-  with("/rest_residuals/0/outlier"_json_pointer, "no", "rest_residuals[0].outlier");
-  with("/outlier_count"_json_pointer, -1, "outlier_count");
-  with("/halves/0/first_rest"_json_pointer, removed, "halves[0].first_rest");
-  with("/segment_comparisons/0/earlier"_json_pointer, "third", "segment_comparisons[0].earlier");
-  with("/thresholds/slip_sigma"_json_pointer, nullptr, "thresholds.slip_sigma");
-  with("/imscal-mounting-report"_json_pointer, 2, "imscal-mounting-report");
-  for (const Case& c : cases) {
-    SCOPED_TRACE(c.field);
-    std::ofstream(file, std::ios::trunc) << c.document.dump();
-    try {
-      read_mounting_report(file);
-      ADD_FAILURE() << "accepted";
-    } catch (const InputError& e) {
-      EXPECT_EQ(e.file(), file.string());
-      EXPECT_EQ(e.field(), c.field) << e.what();
-    }
-  }
+  const json& removed = test_support::kRemovedJson;
+  refused("/verdict"_json_pointer, "maybe", "verdict");
+  refused("/checks/1/level"_json_pointer, 2, "checks[1].level");
+  refused("/combined/T_S_H/quaternion_wxyz"_json_pointer, {1.0, 0.1, 0.0, 0.0},
+          "combined.T_S_H.quaternion_wxyz");
+  refused("/rest_residuals/0/outlier"_json_pointer, "no", "rest_residuals[0].outlier");
+  refused("/outlier_count"_json_pointer, -1, "outlier_count");
+  refused("/halves/0/first_rest"_json_pointer, removed, "halves[0].first_rest");
+  refused("/segment_comparisons/0/earlier"_json_pointer, "third", "segment_comparisons[0].earlier");
+  refused("/thresholds/slip_sigma"_json_pointer, nullptr, "thresholds.slip_sigma");
+  refused("/imscal-mounting-report"_json_pointer, 2, "imscal-mounting-report");
 }
 
 // The report `imscal calibrate` wrote for the shipped campaign (the fuzz target's seed): read

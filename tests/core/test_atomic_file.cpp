@@ -4,13 +4,14 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "core/atomic_file.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace fs = std::filesystem;
 using imscal::AtomicFile;
 using imscal::Overwrite;
+using imscal::test_support::read_text;
 
 namespace {
 fs::path fresh_dir(const std::string& name) {
@@ -18,12 +19,6 @@ fs::path fresh_dir(const std::string& name) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
-}
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 }  // namespace
 
@@ -36,7 +31,7 @@ TEST(AtomicFile, TargetAppearsOnlyOnCommit) {
     EXPECT_FALSE(fs::exists(target));
     file.commit();
   }
-  EXPECT_EQ(slurp(target), "a,b\n1,2\n");
+  EXPECT_EQ(read_text(target), "a,b\n1,2\n");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1);
 }
 
@@ -54,7 +49,7 @@ TEST(AtomicFile, RefusesToOverwriteWithoutPermission) {
   imscal::write_file_atomically(dir / "out.txt", "first");
   EXPECT_THROW(AtomicFile(dir / "out.txt", Overwrite::kRefuse), std::runtime_error);
   imscal::write_file_atomically(dir / "out.txt", "second", Overwrite::kAllow);
-  EXPECT_EQ(slurp(dir / "out.txt"), "second");
+  EXPECT_EQ(read_text(dir / "out.txt"), "second");
 }
 
 // An output that cannot be written names the target a user will look for (never the hidden

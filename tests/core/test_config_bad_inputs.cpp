@@ -36,7 +36,9 @@
 #include "robot/robot_description.hpp"
 #include "robot/robot_log.hpp"
 #include "sim/scenario.hpp"
+#include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 #include "tests/tools/run_campaign.hpp"
 
 namespace imscal {
@@ -122,7 +124,7 @@ TEST(ConfigBadInputs, EveryCaseIsRefusedNamingFileLineAndField) {
 
 // `imscal run` with a bad run config: exit 2, file:line and key in the message, no run folder.
 using RunConfigBadInputs = test_support::ScratchDirTest;
-using test_support::read_file_text;
+using test_support::read_text;
 using test_support::run_imscal;
 
 TEST_F(RunConfigBadInputs, RefusedWithExitTwoFileLineAndKeyAndNoRunFolder) {
@@ -159,7 +161,7 @@ TEST_F(RunConfigBadInputs, RefusedWithExitTwoFileLineAndKeyAndNoRunFolder) {
     std::ofstream(config) << c.yaml;
     const fs::path out = dir_ / ("out-" + c.name), log = dir_ / (c.name + ".log");
     EXPECT_EQ(run_imscal("run " + config.string() + " --out " + out.string(), log), 2);
-    const std::string message = read_file_text(log);
+    const std::string message = read_text(log);
     std::printf("%-32s %s", c.name.c_str(), message.c_str());
     EXPECT_NE(message.find(config.filename().string() + c.where), std::string::npos) << message;
     EXPECT_NE(message.find(c.words), std::string::npos) << message;
@@ -230,7 +232,7 @@ using PayloadPlausibility = test_support::ScratchDirTest;
 
 // `source` with the payload column (the second) of every data line set to `payload_kg`.
 std::string with_payload(const fs::path& source, const std::string& payload_kg) {
-  std::istringstream in(read_file_text(source));
+  std::istringstream in(read_text(source));
   std::string out, line;
   while (std::getline(in, line)) {
     const auto first = line.find(','), second = line.find(',', first + 1);
@@ -286,7 +288,7 @@ TEST_F(PayloadPlausibility, RefusedFarAboveTheRatingInEveryCommandThatTakesAPayl
     const fs::path out = dir_ / ("out-" + c.name.substr(0, c.name.find(' '))),
                    message_file = dir_ / "message.log";
     EXPECT_EQ(run_imscal(c.arguments + " --out " + out.string(), message_file), 2);
-    const std::string message = read_file_text(message_file);
+    const std::string message = read_text(message_file);
     std::printf("%-20s %s", c.name.c_str(), message.c_str());
     EXPECT_NE(message.find(c.file), std::string::npos) << message;
     EXPECT_NE(message.find("field '" + c.field + "'"), std::string::npos) << message;
@@ -307,8 +309,8 @@ TEST_F(PayloadPlausibility, AboveTheRatingIsAWarningWithTheReason) {
                            (dir_ / "model.csv").string(),
                        log),
             0)
-      << read_file_text(log);
-  const std::string message = read_file_text(log);
+      << read_text(log);
+  const std::string message = read_text(log);
   EXPECT_NE(message.find("[warning] " + errors.string() + ": field 'payload_kg': payload 20 kg"),
             std::string::npos)
       << message;

@@ -3,12 +3,12 @@
 // the field; `imscal run`'s folder check (core/run_stage.hpp) goes through the same reader.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <string>
 #include <vector>
 
 #include "core/input_error.hpp"
 #include "core/run_record.hpp"
+#include "tests/support/refused_file.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal {
@@ -48,14 +48,7 @@ TEST_F(RunRecordTest, RefusalsNameTheFileAndTheField) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.text);
-    std::ofstream(file, std::ios::trunc) << c.text;
-    try {
-      read_run_record(file);
-      ADD_FAILURE() << "accepted";
-    } catch (const InputError& e) {
-      EXPECT_EQ(e.file(), file.string());
-      EXPECT_EQ(e.field(), c.field) << e.what();
-    }
+    test_support::expect_refused_naming_field(read_run_record, file, c.text, c.field);
   }
 }
 

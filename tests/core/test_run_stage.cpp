@@ -14,9 +14,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <thread>
 
 #include "core/input_error.hpp"
@@ -25,6 +23,7 @@
 #include "core/sha256.hpp"
 #include "tests/support/scratch_dir.hpp"
 #include "tests/support/stage_outcome.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -36,18 +35,9 @@ using imscal::StageOutcome;
 using imscal::StageRun;
 using imscal::StageStatus;
 using imscal::StageWorkspace;
+using imscal::test_support::read_text;
 using imscal::test_support::stage_outcome;
-
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-void write_text(const fs::path& file, const std::string& text) {
-  std::ofstream(file, std::ios::binary) << text;
-}
+using imscal::test_support::write_text;
 
 // "upper": the input file in upper case, in two files (part1 = first half, part2 = rest). With
 // a pause file set it writes part1, creates the pause file and sleeps, to be killed there.

@@ -8,18 +8,17 @@
 
 #include <chrono>
 #include <condition_variable>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <thread>
 
 #include "core/run_stage.hpp"
 #include "core/subprocess.hpp"
 #include "tests/support/scratch_dir.hpp"
 #include "tests/support/stage_outcome.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -31,15 +30,10 @@ using imscal::StageOutcome;
 using imscal::StageRun;
 using imscal::StageStatus;
 using imscal::StageWorkspace;
+using imscal::test_support::read_text;
 using imscal::test_support::stage_outcome;
+using imscal::test_support::write_text;
 using namespace std::chrono_literals;
-
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 // Two parties wait for each other; false when the other did not come within the time limit.
 // Once both met, later calls meet at once.
@@ -95,7 +89,7 @@ class ScriptedStage : public Stage {
           " " + up +
           (ws.upstream_dir(up) ? ":" + read_text(*ws.upstream_dir(up) / (up + ".txt")) : ":absent");
     const StageOutcome outcome = work_(ws, text);
-    std::ofstream(ws.output_dir() / (name_ + ".txt"), std::ios::binary) << text;
+    write_text(ws.output_dir() / (name_ + ".txt"), text);
     return outcome;
   }
   bool runs_after_failed_check() const override { return summarises_; }
@@ -259,7 +253,7 @@ TEST_F(RunStageConcurrent, AnExceptionWaitsForTheRunningSiblingAndLeavesNothingO
   Rendezvous together;
   const auto throws = [&](StageWorkspace& ws, std::string&) -> StageOutcome {
     together.meet(20s);
-    std::ofstream(ws.output_dir() / "half.txt") << "half";
+    write_text(ws.output_dir() / "half.txt", "half");
     throw std::runtime_error("left broke");
   };
   const auto slow = [&](StageWorkspace&, std::string&) {

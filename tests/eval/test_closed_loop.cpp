@@ -6,18 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 
 #include "eval/closed_loop.hpp"
-#include "sim/motion_planner.hpp"
-#include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
 #include "sim/scenario.hpp"
+#include "tests/support/seed_line_start.hpp"
 
 namespace imscal::eval {
 namespace {
-
-namespace fs = std::filesystem;
 
 // One cell per joint (speed band 0..100 rad/s) with the given FIR model and dead time.
 ident::ParameterTable fir_table(const std::array<std::vector<double>, 6>& b, int dead_time = 0) {
@@ -46,15 +42,11 @@ ident::ParameterTable zero_error_table() {
 }
 
 TEST(ClosedLoop, ZeroErrorTableLeavesTheSimulatorRunUnchanged) {
-  const sim::Scenario scenario =
-      sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets/scenarios/seed-line.yaml");
-  const calib::RobotDescription robot = sim::load_plant_robot(scenario);
-  sim::DesiredJointPath path =
-      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
-  // The first 8 s: the initial rest and most of the PTP move to the line (every joint moves).
-  // Under sanitizers 6.6 s (0.6 s of motion) keeps the run short.
-  const double keep_s = std::getenv("IMSCAL_SANITIZED") ? 6.6 : 8.0;
-  while (path.samples.back().t_s > keep_s) path.samples.pop_back();
+  const test_support::SeedLineStart line =
+      test_support::seed_line_until(test_support::seed_line_move_s());
+  const sim::Scenario& scenario = line.scenario;
+  const calib::RobotDescription& robot = line.robot;
+  const sim::DesiredJointPath& path = line.path;
   const sim::PlantConfig config = sim::make_plant_config(robot, scenario);
   const ClosedLoopRun run =
       run_closed_loop(path, zero_error_table(), "kr16", simulator_plant(config));

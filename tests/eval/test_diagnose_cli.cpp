@@ -11,6 +11,7 @@
 #include "tests/eval/gap_cases.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal {
 namespace {
@@ -20,7 +21,7 @@ using DiagnoseCli = test_support::ScratchDirTest;
 
 constexpr auto* run = &imscal::test_support::run_imscal;
 
-constexpr auto* read = &imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 
 TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesAllOrNothing) {
   const eval::test::GapWorld world;
@@ -37,13 +38,13 @@ TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesAllOrNothing) {
   const std::string args = "diagnose --joint-errors " + (dir_ / "real.csv").string() +
                            " --sim-joint-errors " + (dir_ / "sim.csv").string() + " --robot " +
                            robot + " --out " + out.string();
-  ASSERT_EQ(run(args, dir_ / "a.log"), 0) << read(dir_ / "a.log");
-  const auto report = nlohmann::json::parse(read(out / "report.json"));
+  ASSERT_EQ(run(args, dir_ / "a.log"), 0) << read_text(dir_ / "a.log");
+  const auto report = nlohmann::json::parse(read_text(out / "report.json"));
   EXPECT_EQ(report["schema_version"], 2);
   EXPECT_TRUE(report["significant_gap"].get<bool>());
   EXPECT_EQ(report["candidates"][0]["effect"], "zero_offset");
   EXPECT_EQ(report["candidates"][0]["joint"], "A3");
-  EXPECT_NE(read(out / "report.txt").find("Most likely cause: zero_offset on joint A3"),
+  EXPECT_NE(read_text(out / "report.txt").find("Most likely cause: zero_offset on joint A3"),
             std::string::npos);
   // A3 carries the forearm against gravity: its gear torque along the program never changes
   // sign (checked here on the rigid-body torque of the drive's motion), so a backlash of A3 would
@@ -63,13 +64,13 @@ TEST_F(DiagnoseCli, NamesTheWithheldEffectAndWritesAllOrNothing) {
             1e-9 * group["residual_rms_rad"].get<double>());
   EXPECT_NE(group["separate_by"].get<std::string>().find("changes sign"), std::string::npos);
   EXPECT_EQ(report["candidates"][1]["shape"], eval::kOneFlankShape);
-  EXPECT_NE(read(out / "report.txt").find("indistinguishable from it on these data"),
+  EXPECT_NE(read_text(out / "report.txt").find("indistinguishable from it on these data"),
             std::string::npos);
   // Existing outputs are refused without --force (exit 2, files unchanged), kept with it.
-  const std::string before = read(out / "report.json");
-  EXPECT_EQ(run(args, dir_ / "b.log"), 2) << read(dir_ / "b.log");
-  EXPECT_EQ(read(out / "report.json"), before);
-  EXPECT_EQ(run(args + " --force", dir_ / "c.log"), 0) << read(dir_ / "c.log");
+  const std::string before = read_text(out / "report.json");
+  EXPECT_EQ(run(args, dir_ / "b.log"), 2) << read_text(dir_ / "b.log");
+  EXPECT_EQ(read_text(out / "report.json"), before);
+  EXPECT_EQ(run(args + " --force", dir_ / "c.log"), 0) << read_text(dir_ / "c.log");
   // Neither --table nor --sim-joint-errors: refused, nothing written.
   const fs::path none = dir_ / "none";
   EXPECT_NE(run("diagnose --joint-errors " + (dir_ / "real.csv").string() + " --robot " + robot +
@@ -98,20 +99,20 @@ TEST_F(DiagnoseCli, WritesTheModelErrorModelAndFigures) {
                     " --out " + out.string(),
                 dir_ / "a.log"),
             0)
-      << read(dir_ / "a.log");
+      << read_text(dir_ / "a.log");
   for (const char* f : {"gap-spectrum.svg", "gap-where.svg", "gap-model-error.svg"}) {
-    const std::string svg = read(out / f);
+    const std::string svg = read_text(out / f);
     EXPECT_NE(svg.find("<svg"), std::string::npos) << f;
     EXPECT_NE(svg.find("<path"), std::string::npos) << f;  // something was drawn
   }
-  const auto report = nlohmann::json::parse(read(out / "report.json"));
+  const auto report = nlohmann::json::parse(read_text(out / "report.json"));
   ASSERT_EQ(report["model_error"].size(), 6u);
   const auto& a3 = report["model_error"][2];
   EXPECT_EQ(a3["joint"], "A3");
   EXPECT_FALSE(a3["frequency_response"].empty());
   for (const auto& p : a3["frequency_response"])
     EXPECT_LE(p["band_lower"].get<double>(), p["magnitude_rad_per_rad"].get<double>());
-  EXPECT_NE(read(out / "report.txt").find("Model-error model"), std::string::npos);
+  EXPECT_NE(read_text(out / "report.txt").find("Model-error model"), std::string::npos);
 }
 
 }  // namespace

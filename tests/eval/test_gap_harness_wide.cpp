@@ -27,6 +27,7 @@
 #include "tests/support/record_figure.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -159,7 +160,7 @@ class GapHarnessWide : public test_support::ScratchDirTest {
   // two-sessions-mounting.yaml with its paths made absolute, another program, clock and seed.
   fs::path write_scenario(const std::string& name, const fs::path& program, double clock_s,
                           int seed) {
-    std::string text = test_support::read_file_text(scenarios_ / "two-sessions-mounting.yaml");
+    std::string text = test_support::read_text(scenarios_ / "two-sessions-mounting.yaml");
     const auto replace = [&](const std::string& from, const std::string& to) {
       const auto at = text.find(from);
       if (at == std::string::npos) throw std::runtime_error("scenario lacks " + from);
@@ -189,9 +190,8 @@ class GapHarnessWide : public test_support::ScratchDirTest {
   void run(const std::string& args, const std::string& tag, std::vector<int> ok = {0}) {
     const fs::path log = dir_ / (tag + ".log");
     const int status = test_support::run_imscal(args, log);
-    ASSERT_NE(std::find(ok.begin(), ok.end(), status), ok.end())
-        << args << "\n"
-        << test_support::read_file_text(log);
+    ASSERT_NE(std::find(ok.begin(), ok.end(), status), ok.end()) << args << "\n"
+                                                                 << test_support::read_text(log);
   }
 
   // The mounting session of unit/mount `seed`: its frames.json and the unit's calibration sheet.
@@ -201,7 +201,7 @@ class GapHarnessWide : public test_support::ScratchDirTest {
         write_scenario(tag, datasets_ / "programs/mounting.yaml", 0.0123, seed);
     run("simulate --scenario " + scenario.string() + " --out " + (dir_ / tag).string(), tag);
     // The lab's sheet of the unit: scale factors and misalignments, biases left to the bundle.
-    std::string sheet = test_support::read_file_text(dir_ / tag / "truth/sensor_errors.yaml");
+    std::string sheet = test_support::read_text(dir_ / tag / "truth/sensor_errors.yaml");
     std::string unit;
     std::istringstream lines(sheet);
     for (std::string line; std::getline(lines, line);) {
@@ -247,7 +247,7 @@ class GapHarnessWide : public test_support::ScratchDirTest {
       chain_rms_rad.push_back(std::sqrt(e / double(measured.sample_count())));
       rms += fmt::format(" {:.2g}", chain_rms_rad.back());
     }
-    const auto report = nlohmann::json::parse(test_support::read_file_text(out / "report.json"));
+    const auto report = nlohmann::json::parse(test_support::read_text(out / "report.json"));
     const bool alarm = report.at("significant_gap").get<bool>();
     fmt::print("chain-measured control {} seed {}: chain error RMS per joint [rad]{}; cause {}\n",
                program, seed, rms, alarm ? "raised" : "none");

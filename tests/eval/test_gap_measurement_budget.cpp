@@ -20,6 +20,7 @@
 #include "ident/joint_error_io.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal {
 namespace {
@@ -27,7 +28,7 @@ namespace {
 namespace fs = std::filesystem;
 using MeasurementBudgetCli = test_support::ScratchDirTest;
 constexpr auto* run = &imscal::test_support::run_imscal;
-constexpr auto* read = &imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 
 TEST(MeasurementBudget, ChiSquaredTailMatchesTheTables) {
   // Upper quantiles of chi2 (Abramowitz & Stegun, table 26.8): P(X >= x) = p. Wilson-Hilferty
@@ -66,13 +67,13 @@ nlohmann::json diagnose_through_the_chain(const fs::path& dir, const fs::path& r
                     "/campaign/calibrate.yaml --out " + cal.string(),
                 dir / "cal.log"),
             1)
-      << read(dir / "cal.log");
+      << read_text(dir / "cal.log");
   EXPECT_EQ(run("model-joint-errors --joint-errors " + (cal / "joint_errors.csv").string() +
                     " --scenario " + data + "/scenarios/campaign.yaml --out " +
                     (dir / "model.csv").string(),
                 dir / "model.log"),
             0)
-      << read(dir / "model.log");
+      << read_text(dir / "model.log");
   EXPECT_EQ(
       run("diagnose --joint-errors " + (cal / "joint_errors.csv").string() +
               " --sim-joint-errors " + (dir / "model.csv").string() + " --robot " + data +
@@ -80,8 +81,8 @@ nlohmann::json diagnose_through_the_chain(const fs::path& dir, const fs::path& r
               data + "/scenarios/campaign.yaml --out " + (dir / "out").string(),
           dir / "diagnose.log"),
       0)
-      << read(dir / "diagnose.log");
-  return nlohmann::json::parse(read(dir / "out" / "report.json"));
+      << read_text(dir / "diagnose.log");
+  return nlohmann::json::parse(read_text(dir / "out" / "report.json"));
 }
 
 void print_budget(const char* what, const nlohmann::json& m) {
@@ -131,7 +132,7 @@ TEST_F(MeasurementBudgetCli, ControlMeasuredThroughTheChainIsWithinTheMeasuremen
 TEST_F(MeasurementBudgetCli, WithheldTransmissionErrorIsBeyondTheMeasurement) {
   if (std::getenv("IMSCAL_SANITIZED")) GTEST_SKIP() << "Release only: simulate and diagnose";
   const std::string data = IMSCAL_SOURCE_DIR "/datasets";
-  std::string scenario = read(data + "/scenarios/campaign.yaml");
+  std::string scenario = read_text(data + "/scenarios/campaign.yaml");
   for (std::size_t at = scenario.find("../"); at != std::string::npos;
        at = scenario.find("../", at))
     scenario.replace(at, 3, data + "/");
@@ -146,7 +147,7 @@ TEST_F(MeasurementBudgetCli, WithheldTransmissionErrorIsBeyondTheMeasurement) {
                     (dir_ / "sim").string(),
                 dir_ / "sim.log"),
             0)
-      << read(dir_ / "sim.log");
+      << read_text(dir_ / "sim.log");
   const nlohmann::json report = diagnose_through_the_chain(dir_, dir_ / "sim");
   const auto& m = report["measurement"];
   print_budget("transmission error 30\" on A2", m);

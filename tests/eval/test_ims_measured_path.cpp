@@ -5,30 +5,24 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
-#include <filesystem>
 
 #include "eval/ims_measured_path.hpp"
 #include "eval/verification.hpp"
 #include "robot/forward_kinematics.hpp"
-#include "sim/motion_planner.hpp"
-#include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
+#include "tests/support/seed_line_start.hpp"
 
 namespace imscal::eval {
 namespace {
 
-namespace fs = std::filesystem;
-
 TEST(ImsMeasuredPath, GivesThePlantsFlangePathOnSeedLine) {
-  const sim::Scenario scenario =
-      sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets/scenarios/seed-line.yaml");
-  const calib::RobotDescription robot = sim::load_plant_robot(scenario);
-  sim::DesiredJointPath path =
-      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
   // The initial rest, the approach, the rest before the line and the first line (to ~13 s);
   // under the sanitizers up to the start of the line.
-  const double until_s = std::getenv("IMSCAL_SANITIZED") ? 10.5 : 13.0;
-  while (path.samples.back().t_s > until_s) path.samples.pop_back();
+  const test_support::SeedLineStart line =
+      test_support::seed_line_until(std::getenv("IMSCAL_SANITIZED") ? 10.5 : 13.0);
+  const sim::Scenario& scenario = line.scenario;
+  const calib::RobotDescription& robot = line.robot;
+  const sim::DesiredJointPath& path = line.path;
   sim::PlantConfig config = sim::make_plant_config(robot, scenario);
   config.gravity_in_base_m_s2 = scenario_model_torque(scenario).gravity_in_base_m_s2;
   const sim::PlantLog plant = sim::simulate_plant(config, path, path.cycle_s);

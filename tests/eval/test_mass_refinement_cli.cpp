@@ -9,6 +9,7 @@
 
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -21,7 +22,7 @@ TEST_F(MassRefinementCli, IdentifyRefusesATooShortRecordNamingTheKey) {
   const fs::path source(IMSCAL_SOURCE_DIR);
   for (const std::string key : {"refine_mass_parameters", "refine_gravity"}) {
     std::string text =
-        test_support::read_file_text(source / "datasets/identification/ident-default.yaml");
+        test_support::read_text(source / "datasets/identification/ident-default.yaml");
     const std::string off = key + ": false";
     const std::size_t at = text.find(off);
     ASSERT_NE(at, std::string::npos) << "the shipped config states the key " << key;
@@ -33,7 +34,7 @@ TEST_F(MassRefinementCli, IdentifyRefusesATooShortRecordNamingTheKey) {
             " --config " + config.string() + " --robot " +
             (source / "datasets/robots/kr16.yaml").string() + " --out " + out.string(),
         dir_ / "message.log");
-    const std::string message = test_support::read_file_text(dir_ / "message.log");
+    const std::string message = test_support::read_text(dir_ / "message.log");
     EXPECT_EQ(status, 2) << message;
     EXPECT_NE(message.find("field 'model." + key + "'"), std::string::npos) << message;
     EXPECT_NE(message.find("too short"), std::string::npos) << message;

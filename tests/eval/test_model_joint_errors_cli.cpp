@@ -20,6 +20,7 @@
 #include "sim/scenario.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal {
 namespace {
@@ -28,7 +29,7 @@ namespace fs = std::filesystem;
 using ModelJointErrorsCli = test_support::ScratchDirTest;
 
 constexpr auto* run = &imscal::test_support::run_imscal;
-constexpr auto* read = &imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 
 // A scenario of tests/data/scenarios/short-program.yaml whose plant is kr16.yaml times
 // `deviations` (empty: the nominal robot itself).
@@ -75,7 +76,7 @@ TEST_F(ModelJointErrorsCli, TheNominalModelReproducesANominalPlantOnTheSameSampl
   const std::string args = "model-joint-errors --joint-errors " + (dir_ / "measured.csv").string() +
                            " --scenario " + scenario.string() + " --out " +
                            (dir_ / "model.csv").string();
-  ASSERT_EQ(run(args, dir_ / "a.log"), 0) << read(dir_ / "a.log");
+  ASSERT_EQ(run(args, dir_ / "a.log"), 0) << read_text(dir_ / "a.log");
   const ident::JointErrorLog model = ident::read_joint_errors_csv(dir_ / "model.csv");
   ASSERT_EQ(model.sample_count(), truth.sample_count());
   EXPECT_EQ(model.time_s, truth.time_s);
@@ -98,8 +99,8 @@ TEST_F(ModelJointErrorsCli, TheNominalModelReproducesANominalPlantOnTheSameSampl
                     " --out " + (dir_ / "out").string(),
                 dir_ / "d.log"),
             0)
-      << read(dir_ / "d.log");
-  const auto report = nlohmann::json::parse(read(dir_ / "out" / "report.json"));
+      << read_text(dir_ / "d.log");
+  const auto report = nlohmann::json::parse(read_text(dir_ / "out" / "report.json"));
   EXPECT_FALSE(report["significant_gap"].get<bool>()) << report["verdict"];
   // With --robot instead of the scenario: the simulator's defaults (every effect but the
   // transmission error, the play of every joint, upright gravity, the logged mass as a point
@@ -109,15 +110,15 @@ TEST_F(ModelJointErrorsCli, TheNominalModelReproducesANominalPlantOnTheSameSampl
                     (dir_ / "model-robot.csv").string(),
                 dir_ / "r.log"),
             0)
-      << read(dir_ / "r.log");
+      << read_text(dir_ / "r.log");
   const ident::JointErrorLog by_robot = ident::read_joint_errors_csv(dir_ / "model-robot.csv");
   EXPECT_EQ(by_robot.time_s, truth.time_s);
   EXPECT_EQ(by_robot.q_desired_rad, truth.q_desired_rad);
   // An existing output is refused without --force (exit 2, unchanged), replaced with it.
-  const std::string before = read(dir_ / "model.csv");
-  EXPECT_EQ(run(args, dir_ / "b.log"), 2) << read(dir_ / "b.log");
-  EXPECT_EQ(read(dir_ / "model.csv"), before);
-  EXPECT_EQ(run(args + " --force", dir_ / "c.log"), 0) << read(dir_ / "c.log");
+  const std::string before = read_text(dir_ / "model.csv");
+  EXPECT_EQ(run(args, dir_ / "b.log"), 2) << read_text(dir_ / "b.log");
+  EXPECT_EQ(read_text(dir_ / "model.csv"), before);
+  EXPECT_EQ(run(args + " --force", dir_ / "c.log"), 0) << read_text(dir_ / "c.log");
 }
 
 TEST_F(ModelJointErrorsCli, DiagnoseOnTheModelSideRaisesTheJointThatDiffers) {
@@ -128,7 +129,7 @@ TEST_F(ModelJointErrorsCli, DiagnoseOnTheModelSideRaisesTheJointThatDiffers) {
                     " --scenario " + scenario.string() + " --out " + (dir_ / "model.csv").string(),
                 dir_ / "a.log"),
             0)
-      << read(dir_ / "a.log");
+      << read_text(dir_ / "a.log");
   const std::string robot = std::string(IMSCAL_SOURCE_DIR) + "/datasets/robots/kr16.yaml";
   const fs::path out = dir_ / "out";
   ASSERT_EQ(
@@ -136,14 +137,14 @@ TEST_F(ModelJointErrorsCli, DiagnoseOnTheModelSideRaisesTheJointThatDiffers) {
               (dir_ / "model.csv").string() + " --robot " + robot + " --out " + out.string(),
           dir_ / "b.log"),
       0)
-      << read(dir_ / "b.log");
-  const auto report = nlohmann::json::parse(read(out / "report.json"));
+      << read_text(dir_ / "b.log");
+  const auto report = nlohmann::json::parse(read_text(out / "report.json"));
   EXPECT_TRUE(report["significant_gap"].get<bool>()) << report["verdict"];
   const auto& per_joint = report["gap_rms_per_joint_rad"];
   for (const char* j : {"A2", "A3", "A4", "A5", "A6"})
     EXPECT_GT(per_joint["A1"].get<double>(), 10.0 * per_joint[j].get<double>()) << j;
   EXPECT_TRUE(report["joint_significance"][0]["significant"].get<bool>());
-  const std::string text = read(out / "report.txt");
+  const std::string text = read_text(out / "report.txt");
   EXPECT_NE(text.find("Gap RMS per joint: A1"), std::string::npos);
   EXPECT_EQ(text.find("No significant structured gap"), std::string::npos);
 }
@@ -170,7 +171,7 @@ TEST_F(ModelJointErrorsCli, ARecordWithAGapKeepsItsSamples) {
                     " --scenario " + scenario.string() + " --out " + (dir_ / "model.csv").string(),
                 dir_ / "a.log"),
             0)
-      << read(dir_ / "a.log");
+      << read_text(dir_ / "a.log");
   const ident::JointErrorLog model = ident::read_joint_errors_csv(dir_ / "model.csv");
   EXPECT_EQ(model.time_s, gapped.time_s);
   const auto e_truth = eval::measured_joint_errors(gapped);
@@ -191,7 +192,8 @@ TEST_F(ModelJointErrorsCli, RefusesAnotherRobotsRecordAndMissingInputs) {
                     " --scenario " + scenario.string() + " --out " + (dir_ / "m.csv").string(),
                 dir_ / "a.log"),
             2);
-  EXPECT_NE(read(dir_ / "a.log").find("another-robot"), std::string::npos) << read(dir_ / "a.log");
+  EXPECT_NE(read_text(dir_ / "a.log").find("another-robot"), std::string::npos)
+      << read_text(dir_ / "a.log");
   EXPECT_FALSE(fs::exists(dir_ / "m.csv"));
   // Neither --robot nor --scenario: refused, nothing written.
   EXPECT_NE(run("model-joint-errors --joint-errors " + (dir_ / "other.csv").string() + " --out " +

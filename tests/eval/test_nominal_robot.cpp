@@ -10,7 +10,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -22,6 +21,7 @@
 #include "sim/motion_program.hpp"
 #include "sim/scenario.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -36,13 +36,6 @@ static_assert(!std::is_convertible_v<calib::RobotDescription, sim::NominalRobot>
 static_assert(!std::is_invocable_v<decltype(&nominal_model_torque), const calib::RobotDescription&,
                                    const sim::Scenario&>);
 
-std::string text_of(const fs::path& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 void replace_all(std::string& text, const std::string& from, const std::string& to) {
   for (std::size_t at = text.find(from); at != std::string::npos;
        at = text.find(from, at + to.size()))
@@ -55,7 +48,7 @@ class NominalRobotTest : public test_support::ScratchDirTest {
   // plant_robot and the given extra top-level YAML (e.g. a plant_deviations block).
   sim::Scenario seed_line_with(const fs::path& plant_robot, const std::string& extra,
                                const std::string& name) {
-    std::string yaml = text_of(kDatasets / "scenarios/seed-line.yaml");
+    std::string yaml = test_support::read_text(kDatasets / "scenarios/seed-line.yaml");
     replace_all(yaml, "../", kDatasets.string() + "/");
     replace_all(yaml, "\nrobot: " + (kDatasets / "robots/kr16.yaml").string() + " ",
                 "\nrobot: " + plant_robot.string() + " ");
@@ -66,7 +59,7 @@ class NominalRobotTest : public test_support::ScratchDirTest {
 
   // kr16.yaml with every link 1.2x as heavy: a separate plant robot file.
   fs::path heavier_plant_file() {
-    std::string yaml = text_of(kDatasets / "robots/kr16.yaml");
+    std::string yaml = test_support::read_text(kDatasets / "robots/kr16.yaml");
     for (const char* mass : {"60", "40", "30", "12", "5", "1"}) {
       replace_all(yaml, std::string("mass_kg: ") + mass + " ",
                   "mass_kg: " + std::to_string(1.2 * std::stod(mass)) + " ");
@@ -133,7 +126,7 @@ TEST_F(NominalRobotTest, AJointsOwnFactorReplacesAllAndNoNominalMeansThePlantsFi
               file.joints[j].drive.viscous_nm_s_per_rad * 2);
 
   // Without nominal_robot: the plant's robot file, without its deviations.
-  std::string yaml = text_of(s.file);
+  std::string yaml = test_support::read_text(s.file);
   replace_all(yaml, "\nnominal_robot:", "\n# nominal_robot:");
   const fs::path defaulted = dir_ / "defaulted.yaml";
   std::ofstream(defaulted) << yaml;

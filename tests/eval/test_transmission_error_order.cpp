@@ -11,7 +11,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -23,6 +22,7 @@
 #include "ident/identification_config.hpp"
 #include "ident/parameter_table_io.hpp"
 #include "sim/scenario.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal::eval {
 namespace {
@@ -82,9 +82,7 @@ TEST(TransmissionErrorOrder, FindsASecondOrderWhereAJointHasOne) {
   // order sweep: ~15 s CPU in Release.
   if (std::getenv("IMSCAL_SANITIZED")) GTEST_SKIP() << "slow under the sanitizers";
   const std::filesystem::path shipped = sim::resolve_scenario("deviating-identification");
-  std::stringstream text;
-  text << std::ifstream(shipped).rdbuf();
-  std::string yaml = text.str();
+  std::string yaml = test_support::read_text(shipped);
   // The copy lives elsewhere: its paths (../robots/...) made absolute.
   const std::string datasets = shipped.parent_path().parent_path().string() + "/";
   for (std::size_t at = yaml.find("../"); at != std::string::npos; at = yaml.find("../", at))

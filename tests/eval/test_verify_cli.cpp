@@ -19,6 +19,7 @@
 #include "sim/scenario.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal {
 namespace {
@@ -28,7 +29,7 @@ using VerifyCli = test_support::ScratchDirTest;
 
 constexpr auto* run = &imscal::test_support::run_imscal;
 
-constexpr auto* read = &imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 
 // q̂ = q_d for every joint: no offset at all.
 ident::ParameterTable zero_error_table(const std::string& robot) {
@@ -60,7 +61,7 @@ TEST_F(VerifyCli, ZeroTableVerifiesUnchangedAndEvaluateAgrees) {
                     " --scenario seed-line --segments 'line -y' --cycles 2 --out " + out.string(),
                 dir_ / "verify.log"),
             0)
-      << read(dir_ / "verify.log");
+      << read_text(dir_ / "verify.log");
   const fs::path s = out / "seed-line";
   for (const char* f :
        {"verification.json", "verification.csv", "verification.txt", "fig5_paths.csv",
@@ -69,14 +70,15 @@ TEST_F(VerifyCli, ZeroTableVerifiesUnchangedAndEvaluateAgrees) {
     EXPECT_TRUE(fs::exists(s / f)) << f;
   }
   // Again without --force: refused before any work (exit 2), naming the existing output.
-  const std::string earlier = read(s / "verification.json");
+  const std::string earlier = read_text(s / "verification.json");
   EXPECT_EQ(run("verify --table " + table.string() + " --scenario seed-line --out " + out.string(),
                 dir_ / "again.log"),
             2);
-  EXPECT_NE(read(dir_ / "again.log").find((s / "verification.json").string() + ": field '--out'"),
-            std::string::npos)
-      << read(dir_ / "again.log");
-  EXPECT_EQ(read(s / "verification.json"), earlier);
+  EXPECT_NE(
+      read_text(dir_ / "again.log").find((s / "verification.json").string() + ": field '--out'"),
+      std::string::npos)
+      << read_text(dir_ / "again.log");
+  EXPECT_EQ(read_text(s / "verification.json"), earlier);
   const auto doc = nlohmann::json::parse(earlier);
   ASSERT_EQ(doc["cases"].size(), 2u);
   const auto& before = doc["cases"][0];
@@ -91,7 +93,7 @@ TEST_F(VerifyCli, ZeroTableVerifiesUnchangedAndEvaluateAgrees) {
   EXPECT_LE(before["scatter_floor_mm"].get<double>(),
             before["max_path_deviation_mm"].get<double>());
   EXPECT_GT(before["scatter_floor_mm"].get<double>(), 0.0);  // friction drawn anew per cycle
-  EXPECT_NE(read(s / "verification.txt").find("Scatter floor"), std::string::npos);
+  EXPECT_NE(read_text(s / "verification.txt").find("Scatter floor"), std::string::npos);
 
   // `imscal evaluate` on the written files over the evaluated segment, same window.
   ASSERT_EQ(
@@ -103,8 +105,8 @@ TEST_F(VerifyCli, ZeroTableVerifiesUnchangedAndEvaluateAgrees) {
                       doc["evaluated_to_s"].get<double>() + 1e-6, (dir_ / "figures.json").string()),
           dir_ / "evaluate.log"),
       0)
-      << read(dir_ / "evaluate.log");
-  const auto figures = nlohmann::json::parse(read(dir_ / "figures.json"));
+      << read_text(dir_ / "evaluate.log");
+  const auto figures = nlohmann::json::parse(read_text(dir_ / "figures.json"));
   // Same commanded samples and crossings; only the 17-digit round trip of the files differs.
   EXPECT_NEAR(figures["AT_p_mm"].get<double>(), before["AT_p_mm"].get<double>(), 1e-6);
   EXPECT_NEAR(figures["RT_p_mm"].get<double>(), before["RT_p_mm"].get<double>(), 1e-6);
@@ -121,7 +123,7 @@ TEST_F(VerifyCli, ZeroTableVerifiesUnchangedAndEvaluateAgrees) {
 std::map<std::string, std::string> files_below(const fs::path& folder) {
   std::map<std::string, std::string> files;
   for (const auto& e : fs::recursive_directory_iterator(folder))
-    if (e.is_regular_file()) files[fs::relative(e.path(), folder).string()] = read(e.path());
+    if (e.is_regular_file()) files[fs::relative(e.path(), folder).string()] = read_text(e.path());
   return files;
 }
 
@@ -135,14 +137,14 @@ TEST_F(VerifyCli, AFailingWriteLeavesTheEarlierOutputsAsTheyWere) {
   const std::string arguments = "verify --table " + table.string() +
                                 " --scenario seed-line --segments \"line -y\" --cycles 1 --out " +
                                 out.string();
-  ASSERT_EQ(run(arguments, dir_ / "verify.log"), 0) << read(dir_ / "verify.log");
+  ASSERT_EQ(run(arguments, dir_ / "verify.log"), 0) << read_text(dir_ / "verify.log");
   const auto before = files_below(out);
   ASSERT_GE(before.size(), 9u);  // scenario files, path files of one cycle before and after
   const std::string limited = "sh -c 'trap \"\" XFSZ; ulimit -f 16; " + std::string(IMSCAL_BINARY) +
                               " " + arguments + " --seed 7 --force; echo exit=$?' > " +
                               (dir_ / "limited.log").string() + " 2>&1";
   ASSERT_EQ(std::system(limited.c_str()), 0);
-  const std::string message = read(dir_ / "limited.log");
+  const std::string message = read_text(dir_ / "limited.log");
   EXPECT_NE(message.find("exit=3"), std::string::npos) << message;
   EXPECT_NE(message.find("File too large"), std::string::npos) << message;
   // It names what it could not write: the target, or the smoother's temporary file for its
@@ -171,7 +173,7 @@ TEST_F(VerifyCli, CompensateWritesOffsetsOrRefusesAnotherRobotsTable) {
                     (dir_ / "robot.csv").string() + " --out " + (dir_ / "offsets.csv").string(),
                 dir_ / "compensate.log"),
             0)
-      << read(dir_ / "compensate.log");
+      << read_text(dir_ / "compensate.log");
   std::ifstream in(dir_ / "offsets.csv");
   std::string line;
   std::size_t rows = 0;
@@ -191,18 +193,18 @@ TEST_F(VerifyCli, CompensateWritesOffsetsOrRefusesAnotherRobotsTable) {
                     (dir_ / "robot.csv").string() + " --out " + (dir_ / "other.csv").string(),
                 dir_ / "other.log"),
             2)
-      << read(dir_ / "other.log");
+      << read_text(dir_ / "other.log");
   EXPECT_FALSE(fs::exists(dir_ / "other.csv"));
   // The refusal names the table as the robot's source, not "the robot description".
-  EXPECT_NE(read(dir_ / "other.log").find("the parameter table"), std::string::npos)
-      << read(dir_ / "other.log");
+  EXPECT_NE(read_text(dir_ / "other.log").find("the parameter table"), std::string::npos)
+      << read_text(dir_ / "other.log");
   // A missing output folder is created, as every command creates its --out folder.
   EXPECT_EQ(run("compensate --table " + (dir_ / "zero.json").string() + " --robot-log " +
                     (dir_ / "robot.csv").string() + " --out " +
                     (dir_ / "new" / "folder" / "offsets.csv").string(),
                 dir_ / "new_folder.log"),
             0)
-      << read(dir_ / "new_folder.log");
+      << read_text(dir_ / "new_folder.log");
   EXPECT_TRUE(fs::is_regular_file(dir_ / "new" / "folder" / "offsets.csv"));
 }
 

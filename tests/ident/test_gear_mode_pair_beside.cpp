@@ -1,6 +1,6 @@
 // The gear-mode transmission-error pair beside the plain pair (ident/joint_identification.hpp,
-// GearModePairs::kBeside) against an independent truth. The record is made as in
-// tests/ident/test_transmission_error_input.cpp (a motor with a one-cycle lag, θ(k+1) =
+// GearModePairs::kBeside) against an independent truth. The record is made by
+// tests/ident/lagged_motor_record.hpp (a motor with a one-cycle lag, θ(k+1) =
 // α θ(k) + (1 - α) u(k), driving the link through an elastic gear, the record made backwards
 // from a smooth link path q), with two error terms on the motor side:
 //   θ = m + A_p sin(φ + ψ_p) + A_m Im(e^{jψ_m} y),  m = q + τ / k_g,  φ = f m,
@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "ident/joint_identification.hpp"
+#include "tests/ident/lagged_motor_record.hpp"
 
 namespace {
 namespace ident = imscal::ident;
@@ -32,10 +33,7 @@ constexpr double kRadPerRad = 160.0;
 constexpr double kStiffnessNmPerRad = 4.5e5;
 constexpr double kModeRadS = 2.0 * pi * 15.0, kDamping = 0.05;
 
-struct Record {
-  std::vector<double> q_desired, q_link, torque_nm, payload;
-  std::vector<std::pair<std::size_t, std::size_t>> segments;
-};
+using Record = imscal::test_support::LaggedMotorRecord;
 
 // Link path from rest (zero speed at t = 0, as the identification's filter starts) sweeping the
 // error's frequency f q̇ through ω_n (q̇ up to ~0.9 rad/s, ω_n / f = 0.59 rad/s); still for the
@@ -81,15 +79,7 @@ Record make_record() {
       v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
     }
   }
-  Record r;
-  for (std::size_t k = 0; k < n; ++k) {
-    r.q_desired.push_back((theta[k + 1] - kAlpha * theta[k]) / (1.0 - kAlpha));
-    r.q_link.push_back(q[k]);
-    r.torque_nm.push_back(tau[k]);
-    r.payload.push_back(5.0);
-  }
-  r.segments = {{0, n}};
-  return r;
+  return imscal::test_support::record_from_motor_angle(theta, q, tau, kAlpha);
 }
 
 ident::JointIdentificationOptions options(ident::GearModePairs pairs) {
@@ -113,9 +103,7 @@ ident::JointIdentificationOptions options(ident::GearModePairs pairs) {
 }
 
 ident::JointIdentification identify(const Record& r, const ident::JointIdentificationOptions& o) {
-  const ident::CellGrid one_cell({{ident::OperatingQuantity::kSpeed, {0.0, 5.0}}});
-  return ident::identify_joint("A2", r.q_desired, r.q_link, r.payload, r.segments, kDt, one_cell, o,
-                               r.torque_nm);
+  return imscal::test_support::identify_in_one_cell(r, kDt, o);
 }
 
 // The pair (A cos ψ, A sin ψ) of input pair number `pair` (0: sin/cos after the torque) as the sums

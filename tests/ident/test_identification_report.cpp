@@ -12,6 +12,8 @@
 #include "core/input_error.hpp"
 #include "core/json_output.hpp"
 #include "ident/identification_report.hpp"
+#include "tests/support/json_edit.hpp"
+#include "tests/support/refused_file.hpp"
 #include "tests/support/scratch_dir.hpp"
 
 namespace imscal::ident {
@@ -144,42 +146,25 @@ TEST_F(IdentificationReportTest, WhatIsWrittenIsReadBack) {
 TEST_F(IdentificationReportTest, RefusalsNameTheFileAndTheField) {
   const auto file = dir_ / "identification_report.json";
   const json good = identification_report_json(sample_header(), {sample_joint()});
-  struct Case {
-    json document;
-    std::string field;
+  const auto refused = [&](const json::json_pointer& at, const json& value,
+                           const std::string& field) {
+    SCOPED_TRACE(field);
+    test_support::expect_refused_naming_field(read_identification_report, file,
+                                              test_support::edited(good, at, value).dump(), field);
   };
-  std::vector<Case> cases;
-  const auto with = [&](const json::json_pointer& at, const json& value, std::string field) {
-    json j = good;
-    if (value.is_discarded())
-      j[at.parent_pointer()].erase(at.back());
-    else
-      j[at] = value;
-    cases.push_back({j, std::move(field)});
-  };
-  const json removed(json::value_t::discarded);
-  with("/imscal-identification-report"_json_pointer, removed, "imscal-identification-report");
-  with("/samples"_json_pointer, "many", "samples");
-  with("/joints/0/cells/1/status"_json_pointer, "guessed", "joints[0].cells[1].status");
-  with("/joints/0/cells/0/validation/simulation_fit_percent"_json_pointer, "61",
-       "joints[0].cells[0].validation.simulation_fit_percent");
-  with("/joints/0/backlash/l_rad"_json_pointer, removed, "joints[0].backlash.l_rad");
-  with("/joints/0/cells/0/chosen/na"_json_pointer, 2.5, "joints[0].cells[0].chosen.na");
-  with("/transmission_error_order_search/joints/0/held_out_joint_error_fit_percent"_json_pointer,
-       {1.0}, "transmission_error_order_search.joints[0].held_out_joint_error_fit_percent");
-  with("/joints"_json_pointer, json::object(), "joints");
-  with("/joints/0/table_validation_rows"_json_pointer, removed, "joints[0].table_validation_rows");
-  for (const Case& c : cases) {
-    SCOPED_TRACE(c.field);
-    std::ofstream(file, std::ios::trunc) << c.document.dump();
-    try {
-      read_identification_report(file);
-      ADD_FAILURE() << "accepted";
-    } catch (const InputError& e) {
-      EXPECT_EQ(e.file(), file.string());
-      EXPECT_EQ(e.field(), c.field) << e.what();
-    }
-  }
+  const json& removed = test_support::kRemovedJson;
+  refused("/imscal-identification-report"_json_pointer, removed, "imscal-identification-report");
+  refused("/samples"_json_pointer, "many", "samples");
+  refused("/joints/0/cells/1/status"_json_pointer, "guessed", "joints[0].cells[1].status");
+  refused("/joints/0/cells/0/validation/simulation_fit_percent"_json_pointer, "61",
+          "joints[0].cells[0].validation.simulation_fit_percent");
+  refused("/joints/0/backlash/l_rad"_json_pointer, removed, "joints[0].backlash.l_rad");
+  refused("/joints/0/cells/0/chosen/na"_json_pointer, 2.5, "joints[0].cells[0].chosen.na");
+  refused("/transmission_error_order_search/joints/0/held_out_joint_error_fit_percent"_json_pointer,
+          {1.0}, "transmission_error_order_search.joints[0].held_out_joint_error_fit_percent");
+  refused("/joints"_json_pointer, json::object(), "joints");
+  refused("/joints/0/table_validation_rows"_json_pointer, removed,
+          "joints[0].table_validation_rows");
 }
 
 // The report `imscal identify` wrote for the shipped campaign (the fuzz target's seed, its

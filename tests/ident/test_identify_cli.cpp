@@ -17,9 +17,11 @@
 #include "tests/ident/joint_simulation.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace {
 namespace ident = imscal::ident;
+using imscal::test_support::read_text;
 using imscal::test_support::SimulatedJoint;
 
 constexpr double kDt = 0.002;
@@ -66,10 +68,8 @@ class IdentifyCli : public imscal::test_support::ScratchDirTest {
     // The shipped config of the paper's method (operating-point cells, eq. 3's backlash) with a
     // smaller sweep (the test's joints are of order 2). The default's inverse form with the
     // model torque needs a robot's motion: tests/eval/test_verification.cpp.
-    std::ifstream in(std::string(IMSCAL_SOURCE_DIR) + "/datasets/identification/ident-paper.yaml");
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string config = text.str();
+    std::string config =
+        read_text(std::string(IMSCAL_SOURCE_DIR) + "/datasets/identification/ident-paper.yaml");
     const auto replace = [&](const std::string& from, const std::string& to) {
       const auto at = config.find(from);
       ASSERT_NE(at, std::string::npos) << from;
@@ -88,7 +88,7 @@ class IdentifyCli : public imscal::test_support::ScratchDirTest {
             (dir_ / config).string() + " --out " + (dir_ / "out").string() + " " + extra,
         dir_ / "log.txt");
   }
-  std::string log_text() { return imscal::test_support::read_file_text(dir_ / "log.txt"); }
+  std::string log_text() { return read_text(dir_ / "log.txt"); }
 };
 
 TEST_F(IdentifyCli, WritesALoadableTableThatFitsHeldOutData) {
@@ -155,10 +155,7 @@ TEST_F(IdentifyCli, JointThatCannotBeIdentifiedGetsTheNeutralModel) {
   log.q_internal_rad.emplace_back(log.sample_count(), 0.25);
   std::filesystem::remove(dir_ / "joint_errors.csv");
   ident::write_joint_errors_csv(dir_ / "joint_errors.csv", log);
-  std::ifstream in(dir_ / "ident.yaml");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string config = text.str();
+  std::string config = read_text(dir_ / "ident.yaml");
   const auto at = config.find("max_speed_deg_s: [60, 60]");
   ASSERT_NE(at, std::string::npos);
   config.replace(at, 25, "max_speed_deg_s: [60, 60, 60]");
@@ -251,8 +248,7 @@ TEST_F(IdentifyCli, NonUtf8FileNameIsWrittenAndTheTablesFitIsPrinted) {
   EXPECT_NE(log_text().find("is not valid UTF-8; its invalid bytes are written as U+FFFD"),
             std::string::npos)
       << log_text();
-  const std::string report =
-      imscal::test_support::read_file_text(dir_ / "out" / "identification_report.json");
+  const std::string report = read_text(dir_ / "out" / "identification_report.json");
   EXPECT_NE(report.find("joint_errors_\xef\xbf\xbdt\xef\xbf\xbd.csv"), std::string::npos);
   EXPECT_NE(log_text().find("A1 table: held-out joint-error fit"), std::string::npos) << log_text();
   EXPECT_NE(log_text().find("cell's own held-out fit"), std::string::npos) << log_text();
@@ -296,8 +292,7 @@ std::map<std::string, std::string> files_below(const std::filesystem::path& fold
   std::map<std::string, std::string> files;
   for (const auto& e : std::filesystem::recursive_directory_iterator(folder))
     if (e.is_regular_file())
-      files[std::filesystem::relative(e.path(), folder).string()] =
-          imscal::test_support::read_file_text(e.path());
+      files[std::filesystem::relative(e.path(), folder).string()] = read_text(e.path());
   return files;
 }
 

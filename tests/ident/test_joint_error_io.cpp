@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <iterator>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -12,6 +11,7 @@
 #include "core/input_error.hpp"
 #include "ident/joint_error_io.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace {
 namespace ident = imscal::ident;
@@ -191,11 +191,7 @@ TEST_F(JointErrorFiles, HeaderGivenAtCommitWritesTheSameBytes) {
     EXPECT_THROW(out.commit(), std::logic_error);  // its header is still to come
     out.commit(log);
   }
-  const auto bytes = [](const std::filesystem::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
-  EXPECT_EQ(bytes(deferred), bytes(whole));
+  EXPECT_EQ(imscal::test_support::read_text(deferred), imscal::test_support::read_text(whole));
   EXPECT_FALSE(std::filesystem::exists(dir_ / "deferred.csv.rows"));
   const auto dropped = dir_ / "dropped.csv";
   {

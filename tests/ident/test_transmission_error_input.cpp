@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "ident/joint_identification.hpp"
+#include "tests/ident/lagged_motor_record.hpp"
 
 namespace {
 namespace ident = imscal::ident;
@@ -28,10 +29,7 @@ constexpr double kPhaseRad = 0.7;
 constexpr double kRadPerRad = 160.0;          // harmonic 1 x gear ratio 160
 constexpr double kStiffnessNmPerRad = 4.5e5;  // the KR 16's A2 gear
 
-struct Record {
-  std::vector<double> q_desired, q_link, torque_nm, payload;
-  std::vector<std::pair<std::size_t, std::size_t>> segments;
-};
+using Record = imscal::test_support::LaggedMotorRecord;
 
 Record make_record() {
   const std::size_t n = 15000;  // 30 s
@@ -46,15 +44,7 @@ Record make_record() {
     const double motor = q[k] + tau[k] / kStiffnessNmPerRad;
     theta[k] = motor + kAmplitudeRad * std::sin(kRadPerRad * motor + kPhaseRad);
   }
-  Record r;
-  for (std::size_t k = 0; k < n; ++k) {
-    r.q_desired.push_back((theta[k + 1] - kAlpha * theta[k]) / (1.0 - kAlpha));
-    r.q_link.push_back(q[k]);
-    r.torque_nm.push_back(tau[k]);
-    r.payload.push_back(5.0);
-  }
-  r.segments = {{0, n}};
-  return r;
+  return imscal::test_support::record_from_motor_angle(theta, q, tau, kAlpha);
 }
 
 ident::JointIdentificationOptions options(bool transmission_error, bool compliance) {
@@ -74,9 +64,7 @@ ident::JointIdentificationOptions options(bool transmission_error, bool complian
 }
 
 ident::JointIdentification identify(const Record& r, const ident::JointIdentificationOptions& o) {
-  const ident::CellGrid one_cell({{ident::OperatingQuantity::kSpeed, {0.0, 5.0}}});
-  return ident::identify_joint("A2", r.q_desired, r.q_link, r.payload, r.segments, kDt, one_cell, o,
-                               r.torque_nm);
+  return imscal::test_support::identify_in_one_cell(r, kDt, o);
 }
 
 TEST(TransmissionErrorInput, RecoversTheClosedFormCoefficients) {

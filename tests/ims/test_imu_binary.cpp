@@ -11,15 +11,14 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <string>
 
 #include "core/input_error.hpp"
 #include "ims/imu_binary.hpp"
 #include "ims/imu_csv.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace fs = std::filesystem;
 using imscal::InputError;
@@ -31,6 +30,8 @@ using imscal::ims::ImuSeries;
 using imscal::ims::read_imu_binary;
 using imscal::ims::Site;
 using imscal::ims::write_imu_binary;
+using imscal::test_support::read_text;
+using imscal::test_support::write_text;
 
 namespace {
 
@@ -81,17 +82,6 @@ void expect_bit_identical(const ImuSeries& a, const ImuSeries& b) {
   }
 }
 
-std::string bytes_of(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_bytes(const fs::path& file, const std::string& bytes) {
-  std::ofstream(file, std::ios::binary) << bytes;
-}
-
 // Independent decoding of a little-endian IEEE double, byte by byte.
 double le_double(const std::string& bytes, std::size_t offset) {
   std::uint64_t raw = 0;
@@ -138,7 +128,7 @@ TEST_F(ImuBinary, ByteLayoutIsTheDocumentedOne) {
   s.metadata = {{"k", "vv"}};
   const fs::path file = dir_ / "layout.imsb";
   write_imu_binary(file, s, Overwrite::kAllow);
-  const std::string b = bytes_of(file);
+  const std::string b = read_text(file);
   // magic 8, version 4, quantity 4, dt 8, has_site 4, site 24, count 4, "k" 4+1, "vv" 4+2,
   // records 8, then 3 x 56 bytes.
   const std::size_t header = 8 + 4 + 4 + 8 + 4 + 24 + 4 + 5 + 6 + 8;
@@ -160,19 +150,19 @@ TEST_F(ImuBinary, ByteLayoutIsTheDocumentedOne) {
 }
 
 TEST_F(ImuBinary, EmptyForeignAndWrongVersionFilesAreRefused) {
-  write_bytes(dir_ / "empty.imsb", "");
+  write_text(dir_ / "empty.imsb", "");
   std::string field;
   EXPECT_NE(error_of(dir_ / "empty.imsb", &field).find("empty"), std::string::npos);
   EXPECT_EQ(field, "magic");
-  write_bytes(dir_ / "text.imsb", "# imscal-imu: 1\n# quantity: rates\n");
+  write_text(dir_ / "text.imsb", "# imscal-imu: 1\n# quantity: rates\n");
   EXPECT_NE(error_of(dir_ / "text.imsb", &field).find("not an imscal IMU binary file"),
             std::string::npos);
   EXPECT_EQ(field, "magic");
   write_imu_binary(dir_ / "v.imsb", make_series(600, 0.002, ImuQuantity::kRates, 2),
                    Overwrite::kAllow);
-  std::string b = bytes_of(dir_ / "v.imsb");
+  std::string b = read_text(dir_ / "v.imsb");
   b[8] = 2;
-  write_bytes(dir_ / "v2.imsb", b);
+  write_text(dir_ / "v2.imsb", b);
   EXPECT_NE(error_of(dir_ / "v2.imsb", &field).find("unsupported version 2"), std::string::npos);
   EXPECT_EQ(field, "version");
 }
@@ -180,27 +170,27 @@ TEST_F(ImuBinary, EmptyForeignAndWrongVersionFilesAreRefused) {
 TEST_F(ImuBinary, TruncationIsDetectedByTheSizeCheck) {
   const fs::path whole = dir_ / "whole.imsb";
   write_imu_binary(whole, make_series(600, 0.002, ImuQuantity::kRates, 3), Overwrite::kAllow);
-  const std::string b = bytes_of(whole);
+  const std::string b = read_text(whole);
   const std::size_t header = b.size() - 600 * 56;
   std::string field;
   // Inside record 401, after its t_s and gyro_x (16 of 56 bytes).
-  write_bytes(dir_ / "cut_record.imsb", b.substr(0, header + 400 * 56 + 16));
+  write_text(dir_ / "cut_record.imsb", b.substr(0, header + 400 * 56 + 16));
   std::string message = error_of(dir_ / "cut_record.imsb", &field);
   EXPECT_NE(message.find("record 401 of 600"), std::string::npos) << message;
   EXPECT_NE(message.find("truncated"), std::string::npos) << message;
   EXPECT_EQ(field, "gyro_y_rad_s");
   // Exactly at a record boundary: record 600 is missing whole.
-  write_bytes(dir_ / "cut_boundary.imsb", b.substr(0, header + 599 * 56));
+  write_text(dir_ / "cut_boundary.imsb", b.substr(0, header + 599 * 56));
   message = error_of(dir_ / "cut_boundary.imsb", &field);
   EXPECT_NE(message.find("record 600 of 600"), std::string::npos) << message;
   EXPECT_EQ(field, "t_s");
   // Inside the header.
-  write_bytes(dir_ / "cut_header.imsb", b.substr(0, 20));
+  write_text(dir_ / "cut_header.imsb", b.substr(0, 20));
   message = error_of(dir_ / "cut_header.imsb", &field);
   EXPECT_NE(message.find("truncated header"), std::string::npos) << message;
   EXPECT_EQ(field, "nominal_dt_s");
   // Extra bytes after the last record.
-  write_bytes(dir_ / "long.imsb", b + "xyz");
+  write_text(dir_ / "long.imsb", b + "xyz");
   message = error_of(dir_ / "long.imsb", &field);
   EXPECT_NE(message.find("3 bytes follow the 600 records"), std::string::npos) << message;
   EXPECT_EQ(field, "sample_count");
@@ -208,7 +198,7 @@ TEST_F(ImuBinary, TruncationIsDetectedByTheSizeCheck) {
   std::string corrupt = b;
   corrupt[52] = 1;                                // one metadata entry...
   corrupt.replace(56, 4, "\xff\xff\x00\x00", 4);  // ...of 65535 bytes
-  write_bytes(dir_ / "meta.imsb", corrupt);
+  write_text(dir_ / "meta.imsb", corrupt);
   message = error_of(dir_ / "meta.imsb", &field);
   EXPECT_EQ(field, "metadata");
 }
@@ -216,11 +206,11 @@ TEST_F(ImuBinary, TruncationIsDetectedByTheSizeCheck) {
 TEST_F(ImuBinary, NanRecordNamesRecordAndField) {
   const fs::path whole = dir_ / "whole.imsb";
   write_imu_binary(whole, make_series(600, 0.002, ImuQuantity::kIncrements, 8), Overwrite::kAllow);
-  std::string b = bytes_of(whole);
+  std::string b = read_text(whole);
   const std::size_t header = b.size() - 600 * 56;
   const double nan = std::nan("");
   std::memcpy(b.data() + header + 99 * 56 + 5 * 8, &nan, 8);  // record 100, dv_y (x86: LE)
-  write_bytes(dir_ / "nan.imsb", b);
+  write_text(dir_ / "nan.imsb", b);
   std::string field;
   const std::string message = error_of(dir_ / "nan.imsb", &field);
   EXPECT_NE(message.find("record 100 of 600"), std::string::npos) << message;
@@ -232,11 +222,11 @@ TEST_F(ImuBinary, NanRecordOfALongFileNamesTheFileTotal) {
   const fs::path whole = dir_ / "long.imsb";
   write_imu_binary(whole, make_series(10000, 0.002, ImuQuantity::kIncrements, 9),
                    Overwrite::kAllow);
-  std::string b = bytes_of(whole);
+  std::string b = read_text(whole);
   const std::size_t header = b.size() - 10000 * 56;
   const double nan = std::nan("");
   std::memcpy(b.data() + header + 101 * 56 + 1 * 8, &nan, 8);  // record 102, dtheta_x
-  write_bytes(dir_ / "nan.imsb", b);
+  write_text(dir_ / "nan.imsb", b);
   std::string field;
   const std::string message = error_of(dir_ / "nan.imsb", &field);
   EXPECT_NE(message.find("record 102 of 10000"), std::string::npos) << message;
@@ -247,11 +237,11 @@ TEST_F(ImuBinary, FailedWritesLeaveNothingBehind) {
   s.samples[99].t_s = INFINITY;
   EXPECT_THROW(write_imu_binary(dir_ / "inf.imsb", s, Overwrite::kAllow), std::invalid_argument);
   EXPECT_TRUE(fs::is_empty(dir_));
-  write_bytes(dir_ / "old.imsb", "old");
+  write_text(dir_ / "old.imsb", "old");
   EXPECT_THROW(write_imu_binary(dir_ / "old.imsb", make_series(5, 0.01, ImuQuantity::kRates, 5),
                                 Overwrite::kRefuse),
                std::runtime_error);
-  EXPECT_EQ(bytes_of(dir_ / "old.imsb"), "old");
+  EXPECT_EQ(read_text(dir_ / "old.imsb"), "old");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
 }
 

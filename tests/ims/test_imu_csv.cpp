@@ -13,13 +13,13 @@
 #include <fstream>
 #include <limits>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/input_error.hpp"
 #include "ims/imu_csv.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace fs = std::filesystem;
 using imscal::InputError;
@@ -32,6 +32,8 @@ using imscal::ims::ImuSeries;
 using imscal::ims::read_imu_csv;
 using imscal::ims::Site;
 using imscal::ims::write_imu_csv;
+using imscal::test_support::read_text;
+using imscal::test_support::write_text;
 
 namespace {
 
@@ -84,10 +86,6 @@ std::vector<std::string> lines_of(const fs::path& file) {
   std::string line;
   while (std::getline(in, line)) lines.push_back(line);
   return lines;
-}
-
-void write_text(const fs::path& file, const std::string& text) {
-  std::ofstream(file, std::ios::binary) << text;
 }
 
 TEST_F(ImuCsv, RoundTripIsBitExactForBothQuantities) {
@@ -259,15 +257,13 @@ TEST_F(ImuCsv, FormatMatchesTheFile) {
   const ImuSeries s = make_series(30, 0.01, ImuQuantity::kIncrements, 9);
   const fs::path file = dir_ / "same.csv";
   write_imu_csv(file, s, Overwrite::kAllow);
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  EXPECT_EQ(text.str(), imscal::ims::format_imu_csv(s));
+  const std::string text = read_text(file);
+  EXPECT_EQ(text, imscal::ims::format_imu_csv(s));
   EXPECT_TRUE(
-      text.str().starts_with("# imscal-imu: 1\n# quantity: increments\n"
-                             "# nominal_dt_s: 0.01\n"
-                             "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_m_s,"
-                             "dv_y_m_s,dv_z_m_s\n0.01,"));
+      text.starts_with("# imscal-imu: 1\n# quantity: increments\n"
+                       "# nominal_dt_s: 0.01\n"
+                       "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_m_s,"
+                       "dv_y_m_s,dv_z_m_s\n0.01,"));
 }
 
 }  // namespace

@@ -12,13 +12,13 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
-#include <sstream>
 #include <string>
 
 #include "core/input_error.hpp"
 #include "ims/imu_csv.hpp"
 #include "ims/imu_file.hpp"
 #include "ims/imu_validation.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace fs = std::filesystem;
 using imscal::InputError;
@@ -29,6 +29,7 @@ using imscal::ims::ImuSample;
 using imscal::ims::ImuSeries;
 using imscal::ims::Site;
 using imscal::ims::validate_imu_series;
+using imscal::test_support::read_text;
 
 namespace {
 
@@ -89,20 +90,13 @@ Expected load_expected(const fs::path& file) {
   return e;
 }
 
-std::string file_bytes(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 class BadImuFile : public testing::TestWithParam<const char*> {};
 
 TEST_P(BadImuFile, RefusedWithFileLineAndField) {
   const fs::path file = kBadDir / (std::string(GetParam()) + ".csv");
   const Expected expected = load_expected(kBadDir / (std::string(GetParam()) + ".expected"));
   ASSERT_FALSE(expected.contains.empty());
-  const std::string before = file_bytes(file);
+  const std::string before = read_text(file);
   try {
     imscal::ims::read_imu_csv(file);
     FAIL() << file << " was accepted";
@@ -118,7 +112,7 @@ TEST_P(BadImuFile, RefusedWithFileLineAndField) {
     EXPECT_NE(message.find(expected.contains), std::string::npos) << message;
   }
   // Readers never modify their input.
-  EXPECT_EQ(file_bytes(file), before);
+  EXPECT_EQ(read_text(file), before);
   // A conversion (read, then write) of the bad file leaves no output and no temporary behind.
   const fs::path out_dir =
       fs::temp_directory_path() / fmt::format("imscal-test-bad-imu-{}-{}", ::getpid(), GetParam());

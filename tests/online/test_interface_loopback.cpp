@@ -10,21 +10,17 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 
 #include "eval/closed_loop.hpp"
 #include "online/controller_emulator.hpp"
-#include "sim/motion_planner.hpp"
-#include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
 #include "sim/scenario.hpp"
 #include "tests/support/lag_table.hpp"
 #include "tests/support/loopback_server.hpp"
+#include "tests/support/seed_line_start.hpp"
 
 namespace imscal::online {
 namespace {
-
-namespace fs = std::filesystem;
 
 // Every joint: q̂(k) = 0.5 q̂(k-1) + 0.5 q_d(k-1), one cell: the joint lags its command by about
 // two cycles, a few mrad on the program's moves.
@@ -44,15 +40,11 @@ class Loopback : public ::testing::TestWithParam<ControllerProtocol> {};
 
 TEST_P(Loopback, ClosedLoopThroughSocketsEqualsTheInProcessLoop) {
   const bool egm = GetParam() == ControllerProtocol::kEgm;
-  const sim::Scenario scenario =
-      sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets/scenarios/seed-line.yaml");
-  const calib::RobotDescription robot = sim::load_plant_robot(scenario);
-  sim::DesiredJointPath path =
-      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
-  // The first 8 s (the rest and most of the move to the line: every joint moves); 6.6 s under
-  // sanitizers, as tests/eval/test_closed_loop.cpp.
-  const double keep_s = std::getenv("IMSCAL_SANITIZED") ? 6.6 : 8.0;
-  while (path.samples.back().t_s > keep_s) path.samples.pop_back();
+  const test_support::SeedLineStart line =
+      test_support::seed_line_until(test_support::seed_line_move_s());
+  const sim::Scenario& scenario = line.scenario;
+  const calib::RobotDescription& robot = line.robot;
+  const sim::DesiredJointPath& path = line.path;
   ASSERT_EQ(path.cycle_s, 0.002);
 
   // In process: the precontrol settled at the start pose over the engagement (0.4 s) first.

@@ -7,22 +7,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 
 #include "eval/closed_loop.hpp"
 #include "online/controller_emulator.hpp"
 #include "online/path_follower.hpp"
-#include "sim/motion_planner.hpp"
-#include "sim/motion_program.hpp"
 #include "sim/plant_config.hpp"
-#include "sim/scenario.hpp"
 #include "tests/support/lag_table.hpp"
 #include "tests/support/loopback_server.hpp"
+#include "tests/support/seed_line_start.hpp"
 
 namespace imscal::online {
 namespace {
-
-namespace fs = std::filesystem;
 
 // Joint 0 rests for 10 samples at 0, then moves at 0.001 rad per sample; the others rest.
 LoadedPath ramp_path(std::size_t n) {
@@ -98,13 +93,9 @@ ident::ParameterTable preview_table() {
 }
 
 TEST(RsiPath, APreviewTableThroughSocketsGetsThePathAhead) {
-  const sim::Scenario scenario =
-      sim::load_scenario(fs::path(IMSCAL_SOURCE_DIR) / "datasets/scenarios/seed-line.yaml");
-  const calib::RobotDescription robot = sim::load_plant_robot(scenario);
-  sim::DesiredJointPath path =
-      sim::plan_motion(robot, sim::load_motion_program(scenario.program_file));
-  const double keep_s = std::getenv("IMSCAL_SANITIZED") ? 6.6 : 8.0;
-  while (path.samples.back().t_s > keep_s) path.samples.pop_back();
+  const test_support::SeedLineStart line =
+      test_support::seed_line_until(test_support::seed_line_move_s());
+  const sim::DesiredJointPath& path = line.path;
 
   ident::PrecontrolOptions precontrol;
   precontrol.offset_tolerance_rad.fill(0.05);

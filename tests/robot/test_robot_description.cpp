@@ -5,13 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 
 #include "core/config_node.hpp"
 #include "core/input_error.hpp"
 #include "core/units.hpp"
 #include "robot/robot_description.hpp"
+#include "tests/support/text_file.hpp"
 
 using imscal::ConfigNode;
 using imscal::InputError;
@@ -24,10 +23,7 @@ namespace {
 const char* const kKr16Path = IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml";
 
 std::string kr16_text() {
-  std::ifstream in(kKr16Path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
+  return imscal::test_support::read_text(kKr16Path);
 }
 
 // The KR 16 text with the first occurrence of `from` replaced by `to`.

@@ -19,6 +19,7 @@
 #include "robot/robot_description.hpp"
 #include "robot/urdf_robot.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal::calib {
 namespace {
@@ -254,8 +255,7 @@ InputError load_error(const std::filesystem::path& file) {
 }
 
 TEST_F(UrdfFiles, RefusesAChainWithAPrismaticJoint) {
-  std::ifstream in(kRobots / "kr16.urdf");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text = test_support::read_text(kRobots / "kr16.urdf");
   const std::string revolute = "<joint name=\"joint_a3\" type=\"revolute\"";
   text.replace(text.find(revolute), revolute.size(), "<joint name=\"joint_a3\" type=\"prismatic\"");
   const InputError e = load_error(write_temp("prismatic.urdf", text));

@@ -12,6 +12,7 @@
 #include "sim/motion_planner.hpp"
 #include "sim/motion_program.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal::sim {
 namespace {
@@ -57,8 +58,7 @@ using ScenarioErrors = test_support::ScratchDirTest;
 
 TEST_F(ScenarioErrors, BadScenariosNameFileLineAndKey) {
   const std::string good = [] {
-    std::ifstream in(kScenarios / "seed-line.yaml");
-    std::string text((std::istreambuf_iterator<char>(in)), {});
+    std::string text = imscal::test_support::read_text(kScenarios / "seed-line.yaml");
     const std::string datasets = std::string(IMSCAL_SOURCE_DIR) + "/datasets/";
     for (std::size_t at; (at = text.find("../")) != std::string::npos;)
       text.replace(at, 3, datasets);

@@ -19,6 +19,7 @@
 #include "tests/support/frames_json.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal {
 namespace {
@@ -30,13 +31,13 @@ const fs::path kScenario = fs::path(IMSCAL_TEST_DATA_DIR) / "scenarios" / "short
 
 constexpr auto* run = &imscal::test_support::run_imscal;
 
-constexpr auto* read = &imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 
 TEST_F(SimulateCli, WritesConsistentFilesAndTheSameBytesForTheSameSeed) {
   const fs::path a = dir_ / "a", b = dir_ / "b", c = dir_ / "c";
   ASSERT_EQ(
       run("simulate --scenario " + kScenario.string() + " --out " + a.string(), dir_ / "a.log"), 0)
-      << read(dir_ / "a.log");
+      << read_text(dir_ / "a.log");
   ASSERT_EQ(
       run("simulate --scenario " + kScenario.string() + " --out " + b.string(), dir_ / "b.log"), 0);
   ASSERT_EQ(run("simulate --scenario " + kScenario.string() + " --seed 4 --out " + c.string(),
@@ -47,10 +48,11 @@ TEST_F(SimulateCli, WritesConsistentFilesAndTheSameBytesForTheSameSeed) {
                            "truth/imu_bias.csv", "truth/segments.csv", "truth/scenario.yaml"}) {
     SCOPED_TRACE(file);
     ASSERT_TRUE(fs::is_regular_file(a / file));
-    EXPECT_EQ(read(a / file), read(b / file));  // same seed, same bytes
+    EXPECT_EQ(read_text(a / file), read_text(b / file));  // same seed, same bytes
   }
-  EXPECT_NE(read(a / "imu.csv"), read(c / "imu.csv"));  // another seed: other noise and errors
-  EXPECT_NE(read(a / "truth/frames.json"), read(c / "truth/frames.json"));  // other mount, base
+  // Another seed: other noise and errors, another mount and base.
+  EXPECT_NE(read_text(a / "imu.csv"), read_text(c / "imu.csv"));
+  EXPECT_NE(read_text(a / "truth/frames.json"), read_text(c / "truth/frames.json"));
 
   // robot.csv: 2 ms rows; its internal angles are the truth's motor angles at the same instants.
   const calib::RobotLog log = calib::read_robot_log_csv(a / "robot.csv", "kr16");
@@ -91,7 +93,7 @@ TEST_F(SimulateCli, WritesConsistentFilesAndTheSameBytesForTheSameSeed) {
     EXPECT_LT(std::abs(bias.at(r, bias.column("acc_bias_z_ug"))), 200.0);
 
   // The truth trajectory of S in W is the flange truth through the frames: check 20 instants.
-  const nlohmann::json frames = nlohmann::json::parse(read(a / "truth/frames.json"));
+  const nlohmann::json frames = nlohmann::json::parse(read_text(a / "truth/frames.json"));
   auto pose = [](const nlohmann::json& j) {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = imscal::test_support::quaternion_of(j).toRotationMatrix();
@@ -125,11 +127,11 @@ TEST_F(SimulateCli, RefusesExistingOutputsAndBadScenarios) {
   EXPECT_EQ(run("simulate --scenario " + kScenario.string() + " --out " + (dir_ / "out").string(),
                 dir_ / "refuse.log"),
             2);
-  EXPECT_EQ(read(dir_ / "out" / "robot.csv"), "precious\n");  // nothing lost
-  EXPECT_NE(read(dir_ / "refuse.log").find("--force"), std::string::npos);
+  EXPECT_EQ(read_text(dir_ / "out" / "robot.csv"), "precious\n");  // nothing lost
+  EXPECT_NE(read_text(dir_ / "refuse.log").find("--force"), std::string::npos);
 
   // A copy with a misspelt key, its relative paths made absolute (tests write only to scratch).
-  std::string text = read(kScenario);
+  std::string text = read_text(kScenario);
   const std::string datasets = std::string(IMSCAL_SOURCE_DIR) + "/datasets";
   text.replace(text.find("../../../datasets"), 17, datasets);
   text.replace(text.find("../../../datasets"), 17, datasets);
@@ -141,13 +143,14 @@ TEST_F(SimulateCli, RefusesExistingOutputsAndBadScenarios) {
   const int code = run("simulate --scenario " + bad.string() + " --out " + (dir_ / "x").string(),
                        dir_ / "bad.log");
   EXPECT_EQ(code, 2);
-  EXPECT_NE(read(dir_ / "bad.log").find("sede"), std::string::npos) << read(dir_ / "bad.log");
+  EXPECT_NE(read_text(dir_ / "bad.log").find("sede"), std::string::npos)
+      << read_text(dir_ / "bad.log");
   EXPECT_FALSE(fs::exists(dir_ / "x" / "robot.csv"));
 
   EXPECT_EQ(run("simulate --scenario no-such-scenario --out " + (dir_ / "y").string(),
                 dir_ / "unknown.log"),
             2);
-  EXPECT_NE(read(dir_ / "unknown.log").find("seed-line"), std::string::npos)
+  EXPECT_NE(read_text(dir_ / "unknown.log").find("seed-line"), std::string::npos)
       << "the message lists the shipped scenarios";
 }
 

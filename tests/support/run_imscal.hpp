@@ -1,13 +1,11 @@
 #pragma once
-// The imscal binary as the CLI tests run it (IMSCAL_BINARY, set by tests/CMakeLists.txt), the
-// text of a file they check, and how often a piece occurs in it.
+// The imscal binary as the CLI tests run it (IMSCAL_BINARY, set by tests/CMakeLists.txt), and how
+// often a piece occurs in the text it wrote.
 #include <sys/wait.h>
 
 #include <cstddef>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 namespace imscal::test_support {
@@ -18,14 +16,6 @@ inline int run_imscal(const std::string& arguments, const std::filesystem::path&
       std::string(IMSCAL_BINARY) + " " + arguments + " > '" + log.string() + "' 2>&1";
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-// The whole file as bytes ("" when it cannot be read).
-inline std::string read_file_text(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 // Occurrences of `what` in `text` (overlapping ones counted).

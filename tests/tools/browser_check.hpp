@@ -14,6 +14,7 @@
 
 #include "core/subprocess.hpp"
 #include "tests/support/run_imscal.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal::test_support {
 
@@ -77,7 +78,7 @@ inline BrowserLoad load_in_chromium(const std::string& chromium, const std::file
 inline nlohmann::json figures_in_chromium(const std::string& chromium,
                                           const std::filesystem::path& report,
                                           const std::filesystem::path& profile_dir) {
-  const std::string html = read_file_text(report);
+  const std::string html = read_text(report);
   const std::size_t svg_count = count_of(html, "<svg");
 
   const BrowserLoad plain = load_in_chromium(chromium, report, profile_dir);

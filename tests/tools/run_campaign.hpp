@@ -15,7 +15,7 @@
 #include "ident/joint_error_io.hpp"
 #include "robot/robot_log.hpp"
 #include "tests/ident/joint_simulation.hpp"
-#include "tests/support/run_imscal.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal::test_support {
 
@@ -53,7 +53,7 @@ inline std::filesystem::path write_campaign(const std::filesystem::path& dir,
   ident::write_joint_errors_csv(dir / "joint_errors.csv", log);
 
   std::string config =
-      read_file_text(fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-paper.yaml");
+      read_text(fs::path(IMSCAL_SOURCE_DIR) / "datasets/identification/ident-paper.yaml");
   const auto replace = [&](const std::string& from, const std::string& to) {
     const auto at = config.find(from);
     if (at == std::string::npos) throw std::runtime_error("ident-paper.yaml lacks " + from);

@@ -10,11 +10,12 @@
 
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-using imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 using imscal::test_support::run_imscal;
 
 const fs::path kPoses =
@@ -31,8 +32,8 @@ TEST_F(CalibrateKinematicsCli, WritesTheReportWithBothModelsOnHeldOutPoses) {
   const std::string args = "calibrate-kinematics --robot " + kRobot.string() + " --poses " +
                            kPoses.string() + " --out " + out.string();
   const int code = run_imscal(args, dir_ / "run.log");
-  ASSERT_EQ(code, 0) << read_file_text(dir_ / "run.log");
-  const auto report = nlohmann::json::parse(read_file_text(out));
+  ASSERT_EQ(code, 0) << read_text(dir_ / "run.log");
+  const auto report = nlohmann::json::parse(read_text(out));
   EXPECT_EQ(report.at("fitted_poses").get<int>(), 200);
   EXPECT_EQ(report.at("held_out_poses").get<int>(), 200);
   EXPECT_GT(report.at("nominal").at("held_out_errors").at("rms_mm").get<double>(), 0.8);
@@ -48,7 +49,7 @@ TEST_F(CalibrateKinematicsCli, WritesTheReportWithBothModelsOnHeldOutPoses) {
   EXPECT_EQ(held, 10);
   // The output exists now: refused without --force (exit 2), the file kept.
   EXPECT_EQ(run_imscal(args, dir_ / "again.log"), 2);
-  EXPECT_NE(read_file_text(dir_ / "again.log").find("--force"), std::string::npos);
+  EXPECT_NE(read_text(dir_ / "again.log").find("--force"), std::string::npos);
 }
 
 TEST_F(CalibrateKinematicsCli, AJointInDegreesIsBadInput) {
@@ -60,7 +61,7 @@ TEST_F(CalibrateKinematicsCli, AJointInDegreesIsBadInput) {
                                   poses.string() + " --out " + (dir_ / "k.json").string(),
                               dir_ / "bad.log");
   EXPECT_EQ(code, 2);
-  const std::string log = read_file_text(dir_ / "bad.log");
+  const std::string log = read_text(dir_ / "bad.log");
   EXPECT_NE(log.find("q2_rad"), std::string::npos) << log;
   EXPECT_FALSE(fs::exists(dir_ / "k.json"));
 }
@@ -80,7 +81,7 @@ TEST_F(CalibrateKinematicsCli, OnePoseRepeatedIsBadInput) {
                                   poses.string() + " --out " + (dir_ / "k.json").string(),
                               dir_ / "same.log");
   EXPECT_EQ(code, 2);
-  EXPECT_NE(read_file_text(dir_ / "same.log").find("too little motion"), std::string::npos);
+  EXPECT_NE(read_text(dir_ / "same.log").find("too little motion"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir_ / "k.json"));
 }
 

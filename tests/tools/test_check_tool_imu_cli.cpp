@@ -18,11 +18,12 @@
 
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-using imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 using imscal::test_support::run_imscal;
 
 const fs::path kDir = fs::path(IMSCAL_TEST_DATA_DIR) / "real" / "abb-mems";
@@ -35,12 +36,12 @@ TEST_F(CheckToolImuCli, FastRecordWithSignFlippingPosesIsCalibrated) {
       run_imscal("check-tool-imu --imu " + (kDir / "V_1500_Sequencia1" / "LSM9DS0.csv").string() +
                      " --out " + out.string(),
                  dir_ / "fast.log");
-  const std::string log = read_file_text(dir_ / "fast.log");
+  const std::string log = read_text(dir_ / "fast.log");
   // The solve used to fail on windows without a robot pose at the initial clock offset (the
   // robot's quaternions flip sign around 180 deg about z, leaving 0.2 s without valid poses)
   // and the covariance of the failed solve killed the process. Now it calibrates: exit 0.
   ASSERT_EQ(code, 0) << log;
-  const auto report = nlohmann::json::parse(read_file_text(out));
+  const auto report = nlohmann::json::parse(read_text(out));
   const auto& calibration = report.at("calibration");
   EXPECT_GE(calibration.at("window_count").get<int>(), 10);
   // The LSM9DS0's gyro counts 1/64 of the labelled deg/s (SOURCE.md): scale 1/64 +- 5 %, the
@@ -84,11 +85,11 @@ TEST_F(CheckToolImuCli, PartialLossIsListedAndARefusedReferenceIsReported) {
                                   (kDir / "V_800_Sequencia3" / "MPU6050RM3100.csv").string() +
                                   " --xsens " + xsens.string() + " --out " + out.string(),
                               dir_ / "loss.log");
-  const std::string log = read_file_text(dir_ / "loss.log");
+  const std::string log = read_text(dir_ / "loss.log");
   ASSERT_EQ(code, 0) << log;
   EXPECT_NE(log.find("[orientation_loss]"), std::string::npos) << log;
   EXPECT_NE(log.find("REFUSED"), std::string::npos) << log;
-  const auto report = nlohmann::json::parse(read_file_text(out));
+  const auto report = nlohmann::json::parse(read_text(out));
   const auto& orientation = report.at("orientation");
   // The one partial loss of the record (SOURCE.md: about 30 deg in one turn): 15-40 deg.
   ASSERT_GE(orientation.at("losses").size(), 1u);
@@ -116,7 +117,7 @@ TEST_F(CheckToolImuCli, PartialLossIsListedAndARefusedReferenceIsReported) {
                      (dir_ / "no_such_xsens.csv").string() + " --out " + missing_out.string(),
                  dir_ / "missing.log"),
       2);
-  EXPECT_NE(read_file_text(dir_ / "missing.log").find("no_such_xsens.csv"), std::string::npos);
+  EXPECT_NE(read_text(dir_ / "missing.log").find("no_such_xsens.csv"), std::string::npos);
   EXPECT_FALSE(fs::exists(missing_out));
 
   // --no-restart: the error from the start only.
@@ -126,7 +127,7 @@ TEST_F(CheckToolImuCli, PartialLossIsListedAndARefusedReferenceIsReported) {
                            plain.string(),
                        dir_ / "plain.log"),
             0);
-  const auto plain_report = nlohmann::json::parse(read_file_text(plain));
+  const auto plain_report = nlohmann::json::parse(read_text(plain));
   EXPECT_FALSE(plain_report.at("orientation").contains("with_restarts"));
   EXPECT_DOUBLE_EQ(plain_report.at("orientation").at("from_start").at("rms_deg").get<double>(),
                    from_start);

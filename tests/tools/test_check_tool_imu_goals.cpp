@@ -25,11 +25,12 @@
 #include "tests/support/record_figure.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-using imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 using imscal::test_support::record_figure;
 using imscal::test_support::run_imscal;
 
@@ -66,7 +67,7 @@ bool sanitized() {
 
 // The README's row for `file` (its figures: median, 90th percentile, max, losses), or empty.
 std::vector<double> readme_row(const std::string& file) {
-  std::istringstream readme(read_file_text(fs::path(IMSCAL_SOURCE_DIR) / "README.md"));
+  std::istringstream readme(read_text(fs::path(IMSCAL_SOURCE_DIR) / "README.md"));
   std::string line;
   while (std::getline(readme, line)) {
     const auto start = line.find_first_not_of(' ');
@@ -94,9 +95,9 @@ class CheckToolImuGoals : public imscal::test_support::ScratchDirTest {
       arguments += " --calibration-from " + (kDir / record.calibration_from).string();
     }
     const int code = run_imscal(arguments + " --out " + out.string(), dir_ / (name + ".log"));
-    EXPECT_EQ(code, 0) << record.file << "\n" << read_file_text(dir_ / (name + ".log"));
+    EXPECT_EQ(code, 0) << record.file << "\n" << read_text(dir_ / (name + ".log"));
     if (code != 0) return {};
-    return nlohmann::json::parse(read_file_text(out)).at("orientation");
+    return nlohmann::json::parse(read_text(out)).at("orientation");
   }
 };
 

@@ -18,12 +18,13 @@
 
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal {
 namespace {
 
 namespace fs = std::filesystem;
-using test_support::read_file_text;
+using test_support::read_text;
 using test_support::run_imscal;
 
 const fs::path kSource(IMSCAL_SOURCE_DIR);
@@ -62,7 +63,7 @@ class CommandBadInputs : public test_support::ScratchDirTest {
   // Runs the command; returns its exit code, the message in message_.
   int run(const std::string& arguments) {
     const int status = run_imscal(arguments, dir_ / "message.log");
-    message_ = read_file_text(dir_ / "message.log");
+    message_ = read_text(dir_ / "message.log");
     return status;
   }
   std::string message_;
@@ -128,13 +129,13 @@ TEST_F(CommandBadInputs, MissingFileFolderAndNamedPipeAreRefusedAtOnceWithExitTw
 // core/joint_limit_plausibility.hpp, in every file of joint angles a command checks against its
 // robot: refused with exit 2 naming file, line and column.
 std::string joint_errors_with_a2(const std::string& q_rad) {
-  std::string text = read_file_text(kJointErrors);
+  std::string text = read_text(kJointErrors);
   for (std::size_t column : {3, 9, 15}) text = with_field(text, 6, column, q_rad);
   return text;
 }
 
 std::string robot_log_with_a2(const std::string& q_rad) {
-  std::string text = read_file_text(kSource / "fuzz/corpus/robot_log/valid.csv");
+  std::string text = read_text(kSource / "fuzz/corpus/robot_log/valid.csv");
   for (std::size_t column : {3, 9}) text = with_field(text, 7, column, q_rad);
   return text;
 }
@@ -146,23 +147,22 @@ TEST_F(CommandBadInputs, ABadFieldIsRefusedWithFileLineAndField) {
   };
   const std::vector<Case> cases = {
       {"serve: robot log cycle", "robot.csv",
-       read_file_text(kSource / "tests/data/bad_inputs/robot/bad_cycle.csv"),
+       read_text(kSource / "tests/data/bad_inputs/robot/bad_cycle.csv"),
        "serve --table " + kTable + " --port 0 --robot " + kKr16 +
            " --idle-timeout-s 1 --path INPUT",
        "robot.csv:3", "cycle_s"},
       {"calibrate-kinematics: text for a joint angle", "poses.csv",
-       with_field(read_file_text(kPoses), 3, 7, "abc"),
+       with_field(read_text(kPoses), 3, 7, "abc"),
        "calibrate-kinematics --robot " + kUr10 + " --poses INPUT --out OUT", "poses.csv:3",
        "q1_shoulder_pan_rad"},
-      {"check-tool-imu: text for a rate", "imu.csv",
-       with_field(read_file_text(kToolImu), 3, 1, "abc"), "check-tool-imu --imu INPUT --out OUT",
-       "imu.csv:3", "gyro_x_dps"},
+      {"check-tool-imu: text for a rate", "imu.csv", with_field(read_text(kToolImu), 3, 1, "abc"),
+       "check-tool-imu --imu INPUT --out OUT", "imu.csv:3", "gyro_x_dps"},
       {"diagnose-tool-imu: text for a rate", "imu.csv",
-       with_field(read_file_text(kToolImu), 3, 1, "abc"),
+       with_field(read_text(kToolImu), 3, 1, "abc"),
        "diagnose-tool-imu --imu INPUT --held-out " + kToolImu + " --out OUT", "imu.csv:3",
        "gyro_x_dps"},
       {"model-joint-errors: a corrupted sample", "joint_errors.csv",
-       with_field(read_file_text(kJointErrors), 6, 2, "253"),
+       with_field(read_text(kJointErrors), 6, 2, "253"),
        "model-joint-errors --joint-errors INPUT --robot " + kKr16 + " --out OUT",
        "joint_errors.csv:6", "q_measured_A1_rad"},
       {"model-joint-errors: A2 at 57 deg", "joint_errors.csv", joint_errors_with_a2("1.0"),
@@ -179,15 +179,15 @@ TEST_F(CommandBadInputs, ABadFieldIsRefusedWithFileLineAndField) {
        "compensate --table " + kTable + " --robot " + kKr16 + " --robot-log INPUT --out OUT",
        "robot.csv:7", "q_desired_A2_rad"},
       {"calibrate-kinematics: q1 at 401 deg on the UR10", "poses.csv",
-       with_field(read_file_text(kPoses), 3, 7, "7.0"),
+       with_field(read_text(kPoses), 3, 7, "7.0"),
        "calibrate-kinematics --robot " + kUr10 + " --poses INPUT --out OUT", "poses.csv:3",
        "q1_rad"},
       {"compensate: the log of another robot than the table's", "robot.csv",
-       replaced(read_file_text(kSource / "fuzz/corpus/robot_log/valid.csv"), "# robot: kr16",
+       replaced(read_text(kSource / "fuzz/corpus/robot_log/valid.csv"), "# robot: kr16",
                 "# robot: kr6"),
        "compensate --table " + kTable + " --robot-log INPUT --out OUT", "robot.csv:2", "robot"},
       {"population: a robot file that is no URDF", "robot.urdf",
-       read_file_text(kSource / "tests/data/bad_inputs/configs/robot-urdf-not-xml.urdf"),
+       read_text(kSource / "tests/data/bad_inputs/configs/robot-urdf-not-xml.urdf"),
        "population --nominal INPUT --seeds 1 --out OUT", "robot.urdf", ""},
   };
   for (const Case& c : cases) {
@@ -232,7 +232,7 @@ TEST_F(CommandBadInputs, OutputsThatExistOrAreTheWrongKindAreRefusedWithExitTwo)
               std::string::npos)
         << message_;
     EXPECT_NE(message_.find("--force"), std::string::npos) << message_;
-    EXPECT_EQ(read_file_text(existing), "earlier output\n");
+    EXPECT_EQ(read_text(existing), "earlier output\n");
     EXPECT_EQ(run(command.arguments + " --out " + folder.string() + " --force"), 2) << message_;
     EXPECT_NE(message_.find(folder.string() + ": field '--out': is a folder, not a file"),
               std::string::npos)
@@ -245,7 +245,7 @@ TEST_F(CommandBadInputs, OutputsThatExistOrAreTheWrongKindAreRefusedWithExitTwo)
             2)
       << message_;
   EXPECT_NE(message_.find("is a file, not a folder"), std::string::npos) << message_;
-  EXPECT_EQ(read_file_text(dir_ / "a_file"), "not a folder\n");
+  EXPECT_EQ(read_text(dir_ / "a_file"), "not a folder\n");
   // A joint within the margin beyond its limit (A2 at 37.2 deg, 2.2 deg beyond): a warning with
   // file, line, column and limit, and the command runs.
   std::ofstream(dir_ / "near.csv") << joint_errors_with_a2("0.65");

@@ -10,11 +10,12 @@
 
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-using imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 using imscal::test_support::run_imscal;
 
 const fs::path kDir = fs::path(IMSCAL_TEST_DATA_DIR) / "real" / "abb-mems";
@@ -28,10 +29,10 @@ TEST_F(DiagnoseToolImuCli, Lsm9ds0UnitAxesAndClock) {
                      " --held-out " + (kDir / "V_500_Sequencia3" / "LSM9DS0.csv").string() +
                      " --out " + out.string(),
                  dir_ / "run.log");
-  const std::string log = read_file_text(dir_ / "run.log");
+  const std::string log = read_text(dir_ / "run.log");
   ASSERT_EQ(code, 0) << log;
   EXPECT_NE(log.find("1/63.9"), std::string::npos) << log;
-  const auto report = nlohmann::json::parse(read_file_text(out));
+  const auto report = nlohmann::json::parse(read_text(out));
   // Bounds as in tests/eval/test_gap_real_imu.cpp: 1/64 within 5 %, axes 94 deg within 1.5 deg
   // of the record check's 94.7, clock within 0.03 s of its 0.089 s.
   EXPECT_NEAR(report.at("unit_scale").get<double>() * 64.0, 1.0, 0.05);
@@ -51,7 +52,7 @@ TEST_F(DiagnoseToolImuCli, AnAhrsRecordIsBadInput) {
                      " --held-out " + (kDir / "V_500_Sequencia3" / "LSM9DS0.csv").string(),
                  dir_ / "bad.log");
   EXPECT_EQ(code, 2);
-  EXPECT_NE(read_file_text(dir_ / "bad.log").find("no raw gyro"), std::string::npos);
+  EXPECT_NE(read_text(dir_ / "bad.log").find("no raw gyro"), std::string::npos);
 }
 
 }  // namespace

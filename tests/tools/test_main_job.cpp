@@ -26,6 +26,7 @@
 #include "tests/support/frames_json.hpp"
 #include "tests/support/record_figure.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 #include "tests/tools/browser_check.hpp"
 #include "tests/tools/run_campaign.hpp"
 
@@ -35,7 +36,7 @@ namespace {
 namespace fs = std::filesystem;
 using imscal::test_support::count_of;
 using imscal::test_support::quaternion_of;
-using imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 using imscal::test_support::run_imscal;
 using nlohmann::json;
 
@@ -76,7 +77,7 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
   // compilers: GCC Release and clang with the sanitizers write the same bytes).
   const fs::path sim = dir_ / "sim";
   ASSERT_EQ(run_imscal("simulate --scenario campaign --out " + sim.string(), dir_ / "sim.log"), 0)
-      << read_file_text(dir_ / "sim.log");
+      << read_text(dir_ / "sim.log");
   for (const char* file : {"imu.csv", "robot.csv"})
     EXPECT_EQ(imscal::sha256_hex_of_file(sim / file), imscal::sha256_hex_of_file(kCampaign / file))
         << file << " differs from what datasets/campaign/regenerate.sh writes";
@@ -86,9 +87,9 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
   ASSERT_EQ(run_imscal("run " + (kCampaign / "run.yaml").string() + " --out " + out.string(),
                        dir_ / "run.log"),
             0)
-      << read_file_text(dir_ / "run.log");
+      << read_text(dir_ / "run.log");
   for (const char* stage : {"validate", "calibrate", "identify", "verify", "diagnose", "report"}) {
-    const json record = json::parse(read_file_text(out / stage / imscal::kStageRecordName));
+    const json record = json::parse(read_text(out / stage / imscal::kStageRecordName));
     EXPECT_EQ(record.value("status", ""), "ok") << stage;
   }
 
@@ -96,9 +97,9 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
   // measured 0.0026 deg, 0.021 mm) and the tilt of R in W (0.005 deg; measured 0.003 deg).
   // The heading of R in W is gyrocompass-limited (1-sigma 0.16 deg; measured 0.22 deg off): 3
   // sigma of the run's own estimate.
-  const json frames = json::parse(read_file_text(out / "calibrate" / "frames.json"));
-  const json truth = json::parse(read_file_text(sim / "truth" / "frames.json"));
-  const json mounting = json::parse(read_file_text(out / "calibrate" / "mounting_report.json"));
+  const json frames = json::parse(read_text(out / "calibrate" / "frames.json"));
+  const json truth = json::parse(read_text(sim / "truth" / "frames.json"));
+  const json mounting = json::parse(read_text(out / "calibrate" / "mounting_report.json"));
   EXPECT_NE(mounting.at("verdict"), "fail") << mounting.at("reasons").dump(1);
   EXPECT_LT(quaternion_of(frames.at("T_S_H")).angularDistance(quaternion_of(truth.at("T_S_H"))),
             0.005 * kRadPerDeg);
@@ -138,7 +139,7 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
   // 0.93 mm, -91.1 %; 10.31 -> 5.51 mm, -46.5 % with the paper's forward form). A precontrol that
   // no longer helps (< 20 % reduction) is a regression of identify or verify.
   const json verification =
-      json::parse(read_file_text(out / "verify" / "campaign-line" / "verification.json"));
+      json::parse(read_text(out / "verify" / "campaign-line" / "verification.json"));
   ASSERT_EQ(verification.at("cases").size(), 2u);
   for (const auto& c : verification.at("cases")) {
     for (const char* figure : {"AT_p_mm", "RT_p_mm", "AV_percent", "max_path_deviation_mm"})
@@ -157,7 +158,7 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
       verification.at("cases")[1].at("reduction_of_max_path_deviation_percent").get<double>());
 
   // The report: every section, every figure drawn (gnuplot's SVG curves are <path> elements).
-  const std::string html = read_file_text(out / "report" / "report.html");
+  const std::string html = read_text(out / "report" / "report.html");
   for (const char* part :
        {"Default campaign", "mounting verdict", "(paper Fig. 2)", "Identified error models",
         "Operating-point table coverage", "AT_p", "Fig. 5 (campaign-line)",
@@ -183,7 +184,7 @@ TEST_F(MainJob, ShippedCampaignRunsEndToEndAgainstItsRegeneratedTruth) {
   ASSERT_EQ(run_imscal("run " + (kCampaign / "run.yaml").string() + " --out " + out.string(),
                        dir_ / "again.log"),
             0);
-  EXPECT_EQ(count_of(read_file_text(dir_ / "again.log"), "skipped (inputs unchanged)"), 6u);
+  EXPECT_EQ(count_of(read_text(dir_ / "again.log"), "skipped (inputs unchanged)"), 6u);
 }
 
 }  // namespace

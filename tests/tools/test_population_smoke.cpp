@@ -16,6 +16,7 @@
 
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal {
 namespace {
@@ -23,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 using PopulationSmoke = test_support::ScratchDirTest;
 constexpr auto* run = &test_support::run_imscal;
-constexpr auto* read = &test_support::read_file_text;
+using test_support::read_text;
 
 TEST_F(PopulationSmoke, ThreePlantsThroughTheChain) {
   if (std::getenv("IMSCAL_SANITIZED")) GTEST_SKIP() << "3 plants through the chain: Release only";
@@ -31,8 +32,8 @@ TEST_F(PopulationSmoke, ThreePlantsThroughTheChain) {
   const fs::path out = dir_ / "population";
   const std::string arguments = "population --nominal " + nominal.string() +
                                 " --seeds 1000-1002 --cycles 1 --out " + out.string();
-  ASSERT_EQ(run(arguments, dir_ / "first.log"), 0) << read(dir_ / "first.log");
-  const std::string summary = read(out / "summary.txt");
+  ASSERT_EQ(run(arguments, dir_ / "first.log"), 0) << read_text(dir_ / "first.log");
+  const std::string summary = read_text(out / "summary.txt");
   std::printf("%s", summary.c_str());
   EXPECT_NE(summary.find("3 plants finished, 0 failed"), std::string::npos) << summary;
   EXPECT_NE(summary.find("seed_line_reduction_percent: 3 plants, median"), std::string::npos);
@@ -49,20 +50,20 @@ TEST_F(PopulationSmoke, ThreePlantsThroughTheChain) {
   for (int seed : {1000, 1001, 1002}) {
     const fs::path plant = out / ("plant-" + std::to_string(seed));
     EXPECT_TRUE(fs::exists(plant / "verify-iso9283" / "iso9283" / "verification.json"));
-    EXPECT_NE(read(plant / "plant" / "identification.yaml").find("plant_deviations:"),
+    EXPECT_NE(read_text(plant / "plant" / "identification.yaml").find("plant_deviations:"),
               std::string::npos);
     for (const char* step : {"calibrate.log", "calibrate-frames.log", "identify.log"}) {
-      const std::string log = read(plant / step);
+      const std::string log = read_text(plant / step);
       const std::string command = log.substr(0, log.find('\n'));
       EXPECT_NE(command.find("--robot " + nominal.string()), std::string::npos) << command;
       EXPECT_EQ(command.find("plant/"), std::string::npos) << command;
     }
   }
   // A rerun skips the finished plants and writes the same summary.
-  ASSERT_EQ(run(arguments, dir_ / "second.log"), 0) << read(dir_ / "second.log");
-  EXPECT_NE(read(dir_ / "second.log").find("plant 1002 (3/3) finished before, skipped"),
+  ASSERT_EQ(run(arguments, dir_ / "second.log"), 0) << read_text(dir_ / "second.log");
+  EXPECT_NE(read_text(dir_ / "second.log").find("plant 1002 (3/3) finished before, skipped"),
             std::string::npos);
-  EXPECT_EQ(read(out / "summary.txt"), summary);
+  EXPECT_EQ(read_text(out / "summary.txt"), summary);
 }
 
 }  // namespace

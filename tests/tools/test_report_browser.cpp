@@ -12,13 +12,14 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 #include "tests/tools/browser_check.hpp"
 #include "tests/tools/run_campaign.hpp"
 
 namespace {
 namespace fs = std::filesystem;
 using imscal::test_support::count_of;
-using imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 
 using ReportBrowser = imscal::test_support::ScratchDirTest;
 
@@ -32,9 +33,9 @@ TEST_F(ReportBrowser, LoadsWithoutErrorsAndEveryFigureIsDrawn) {
   ASSERT_EQ(imscal::test_support::run_imscal(
                 "run " + config.string() + " --out " + (dir_ / "out").string(), dir_ / "log.txt"),
             0)
-      << read_file_text(dir_ / "log.txt");
+      << read_text(dir_ / "log.txt");
   const fs::path report = dir_ / "out" / "report" / "report.html";
-  const std::string html = read_file_text(report);
+  const std::string html = read_text(report);
   // Self-contained: no script, no external resource.
   EXPECT_EQ(html.find("<script"), std::string::npos);
   EXPECT_EQ(html.find("src="), std::string::npos);

@@ -13,13 +13,15 @@
 #include <nlohmann/json.hpp>
 
 #include "core/run_stage.hpp"
+#include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 #include "tests/tools/run_campaign.hpp"
 
 namespace {
 namespace fs = std::filesystem;
 using imscal::test_support::count_of;
-using imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 using imscal::test_support::run_imscal;
 
 using RunChain = imscal::test_support::ScratchDirTest;
@@ -32,7 +34,7 @@ TEST_F(RunChain, IdentifyVerifyDiagnoseAndReport) {
                            truth.string(),
                        dir_ / "truth.log"),
             0)
-      << read_file_text(dir_ / "truth.log");
+      << read_text(dir_ / "truth.log");
   ASSERT_TRUE(fs::exists(truth / "joint_errors_truth.csv"));
   const fs::path config = dir_ / "run.yaml";
   std::ofstream(config) << "imscal-run-config: 1\n"
@@ -51,17 +53,16 @@ TEST_F(RunChain, IdentifyVerifyDiagnoseAndReport) {
                            "  robot: " IMSCAL_SOURCE_DIR "/datasets/robots/kr16.yaml\n";
   const fs::path out = dir_ / "out";
   ASSERT_EQ(run_imscal("run " + config.string() + " --out " + out.string(), dir_ / "run.log"), 0)
-      << read_file_text(dir_ / "run.log");
+      << read_text(dir_ / "run.log");
   for (const char* file : {"identify/parameters.json", "verify/seed-line/verification.json",
                            "verify/seed-line/fig5_paths.csv", "verify/seed-line/fig6_deviation.csv",
                            "diagnose/report.json", "diagnose/report.txt", "report/report.html"})
     EXPECT_TRUE(fs::exists(out / file)) << file;
   for (const char* stage : {"identify", "verify", "diagnose", "report"}) {
-    const auto record =
-        nlohmann::json::parse(read_file_text(out / stage / imscal::kStageRecordName));
+    const auto record = nlohmann::json::parse(read_text(out / stage / imscal::kStageRecordName));
     EXPECT_EQ(record.value("status", ""), "ok") << stage;
   }
-  const std::string html = read_file_text(out / "report" / "report.html");
+  const std::string html = read_text(out / "report" / "report.html");
   // The ISO 9283 table of verify, the two figures of the verified scenario and the diagnosis.
   EXPECT_NE(html.find("AT_p"), std::string::npos);
   EXPECT_NE(html.find("Fig. 5 (seed-line)"), std::string::npos);
@@ -74,7 +75,7 @@ TEST_F(RunChain, IdentifyVerifyDiagnoseAndReport) {
 
   // Nothing changed: every stage is skipped.
   ASSERT_EQ(run_imscal("run " + config.string() + " --out " + out.string(), dir_ / "again.log"), 0);
-  const std::string again = read_file_text(dir_ / "again.log");
+  const std::string again = read_text(dir_ / "again.log");
   EXPECT_EQ(count_of(again, "skipped (inputs unchanged)"), 4u) << again;
 }
 

@@ -18,12 +18,14 @@
 
 #include "ident/joint_error_io.hpp"
 #include "ident/parameter_table_io.hpp"
+#include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 #include "tests/tools/run_campaign.hpp"
 
 namespace {
 namespace fs = std::filesystem;
-using imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 using imscal::test_support::run_imscal;
 using nlohmann::json;
 
@@ -33,7 +35,7 @@ class RunCli : public imscal::test_support::ScratchDirTest {
     return run_imscal("run " + config.string() + " --out " + out.string() + " " + extra,
                       dir_ / "log.txt");
   }
-  std::string log() { return read_file_text(dir_ / "log.txt"); }
+  std::string log() { return read_text(dir_ / "log.txt"); }
   static std::string stage_line(const std::string& log, const std::string& stage) {
     // The summary lines on stdout: "<stage padded> <what> <status> <seconds> s <message>".
     const auto at = log.find("\n" + stage + " ");
@@ -53,10 +55,9 @@ class RunCli : public imscal::test_support::ScratchDirTest {
   static void expect_same_outputs(const fs::path& a, const fs::path& b) {
     for (const char* file : {"validate/validation.json", "identify/parameters.json",
                              "identify/parameters.csv", "report/report.html"})
-      EXPECT_EQ(read_file_text(a / file), read_file_text(b / file)) << file;
-    EXPECT_EQ(
-        without_seconds(json::parse(read_file_text(a / "identify/identification_report.json"))),
-        without_seconds(json::parse(read_file_text(b / "identify/identification_report.json"))));
+      EXPECT_EQ(read_text(a / file), read_text(b / file)) << file;
+    EXPECT_EQ(without_seconds(json::parse(read_text(a / "identify/identification_report.json"))),
+              without_seconds(json::parse(read_text(b / "identify/identification_report.json"))));
   }
 };
 
@@ -72,10 +73,10 @@ TEST_F(RunCli, RunsTheChainThenSkipsItThenRerunsWhatChanged) {
   // The table is the one `imscal identify` writes, from the configured data.
   const auto table = imscal::ident::read_parameters_json(out / "identify" / "parameters.json");
   EXPECT_EQ(table.joints.size(), 2u);
-  const json record = json::parse(read_file_text(out / "identify" / "stage.json"));
+  const json record = json::parse(read_text(out / "identify" / "stage.json"));
   EXPECT_EQ(record["status"], "ok");
   EXPECT_EQ(record["inputs"]["files"][0]["sha256"], table.source.sha256);
-  const json validation = json::parse(read_file_text(out / "validate" / "validation.json"));
+  const json validation = json::parse(read_text(out / "validate" / "validation.json"));
   EXPECT_EQ(validation["robot_log"]["samples"], 10001);
   // The robot log spans 0..20 s; the IMS record starts at or before 0 and lasts 60 s.
   EXPECT_NEAR(validation["overlap"]["duration_s"].get<double>(), 20.0, 0.01);
@@ -119,12 +120,12 @@ TEST_F(RunCli, ExitCodesNameTheReason) {
             std::string::npos)
       << log();
   EXPECT_FALSE(fs::exists(dir_ / "strict" / "identify"));
-  const std::string report = read_file_text(dir_ / "strict" / "report" / "report.html");
+  const std::string report = read_text(dir_ / "strict" / "report" / "report.html");
   EXPECT_NE(report.find("less than validate.min_overlap_s = 30 s"), std::string::npos);
   EXPECT_NE(report.find("the identify stage did not run"), std::string::npos);
 
   // 2: a robot log that does not overlap the IMS record at all (shifted by 1000 s).
-  std::string robot = read_file_text(dir_ / "robot.csv");
+  std::string robot = read_text(dir_ / "robot.csv");
   std::ofstream shifted(dir_ / "robot.csv");
   std::istringstream lines(robot);
   for (std::string line; std::getline(lines, line);) {
@@ -221,7 +222,7 @@ TEST_F(RunCli, KilledDuringIdentificationResumesToTheSameOutputs) {
   ::kill(child, SIGKILL);
   int status = 0;
   ::waitpid(child, &status, 0);
-  ASSERT_TRUE(in_identify) << read_file_text(dir_ / "killed.txt");
+  ASSERT_TRUE(in_identify) << read_text(dir_ / "killed.txt");
   ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before it was killed";
   EXPECT_TRUE(fs::exists(out / "validate" / "stage.json"));
   EXPECT_FALSE(fs::exists(out / "identify"));

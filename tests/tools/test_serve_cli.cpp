@@ -17,11 +17,12 @@
 #include "tests/support/lag_table.hpp"
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal::online {
 namespace {
 
-using test_support::read_file_text;
+using test_support::read_text;
 using test_support::run_imscal;
 
 class ServeCli : public test_support::ScratchDirTest {};
@@ -58,7 +59,7 @@ TEST_F(ServeCli, ServesTheControllerAndLogsItsFaults) {
     UdpPeer from;
     up = controller.receive(buffer.data(), int(buffer.size()), 0.1, &from) > 0;
   }
-  ASSERT_TRUE(up) << read_file_text(dir_ / "serve.log");
+  ASSERT_TRUE(up) << read_text(dir_ / "serve.log");
   std::vector<std::array<double, kRsiAxes>> setpoint(1000);
   for (std::size_t k = 0; k < setpoint.size(); ++k)
     for (int a = 0; a < kRsiAxes; ++a) setpoint[k][std::size_t(a)] = 0.1 * std::sin(0.004 * k);
@@ -69,7 +70,7 @@ TEST_F(ServeCli, ServesTheControllerAndLogsItsFaults) {
   options.faults = {{300, InjectedFault::kMalformed}, {600, InjectedFault::kDrop}};
   const EmulatorRun run = emulate_controller(controller, peer, setpoint, options);
   server.join();
-  const std::string log = read_file_text(dir_ / "serve.log");
+  const std::string log = read_text(dir_ / "serve.log");
   EXPECT_EQ(exit_code, 0) << log;
   EXPECT_EQ(run.missed, 0u);
   EXPECT_NE(log.find("malformed datagram refused"), std::string::npos) << log;
@@ -127,7 +128,7 @@ TEST_F(ServeCli, PlaysTheLoadedPathToAnEgmController) {
     up = controller.receive(buffer.data(), int(buffer.size()), 0.1, &from) > 0;
     ++away.seqno;
   }
-  ASSERT_TRUE(up) << read_file_text(dir_ / "serve.log");
+  ASSERT_TRUE(up) << read_text(dir_ / "serve.log");
   std::vector<std::array<double, kRsiAxes>> setpoint;
   for (std::size_t k = 0; k < path.samples.size(); k += 2) {
     std::array<double, kRsiAxes> q{};
@@ -141,7 +142,7 @@ TEST_F(ServeCli, PlaysTheLoadedPathToAnEgmController) {
   options.answer_timeout_s = 2.0;  // a stalled server (loaded machine) is not a missed answer
   const EmulatorRun run = emulate_controller(controller, peer, setpoint, options);
   server.join();
-  const std::string log = read_file_text(dir_ / "serve.log");
+  const std::string log = read_text(dir_ / "serve.log");
   EXPECT_EQ(exit_code, 0) << log;
   EXPECT_EQ(run.missed, 0u);
   EXPECT_NE(log.find("not at the path's first pose"), std::string::npos) << log;
@@ -158,8 +159,8 @@ TEST_F(ServeCli, RefusesEgmWithoutThePath) {
       run_imscal("serve --protocol egm --table " + (dir_ / "table.json").string() + " --port 0",
                  dir_ / "serve.log"),
       2);
-  EXPECT_NE(read_file_text(dir_ / "serve.log").find("--path"), std::string::npos)
-      << read_file_text(dir_ / "serve.log");
+  EXPECT_NE(read_text(dir_ / "serve.log").find("--path"), std::string::npos)
+      << read_text(dir_ / "serve.log");
 }
 
 TEST_F(ServeCli, FollowsALoadedPathForATableWithPreview) {
@@ -188,7 +189,7 @@ TEST_F(ServeCli, FollowsALoadedPathForATableWithPreview) {
     UdpPeer from;
     up = controller.receive(buffer.data(), int(buffer.size()), 0.1, &from) > 0;
   }
-  ASSERT_TRUE(up) << read_file_text(dir_ / "serve.log");
+  ASSERT_TRUE(up) << read_text(dir_ / "serve.log");
   std::vector<std::array<double, kRsiAxes>> setpoint;
   for (std::size_t k = 0; k < path.samples.size(); k += 2) {
     std::array<double, kRsiAxes> q{};
@@ -200,7 +201,7 @@ TEST_F(ServeCli, FollowsALoadedPathForATableWithPreview) {
   options.answer_timeout_s = 2.0;  // a stalled server (loaded machine) is not a missed answer
   const EmulatorRun run = emulate_controller(controller, peer, setpoint, options);
   server.join();
-  const std::string log = read_file_text(dir_ / "serve.log");
+  const std::string log = read_text(dir_ / "serve.log");
   EXPECT_EQ(exit_code, 0) << log;
   EXPECT_EQ(run.missed, 0u);
   EXPECT_EQ(log.find("off the loaded path"), std::string::npos) << log;
@@ -218,8 +219,8 @@ TEST_F(ServeCli, RefusesATableWithPreview) {
   EXPECT_EQ(run_imscal("serve --table " + (dir_ / "preview.json").string() + " --port 0",
                        dir_ / "serve.log"),
             2);
-  EXPECT_NE(read_file_text(dir_ / "serve.log").find("preview_cycles"), std::string::npos)
-      << read_file_text(dir_ / "serve.log");
+  EXPECT_NE(read_text(dir_ / "serve.log").find("preview_cycles"), std::string::npos)
+      << read_text(dir_ / "serve.log");
 }
 
 }  // namespace

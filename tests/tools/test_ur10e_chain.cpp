@@ -23,10 +23,11 @@
 
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace {
 namespace fs = std::filesystem;
-using imscal::test_support::read_file_text;
+using imscal::test_support::read_text;
 using imscal::test_support::run_imscal;
 
 using Ur10eChain = imscal::test_support::ScratchDirTest;
@@ -38,7 +39,7 @@ struct Reduction {
 };
 
 Reduction reduction_of(const fs::path& verification_json) {
-  const nlohmann::json v = nlohmann::json::parse(read_file_text(verification_json));
+  const nlohmann::json v = nlohmann::json::parse(read_text(verification_json));
   const nlohmann::json& before = v.at("cases").at(0);
   const nlohmann::json& after = v.at("cases").at(1);
   EXPECT_EQ(before.at("case"), "uncompensated");
@@ -56,7 +57,7 @@ void print(const char* what, const Reduction& r) {
 
 void simulate(const std::string& scenario, const fs::path& out, const fs::path& log) {
   ASSERT_EQ(run_imscal("simulate --scenario " + scenario + " --out " + out.string(), log), 0)
-      << read_file_text(log);
+      << read_text(log);
 }
 
 TEST_F(Ur10eChain, CampaignThroughImscalRun) {
@@ -75,9 +76,8 @@ TEST_F(Ur10eChain, CampaignThroughImscalRun) {
   const fs::path out = dir_ / "out";
   // Exit 0: every stage ok, the mounting verdict included (a `warn` or `fail` would be 1).
   ASSERT_EQ(run_imscal("run " + config.string() + " --out " + out.string(), dir_ / "run.log"), 0)
-      << read_file_text(dir_ / "run.log");
-  EXPECT_NE(read_file_text(out / "calibrate" / "summary.txt").find("VERDICT: pass"),
-            std::string::npos);
+      << read_text(dir_ / "run.log");
+  EXPECT_NE(read_text(out / "calibrate" / "summary.txt").find("VERDICT: pass"), std::string::npos);
   const Reduction line = reduction_of(out / "verify" / "ur10e-campaign-line" / "verification.json");
   print("UR10e campaign, seed-line-like line", line);
   // Measured 90.8 % true, 88.6 % through the IMS chain; 5 pp of margin for a changed draw. The
@@ -97,7 +97,7 @@ TEST_F(Ur10eChain, TwoSessionsCalibrateFramesIdentifyVerify) {
   }
   // The unit's lab calibration: the simulated unit's scale factors and misalignments (the
   // sessions share the scenario seed, hence the unit), biases left to the bundle.
-  std::string unit = read_file_text(dir_ / "sim-mounting" / "truth" / "sensor_errors.yaml");
+  std::string unit = read_text(dir_ / "sim-mounting" / "truth" / "sensor_errors.yaml");
   for (const char* bias : {"  bias_deg_per_h: ", "  bias_ug: "}) {
     const auto at = unit.find(bias);
     ASSERT_NE(at, std::string::npos) << bias;
@@ -116,13 +116,13 @@ TEST_F(Ur10eChain, TwoSessionsCalibrateFramesIdentifyVerify) {
   };
   ASSERT_EQ(
       run_imscal(calibrate("mounting", " --out " + (dir_ / "cal").string()), dir_ / "cal.log"), 0)
-      << read_file_text(dir_ / "cal.log");
+      << read_text(dir_ / "cal.log");
   ASSERT_EQ(run_imscal(
                 calibrate("identification", " --frames " + (dir_ / "cal" / "frames.json").string() +
                                                 " --out " + (dir_ / "calf").string()),
                 dir_ / "calf.log"),
             0)
-      << read_file_text(dir_ / "calf.log");
+      << read_text(dir_ / "calf.log");
   ASSERT_EQ(
       run_imscal("identify --joint-errors " + (dir_ / "calf" / "joint_errors.csv").string() +
                      " --config " + (kDatasets / "identification" / "ident-ur10e.yaml").string() +
@@ -130,7 +130,7 @@ TEST_F(Ur10eChain, TwoSessionsCalibrateFramesIdentifyVerify) {
                      (dir_ / "ident").string(),
                  dir_ / "ident.log"),
       0)
-      << read_file_text(dir_ / "ident.log");
+      << read_text(dir_ / "ident.log");
   const auto verify = [&](const std::string& scenario, const std::string& segments) {
     const fs::path out = dir_ / ("v-" + scenario);
     EXPECT_EQ(run_imscal("verify --table " + (dir_ / "ident" / "parameters.json").string() +
@@ -138,7 +138,7 @@ TEST_F(Ur10eChain, TwoSessionsCalibrateFramesIdentifyVerify) {
                              " --cycles 1 --no-ablation --out " + out.string(),
                          dir_ / (scenario + ".log")),
               0)
-        << read_file_text(dir_ / (scenario + ".log"));
+        << read_text(dir_ / (scenario + ".log"));
     return reduction_of(out / scenario / "verification.json");
   };
   const Reduction line = verify("ur10e-seed-line", "");

@@ -12,9 +12,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "tests/support/run_imscal.hpp"
 #include "tests/support/run_shell.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 #include "tests/workflows/fleet_checks.hpp"
 
 namespace imscal {
@@ -22,7 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using FleetOnSlurm = test_support::ScratchDirTest;
-using test_support::read_file_text;
+using test_support::read_text;
 
 const fs::path kSource = IMSCAL_SOURCE_DIR;
 const fs::path kCluster = kSource / "tests" / "workflows" / "slurm-single-node.sh";
@@ -42,7 +42,7 @@ TEST_F(FleetOnSlurm, ThreeCampaignsAsSlurmJobs) {
   ASSERT_EQ(test_support::run_shell(kCluster.string() + " start " + cluster.dir.string(),
                                     dir_ / "cluster-start.log"),
             0)
-      << read_file_text(dir_ / "cluster-start.log");
+      << read_text(dir_ / "cluster-start.log");
   const fs::path campaign = kSource / "datasets" / "campaign" / "run.yaml";
   std::ofstream(dir_ / "fleet.yaml")
       << "imscal: " << IMSCAL_BINARY << "\nout: " << (dir_ / "results").string()
@@ -54,13 +54,13 @@ TEST_F(FleetOnSlurm, ThreeCampaignsAsSlurmJobs) {
                               (kSource / "workflows" / "profiles" / "slurm").string() +
                               " --directory " + dir_.string();
   ASSERT_EQ(test_support::run_shell(command, dir_ / "fleet.log"), 0)
-      << read_file_text(dir_ / "fleet.log") << read_file_text(cluster.dir / "slurmctld.log");
+      << read_text(dir_ / "fleet.log") << read_text(cluster.dir / "slurmctld.log");
 
   int slurm_logs = 0;
   for (const auto& entry : fs::directory_iterator(dir_ / ".snakemake"))
     if (entry.path().filename().string().rfind("slurm-", 0) == 0) ++slurm_logs;
   EXPECT_EQ(slurm_logs, 4) << "three campaigns and the summary, each a Slurm job";
-  EXPECT_NE(read_file_text(dir_ / "fleet.log").find("Submitted job"), std::string::npos);
+  EXPECT_NE(read_text(dir_ / "fleet.log").find("Submitted job"), std::string::npos);
   const auto rows = test_support::read_fleet_csv(dir_ / "results" / "fleet.csv");
   ASSERT_EQ(rows.size(), 3u);
   for (const auto& row : rows)

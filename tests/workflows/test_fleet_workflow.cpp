@@ -11,9 +11,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "tests/support/run_imscal.hpp"
 #include "tests/support/run_shell.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 #include "tests/workflows/fleet_checks.hpp"
 
 namespace imscal {
@@ -21,7 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using FleetWorkflow = test_support::ScratchDirTest;
-using test_support::read_file_text;
+using test_support::read_text;
 
 const fs::path kSource = IMSCAL_SOURCE_DIR;
 
@@ -40,7 +40,7 @@ fs::path write_config(const fs::path& dir, const std::string& name, bool with_br
 // A campaign whose IMS record does not exist: `imscal run` refuses it (exit 2).
 void write_broken_campaign(const fs::path& dir) {
   fs::create_directories(dir / "broken");
-  std::string run = read_file_text(kSource / "datasets" / "campaign" / "run.yaml");
+  std::string run = read_text(kSource / "datasets" / "campaign" / "run.yaml");
   run.replace(run.find("imu: imu.csv"), 12, "imu: missing.csv");
   std::ofstream(dir / "broken" / "run.yaml") << run;
 }
@@ -57,7 +57,7 @@ TEST_F(FleetWorkflow, ThreeCampaignsAFailureReportedAndARerunOfWhatIsMissing) {
   write_broken_campaign(dir_);
   const fs::path first = write_config(dir_, "with-broken.yaml", true);
   EXPECT_NE(test_support::run_shell(snakemake(first, dir_), dir_ / "first.log"), 0);
-  const std::string log = read_file_text(dir_ / "first.log");
+  const std::string log = read_text(dir_ / "first.log");
   EXPECT_NE(log.find("Error in rule run_campaign"), std::string::npos) << log;
   EXPECT_NE(log.find("robot-broken"), std::string::npos) << log;
   EXPECT_FALSE(fs::exists(dir_ / "results" / "runs" / "robot-broken")) << "half-written run";
@@ -67,8 +67,8 @@ TEST_F(FleetWorkflow, ThreeCampaignsAFailureReportedAndARerunOfWhatIsMissing) {
 
   const fs::path second = write_config(dir_, "fleet.yaml", false);
   ASSERT_EQ(test_support::run_shell(snakemake(second, dir_), dir_ / "second.log"), 0)
-      << read_file_text(dir_ / "second.log");
-  const std::string rerun = read_file_text(dir_ / "second.log");
+      << read_text(dir_ / "second.log");
+  const std::string rerun = read_text(dir_ / "second.log");
   EXPECT_EQ(rerun.find("rule run_campaign"), std::string::npos) << "reran a finished campaign";
   EXPECT_NE(rerun.find("rule fleet_summary"), std::string::npos) << rerun;
 

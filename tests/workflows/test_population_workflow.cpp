@@ -15,13 +15,14 @@
 #include "tests/support/run_imscal.hpp"
 #include "tests/support/run_shell.hpp"
 #include "tests/support/scratch_dir.hpp"
+#include "tests/support/text_file.hpp"
 
 namespace imscal {
 namespace {
 
 namespace fs = std::filesystem;
 using PopulationWorkflow = test_support::ScratchDirTest;
-using test_support::read_file_text;
+using test_support::read_text;
 
 const fs::path kSource = IMSCAL_SOURCE_DIR;
 const fs::path kNominal = kSource / "datasets" / "robots" / "kr16.yaml";
@@ -54,21 +55,19 @@ TEST_F(PopulationWorkflow, StepsOnTheEngineGiveTheLoopsRows) {
   if (std::getenv("IMSCAL_SANITIZED")) GTEST_SKIP() << "3 plants twice: Release only";
   ASSERT_TRUE(test_support::on_path("snakemake")) << "scripts/install-deps.sh installs snakemake";
   ASSERT_EQ(test_support::run_shell(snakemake(dir_), dir_ / "engine.log"), 0)
-      << read_file_text(dir_ / "engine.log");
-  const std::string summary = read_file_text(dir_ / "engine" / "summary.txt");
+      << read_text(dir_ / "engine.log");
+  const std::string summary = read_text(dir_ / "engine" / "summary.txt");
   EXPECT_NE(summary.find("3 plants finished, 0 failed"), std::string::npos) << summary;
   // One job per plant and step (9 x 3), the summary and the target rule `all`.
-  EXPECT_NE(read_file_text(dir_ / "engine.log").find("29 of 29 steps (100%) done"),
-            std::string::npos);
+  EXPECT_NE(read_text(dir_ / "engine.log").find("29 of 29 steps (100%) done"), std::string::npos);
 
   ASSERT_EQ(test_support::run_shell(snakemake(dir_), dir_ / "rerun.log"), 0);
-  EXPECT_NE(read_file_text(dir_ / "rerun.log").find("Nothing to be done"), std::string::npos)
-      << read_file_text(dir_ / "rerun.log");
+  EXPECT_NE(read_text(dir_ / "rerun.log").find("Nothing to be done"), std::string::npos)
+      << read_text(dir_ / "rerun.log");
 
   const std::string loop = "population --nominal " + kNominal.string() +
                            " --seeds 1000-1002 --cycles 1 --out " + (dir_ / "loop").string();
-  ASSERT_EQ(test_support::run_imscal(loop, dir_ / "loop.log"), 0)
-      << read_file_text(dir_ / "loop.log");
+  ASSERT_EQ(test_support::run_imscal(loop, dir_ / "loop.log"), 0) << read_text(dir_ / "loop.log");
   const auto engine = rows_of(dir_ / "engine" / "population.csv");
   const auto in_process = rows_of(dir_ / "loop" / "population.csv");
   ASSERT_EQ(engine.size(), 3u);
