@@ -84,10 +84,10 @@ class ScriptedStage : public Stage {
   StageOutcome run(StageWorkspace& ws) override {
     ++runs;
     std::string text = name_;
-    for (const std::string& up : upstream_)
-      text +=
-          " " + up +
-          (ws.upstream_dir(up) ? ":" + read_text(*ws.upstream_dir(up) / (up + ".txt")) : ":absent");
+    for (const std::string& up : upstream_) {
+      text += " " + up + ":";
+      text += ws.upstream_dir(up) ? read_text(*ws.upstream_dir(up) / (up + ".txt")) : "absent";
+    }
     const StageOutcome outcome = work_(ws, text);
     write_text(ws.output_dir() / (name_ + ".txt"), text);
     return outcome;
