@@ -8,7 +8,8 @@
 // baseline) hold under the same load. A baseline without `cpu_seconds` in its records gives its
 // stages' wall time only.
 //   IMSCAL_BASELINE_BINARY=/path/to/old/imscal bench/bench_campaign_stages
-//   (add --benchmark_counters_tabular=true for a table)
+//   (add --benchmark_counters_tabular=true for a table; --benchmark_report_aggregates_only=true
+//   for the aggregates of the five repetitions alone)
 #include <benchmark/benchmark.h>
 #include <nlohmann/json.hpp>
 
@@ -93,7 +94,20 @@ void BM_CampaignRun_StageByStage(benchmark::State& state) {
   fs::remove_all(scratch);
 }
 
-BENCHMARK(BM_CampaignRun_StageByStage)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(3);
+// Five repetitions of one run each (this build's and the baseline's alternating): the aggregates
+// give the mean, median, spread (stddev) and the fastest and slowest of the five.
+BENCHMARK(BM_CampaignRun_StageByStage)
+    ->UseManualTime()
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->Repetitions(5)
+    ->ComputeStatistics("min",
+                        [](const std::vector<double>& v) {
+                          return *std::min_element(v.begin(), v.end());
+                        })
+    ->ComputeStatistics("max", [](const std::vector<double>& v) {
+      return *std::max_element(v.begin(), v.end());
+    });
 
 }  // namespace
 

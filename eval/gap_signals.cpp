@@ -107,31 +107,172 @@ Eigen::Matrix<double, 6, 6> damped_inverse(const Eigen::Matrix<double, 6, 6>& jb
                               .inverse();
 }
 
-// The start-pose block of ImsChainColumns: the chain starts its smoothing at the first sample's
-// pose from that rest's estimated joint angles q0 + dq0, and the IMS measures only the motion from
-// there, so every later flange pose carries the same base-frame error D = T(q0 + dq0) T(q0)^-1;
-// in the flange at time t that is the body twist Ad(T(t)^-1 T(q0)) Jb(q0) dq0, which the inverse
-// kinematics turns into the gap -Jb(q(t))^-1 of it (-dq0 at the start).
-void add_start_pose_columns(const calib::KinematicModel& kin,
-                            const std::vector<std::vector<double>>& q_rad,
-                            std::vector<GapSignals::ImsChainColumns>& out) {
-  const std::size_t n = q_rad.empty() ? 0 : q_rad.front().size(), nj = out.size();
-  for (auto& c : out) c.start_pose.setZero(Eigen::Index(n), 6);
-  if (n == 0 || nj != std::size_t(calib::kJointCount)) return;
-  const auto pose = [&](std::size_t k, calib::JointVector& q) {
-    for (std::size_t j = 0; j < nj; ++j) q[long(j)] = q_rad[j][k];
-    return calib::forward_kinematics<double>(kin, q);
-  };
-  calib::JointVector q;
-  const Eigen::Isometry3d T0 = pose(0, q);
-  const Eigen::Matrix<double, 6, 6> jb0 =
-      body_jacobian(calib::geometric_jacobian(kin, q), T0.linear());
-  for (std::size_t k = 0; k < n; ++k) {
-    const Eigen::Isometry3d T = pose(k, q);
-    const Eigen::Matrix<double, 6, 6> gap =
-        -damped_inverse(body_jacobian(calib::geometric_jacobian(kin, q), T.linear())) *
-        adjoint(T.inverse() * T0) * jb0;
-    for (std::size_t j = 0; j < nj; ++j) out[j].start_pose.row(Eigen::Index(k)) = gap.row(long(j));
+// Central-difference step of the DH numbers [m, rad]: truncation ~step² far below the 1e-6
+// relative accuracy the fit needs, rounding ~1e-16 / step harmless.
+constexpr double kDhStep = 1e-6;
+
+// cos and sin of an angle.
+struct CosSin {
+  double c, s;
+};
+CosSin cos_sin(double angle_rad) {
+  return {std::cos(angle_rad), std::sin(angle_rad)};
+}
+
+// calib::dh_link_transform with the cosine and sine of the twist alpha and the joint angle theta
+// given (the same arithmetic): a sample's seven transforms of a link share their trigonometry.
+Eigen::Isometry3d link_transform(calib::DhConvention convention, double a_m, CosSin alpha,
+                                 double d_m, CosSin theta) {
+  Eigen::Isometry3d z = Eigen::Isometry3d::Identity(), x = z;
+  z.linear() << theta.c, -theta.s, 0.0, theta.s, theta.c, 0.0, 0.0, 0.0, 1.0;
+  z.translation() << 0.0, 0.0, d_m;
+  x.linear() << 1.0, 0.0, 0.0, 0.0, alpha.c, -alpha.s, 0.0, alpha.s, alpha.c;
+  x.translation() << a_m, 0.0, 0.0;
+  return convention == calib::DhConvention::kStandard ? z * x : x * z;
+}
+
+// calib::geometric_jacobian from the chain's poses at q (the same arithmetic), which a sample
+// has computed already.
+calib::Jacobian geometric_jacobian(const calib::ChainPoses<double>& poses) {
+  const Eigen::Vector3d p_flange = poses.T_R_H.translation();
+  calib::Jacobian jacobian;
+  for (int i = 0; i < calib::kJointCount; ++i) {
+    const Eigen::Vector3d axis = poses.T_R_axis[i].linear().col(2);
+    const Eigen::Vector3d origin = poses.T_R_axis[i].translation();
+    jacobian.block<3, 1>(0, i) = axis.cross(p_flange - origin);
+    jacobian.block<3, 1>(3, i) = axis;
+  }
+  return jacobian;
+}
+
+// DH sensitivities at joint angles q (chain poses `poses`, flange T): a change of link i's numbers
+// is a local twist xi_l after link frame i+1 (central differences of the link transform alone),
+// moved to the flange by the adjoint. The perturbed numbers are a +- da etc. with da = 0 for the
+// others, as written (alpha + 0 and alpha - 0 differ in the sign of a zero alpha).
+Eigen::Matrix<double, 6, 18> dh_twists(const calib::KinematicModel& kin,
+                                       const calib::JointVector& q,
+                                       const calib::ChainPoses<double>& poses,
+                                       const Eigen::Isometry3d& T) {
+  Eigen::Matrix<double, 6, 18> dh_twist;
+  for (int i = 0; i < 6; ++i) {
+    const calib::DhParameters& dh = kin.dh[i];
+    const CosSin theta = cos_sin(q[i] + dh.offset_rad);
+    const CosSin alpha_plus = cos_sin(dh.alpha_rad + 0.0),
+                 alpha_minus = cos_sin(dh.alpha_rad - 0.0);
+    const CosSin alpha_stepped[2] = {cos_sin(dh.alpha_rad + kDhStep),
+                                     cos_sin(dh.alpha_rad - kDhStep)};
+    const Eigen::Isometry3d a_inv =
+        link_transform(kin.convention, dh.a_m, alpha_minus, dh.d_m, theta).inverse();
+    const Eigen::Isometry3d T_next_H = poses.T_R_link[std::size_t(i) + 1].inverse() * T;
+    const Eigen::Matrix<double, 6, 6> to_flange = adjoint(T_next_H.inverse());
+    for (int p = 0; p < 3; ++p) {
+      const double da = p == 0 ? kDhStep : 0.0, dd = p == 2 ? kDhStep : 0.0;
+      const Eigen::Isometry3d plus = link_transform(
+          kin.convention, dh.a_m + da, p == 1 ? alpha_stepped[0] : alpha_plus, dh.d_m + dd, theta);
+      const Eigen::Isometry3d minus = link_transform(
+          kin.convention, dh.a_m - da, p == 1 ? alpha_stepped[1] : alpha_minus, dh.d_m - dd, theta);
+      const Twist local =
+          (small_twist(a_inv * plus) - small_twist(a_inv * minus)) / (2.0 * kDhStep);
+      dh_twist.col(3 * i + p) = to_flange * local;
+    }
+  }
+  return dh_twist;
+}
+
+// The joint angles and rates along which the chain's columns are formed.
+struct ChainInputs {
+  const calib::KinematicModel& kin;
+  const std::vector<std::vector<double>>& q_rad;
+  const std::vector<std::vector<double>>& qd_rad_s;
+  const std::vector<double>& time_s;
+
+  calib::JointVector joints_at(std::size_t k, const std::vector<std::vector<double>>& x) const {
+    calib::JointVector v;
+    for (std::size_t j = 0; j < std::size_t(calib::kJointCount); ++j) v[long(j)] = x[j][k];
+    return v;
+  }
+};
+
+// Where the chain starts: the flange pose and body Jacobian at the first sample.
+struct ChainStart {
+  Eigen::Isometry3d T_R_H0;
+  Eigen::Matrix<double, 6, 6> jb0;
+};
+
+// What the gyro's integrals need of a sample: the rates of the attitude error per unit bias and
+// scale error (base frame) and the gap per unit body twist.
+struct ChainRates {
+  Eigen::Matrix3d bias_rate, scale_rate;
+  Eigen::Matrix<double, 6, 6> gap_per_twist;
+};
+
+// Sample k's rows of every column except the gyro's (those integrate over the earlier samples:
+// fill_gyro_integral_columns, from `rates`).
+void fill_chain_sample(const ChainInputs& in, const ChainStart& start, std::size_t k,
+                       std::vector<GapSignals::ImsChainColumns>& out, ChainRates& rates) {
+  const calib::JointVector q = in.joints_at(k, in.q_rad), qd = in.joints_at(k, in.qd_rad_s);
+  const calib::ChainPoses<double> poses = calib::chain_poses<double>(in.kin, q);
+  const Eigen::Isometry3d T = poses.T_R_H;
+  const Eigen::Matrix3d& R = T.linear();
+  const calib::Jacobian jg = geometric_jacobian(poses);
+  // The gap per unit body twist of the flange pose error: -(q_m - q).
+  const Eigen::Matrix<double, 6, 6> gap_per_twist = -damped_inverse(body_jacobian(jg, R));
+  const Eigen::Matrix<double, 6, 6> mounting_twist =
+      adjoint((start.T_R_H0.inverse() * T).inverse()) - Eigen::Matrix<double, 6, 6>::Identity();
+  Twist accel_twist = Twist::Zero();
+  accel_twist.head<3>() = R.transpose() * (T.translation() - start.T_R_H0.translation());
+
+  // The start pose: the chain starts its smoothing at the first sample's pose from that rest's
+  // estimated joint angles q0 + dq0, and the IMS measures only the motion from there, so every
+  // later flange pose carries the same base-frame error D = T(q0 + dq0) T(q0)^-1; in the flange
+  // at time t that is the body twist Ad(T(t)^-1 T(q0)) Jb(q0) dq0, which the inverse kinematics
+  // turns into the gap -Jb(q(t))^-1 of it (-dq0 at the start).
+  const Eigen::Matrix<double, 6, 6> start_gap =
+      gap_per_twist * adjoint(T.inverse() * start.T_R_H0) * start.jb0;
+  const Eigen::Matrix<double, 6, 18> dh_gap = gap_per_twist * dh_twists(in.kin, q, poses, T);
+  const Eigen::Matrix<double, 6, 6> mounting_gap = gap_per_twist * mounting_twist;
+  const Twist accel_gap = gap_per_twist * accel_twist;
+  const Eigen::Matrix<double, 6, 3> world_gap =
+      gap_per_twist.rightCols<3>() * R.transpose() * (in.time_s[k] - in.time_s[0]);
+  const Eigen::Index row = Eigen::Index(k);
+  for (std::size_t j = 0; j < out.size(); ++j) {
+    const Eigen::Index jr = Eigen::Index(j);
+    out[j].dh.row(row) = dh_gap.row(jr);
+    out[j].mounting.row(row) = mounting_gap.row(jr);
+    out[j].accel_scale(row, 0) = accel_gap[jr];
+    out[j].world_rate.row(row) = world_gap.row(jr);
+    out[j].start_pose.row(row) = start_gap.row(jr);
+  }
+  const Eigen::Vector3d w_body = R.transpose() * (jg.bottomRows<3>() * qd);
+  rates.bias_rate = R;  // column i: R e_i
+  rates.scale_rate = R * w_body.asDiagonal();
+  rates.gap_per_twist = gap_per_twist;
+}
+
+// The gyro bias and scale columns: attitude error integrals (trapezoid over the sample times,
+// base frame) of the rates, in sample order.
+void fill_gyro_integral_columns(const std::vector<double>& time_s,
+                                const std::vector<ChainRates>& rates,
+                                std::vector<GapSignals::ImsChainColumns>& out) {
+  Eigen::Matrix3d bias_integral = Eigen::Matrix3d::Zero(), scale_integral = bias_integral;
+  for (std::size_t k = 0; k < rates.size(); ++k) {
+    const ChainRates& r = rates[k];
+    if (k > 0) {
+      const double dt = time_s[k] - time_s[k - 1];
+      bias_integral += 0.5 * dt * (r.bias_rate + rates[k - 1].bias_rate);
+      scale_integral += 0.5 * dt * (r.scale_rate + rates[k - 1].scale_rate);
+    }
+    const Eigen::Matrix3d& R = r.bias_rate;
+    Eigen::Matrix<double, 6, 3> bias_twist = Eigen::Matrix<double, 6, 3>::Zero(),
+                                scale_twist = bias_twist;
+    bias_twist.bottomRows<3>() = R.transpose() * bias_integral;
+    scale_twist.bottomRows<3>() = R.transpose() * scale_integral;
+    const Eigen::Matrix<double, 6, 3> bias_gap = r.gap_per_twist * bias_twist;
+    const Eigen::Matrix<double, 6, 3> scale_gap = r.gap_per_twist * scale_twist;
+    for (std::size_t j = 0; j < out.size(); ++j) {
+      out[j].gyro_bias.row(Eigen::Index(k)) = bias_gap.row(Eigen::Index(j));
+      out[j].gyro_scale.row(Eigen::Index(k)) = scale_gap.row(Eigen::Index(j));
+    }
   }
 }
 
@@ -219,87 +360,21 @@ std::vector<GapSignals::ImsChainColumns> ims_chain_columns(
     c.world_rate.setZero(Eigen::Index(n), 3);
   }
   if (n == 0) return out;
-  const auto joints_at = [&](std::size_t k, const std::vector<std::vector<double>>& x) {
-    calib::JointVector v;
-    for (std::size_t j = 0; j < nj; ++j) v[long(j)] = x[j][k];
-    return v;
-  };
-  const Eigen::Isometry3d T_R_H0 = calib::forward_kinematics<double>(kin, joints_at(0, q_rad));
-  Eigen::Matrix3d bias_integral = Eigen::Matrix3d::Zero(), scale_integral = bias_integral;
-  Eigen::Matrix3d previous_bias_rate = Eigen::Matrix3d::Zero(), previous_scale_rate = bias_integral;
-  // Central-difference step of the DH numbers [m, rad]: truncation ~step² far below the 1e-6
-  // relative accuracy the fit needs, rounding ~1e-16 / step harmless.
-  const double step = 1e-6;
-  for (std::size_t k = 0; k < n; ++k) {
-    const calib::JointVector q = joints_at(k, q_rad), qd = joints_at(k, qd_rad_s);
-    const calib::ChainPoses<double> poses = calib::chain_poses<double>(kin, q);
-    const Eigen::Isometry3d T = poses.T_R_H;
-    const Eigen::Matrix3d& R = T.linear();
-    const calib::Jacobian jg = calib::geometric_jacobian(kin, q);
-    // The gap per unit body twist of the flange pose error: -(q_m - q).
-    const Eigen::Matrix<double, 6, 6> gap_per_twist = -damped_inverse(body_jacobian(jg, R));
-
-    // DH sensitivities: a change of link i's numbers is a local twist xi_l after link frame i+1
-    // (central differences of the link transform alone), moved to the flange by the adjoint.
-    Eigen::Matrix<double, 6, 18> dh_twist;
-    for (int i = 0; i < 6; ++i) {
-      const calib::DhParameters& dh = kin.dh[i];
-      const double theta = q[i] + dh.offset_rad;
-      const Eigen::Isometry3d a_inv =
-          calib::dh_link_transform(kin.convention, dh.a_m, dh.alpha_rad, dh.d_m, theta).inverse();
-      const Eigen::Isometry3d T_next_H = poses.T_R_link[std::size_t(i) + 1].inverse() * T;
-      const Eigen::Matrix<double, 6, 6> to_flange = adjoint(T_next_H.inverse());
-      for (int p = 0; p < 3; ++p) {
-        const double da = p == 0 ? step : 0.0, dalpha = p == 1 ? step : 0.0,
-                     dd = p == 2 ? step : 0.0;
-        const Eigen::Isometry3d plus = calib::dh_link_transform(
-            kin.convention, dh.a_m + da, dh.alpha_rad + dalpha, dh.d_m + dd, theta);
-        const Eigen::Isometry3d minus = calib::dh_link_transform(
-            kin.convention, dh.a_m - da, dh.alpha_rad - dalpha, dh.d_m - dd, theta);
-        const Twist local = (small_twist(a_inv * plus) - small_twist(a_inv * minus)) / (2.0 * step);
-        dh_twist.col(3 * i + p) = to_flange * local;
-      }
-    }
-    const Eigen::Matrix<double, 6, 6> mounting_twist =
-        adjoint((T_R_H0.inverse() * T).inverse()) - Eigen::Matrix<double, 6, 6>::Identity();
-
-    // Attitude error integrals (trapezoid over the sample times), base frame.
-    const Eigen::Vector3d w_body = R.transpose() * (jg.bottomRows<3>() * qd);
-    const Eigen::Matrix3d bias_rate = R;  // column i: R e_i
-    const Eigen::Matrix3d scale_rate = R * w_body.asDiagonal();
-    if (k > 0) {
-      const double dt = time_s[k] - time_s[k - 1];
-      bias_integral += 0.5 * dt * (bias_rate + previous_bias_rate);
-      scale_integral += 0.5 * dt * (scale_rate + previous_scale_rate);
-    }
-    previous_bias_rate = bias_rate;
-    previous_scale_rate = scale_rate;
-    Eigen::Matrix<double, 6, 3> bias_twist = Eigen::Matrix<double, 6, 3>::Zero(),
-                                scale_twist = bias_twist;
-    bias_twist.bottomRows<3>() = R.transpose() * bias_integral;
-    scale_twist.bottomRows<3>() = R.transpose() * scale_integral;
-    Twist accel_twist = Twist::Zero();
-    accel_twist.head<3>() = R.transpose() * (T.translation() - T_R_H0.translation());
-
-    const Eigen::Matrix<double, 6, 18> dh_gap = gap_per_twist * dh_twist;
-    const Eigen::Matrix<double, 6, 6> mounting_gap = gap_per_twist * mounting_twist;
-    const Eigen::Matrix<double, 6, 3> bias_gap = gap_per_twist * bias_twist;
-    const Eigen::Matrix<double, 6, 3> scale_gap = gap_per_twist * scale_twist;
-    const Twist accel_gap = gap_per_twist * accel_twist;
-    const Eigen::Matrix<double, 6, 3> world_gap =
-        gap_per_twist.rightCols<3>() * R.transpose() * (time_s[k] - time_s[0]);
-    const Eigen::Index row = Eigen::Index(k);
-    for (std::size_t j = 0; j < nj; ++j) {
-      const Eigen::Index jr = Eigen::Index(j);
-      out[j].dh.row(row) = dh_gap.row(jr);
-      out[j].mounting.row(row) = mounting_gap.row(jr);
-      out[j].gyro_bias.row(row) = bias_gap.row(jr);
-      out[j].gyro_scale.row(row) = scale_gap.row(jr);
-      out[j].accel_scale(row, 0) = accel_gap[jr];
-      out[j].world_rate.row(row) = world_gap.row(jr);
-    }
-  }
-  add_start_pose_columns(kin, q_rad, out);
+  for (auto& c : out) c.start_pose.setZero(Eigen::Index(n), 6);
+  const ChainInputs in{kin, q_rad, qd_rad_s, time_s};
+  ChainStart start;
+  start.T_R_H0 = calib::forward_kinematics<double>(kin, in.joints_at(0, q_rad));
+  start.jb0 =
+      body_jacobian(calib::geometric_jacobian(kin, in.joints_at(0, q_rad)), start.T_R_H0.linear());
+  // Blocks of samples are independent tasks on the cores (core/parallel_tasks.hpp); the gyro
+  // integrals run over all samples afterwards, in sample order.
+  std::vector<ChainRates> rates(n);
+  constexpr std::size_t kBlock = 4096;
+  run_parallel_tasks((n + kBlock - 1) / kBlock, [&](std::size_t b) {
+    for (std::size_t k = b * kBlock; k < std::min(n, (b + 1) * kBlock); ++k)
+      fill_chain_sample(in, start, k, out, rates[k]);
+  });
+  fill_gyro_integral_columns(time_s, rates, out);
   return out;
 }
 
