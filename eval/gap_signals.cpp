@@ -131,20 +131,6 @@ Eigen::Isometry3d link_transform(calib::DhConvention convention, double a_m, Cos
   return convention == calib::DhConvention::kStandard ? z * x : x * z;
 }
 
-// calib::geometric_jacobian from the chain's poses at q (the same arithmetic), which a sample
-// has computed already.
-calib::Jacobian geometric_jacobian(const calib::ChainPoses<double>& poses) {
-  const Eigen::Vector3d p_flange = poses.T_R_H.translation();
-  calib::Jacobian jacobian;
-  for (int i = 0; i < calib::kJointCount; ++i) {
-    const Eigen::Vector3d axis = poses.T_R_axis[i].linear().col(2);
-    const Eigen::Vector3d origin = poses.T_R_axis[i].translation();
-    jacobian.block<3, 1>(0, i) = axis.cross(p_flange - origin);
-    jacobian.block<3, 1>(3, i) = axis;
-  }
-  return jacobian;
-}
-
 // DH sensitivities at joint angles q (chain poses `poses`, flange T): a change of link i's numbers
 // is a local twist xi_l after link frame i+1 (central differences of the link transform alone),
 // moved to the flange by the adjoint. The perturbed numbers are a +- da etc. with da = 0 for the
@@ -214,7 +200,7 @@ void fill_chain_sample(const ChainInputs& in, const ChainStart& start, std::size
   const calib::ChainPoses<double> poses = calib::chain_poses<double>(in.kin, q);
   const Eigen::Isometry3d T = poses.T_R_H;
   const Eigen::Matrix3d& R = T.linear();
-  const calib::Jacobian jg = geometric_jacobian(poses);
+  const calib::Jacobian jg = calib::geometric_jacobian(poses);
   // The gap per unit body twist of the flange pose error: -(q_m - q).
   const Eigen::Matrix<double, 6, 6> gap_per_twist = -damped_inverse(body_jacobian(jg, R));
   const Eigen::Matrix<double, 6, 6> mounting_twist =

@@ -1,11 +1,12 @@
 #include "robot/jacobian.hpp"
 
-#include "robot/forward_kinematics.hpp"
-
 namespace imscal::calib {
 
 Jacobian geometric_jacobian(const KinematicModel& model, const JointVector& q) {
-  const ChainPoses<double> poses = chain_poses<double>(model, q);
+  return geometric_jacobian(chain_poses<double>(model, q));
+}
+
+Jacobian geometric_jacobian(const ChainPoses<double>& poses) {
   const Eigen::Vector3d p_flange = poses.T_R_H.translation();
   Jacobian jacobian;
   for (int i = 0; i < kJointCount; ++i) {

@@ -6,6 +6,7 @@
 // ChainJntToJacSolver on a chain ending at H).
 #include <Eigen/Core>
 
+#include "robot/forward_kinematics.hpp"
 #include "robot/robot_description.hpp"
 
 namespace imscal::calib {
@@ -13,5 +14,7 @@ namespace imscal::calib {
 using Jacobian = Eigen::Matrix<double, 6, kJointCount>;
 
 Jacobian geometric_jacobian(const KinematicModel& model, const JointVector& q);
+// The same from the chain's poses at q, for a caller that has them already.
+Jacobian geometric_jacobian(const ChainPoses<double>& poses);
 
 }  // namespace imscal::calib
