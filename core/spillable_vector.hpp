@@ -148,7 +148,12 @@ class SpillableVector {
     SpillMapping mapping;
     size_type size = 0;
   };
-  T* file_elements() const { return std::launder(reinterpret_cast<T*>(file_->mapping.data())); }
+  // The file's elements (std::launder: they were made by placement new in the mapping, and
+  // launder may only see a live object, so not when there is none).
+  T* file_elements() const {
+    T* first = reinterpret_cast<T*>(file_->mapping.data());
+    return file_->size == 0 ? first : std::launder(first);
+  }
   void append_to_file(const T* first, const T* last) {
     if (!on_file()) file_ = std::make_unique<File>();
     reserve(size() + size_type(last - first));
