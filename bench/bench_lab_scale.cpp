@@ -204,6 +204,7 @@ void time_calibrate(benchmark::State& state, const std::string& binary) {
   const int minutes = int(state.range(0));
   const fs::path root = bench_root(minutes);
   const fs::path folder = record_config(minutes, root).parent_path();
+  fs::create_directories(root);  // the campaign's (argument 0) is not made by record_config
   const double recorded_min = record_minutes(folder / "run.yaml");
   ChildRun r;
   for (auto _ : state) {
