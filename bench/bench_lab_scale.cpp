@@ -13,12 +13,17 @@
 //   bench/bench_lab_scale --benchmark_counters_tabular=true
 //   bench/bench_lab_scale --benchmark_filter='Run/(0|5)/'   (the baseline and 5 minutes only)
 //   bench/bench_lab_scale --benchmark_filter='Calibrate'    (calibrate alone)
+// BM_LabScaleCalibrate/MINUTES/1 times the `calibrate` of the binary named by
+// IMSCAL_BENCH_BASELINE on the same record, right before this build's (/MINUTES/0): the
+// before/after ratio measured in one run (skipped when the variable is not set):
+//   IMSCAL_BENCH_BASELINE=/path/to/main/imscal bench/bench_lab_scale --benchmark_filter=Calibrate
 #include <benchmark/benchmark.h>
 
 #include "child_process.hpp"
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -34,9 +39,11 @@ const fs::path kSource(IMSCAL_SOURCE_DIR);
 
 using imscal::bench::ChildRun;
 
-// Runs imscal with `arguments`, its output into `log`; throws when it fails.
-ChildRun run_imscal(const std::vector<std::string>& arguments, const fs::path& log) {
-  std::vector<std::string> words{IMSCAL_BINARY};
+// Runs imscal (this build's, or `binary`) with `arguments`, its output into `log`; throws when
+// it fails.
+ChildRun run_imscal(const std::vector<std::string>& arguments, const fs::path& log,
+                    const std::string& binary = IMSCAL_BINARY) {
+  std::vector<std::string> words{binary};
   words.insert(words.end(), arguments.begin(), arguments.end());
   return imscal::bench::run_child(std::move(words), log);
 }
@@ -192,11 +199,12 @@ void BM_LabScaleRun(benchmark::State& state) {
   fs::remove_all(root / "run");
 }
 
-// `imscal calibrate` alone with the run's calibrate config on the same records.
-void BM_LabScaleCalibrate(benchmark::State& state) {
+// `imscal calibrate` of `binary` alone with the run's calibrate config on the same records.
+void time_calibrate(benchmark::State& state, const std::string& binary) {
   const int minutes = int(state.range(0));
   const fs::path root = bench_root(minutes);
   const fs::path folder = record_config(minutes, root).parent_path();
+  fs::create_directories(root);  // the campaign's (argument 0) is not made by record_config
   const double recorded_min = record_minutes(folder / "run.yaml");
   ChildRun r;
   for (auto _ : state) {
@@ -204,11 +212,19 @@ void BM_LabScaleCalibrate(benchmark::State& state) {
         {"calibrate", "--imu", (folder / "imu.csv").string(), "--robot-log",
          (folder / "robot.csv").string(), "--config", (folder / "calibrate.yaml").string(), "--out",
          (root / "calibrate").string(), "--force"},
-        root / "calibrate.log");
+        root / "calibrate.log", binary);
     state.SetIterationTime(r.wall_s);
   }
   set_counters(state, r, recorded_min);
   fs::remove_all(root / "calibrate");
+}
+
+// Argument 1: 0 this build's binary, 1 the baseline's (IMSCAL_BENCH_BASELINE).
+void BM_LabScaleCalibrate(benchmark::State& state) {
+  if (state.range(1) == 0) return time_calibrate(state, IMSCAL_BINARY);
+  const char* baseline = std::getenv("IMSCAL_BENCH_BASELINE");
+  if (baseline == nullptr) return state.SkipWithError("IMSCAL_BENCH_BASELINE is not set");
+  time_calibrate(state, baseline);
 }
 
 BENCHMARK(BM_LabScaleRun)
@@ -220,11 +236,9 @@ BENCHMARK(BM_LabScaleRun)
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 
+// Each record's baseline right before this build's, so that the two see the same load.
 BENCHMARK(BM_LabScaleCalibrate)
-    ->Arg(0)
-    ->Arg(5)
-    ->Arg(15)
-    ->Arg(30)
+    ->ArgsProduct({{0, 5, 15, 30}, {1, 0}})
     ->UseManualTime()
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
