@@ -129,9 +129,29 @@ void check_heading_reference(const std::optional<HeadingReference>& heading,
                                  heading->source, heading->yaw_rad, heading->sigma_rad));
 }
 
+namespace {
+
+// The named blocks of FrameUnknowns in their buffer order, with their sizes: the one list the
+// buffer's size and its layout both come from.
+struct NamedBlock {
+  double* FrameUnknowns::*block;
+  std::size_t size;
+};
+constexpr NamedBlock kNamedBlocks[] = {{&FrameUnknowns::q_W_R, 4}, {&FrameUnknowns::q_S_H, 4},
+                                       {&FrameUnknowns::p_S_H, 3}, {&FrameUnknowns::b_g, 3},
+                                       {&FrameUnknowns::dt, 1},    {&FrameUnknowns::link_share, 1},
+                                       {&FrameUnknowns::s_g, 3},   {&FrameUnknowns::s_a, 3},
+                                       {&FrameUnknowns::m_w, 6},   {&FrameUnknowns::m_p, 6}};
+constexpr std::size_t named_blocks_size() {
+  std::size_t size = 0;
+  for (const NamedBlock& b : kNamedBlocks) size += b.size;
+  return size;
+}
+
+}  // namespace
+
 void FrameUnknowns::allocate(std::size_t rest_count, std::size_t acc_bias_count) {
-  constexpr std::size_t kNamedSize = 4 + 4 + 3 + 3 + 1 + 1 + 3 + 3 + 6 + 6;
-  storage_.assign(6 * rest_count + 3 * acc_bias_count + kNamedSize, 0.0);
+  storage_.assign(6 * rest_count + 3 * acc_bias_count + named_blocks_size(), 0.0);
   double* next = storage_.data();
   const auto take = [&next](std::size_t size) {
     double* block = next;
@@ -143,16 +163,7 @@ void FrameUnknowns::allocate(std::size_t rest_count, std::size_t acc_bias_count)
   b_a_blocks.clear();
   for (std::size_t i = 0; i < acc_bias_count; ++i) b_a.push_back(take(3));
   for (std::size_t i = 0; i < rest_count; ++i) dq.push_back(take(6));
-  q_W_R = take(4);
-  q_S_H = take(4);
-  p_S_H = take(3);
-  b_g = take(3);
-  dt = take(1);
-  link_share = take(1);
-  s_g = take(3);
-  s_a = take(3);
-  m_w = take(6);
-  m_p = take(6);
+  for (const NamedBlock& b : kNamedBlocks) this->*b.block = take(b.size);
   q_W_R[3] = 1.0;  // identity, Eigen order x, y, z, w
   q_S_H[3] = 1.0;
 }

@@ -49,7 +49,8 @@ namespace imscal::calib {
 // its sparse QR rounds by that order: blocks in separate allocations would make the covariance's
 // last bits follow the heap's layout (what was allocated and freed before, down to the output
 // folder's name). In one buffer the order is fixed: the accelerometer biases, the joint
-// deviations, then the named blocks in their declaration order below.
+// deviations, then the named blocks in their declaration order below. A new named block goes into
+// kNamedBlocks (frame_bundle.cpp), the one list that sizes the buffer and lays it out.
 struct FrameUnknowns {
   FrameUnknowns() = default;
   FrameUnknowns(const FrameUnknowns&) = delete;  // the pointers below point into storage_

@@ -126,10 +126,7 @@ std::vector<ShapePool> shape_pools(const ShapeContext& x) {
 }
 
 std::vector<CandidateShape> shapes(const ShapeContext& x) {
-  std::vector<CandidateShape> out;
-  for (const ShapePool& pool : shape_pools(x))
-    for (auto& shape : shapes_from_pool(pool)) out.push_back(std::move(shape));
-  return out;
+  return shapes_from_pools(shape_pools(x));
 }
 
 // Half the step of a backlash's modelled gap between the two flanks: the medians of its own

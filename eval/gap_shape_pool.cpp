@@ -140,9 +140,10 @@ PooledShape local_pooled_shape(std::size_t joints, std::size_t joint, std::strin
   return shape;
 }
 
-std::vector<CandidateShape> shapes_from_pool(const ShapePool& pool) {
+std::vector<CandidateShape> shapes_from_pools(const std::vector<ShapePool>& pools) {
   std::vector<CandidateShape> out;
-  for (std::size_t i = 0; i < pool.shapes.size(); ++i) out.push_back(shape_from_pool(pool, i));
+  for (const ShapePool& pool : pools)
+    for (std::size_t i = 0; i < pool.shapes.size(); ++i) out.push_back(shape_from_pool(pool, i));
   return out;
 }
 

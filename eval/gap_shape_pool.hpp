@@ -44,8 +44,9 @@ struct ShapePool {
 // A shape of the pool with its own columns (samples x its parameters per joint it acts on).
 CandidateShape shape_from_pool(const ShapePool& pool, std::size_t index);
 
-// Every shape of the pool, in order.
-std::vector<CandidateShape> shapes_from_pool(const ShapePool& pool);
+// Every shape of every pool, pool by pool: the `shapes` of an effect with `shape_pools`
+// (eval/gap_effects.hpp), in the order its pools validate them.
+std::vector<CandidateShape> shapes_from_pools(const std::vector<ShapePool>& pools);
 
 // The validation error summed over the folds of each shape of the pool fitted to y ([joint]),
 // the same as cross_validation_sse of its columns: by the normal equations from the pool's Gram

@@ -111,30 +111,11 @@ Eigen::Matrix<double, 6, 6> damped_inverse(const Eigen::Matrix<double, 6, 6>& jb
 // relative accuracy the fit needs, rounding ~1e-16 / step harmless.
 constexpr double kDhStep = 1e-6;
 
-// cos and sin of an angle.
-struct CosSin {
-  double c, s;
-};
-CosSin cos_sin(double angle_rad) {
-  return {std::cos(angle_rad), std::sin(angle_rad)};
-}
-
-// calib::dh_link_transform with the cosine and sine of the twist alpha and the joint angle theta
-// given (the same arithmetic): a sample's seven transforms of a link share their trigonometry.
-Eigen::Isometry3d link_transform(calib::DhConvention convention, double a_m, CosSin alpha,
-                                 double d_m, CosSin theta) {
-  Eigen::Isometry3d z = Eigen::Isometry3d::Identity(), x = z;
-  z.linear() << theta.c, -theta.s, 0.0, theta.s, theta.c, 0.0, 0.0, 0.0, 1.0;
-  z.translation() << 0.0, 0.0, d_m;
-  x.linear() << 1.0, 0.0, 0.0, 0.0, alpha.c, -alpha.s, 0.0, alpha.s, alpha.c;
-  x.translation() << a_m, 0.0, 0.0;
-  return convention == calib::DhConvention::kStandard ? z * x : x * z;
-}
-
 // DH sensitivities at joint angles q (chain poses `poses`, flange T): a change of link i's numbers
 // is a local twist xi_l after link frame i+1 (central differences of the link transform alone),
 // moved to the flange by the adjoint. The perturbed numbers are a +- da etc. with da = 0 for the
-// others, as written (alpha + 0 and alpha - 0 differ in the sign of a zero alpha).
+// others, as written (alpha + 0 and alpha - 0 differ in the sign of a zero alpha). A sample's
+// seven transforms of a link share their trigonometry (calib::dh_link_transform of cos and sin).
 Eigen::Matrix<double, 6, 18> dh_twists(const calib::KinematicModel& kin,
                                        const calib::JointVector& q,
                                        const calib::ChainPoses<double>& poses,
@@ -142,20 +123,21 @@ Eigen::Matrix<double, 6, 18> dh_twists(const calib::KinematicModel& kin,
   Eigen::Matrix<double, 6, 18> dh_twist;
   for (int i = 0; i < 6; ++i) {
     const calib::DhParameters& dh = kin.dh[i];
-    const CosSin theta = cos_sin(q[i] + dh.offset_rad);
-    const CosSin alpha_plus = cos_sin(dh.alpha_rad + 0.0),
-                 alpha_minus = cos_sin(dh.alpha_rad - 0.0);
-    const CosSin alpha_stepped[2] = {cos_sin(dh.alpha_rad + kDhStep),
-                                     cos_sin(dh.alpha_rad - kDhStep)};
+    using calib::cos_sin;
+    const calib::CosSin<double> theta = cos_sin(q[i] + dh.offset_rad);
+    const calib::CosSin<double> alpha_plus = cos_sin(dh.alpha_rad + 0.0),
+                                alpha_minus = cos_sin(dh.alpha_rad - 0.0);
+    const calib::CosSin<double> alpha_stepped[2] = {cos_sin(dh.alpha_rad + kDhStep),
+                                                    cos_sin(dh.alpha_rad - kDhStep)};
     const Eigen::Isometry3d a_inv =
-        link_transform(kin.convention, dh.a_m, alpha_minus, dh.d_m, theta).inverse();
+        calib::dh_link_transform(kin.convention, dh.a_m, alpha_minus, dh.d_m, theta).inverse();
     const Eigen::Isometry3d T_next_H = poses.T_R_link[std::size_t(i) + 1].inverse() * T;
     const Eigen::Matrix<double, 6, 6> to_flange = adjoint(T_next_H.inverse());
     for (int p = 0; p < 3; ++p) {
       const double da = p == 0 ? kDhStep : 0.0, dd = p == 2 ? kDhStep : 0.0;
-      const Eigen::Isometry3d plus = link_transform(
+      const Eigen::Isometry3d plus = calib::dh_link_transform(
           kin.convention, dh.a_m + da, p == 1 ? alpha_stepped[0] : alpha_plus, dh.d_m + dd, theta);
-      const Eigen::Isometry3d minus = link_transform(
+      const Eigen::Isometry3d minus = calib::dh_link_transform(
           kin.convention, dh.a_m - da, p == 1 ? alpha_stepped[1] : alpha_minus, dh.d_m - dd, theta);
       const Twist local =
           (small_twist(a_inv * plus) - small_twist(a_inv * minus)) / (2.0 * kDhStep);

@@ -358,12 +358,7 @@ IdentificationConfig load_identification_config(const ConfigNode& root) {
   // coefficients move behind the dead time when the model is written in the angle form, so
   // taps + largest dead time must fit the runtime's kMaxPrecontrolOrder per input.
   if (o.model_torque_input || o.direction_input || o.transmission_error_input) {
-    const int taps = std::max({o.model_torque_input || o.direction_input ? o.input_taps : 0,
-                               o.torque_sign_input ? o.torque_sign_taps : 0,
-                               o.transmission_error_input ? o.transmission_error_taps : 0,
-                               o.transmission_error_mode_pairs == GearModePairs::kBeside
-                                   ? o.transmission_error_mode_taps
-                                   : 0});
+    const int taps = longest_extra_input_taps(o);
     const int longest = taps + o.grid.dead_time_max;
     if (longest > kMaxPrecontrolOrder) {
       const ConfigNode at =

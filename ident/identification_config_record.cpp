@@ -41,12 +41,7 @@ bool given(double duration_s) {
 
 void check_precontrol_capacity(const IdentificationConfig& config, double cycle_s) {
   const JointIdentificationOptions& o = config.options;
-  const int taps = std::max({o.model_torque_input || o.direction_input ? o.input_taps : 0,
-                             o.torque_sign_input ? o.torque_sign_taps : 0,
-                             o.transmission_error_input ? o.transmission_error_taps : 0,
-                             o.transmission_error_mode_pairs == GearModePairs::kBeside
-                                 ? o.transmission_error_mode_taps
-                                 : 0});
+  const int taps = longest_extra_input_taps(o);
   if (taps + o.grid.dead_time_max <= kMaxPrecontrolOrder) return;
   refuse(config, given(config.durations.input_history_s) ? "model.input_history_s" : "model",
          fmt::format("at {} s per cycle the further inputs take {} coefficients, plus the largest "

@@ -359,6 +359,16 @@ int extra_input_taps(TableInput input, const JointIdentificationOptions& options
   return options.input_taps;
 }
 
+int longest_extra_input_taps(const JointIdentificationOptions& options) {
+  const JointIdentificationOptions& o = options;
+  return std::max({o.model_torque_input || o.direction_input ? o.input_taps : 0,
+                   o.torque_sign_input ? o.torque_sign_taps : 0,
+                   o.transmission_error_input ? o.transmission_error_taps : 0,
+                   o.transmission_error_mode_pairs == GearModePairs::kBeside
+                       ? o.transmission_error_mode_taps
+                       : 0});
+}
+
 ExogenousParameters exogenous_parameters(const JointIdentificationOptions& options,
                                          double torque_sign_scale_nm) {
   ExogenousParameters p;

@@ -199,6 +199,9 @@ std::vector<TableInput> extra_inputs_of(const JointIdentificationOptions& option
 int extra_input_count(const JointIdentificationOptions& options);
 // The taps the options give one of them (OrderGrid::extra_taps).
 int extra_input_taps(TableInput input, const JointIdentificationOptions& options);
+// The most taps any switched-on further input takes (0: none): with the largest dead time, what
+// the precontrol must hold per input (kMaxPrecontrolOrder, ident/precontrol.hpp).
+int longest_extra_input_taps(const JointIdentificationOptions& options);
 // The constants of the inputs for one joint, with the torque-sign scale found from its data.
 ExogenousParameters exogenous_parameters(const JointIdentificationOptions& options,
                                          double torque_sign_scale_nm);

@@ -1,7 +1,6 @@
 #include "ims/imu_binary.hpp"
 
 #include <fmt/format.h>
-#include <sys/mman.h>
 
 #include <algorithm>
 #include <array>
@@ -15,6 +14,7 @@
 
 #include "core/input_error.hpp"
 #include "core/input_file.hpp"
+#include "ims/huge_pages.hpp"
 
 namespace imscal::ims {
 namespace fs = std::filesystem;
@@ -24,17 +24,6 @@ namespace {
 constexpr std::size_t kValuesPerRecord = 7;
 constexpr std::size_t kRecordBytes = kValuesPerRecord * sizeof(double);
 constexpr std::uint32_t kVersion = 1;
-
-// Asks for transparent huge pages on a large sample buffer: an hour at 2 kHz is 400 MB, and
-// faulting it in 4 KiB pages costs more than decoding it. Only a hint; ignored where unsupported.
-void advise_huge_pages(const void* data, std::size_t bytes) {
-  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-  if (bytes < 4 * kHugePage) return;
-  const auto first = reinterpret_cast<std::uintptr_t>(data);
-  const std::uintptr_t begin = (first + kHugePage - 1) & ~(kHugePage - 1);
-  const std::uintptr_t end = (first + bytes) & ~(kHugePage - 1);
-  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-}
 
 template <typename T>
 T from_little_endian(const char* bytes) {

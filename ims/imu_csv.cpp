@@ -23,6 +23,7 @@
 #include "core/input_error.hpp"
 #include "core/input_file.hpp"
 #include "core/units.hpp"
+#include "ims/huge_pages.hpp"
 
 namespace imscal::ims {
 namespace fs = std::filesystem;
@@ -31,17 +32,6 @@ namespace {
 
 constexpr std::size_t kColumns = 7;
 constexpr std::size_t kValidationBatch = 4096;  // samples; a power of two
-
-// Asks for transparent huge pages on a large sample buffer: an hour at 2 kHz is 400 MB, and
-// faulting it in 4 KiB pages costs more than decoding it. Only a hint; ignored where unsupported.
-void advise_huge_pages(const void* data, std::size_t bytes) {
-  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-  if (bytes < 4 * kHugePage) return;
-  const auto first = reinterpret_cast<std::uintptr_t>(data);
-  const std::uintptr_t begin = (first + kHugePage - 1) & ~(kHugePage - 1);
-  const std::uintptr_t end = (first + bytes) & ~(kHugePage - 1);
-  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-}
 
 // ---------------------------------------------------------------------------------------------
 // Column names and their units.

@@ -15,39 +15,50 @@ namespace imscal::calib {
 template <typename T>
 using Isometry3 = Eigen::Transform<T, 3, Eigen::Isometry>;
 
-// Rigid transform with rotation about z by theta and translation (0, 0, d), and likewise about x.
+// The cosine and sine of an angle, for callers that reuse them across several transforms.
 template <typename T>
-Isometry3<T> rot_z_trans_z(const T& theta, const T& d) {
+struct CosSin {
+  T c, s;
+};
+template <typename T>
+CosSin<T> cos_sin(const T& angle_rad) {
   using std::cos;
   using std::sin;
+  return {cos(angle_rad), sin(angle_rad)};
+}
+
+// Rigid transform with rotation about z by theta and translation (0, 0, d), and likewise about x.
+template <typename T>
+Isometry3<T> rot_z_trans_z(const CosSin<T>& theta, const T& d) {
   Isometry3<T> out = Isometry3<T>::Identity();
-  const T c = cos(theta);
-  const T s = sin(theta);
-  out.linear() << c, -s, T(0), s, c, T(0), T(0), T(0), T(1);
+  out.linear() << theta.c, -theta.s, T(0), theta.s, theta.c, T(0), T(0), T(0), T(1);
   out.translation() << T(0), T(0), d;
   return out;
 }
 template <typename T>
-Isometry3<T> trans_x_rot_x(const T& a, const T& alpha) {
-  using std::cos;
-  using std::sin;
+Isometry3<T> trans_x_rot_x(const T& a, const CosSin<T>& alpha) {
   Isometry3<T> out = Isometry3<T>::Identity();
-  const T c = cos(alpha);
-  const T s = sin(alpha);
-  out.linear() << T(1), T(0), T(0), T(0), c, -s, T(0), s, c;
+  out.linear() << T(1), T(0), T(0), T(0), alpha.c, -alpha.s, T(0), alpha.s, alpha.c;
   out.translation() << a, T(0), T(0);
   return out;
 }
 
-// A_i: link frame i in link frame i-1 (see DhConvention for the two conventions).
-// theta = q_i + offset_i.
+// A_i: link frame i in link frame i-1 (see DhConvention for the two conventions), with the
+// cosine and sine of the twist alpha and of theta = q_i + offset_i given.
 template <typename T>
-Isometry3<T> dh_link_transform(DhConvention convention, const T& a, const T& alpha, const T& d,
-                               const T& theta) {
+Isometry3<T> dh_link_transform(DhConvention convention, const T& a, const CosSin<T>& alpha,
+                               const T& d, const CosSin<T>& theta) {
   if (convention == DhConvention::kStandard) {
     return rot_z_trans_z(theta, d) * trans_x_rot_x(a, alpha);
   }
   return trans_x_rot_x(a, alpha) * rot_z_trans_z(theta, d);
+}
+
+// A_i from the angles alpha and theta = q_i + offset_i.
+template <typename T>
+Isometry3<T> dh_link_transform(DhConvention convention, const T& a, const T& alpha, const T& d,
+                               const T& theta) {
+  return dh_link_transform(convention, a, cos_sin(alpha), d, cos_sin(theta));
 }
 
 template <typename T>
@@ -83,7 +94,7 @@ ChainPoses<T> chain_poses(const KinematicModel& model, const Eigen::Matrix<T, 6,
       out.T_R_axis[i] = out.T_R_link[i];
     } else {
       // Modified DH: the joint turns about z_i, i.e. after Rx(alpha_{i-1}) Tx(a_{i-1}).
-      out.T_R_axis[i] = out.T_R_link[i] * trans_x_rot_x(T(p.a_m), T(p.alpha_rad));
+      out.T_R_axis[i] = out.T_R_link[i] * trans_x_rot_x(T(p.a_m), cos_sin(T(p.alpha_rad)));
     }
     out.T_R_link[i + 1] = out.T_R_link[i] * dh_link_transform(model.convention, p, q(i));
   }

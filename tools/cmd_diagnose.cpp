@@ -34,24 +34,40 @@ struct DiagnoseArgs {
 
 constexpr const char* kSvgProlog = "<?xml version=\"1.0\" encoding=\"utf-8\" standalone=\"no\"?>\n";
 
-// The three figures are drawn side by side, each by its own gnuplot (its own temporary folder):
+// A figure of the diagnosis: its file and how gnuplot draws it.
+struct FigureSpec {
+  const char* file;
+  std::string (*draw)(tools::GnuplotRenderer& gnuplot, const eval::GapSession& s);
+};
+constexpr std::array<FigureSpec, 3> kFigures = {{
+    {"gap-spectrum.svg",
+     [](tools::GnuplotRenderer& g, const eval::GapSession& s) {
+       return tools::spectrum_figure(g, s.signals);
+     }},
+    {"gap-where.svg",
+     [](tools::GnuplotRenderer& g, const eval::GapSession& s) {
+       return tools::where_figure(g, s.diagnosis);
+     }},
+    {"gap-model-error.svg",
+     [](tools::GnuplotRenderer& g, const eval::GapSession& s) {
+       return tools::model_error_figure(g, s.signals, s.diagnosis);
+     }},
+}};
+
+// The figures are drawn side by side, each by its own gnuplot (its own temporary folder):
 // gnuplot runs ~0.05-0.1 s a figure, after the diagnosis, with the cores otherwise idle.
 void write_figures(const imscal::OutputFolder& folder, const eval::GapSession& s,
                    double timeout_s) {
-  const std::array<const char*, 3> names = {"gap-spectrum.svg", "gap-where.svg",
-                                            "gap-model-error.svg"};
-  std::array<std::string, 3> svg;
+  std::array<std::string, kFigures.size()> svg;
   imscal::run_parallel_tasks(
-      names.size(),
+      kFigures.size(),
       [&](std::size_t i) {
         tools::GnuplotRenderer gnuplot(timeout_s);
-        if (i == 0) svg[i] = tools::spectrum_figure(gnuplot, s.signals);
-        if (i == 1) svg[i] = tools::where_figure(gnuplot, s.diagnosis);
-        if (i == 2) svg[i] = tools::model_error_figure(gnuplot, s.signals, s.diagnosis);
+        svg[i] = kFigures[i].draw(gnuplot, s);
       },
-      unsigned(names.size()));
-  for (std::size_t i = 0; i < names.size(); ++i)
-    imscal::write_file_atomically(folder.staged(names[i]), kSvgProlog + svg[i] + "\n",
+      unsigned(kFigures.size()));
+  for (std::size_t i = 0; i < kFigures.size(); ++i)
+    imscal::write_file_atomically(folder.staged(kFigures[i].file), kSvgProlog + svg[i] + "\n",
                                   imscal::Overwrite::kAllow);
 }
 
@@ -59,8 +75,7 @@ void run(const DiagnoseArgs& args) {
   const auto overwrite = args.force ? imscal::Overwrite::kAllow : imscal::Overwrite::kRefuse;
   std::vector<fs::path> outputs = {"report.json", "report.txt"};
   if (args.figures)
-    for (const char* f : {"gap-spectrum.svg", "gap-where.svg", "gap-model-error.svg"})
-      outputs.push_back(f);
+    for (const FigureSpec& figure : kFigures) outputs.push_back(figure.file);
   imscal::OutputFolder folder(args.out, outputs, overwrite);
   const eval::GapSession s = eval::diagnose_gap_session(args.session);
   const eval::Diagnosis& d = s.diagnosis;
