@@ -1,8 +1,12 @@
-// Coulomb friction: u = tanh(q̇_a / v_s), v_s 5, 10, 20 mrad/s: the friction acts on the motor's
-// own velocity and the PI loop works it off after every reversal: [L_100ms,0..5 u],
-// [L_100ms,0..3 u], [L_30ms,0..5 u] or [HP_30/100/300ms u]. Bound: u's level >= 0 when the
-// nominal model has no friction. In the nominal model: ΔF_c [N m] of the joint's drive (switched
-// on when the nominal has it off); F_c + ΔF_c >= 0.
+// Coulomb friction: u = tanh(q̇_a / v_s), v_s 5, 10, 20 mrad/s (physical rate thresholds, well
+// below any programmed speed; not the simulator's smoothing). The friction's static level: [u]
+// (the share that acts at the gear output deflects the link by ΔF_c / k for as long as the joint
+// moves), so that a changed friction level is a parameter change of its own; its transient:
+// the friction acts on the motor's own velocity and the PI loop works it off after every
+// reversal: [u, HP_30/100/300ms u], [HP_30/100/300ms u], [L_100ms,0..5 u], [L_100ms,0..3 u] or
+// [L_30ms,0..5 u]. Bound: u's level >= 0 when the nominal model has no friction. In the nominal
+// model: ΔF_c [N m] of the joint's drive (switched on when the nominal has it off);
+// F_c + ΔF_c >= 0.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -24,8 +28,15 @@ std::vector<CandidateShape> shapes(const ShapeContext& x) {
   for (double scale : {0.005, 0.01, 0.02}) {
     const Column sv = (x.qd_actual / scale).array().tanh().matrix();
     const int mrad = int(std::lround(1000.0 * scale));
+    const std::size_t first = out.size();
+    out.push_back(x.local(fmt::format("sign(qd / {} mrad/s)", mrad), {sv}, {"static_rad"}));
     std::vector<Column> hp;
     for (double tau : {0.03, 0.1, 0.3}) hp.push_back(sv - lag(sv, tau, x.s));
+    std::vector<Column> static_and_hp{sv};
+    static_and_hp.insert(static_and_hp.end(), hp.begin(), hp.end());
+    out.push_back(x.local(fmt::format("sign(qd / {} mrad/s) + high-passed 30/100/300 ms", mrad),
+                          static_and_hp,
+                          {"static_rad", "hp30ms_rad", "hp100ms_rad", "hp300ms_rad"}));
     out.push_back(x.local(fmt::format("sign(qd / {} mrad/s) high-passed 30/100/300 ms", mrad), hp,
                           {"hp30ms_rad", "hp100ms_rad", "hp300ms_rad"}));
     for (const auto& [tl, order] : {std::pair{0.1, 6}, std::pair{0.1, 4}, std::pair{0.03, 6}}) {
@@ -34,7 +45,7 @@ std::vector<CandidateShape> shapes(const ShapeContext& x) {
           x.local(fmt::format("sign(qd / {} mrad/s) through Laguerre {} ms x{}", mrad, ms, order),
                   laguerre(sv, tl, order, x.s), numbered(fmt::format("laguerre{}ms_", ms), order)));
     }
-    for (std::size_t i = out.size() - 4; i < out.size(); ++i)
+    for (std::size_t i = first; i < out.size(); ++i)
       out[i].level_signal = sv, out[i].level_lower = lower;
   }
   return out;
