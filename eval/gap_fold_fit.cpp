@@ -2,25 +2,11 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
-#include <cstdlib>
-#include <cstring>
 
 #include "eval/gap_normal_equations.hpp"
 
 namespace imscal::eval {
 namespace {
-
-// MEASUREMENT SWITCH (not for merge): IMSCAL_FOLD_FIT = truncated (default) | refused | ridge.
-enum class FoldFitKind { kTruncated, kTruncatedWhereRefused, kRidge };
-FoldFitKind fold_fit_kind() {
-  static const FoldFitKind kind = [] {
-    const char* e = std::getenv("IMSCAL_FOLD_FIT");
-    if (e && std::strcmp(e, "refused") == 0) return FoldFitKind::kTruncatedWhereRefused;
-    if (e && std::strcmp(e, "ridge") == 0) return FoldFitKind::kRidge;
-    return FoldFitKind::kTruncated;
-  }();
-  return kind;
-}
 
 // The scaled normal equations g theta_s = b of the augmented Gram matrix `a` (lower triangle),
 // theta = theta_s / scale.
@@ -62,12 +48,7 @@ Eigen::MatrixXd truncated_inverse(const Eigen::MatrixXd& g, double min_relative)
 Eigen::VectorXd bounded_solution(const ScaledProblem& sp, const Eigen::MatrixXd& pinv,
                                  const FoldBound& bound) {
   Eigen::VectorXd theta_s = pinv * sp.b;
-  // MEASUREMENT SWITCH (not for merge): IMSCAL_FOLD_BOUND=off leaves the bounds out.
-  static const bool bounds_off = [] {
-    const char* e = std::getenv("IMSCAL_FOLD_BOUND");
-    return e && std::strcmp(e, "off") == 0;
-  }();
-  if (!bounds_off && bound.weights.size() == theta_s.size()) {
+  if (bound.weights.size() == theta_s.size()) {
     const Eigen::VectorXd w = bound.weights.cwiseProduct(sp.inverse_scale);
     const double level = w.dot(theta_s), violation = bound.lower - level;
     // Tolerance: rounding of the level (as eval/gap_bounds.cpp).
@@ -80,39 +61,6 @@ Eigen::VectorXd bounded_solution(const ScaledProblem& sp, const Eigen::MatrixXd&
   return theta_s.cwiseProduct(sp.inverse_scale);
 }
 
-// Whether the fit rows' own scaling gives a Gram matrix the normal equations accept
-// (eval/gap_normal_equations.hpp); then `pinv` is its inverse in that scaling.
-bool plain_fit(const Eigen::MatrixXd& fit, ScaledProblem& sp, Eigen::MatrixXd& pinv) {
-  const Eigen::Index p = fit.rows() - 1;
-  const Eigen::VectorXd scale = fit.diagonal().head(p).cwiseSqrt();
-  if (p == 0 || !(scale.minCoeff() > 0.0)) return false;
-  sp = scaled(fit, scale);
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(sp.g);
-  const Eigen::VectorXd& lambda = eigen.eigenvalues();
-  if (eigen.info() != Eigen::Success || !(lambda[0] * kMaxGramCondition >= lambda[p - 1]))
-    return false;
-  pinv =
-      eigen.eigenvectors() * lambda.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
-  return true;
-}
-
-// Ridge: (g + k I)^-1 with k = p sigma² / |theta_s|² (Hoerl, Kennard & Baldwin 1975) from the
-// truncated fit's residual variance over `rows` fit rows.
-Eigen::MatrixXd ridge_inverse(const Eigen::MatrixXd& fit, const ScaledProblem& sp,
-                              const Eigen::MatrixXd& pinv, double rows) {
-  const Eigen::Index p = sp.g.rows();
-  const Eigen::VectorXd theta_s = pinv * sp.b;
-  const double sse = sse_of_gram(fit, theta_s.cwiseProduct(sp.inverse_scale));
-  const double dof = rows - double(p);
-  const double norm2 = theta_s.squaredNorm();
-  if (!(dof > 0.0) || !(norm2 > 0.0)) return pinv;
-  const double k = double(p) * (sse / dof) / norm2;
-  Eigen::MatrixXd regular = sp.g;
-  for (Eigen::Index c = 0; c < p; ++c)
-    if (sp.inverse_scale[c] > 0.0) regular(c, c) += k;
-  return truncated_inverse(regular, 1.0 / kMaxGramCondition);
-}
-
 }  // namespace
 
 Eigen::VectorXd truncated_fit(const Eigen::MatrixXd& fit, const Eigen::VectorXd& scale,
@@ -121,34 +69,8 @@ Eigen::VectorXd truncated_fit(const Eigen::MatrixXd& fit, const Eigen::VectorXd&
   return bounded_solution(sp, truncated_inverse(sp.g, 1.0 / kMaxGramCondition), bound);
 }
 
-namespace {
-
-Eigen::VectorXd fold_theta(const Eigen::MatrixXd& fit, const Eigen::VectorXd& scale,
-                           const FoldBound& bound, double rows) {
-  const FoldFitKind kind = fold_fit_kind();
-  if (kind == FoldFitKind::kTruncatedWhereRefused) {
-    ScaledProblem sp;
-    Eigen::MatrixXd pinv;
-    if (plain_fit(fit, sp, pinv)) return bounded_solution(sp, pinv, bound);
-  }
-  if (kind == FoldFitKind::kRidge && rows > 0.0) {
-    const ScaledProblem sp = scaled(fit, scale);
-    const Eigen::MatrixXd pinv = truncated_inverse(sp.g, 1.0 / kMaxGramCondition);
-    return bounded_solution(sp, ridge_inverse(fit, sp, pinv, rows), bound);
-  }
-  return truncated_fit(fit, scale, bound);
-}
-
-}  // namespace
-
 double folds_validation_sse(const std::vector<Eigen::MatrixXd>& grams,
                             const std::vector<FoldBound>& bounds) {
-  return folds_validation_sse(grams, bounds, {});
-}
-
-double folds_validation_sse(const std::vector<Eigen::MatrixXd>& grams,
-                            const std::vector<FoldBound>& bounds,
-                            const std::vector<double>& fold_rows) {
   if (grams.empty()) return 0.0;
   Eigen::MatrixXd total = Eigen::MatrixXd::Zero(grams[0].rows(), grams[0].cols());
   for (const Eigen::MatrixXd& a : grams) total += a;
@@ -158,14 +80,10 @@ double folds_validation_sse(const std::vector<Eigen::MatrixXd>& grams,
   double sse = 0.0;
   for (std::size_t i = 0; i < grams.size(); ++i) {
     Eigen::MatrixXd fit = Eigen::MatrixXd::Zero(total.rows(), total.cols());
-    double rows = 0.0;
     for (std::size_t j = 0; j < grams.size(); ++j)
-      if (j != i) {
-        fit += grams[j];
-        if (j < fold_rows.size()) rows += fold_rows[j];
-      }
+      if (j != i) fit += grams[j];
     const FoldBound& bound = i < bounds.size() ? bounds[i] : none;
-    sse += sse_of_gram(grams[i], fold_theta(fit, scale, bound, rows));
+    sse += sse_of_gram(grams[i], truncated_fit(fit, scale, bound));
   }
   return sse;
 }

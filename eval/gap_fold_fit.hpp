@@ -41,10 +41,6 @@ Eigen::VectorXd truncated_fit(const Eigen::MatrixXd& fit, const Eigen::VectorXd&
 // (lower triangle) and each fold fit's bound (`bounds`: one per fold, or empty: none).
 double folds_validation_sse(const std::vector<Eigen::MatrixXd>& grams,
                             const std::vector<FoldBound>& bounds);
-// MEASUREMENT (ridge): with each fold's row count.
-double folds_validation_sse(const std::vector<Eigen::MatrixXd>& grams,
-                            const std::vector<FoldBound>& bounds,
-                            const std::vector<double>& fold_rows);
 
 // The level weights of each fold fit (eval/gap_bounds.hpp) from each fold's sums over its rows of
 // u x_c (`cross`, over the parameters) and u² (`uu`): the fit rows' sums, divided. Zero where u

@@ -60,15 +60,6 @@ std::vector<FoldBound> level_bounds(const PooledShape& shape,
   return fold_bounds(cross, uu, shape.level_lower);
 }
 
-// The rows of each fold over the joints the shape acts on (the ridge's residual variance).
-std::vector<double> fold_rows(const PooledShape& shape, const TrainingFolds& folds) {
-  std::size_t joints = 0;
-  for (const auto& cols : shape.pool_columns) joints += !cols.empty();
-  std::vector<double> out;
-  for (const auto& fold : folds.folds) out.push_back(double(fold.size() * joints));
-  return out;
-}
-
 // The shape's columns per joint (samples x its parameters where it acts, else empty).
 std::vector<Eigen::MatrixXd> columns_of(const ShapePool& pool, const PooledShape& shape) {
   const Eigen::Index p = width_of(shape);
@@ -116,7 +107,7 @@ std::vector<PooledShape> independent_parts(const PooledShape& shape) {
 }
 
 // The validation error of one shape of the pool (grams: [fold][joint]).
-double shape_validation_sse(const PooledShape& shape, const TrainingFolds& folds,
+double shape_validation_sse(const PooledShape& shape,
                             const std::vector<std::vector<Eigen::MatrixXd>>& grams) {
   double sse = 0.0;
   for (PooledShape part : independent_parts(shape)) {
@@ -124,7 +115,7 @@ double shape_validation_sse(const PooledShape& shape, const TrainingFolds& folds
     part.level_lower = shape.level_lower;
     std::vector<Eigen::MatrixXd> part_folds;
     for (const auto& fold : grams) part_folds.push_back(shape_gram(part, fold));
-    sse += folds_validation_sse(part_folds, level_bounds(part, grams), fold_rows(part, folds));
+    sse += folds_validation_sse(part_folds, level_bounds(part, grams));
   }
   return sse;
 }
@@ -174,8 +165,7 @@ std::vector<double> pooled_cross_validation_sse(const ShapePool& pool,
             augmented_gram(pool.columns[j], y[j], folds.folds[f]).selfadjointView<Eigen::Lower>();
   }
   std::vector<double> out;
-  for (const PooledShape& shape : pool.shapes)
-    out.push_back(shape_validation_sse(shape, folds, grams));
+  for (const PooledShape& shape : pool.shapes) out.push_back(shape_validation_sse(shape, grams));
   return out;
 }
 

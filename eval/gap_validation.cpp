@@ -50,12 +50,8 @@ double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>&
 double cross_validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                             const TrainingFolds& folds) {
   std::vector<Eigen::MatrixXd> grams;
-  std::vector<double> rows;
-  for (const auto& fold : folds.folds) {
-    grams.push_back(augmented_gram(columns, y, fold));
-    rows.push_back(double(fold.size()));
-  }
-  return folds_validation_sse(grams, {}, rows);
+  for (const auto& fold : folds.folds) grams.push_back(augmented_gram(columns, y, fold));
+  return folds_validation_sse(grams, {});
 }
 
 namespace {
@@ -89,18 +85,16 @@ double cross_validation_sse(const std::vector<Eigen::MatrixXd>& columns,
   if (joints.empty()) return 0.0;
   const Eigen::Index p = columns[joints.front()].cols();
   std::vector<Eigen::MatrixXd> grams;
-  std::vector<double> rows;
   for (const auto& fold : folds.folds) {
     Eigen::MatrixXd a = Eigen::MatrixXd::Zero(p + 1, p + 1);
     for (std::size_t j : joints) add_augmented_gram(columns[j], y[j], fold, a);
     grams.push_back(std::move(a));
-    rows.push_back(double(fold.size() * joints.size()));
   }
   std::vector<FoldBound> bounds;
   if (level.signal && level.signal->size() > 0 && level.joint < columns.size() &&
       columns[level.joint].size() > 0)
     bounds = level_bounds(columns[level.joint], level, folds);
-  return folds_validation_sse(grams, bounds, rows);
+  return folds_validation_sse(grams, bounds);
 }
 
 }  // namespace imscal::eval
