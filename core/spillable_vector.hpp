@@ -96,8 +96,10 @@ class SpillableVector {
   template <class... Args>
   T& emplace_back(Args&&... args) {
     if (!on_file()) return memory_.emplace_back(std::forward<Args>(args)...);
+    // Made before growing: an argument may be an element of this array, which growing moves.
+    T value(std::forward<Args>(args)...);
     if (size() == capacity()) reserve(std::max<size_type>(2 * size(), 1024));
-    T* at_end = ::new (static_cast<void*>(end())) T(std::forward<Args>(args)...);
+    T* at_end = ::new (static_cast<void*>(end())) T(std::move(value));
     ++file_->size;
     return *at_end;
   }
@@ -106,8 +108,9 @@ class SpillableVector {
   void resize(size_type n) { resize(n, T()); }
   void resize(size_type n, const T& value) {
     if (!on_file()) return memory_.resize(n, value);
+    const T fill = value;  // before growing: `value` may be an element of this array
     reserve(n);
-    std::uninitialized_fill(end(), data() + std::max(n, size()), value);
+    std::uninitialized_fill(end(), data() + std::max(n, size()), fill);
     file_->size = n;
   }
   void shrink_to_fit() {

@@ -73,6 +73,29 @@ TEST(SpillableVector, FollowsAVectorInMemoryAndOnFile) {
   EXPECT_TRUE(same_bits(array, truth));
 }
 
+// An element of the array appended to it when the file is full: the copy is made before the
+// file grows, so it holds the element's bits wherever the mapping moves (as std::vector's
+// push_back of its own element).
+TEST(SpillableVector, AppendsItsOwnElementWhenTheFileGrows) {
+  std::vector<Sample> truth;
+  SpillableVector<Sample> array;
+  array.push_back(sample_of(1));
+  truth.push_back(sample_of(1));
+  array.spill_to_file();
+  for (int growth = 0; growth < 4; ++growth) {
+    while (array.size() < array.capacity()) {
+      array.push_back(sample_of(array.size() + 1));
+      truth.push_back(sample_of(truth.size() + 1));
+    }
+    array.push_back(array.front());
+    truth.push_back(truth.front());
+    array.resize(array.size() + 3, array[1]);
+    truth.resize(truth.size() + 3, truth[1]);
+  }
+  ASSERT_TRUE(array.on_file());
+  EXPECT_TRUE(same_bits(array, truth));
+}
+
 // The resident kB of the mapping that holds `address`, from /proc/self/smaps.
 long resident_kb_of_mapping(const void* address) {
   std::ifstream smaps("/proc/self/smaps");
