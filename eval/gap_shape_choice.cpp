@@ -33,8 +33,12 @@ std::size_t choose(const std::vector<ShapeScore>& scores) {
   return chosen;
 }
 
-ShapeScore score_of(const CandidateShape& shape, const GapSignals& s, const TrainingFolds& folds) {
-  return {cross_validation_sse(shape.columns, s.gap_rad, folds), shape.parameter_names.size()};
+ShapeScore score_of(const CandidateShape& shape, std::size_t joint, const GapSignals& s,
+                    const TrainingFolds& folds) {
+  // Within the shape's physical bound on its own joint, as its final fit (eval/gap_candidates.cpp).
+  const ValidationLevel level{joint, &shape.level_signal, shape.level_lower};
+  return {cross_validation_sse(shape.columns, s.gap_rad, folds, level),
+          shape.parameter_names.size()};
 }
 
 // The chosen shape of an effect whose shapes are drawn from pools (EffectDefinition::shape_pools).
@@ -73,14 +77,14 @@ std::optional<CandidateShape> chosen_shape(EffectKind kind, const GapSignals& s,
     std::vector<CandidateShape> shapes = effect.shapes(context);
     if (shapes.empty()) return std::nullopt;
     if (shapes.size() > 1 && folds.usable())
-      for (const CandidateShape& shape : shapes) scores.push_back(score_of(shape, s, folds));
+      for (const CandidateShape& shape : shapes) scores.push_back(score_of(shape, joint, s, folds));
     return std::move(shapes[choose(scores)]);
   }
   const std::size_t count = effect.shape_count(context);
   if (count == 0) return std::nullopt;
   if (count > 1 && folds.usable())
     for (std::size_t i = 0; i < count; ++i)
-      scores.push_back(score_of(effect.shape_at(context, i), s, folds));
+      scores.push_back(score_of(effect.shape_at(context, i), joint, s, folds));
   return effect.shape_at(context, choose(scores));
 }
 

@@ -1,9 +1,9 @@
 #include "eval/gap_shape_pool.hpp"
 
 #include <algorithm>
-#include <optional>
 #include <utility>
 
+#include "eval/gap_fold_fit.hpp"
 #include "eval/gap_normal_equations.hpp"
 
 namespace imscal::eval {
@@ -39,19 +39,25 @@ Eigen::MatrixXd shape_gram(const PooledShape& shape, const std::vector<Eigen::Ma
   return a;
 }
 
-// The validation error from the shape's fold Gram matrices; nullopt when a fold's fit is
-// ill-conditioned (eval/gap_validation.cpp then takes the QR on the columns).
-std::optional<double> gram_validation_sse(const std::vector<Eigen::MatrixXd>& folds) {
-  double sse = 0.0;
-  for (std::size_t i = 0; i < folds.size(); ++i) {
-    Eigen::MatrixXd fit = Eigen::MatrixXd::Zero(folds[i].rows(), folds[i].cols());
-    for (std::size_t j = 0; j < folds.size(); ++j)
-      if (j != i) fit += folds[j];
-    const std::optional<GramSolution> solution = solve_normal_equations(fit);
-    if (!solution) return std::nullopt;
-    sse += sse_of_gram(folds[i], solution->theta);
+// The fold fits' bounds of the shape's level (PooledShape::level_column of level_joint, a pool
+// column) from the pool's fold Gram matrices ([fold][joint]): the sums of u x_c over the shape's
+// parameters on that joint and of u². None when the shape has no level or no columns there.
+std::vector<FoldBound> level_bounds(const PooledShape& shape,
+                                    const std::vector<std::vector<Eigen::MatrixXd>>& grams) {
+  const std::vector<Eigen::Index>& cols = columns_on(shape, shape.level_joint);
+  if (shape.level_column < 0 || cols.empty()) return {};
+  std::vector<Eigen::VectorXd> cross;
+  std::vector<double> uu;
+  for (const auto& fold : grams) {
+    const Eigen::MatrixXd& g = fold[shape.level_joint];
+    Eigen::VectorXd c = Eigen::VectorXd::Zero(width_of(shape));
+    for (std::size_t i = 0; i < cols.size(); ++i)
+      c[shape.first_parameter[shape.level_joint] + Eigen::Index(i)] =
+          g(shape.level_column, cols[i]);
+    cross.push_back(std::move(c));
+    uu.push_back(g(shape.level_column, shape.level_column));
   }
-  return sse;
+  return fold_bounds(cross, uu, shape.level_lower);
 }
 
 // The shape's columns per joint (samples x its parameters where it acts, else empty).
@@ -101,15 +107,15 @@ std::vector<PooledShape> independent_parts(const PooledShape& shape) {
 }
 
 // The validation error of one shape of the pool (grams: [fold][joint]).
-double shape_validation_sse(const ShapePool& pool, const PooledShape& shape,
-                            const std::vector<std::vector<double>>& y, const TrainingFolds& folds,
+double shape_validation_sse(const PooledShape& shape,
                             const std::vector<std::vector<Eigen::MatrixXd>>& grams) {
   double sse = 0.0;
-  for (const PooledShape& part : independent_parts(shape)) {
+  for (PooledShape part : independent_parts(shape)) {
+    part.level_column = shape.level_column, part.level_joint = shape.level_joint,
+    part.level_lower = shape.level_lower;
     std::vector<Eigen::MatrixXd> part_folds;
     for (const auto& fold : grams) part_folds.push_back(shape_gram(part, fold));
-    const std::optional<double> gram_sse = gram_validation_sse(part_folds);
-    sse += gram_sse ? *gram_sse : cross_validation_sse(columns_of(pool, part), y, folds);
+    sse += folds_validation_sse(part_folds, level_bounds(part, grams));
   }
   return sse;
 }
@@ -160,8 +166,7 @@ std::vector<double> pooled_cross_validation_sse(const ShapePool& pool,
             augmented_gram(pool.columns[j], y[j], folds.folds[f]).selfadjointView<Eigen::Lower>();
   }
   std::vector<double> out;
-  for (const PooledShape& shape : pool.shapes)
-    out.push_back(shape_validation_sse(pool, shape, y, folds, grams));
+  for (const PooledShape& shape : pool.shapes) out.push_back(shape_validation_sse(shape, grams));
   return out;
 }
 

@@ -49,11 +49,10 @@ CandidateShape shape_from_pool(const ShapePool& pool, std::size_t index);
 std::vector<CandidateShape> shapes_from_pools(const std::vector<ShapePool>& pools);
 
 // The validation error summed over the folds of each shape of the pool fitted to y ([joint]),
-// the same as cross_validation_sse of its columns: by the normal equations from the pool's Gram
-// matrices where a fold's fit is well conditioned, otherwise by cross_validation_sse of its
-// copied columns. A shape whose joints each have parameters of their own is that many separate
-// problems (its Gram matrices are block-diagonal): each joint's is solved alone and their errors
-// add.
+// the same as cross_validation_sse of its columns within its level's bound: the fold fits
+// (eval/gap_fold_fit.hpp) from the pool's Gram matrices. A shape whose joints each have
+// parameters of their own is that many separate problems (its Gram matrices are block-diagonal):
+// each joint's is solved alone and their errors add.
 std::vector<double> pooled_cross_validation_sse(const ShapePool& pool,
                                                 const std::vector<std::vector<double>>& y,
                                                 const TrainingFolds& folds);

@@ -20,21 +20,29 @@ struct TrainingFolds {
 };
 TrainingFolds training_folds(const GapSignals& signals, const std::vector<bool>& training);
 
-// Sum of squared residuals on the rows `check` of the LS fit of columns to y on the rows `fit`
-// (parameters only: no sigma is needed to choose a shape). Solved by the normal equations of the
-// scaled columns when they are well conditioned, by the column-pivoted QR otherwise
-// (eval/gap_normal_equations.hpp): each fold's Gram matrix is formed once and the folds' fits
-// are summed from them.
+// Sum of squared residuals on the rows `check` of the fold fit of columns to y on the rows `fit`
+// (parameters only: no sigma is needed to choose a shape): the truncated LS fit of
+// eval/gap_fold_fit.hpp, the columns scaled over the fit and check rows.
 double validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                       const std::vector<Eigen::Index>& fit, const std::vector<Eigen::Index>& check);
 
-// The validation error summed over the folds.
+// The validation error summed over the folds: each fold's Gram matrix is formed once and the
+// folds' fits are summed from them (eval/gap_fold_fit.hpp).
 double cross_validation_sse(const Eigen::MatrixXd& columns, const std::vector<double>& y,
                             const TrainingFolds& folds);
 
+// A shape's physical bound in its fold fits (CandidateShape::level_signal and level_lower, on the
+// shape's own joint; eval/gap_bounds.hpp). No signal: unbounded.
+struct ValidationLevel {
+  std::size_t joint = 0;
+  const Eigen::VectorXd* signal = nullptr;
+  double lower = 0.0;
+};
+
 // The same for one parameter vector over several joints (the rows of every joint that has
-// columns, eval/gap_joint_stack.hpp; the folds' rows on each).
+// columns, eval/gap_joint_stack.hpp; the folds' rows on each), each fold fit within `level`.
 double cross_validation_sse(const std::vector<Eigen::MatrixXd>& columns,
-                            const std::vector<std::vector<double>>& y, const TrainingFolds& folds);
+                            const std::vector<std::vector<double>>& y, const TrainingFolds& folds,
+                            const ValidationLevel& level = {});
 
 }  // namespace imscal::eval

@@ -189,7 +189,7 @@ TEST(GapNormalEquations, CrossValidationMatchesFoldFitsByQr) {
   EXPECT_NEAR(cross_validation_sse(columns, gap, folds), stacked_truth, 1e-7 * stacked_truth);
 }
 
-TEST(GapNormalEquations, IllConditionedFitFallsBackToTheQr) {
+TEST(GapNormalEquations, IllConditionedFitFallsBackToTheQrAndItsFoldFitsTruncate) {
   Problem p = random_problem(7);
   std::mt19937_64 rng(8);
   std::normal_distribution<double> normal(0.0, 1e-7);
@@ -202,9 +202,14 @@ TEST(GapNormalEquations, IllConditionedFitFallsBackToTheQr) {
   const Eigen::VectorXd theta = qr_theta(p.x, p.y, rows);
   const double rms = std::sqrt(direct_sse(p.x, p.y, rows, theta) / double(rows.size()));
   EXPECT_NEAR(fit.rms, rms, 1e-9 * rms);
+  // The validation's fold fits leave the direction x1 - x3, which the rows barely determine,
+  // out (eval/gap_fold_fit.hpp): the fit of columns 0-2 by the QR, to the ~1e-7 the two columns
+  // differ by (1e-5 of the error leaves room).
   const TrainingFolds folds = two_folds(30, 60);
-  const double truth = qr_cross_validation_sse(p, folds);
-  EXPECT_NEAR(cross_validation_sse(p.x, p.y, folds), truth, 1e-9 * truth);
+  Problem three = p;
+  three.x = p.x.leftCols(3);
+  const double truth = qr_cross_validation_sse(three, folds);
+  EXPECT_NEAR(cross_validation_sse(p.x, p.y, folds), truth, 1e-5 * truth);
 }
 
 TEST(GapNormalEquations, FitSigmaMatchesTheQrCovariance) {

@@ -1,7 +1,7 @@
 // Shapes drawn from a pool of columns (eval/gap_shape_pool.hpp): their validation errors from the
 // pool's Gram matrices against a second method, the least squares of each fold's stacked rows by
 // a column-pivoted QR of the copied columns; the copied shapes' columns, zero blocks and level
-// signal; and the fallback of a rank-deficient shape.
+// signal; and a rank-deficient shape.
 #include <gtest/gtest.h>
 
 #include <Eigen/QR>
@@ -125,11 +125,10 @@ TEST(GapShapePool, CopiedShapeHasItsColumnsZeroBlocksAndLevelSignal) {
   EXPECT_EQ(sh.parameter_names, (std::vector<std::string>{"p0", "p2"}));
 }
 
-TEST(GapShapePool, RankDeficientShapeFallsBackToTheColumnsOwnValidation) {
-  // A column taken twice: the normal equations refuse it, the column-pivoted QR of the copied
-  // columns fits it (the same as the shape's own cross_validation_sse, bit for bit), and the
-  // fit is that of the single column (the residual of an LS fit does not depend on the
-  // duplicate), to rounding.
+TEST(GapShapePool, RankDeficientShapeIsTheFitOfItsSingleColumn) {
+  // A column taken twice: the fold fits leave the zero eigen-direction out (eval/gap_fold_fit.hpp;
+  // the same as the shape's own cross_validation_sse, bit for bit), and the fit is that of the
+  // single column (the residual of an LS fit does not depend on the duplicate), to rounding.
   const GapSignals s = record(1);
   std::vector<std::vector<double>> y;
   ShapePool pool = pool_of(1, 3, y);
