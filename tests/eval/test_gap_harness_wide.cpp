@@ -260,8 +260,8 @@ class GapHarnessWide : public test_support::ScratchDirTest {
 // ±20 pp >= 85 %, every effect of a multi-effect case found >= 80 %, false alarms <= 10 % with
 // the chain-measured controls. Met: the shrinkage (development 22/24, held out 23/24) and the
 // development set's false alarms (0/6). Missed, and held here at the measured level so that a fall
-// shows (decisions 0050, 0057, 0058, 0064 and 0065 say why): ranked first 19/24 and 18/24, joint
-// located 20/24 and 20/24, multi-effect 4/6 and 3/6 (effects at the noise floor; a member of one
+// shows (decisions 0050, 0057, 0058, 0064 and 0065 say why): ranked first 19/24 and 19/24, joint
+// located 20/24 and 20/24, multi-effect 5/6 and 3/6 (effects at the noise floor; a member of one
 // joint standing for another's), false alarms 1/9 held out: the mixed program on mount 2 stays
 // beyond on A6 (after its fast cross move the chain's position is 30-90 um off, which the
 // inverse kinematics turns into +-3e-4 rad on A4/A6: 2-2.4 of the smoother's sigma there, but 5
@@ -279,12 +279,12 @@ void expect_goals_or_the_measured_level(const Tally& development, const Tally& h
   EXPECT_GE(pct(development.within, development.effect_cases), 85.0);
   EXPECT_GE(pct(held_out.within, held_out.effect_cases), 85.0);
   EXPECT_GE(development.first, 19);
-  EXPECT_GE(held_out.first, 18);
+  EXPECT_GE(held_out.first, 19);
   EXPECT_GE(development.above_noise_first, 18);
   EXPECT_GE(held_out.above_noise_first, 13);
   EXPECT_GE(development.located, 20);
   EXPECT_GE(held_out.located, 20);
-  EXPECT_GE(development.all_found, 4);
+  EXPECT_GE(development.all_found, 5);
   EXPECT_GE(held_out.all_found, 3);
   // The chain measured at its level: the median of its error RMS over the 36 joint records within
   // 3e-5..1.5e-4 rad (measured 6.2e-5; the lab's chain 5e-5..8e-5, 1.3e-5..3.3e-4 here per joint).
