@@ -27,7 +27,9 @@
 //    G z^P_v P = z^P_v z^-δ Q / N, Q = C_s + i C_c, N = A + z^-δ (1 - z^-1) z^P_v B.
 //    Amplitude |·| [rad] and phase arg(·) [rad] of the error a sin(φ + ψ); as Ω -> 0 they are
 //    the static gains' √(g_s² + g_c²) and atan2(g_c, g_s). Each cell is taken at its own rms
-//    speed; the report gives the speed and frequency the cells' weights average to.
+//    speed; the report gives the speed and frequency the cells' weights average to. The 1σ is
+//    the fit's alone: where the response changes across a cell's speeds (the slow joints of the
+//    population's plants, 1.5-2.4x the plant's error at their rms speed) it does not cover that.
 // 1σ by first-order propagation (delta method) of the least-squares covariance σ_e² (ΦᵀΦ)⁻¹ of
 // θ = [α; β; c] (ident/arx_fit.hpp), which takes the equation errors as white: the chosen ARX
 // order whitens them (the validation's residual correlation test says where it did not).
