@@ -104,15 +104,19 @@ json estimate_json(const StructureEstimate& e) {
 }
 
 json structure_json(const IdentifiedStructure& s) {
-  return {{"cells", s.cells},
-          {"compliance_rad_per_nm", estimate_json(s.compliance_rad_per_nm)},
-          {"nominal_compliance_rad_per_nm", json_number_or_null(s.nominal_compliance_rad_per_nm)},
-          {"stiffness_nm_per_rad", estimate_json(s.stiffness_nm_per_rad)},
-          {"direction_offset_rad", estimate_json(s.direction_offset_rad)},
-          {"transmission_error_harmonic_per_motor_rev",
-           json_number_or_null(s.transmission_error_harmonic_per_motor_rev)},
-          {"transmission_error_amplitude_rad", estimate_json(s.transmission_error_amplitude_rad)},
-          {"transmission_error_phase_rad", estimate_json(s.transmission_error_phase_rad)}};
+  return {
+      {"cells", s.cells},
+      {"compliance_rad_per_nm", estimate_json(s.compliance_rad_per_nm)},
+      {"nominal_compliance_rad_per_nm", json_number_or_null(s.nominal_compliance_rad_per_nm)},
+      {"stiffness_nm_per_rad", estimate_json(s.stiffness_nm_per_rad)},
+      {"direction_offset_rad", estimate_json(s.direction_offset_rad)},
+      {"transmission_error_harmonic_per_motor_rev",
+       json_number_or_null(s.transmission_error_harmonic_per_motor_rev)},
+      {"transmission_error_amplitude_rad", estimate_json(s.transmission_error_amplitude_rad)},
+      {"transmission_error_phase_rad", estimate_json(s.transmission_error_phase_rad)},
+      {"transmission_error_joint_speed_rad_s",
+       json_number_or_null(s.transmission_error_joint_speed_rad_s)},
+      {"transmission_error_frequency_hz", json_number_or_null(s.transmission_error_frequency_hz)}};
 }
 
 json joint_json(const JointIdentification& r, double seconds, const IdentifiedStructure& s) {
@@ -235,6 +239,11 @@ IdentifiedStructure structure_of(const JsonField& f) {
       f["transmission_error_harmonic_per_motor_rev"].number_or_nan();
   s.transmission_error_amplitude_rad = estimate_of(f["transmission_error_amplitude_rad"]);
   s.transmission_error_phase_rad = estimate_of(f["transmission_error_phase_rad"]);
+  // Reports without them gave the pair's static gains (no frequency): read as NaN.
+  if (const auto speed = f.optional("transmission_error_joint_speed_rad_s"))
+    s.transmission_error_joint_speed_rad_s = speed->number_or_nan();
+  if (const auto frequency = f.optional("transmission_error_frequency_hz"))
+    s.transmission_error_frequency_hz = frequency->number_or_nan();
   return s;
 }
 

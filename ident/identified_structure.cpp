@@ -1,8 +1,11 @@
 #include "ident/identified_structure.hpp"
 
 #include <cmath>
+#include <complex>
+#include <numbers>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ident/joint_identification.hpp"
@@ -36,40 +39,39 @@ bool compliance_is_significant(const StaticGains& g, int torque) {
          g.gain(torque) > kSignificantSigmas * std::sqrt(g.covariance(torque, torque));
 }
 
-void set_transmission_error(IdentifiedStructure& s, const StaticGains& g, int sin_input,
-                            int cos_input) {
-  if (sin_input < 0 || cos_input < 0) return;
-  const double gs = g.gain(sin_input), gc = g.gain(cos_input);
-  const double amplitude = std::hypot(gs, gc);
-  Eigen::VectorXd d_amplitude = Eigen::VectorXd::Zero(g.gain.size());
-  Eigen::VectorXd d_phase = Eigen::VectorXd::Zero(g.gain.size());
-  if (amplitude > 0.0) {
-    d_amplitude(sin_input) = gs / amplitude;
-    d_amplitude(cos_input) = gc / amplitude;
-    d_phase(sin_input) = -gc / (amplitude * amplitude);
-    d_phase(cos_input) = gs / (amplitude * amplitude);
-  }
-  s.transmission_error_amplitude_rad = propagated(amplitude, d_amplitude, g.covariance);
-  s.transmission_error_phase_rad = propagated(std::atan2(gc, gs), d_phase, g.covariance);
-}
-
-// Inverse-variance weighted combination of the cells' gains, input by input; the covariance of
-// two inputs is Σ w_a w_b cov_ab / (Σ w_a Σ w_b) (independent cells).
-StaticGains combined(const std::vector<StaticGains>& cells) {
-  const Eigen::Index n = cells.front().gain.size();
+// Inverse-variance weighted combination of the cells' estimates, component by component; the
+// covariance of two components is Σ w_a w_b cov_ab / (Σ w_a Σ w_b) (independent cells).
+template <class Estimate, class Vector, class Matrix>
+Estimate combined(const std::vector<Estimate>& cells, Vector Estimate::*value,
+                  Matrix Estimate::*covariance) {
+  const Eigen::Index n = (cells.front().*value).size();
   Eigen::VectorXd weight_sum = Eigen::VectorXd::Zero(n), weighted = Eigen::VectorXd::Zero(n);
   Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(n, n);
-  for (const StaticGains& g : cells) {
-    const Eigen::VectorXd w = g.covariance.diagonal().cwiseInverse();
+  for (const Estimate& g : cells) {
+    const Eigen::VectorXd w = (g.*covariance).diagonal().cwiseInverse();
     weight_sum += w;
-    weighted += w.cwiseProduct(g.gain);
-    cross += w.asDiagonal() * g.covariance * w.asDiagonal();
+    weighted += w.cwiseProduct(g.*value);
+    cross += w.asDiagonal() * (g.*covariance) * w.asDiagonal();
   }
-  StaticGains out;
-  out.gain = weighted.cwiseQuotient(weight_sum);
+  Estimate out;
+  out.*value = weighted.cwiseQuotient(weight_sum);
   const Eigen::VectorXd inverse = weight_sum.cwiseInverse();
-  out.covariance = inverse.asDiagonal() * cross * inverse.asDiagonal();
+  out.*covariance = inverse.asDiagonal() * cross * inverse.asDiagonal();
   return out;
+}
+
+// The pair's inputs: the plain pair where the table has it, else the gear-mode pair.
+std::pair<int, int> transmission_error_pair(std::span<const TableInput> inputs) {
+  const bool plain = has_input(inputs, TableInput::kTransmissionErrorSin);
+  return {index_of(inputs, plain ? TableInput::kTransmissionErrorSin
+                                 : TableInput::kTransmissionErrorModeSin),
+          index_of(inputs, plain ? TableInput::kTransmissionErrorCos
+                                 : TableInput::kTransmissionErrorModeCos)};
+}
+
+// A cell's weight in the speed the combined pair is given at: the inverse of its variance.
+double pair_weight(const PairResponse& r) {
+  return 1.0 / r.covariance.trace();
 }
 
 }  // namespace
@@ -95,6 +97,64 @@ StaticGains static_gains(const ArxFitResult& fit, std::span<const TableInput> in
   return out;
 }
 
+PairResponse transmission_error_response(const ArxFitResult& fit,
+                                         std::span<const TableInput> inputs, double frequency_rad_s,
+                                         FitForm form) {
+  const ArxStructure& s = fit.model.structure();
+  if (std::size_t(s.extra_inputs) != inputs.size())
+    throw std::invalid_argument("transmission_error_response: the model has " +
+                                std::to_string(s.extra_inputs) + " further inputs, the table " +
+                                std::to_string(inputs.size()));
+  const auto [sin_input, cos_input] = transmission_error_pair(inputs);
+  if (sin_input < 0 || cos_input < 0)
+    throw std::invalid_argument("transmission_error_response: no transmission-error pair");
+  using Complex = std::complex<double>;
+  const Complex i(0.0, 1.0);
+  const Complex u = std::polar(1.0, -frequency_rad_s * fit.model.sample_time_s());  // z^-1
+  const auto power = [&](int k) { return std::pow(u, k); };
+  // The preview's lead z^P_v and the delay z^-δ, and N = A + z^-δ (1 - z^-1) z^P_v B in the
+  // inverse form (N = A otherwise), Q = C_s + i C_c: the error at the link z^P_v z^-δ Q / N.
+  const Complex lead = form.inverse ? power(-form.preview_cycles) : Complex(1.0);
+  const Complex delay = power(s.dead_time);
+  const Complex loop = form.inverse ? delay * (1.0 - u) * lead : Complex(0.0);
+  Complex n = 1.0, q = 0.0;
+  for (int k = 0; k < s.na; ++k) n += fit.model.a()(k) * power(k + 1);
+  for (int j = 0; j < s.nb; ++j) n += loop * fit.model.b()(j) * power(j);
+  const int first_sin = s.extra_offset(sin_input), first_cos = s.extra_offset(cos_input);
+  for (int l = 0; l < s.nx[std::size_t(sin_input)]; ++l)
+    q += fit.model.c()(first_sin + l) * power(l);
+  for (int l = 0; l < s.nx[std::size_t(cos_input)]; ++l)
+    q += i * fit.model.c()(first_cos + l) * power(l);
+  const Complex response = lead * delay * q / n;
+  // Its gradient in θ = [α; β; c]: ∂/∂α_i = -r z^-i / N, ∂/∂β_j = -r loop z^-j / N,
+  // ∂/∂c_s,l = z^P_v z^-δ z^-l / N and i times that for c_c,l.
+  Eigen::VectorXcd gradient = Eigen::VectorXcd::Zero(s.parameter_count());
+  for (int k = 0; k < s.na; ++k) gradient(k) = -response * power(k + 1) / n;
+  for (int j = 0; j < s.nb; ++j) gradient(s.na + j) = -response * loop * power(j) / n;
+  const int c0 = s.na + s.nb;
+  for (int l = 0; l < s.nx[std::size_t(sin_input)]; ++l)
+    gradient(c0 + first_sin + l) = lead * delay * power(l) / n;
+  for (int l = 0; l < s.nx[std::size_t(cos_input)]; ++l)
+    gradient(c0 + first_cos + l) = i * lead * delay * power(l) / n;
+  Eigen::MatrixXd jacobian(2, s.parameter_count());
+  jacobian.row(0) = gradient.real().transpose();
+  jacobian.row(1) = gradient.imag().transpose();
+  return {Eigen::Vector2d(response.real(), response.imag()),
+          jacobian * fit.covariance * jacobian.transpose()};
+}
+
+void set_transmission_error(IdentifiedStructure& s, const PairResponse& r) {
+  const double re = r.re_im_rad(0), im = r.re_im_rad(1);
+  const double amplitude = std::hypot(re, im);
+  Eigen::Vector2d d_amplitude = Eigen::Vector2d::Zero(), d_phase = Eigen::Vector2d::Zero();
+  if (amplitude > 0.0) {
+    d_amplitude = Eigen::Vector2d(re, im) / amplitude;
+    d_phase = Eigen::Vector2d(-im, re) / (amplitude * amplitude);
+  }
+  s.transmission_error_amplitude_rad = propagated(amplitude, d_amplitude, r.covariance);
+  s.transmission_error_phase_rad = propagated(std::atan2(im, re), d_phase, r.covariance);
+}
+
 IdentifiedStructure structure_of_gains(const StaticGains& g, std::span<const TableInput> inputs) {
   IdentifiedStructure s;
   s.cells = 1;
@@ -106,26 +166,37 @@ IdentifiedStructure structure_of_gains(const StaticGains& g, std::span<const Tab
     s.stiffness_nm_per_rad = {1.0 / c, s.compliance_rad_per_nm.sigma / (c * c)};
   }
   s.direction_offset_rad = gain_estimate(g, direction);
-  // The plain pair's gains; with the gear-mode pair instead of it, that pair's (the mode's gain
-  // is 1 at rest).
-  const bool plain = has_input(inputs, TableInput::kTransmissionErrorSin);
-  set_transmission_error(s, g,
-                         index_of(inputs, plain ? TableInput::kTransmissionErrorSin
-                                                : TableInput::kTransmissionErrorModeSin),
-                         index_of(inputs, plain ? TableInput::kTransmissionErrorCos
-                                                : TableInput::kTransmissionErrorModeCos));
   return s;
 }
 
 IdentifiedStructure identified_structure(const JointIdentification& joint,
-                                         std::span<const TableInput> inputs) {
+                                         std::span<const TableInput> inputs, FitForm form) {
+  const auto [sin_input, cos_input] = transmission_error_pair(inputs);
+  const bool pair = sin_input >= 0 && cos_input >= 0;
+  const double phase_rate_rad_per_rad = joint.parameters.transmission_error_rad_per_rad;
   std::vector<StaticGains> cells;
-  for (const CellIdentification& cell : joint.cells)
-    if (cell.status == CellStatus::kIdentified && cell.fit && !inputs.empty())
-      cells.push_back(static_gains(*cell.fit, inputs));
+  std::vector<PairResponse> responses;
+  double speed_sum = 0.0, weight_sum = 0.0;
+  for (const CellIdentification& cell : joint.cells) {
+    if (cell.status != CellStatus::kIdentified || !cell.fit || inputs.empty()) continue;
+    cells.push_back(static_gains(*cell.fit, inputs));
+    if (!pair) continue;
+    responses.push_back(transmission_error_response(
+        *cell.fit, inputs, phase_rate_rad_per_rad * cell.rms_speed_rad_s, form));
+    speed_sum += pair_weight(responses.back()) * cell.rms_speed_rad_s;
+    weight_sum += pair_weight(responses.back());
+  }
   if (cells.empty()) return {};
-  IdentifiedStructure s = structure_of_gains(combined(cells), inputs);
+  IdentifiedStructure s =
+      structure_of_gains(combined(cells, &StaticGains::gain, &StaticGains::covariance), inputs);
   s.cells = cells.size();
+  if (pair) {
+    set_transmission_error(
+        s, combined(responses, &PairResponse::re_im_rad, &PairResponse::covariance));
+    s.transmission_error_joint_speed_rad_s = speed_sum / weight_sum;
+    s.transmission_error_frequency_hz =
+        phase_rate_rad_per_rad * s.transmission_error_joint_speed_rad_s / (2.0 * std::numbers::pi);
+  }
   return s;
 }
 

@@ -14,8 +14,22 @@
 //    the speed tends to zero [rad], half the step at a reversal. It is not the Coulomb friction
 //    through the gear's compliance: on the simulated KR 16 (A4: 10 N m through 3e4 N m/rad,
 //    69″) it is 9″, the rest taken by the increments' terms and the position loop;
-//  * transmission error sin(φ), cos(φ): the pair of gains (g_s, g_c) is the error
-//    A sin(φ + ψ) with amplitude A = √(g_s² + g_c²) [rad] and phase ψ = atan2(g_c, g_s) [rad].
+//  * transmission error sin(φ), cos(φ): the pair is fitted where the joint moves, so its
+//    static gains are not what the data hold (their many taps leave C_e(1) free: 2-4x the
+//    plant's error on the population's plants, decision 0085). At the joint speed v the error's
+//    phase φ = f x turns at Ω = f v [rad/s] (f the phase rate per joint radian), and the pair's
+//    responses H_e = z^-δ C_e(z^-1) / A(z^-1) at z = e^{iΩT} (T the cycle) turn the inputs
+//    sin(Ωt), cos(Ωt) into Im(P e^{iΩt}), P = H_s + i H_c. In the joint-error form that is the
+//    error the pair adds at the link. In the inverse form it is the command offset that cancels
+//    it, with the pair's inputs P_v cycles ahead: the link follows the command through the loop
+//    G, which the same model holds (u = y + e, e = H_w (1 - z^-1) z^P_v y + ..., so 1 / G =
+//    1 + H_w (1 - z^-1) z^P_v with H_w = z^-δ B / A), and the error at the link is
+//    G z^P_v P = z^P_v z^-δ Q / N, Q = C_s + i C_c, N = A + z^-δ (1 - z^-1) z^P_v B.
+//    Amplitude |·| [rad] and phase arg(·) [rad] of the error a sin(φ + ψ); as Ω -> 0 they are
+//    the static gains' √(g_s² + g_c²) and atan2(g_c, g_s). Each cell is taken at its own rms
+//    speed; the report gives the speed and frequency the cells' weights average to. The 1σ is
+//    the fit's alone: where the response changes across a cell's speeds (the slow joints of the
+//    population's plants, 1.5-2.4x the plant's error at their rms speed) it does not cover that.
 // 1σ by first-order propagation (delta method) of the least-squares covariance σ_e² (ΦᵀΦ)⁻¹ of
 // θ = [α; β; c] (ident/arx_fit.hpp), which takes the equation errors as white: the chosen ARX
 // order whitens them (the validation's residual correlation test says where it did not).
@@ -45,8 +59,13 @@ struct IdentifiedStructure {
   StructureEstimate compliance_rad_per_nm;
   StructureEstimate stiffness_nm_per_rad;
   StructureEstimate direction_offset_rad;
+  // The transmission error a sin(φ + ψ) at the link, at the error's frequency in the data: its
+  // amplitude a, phase ψ, and the joint speed and error frequency (Ω / 2π) the cells give them
+  // at (each cell's rms speed, averaged with the weights that combine the cells).
   StructureEstimate transmission_error_amplitude_rad;
   StructureEstimate transmission_error_phase_rad;
+  double transmission_error_joint_speed_rad_s = std::numeric_limits<double>::quiet_NaN();
+  double transmission_error_frequency_hz = std::numeric_limits<double>::quiet_NaN();
   // The values the identification was given (NaN where it had none): the config's gear
   // compliance 1 / k and the transmission error's harmonic per motor revolution.
   double nominal_compliance_rad_per_nm = std::numeric_limits<double>::quiet_NaN();
@@ -62,13 +81,39 @@ struct StaticGains {
 };
 StaticGains static_gains(const ArxFitResult& fit, std::span<const TableInput> inputs);
 
-// The structure of one cell's gains (NaN where the input is absent).
+// How a fit's error relates to the link (ident/joint_identification.hpp, ArxModelForm): the
+// inverse form's error is a command offset and its inputs lead by preview_cycles; the others'
+// error is the link's.
+struct FitForm {
+  bool inverse = false;
+  int preview_cycles = 0;
+};
+
+// The transmission-error pair of one fitted cell model at the error's frequency Ω [rad/s]: the
+// error at the link as [Re, Im] of its complex amplitude (above), with covariance (delta method,
+// analytic gradient in θ). The pair is the plain one where `inputs` has it, else the gear-mode
+// one (the mode's gain is in its inputs: this is the error before the mode). Throws
+// std::invalid_argument when the fit's structure does not have inputs.size() further inputs or
+// `inputs` has no pair.
+struct PairResponse {
+  Eigen::Vector2d re_im_rad;
+  Eigen::Matrix2d covariance;
+};
+PairResponse transmission_error_response(const ArxFitResult& fit,
+                                         std::span<const TableInput> inputs, double frequency_rad_s,
+                                         FitForm form = {});
+
+// The structure of one cell's gains (NaN where the input is absent; the transmission error is
+// left NaN: it needs the frequency, set_transmission_error).
 IdentifiedStructure structure_of_gains(const StaticGains& gains,
                                        std::span<const TableInput> inputs);
+// The amplitude and phase of a pair's response, with 1σ.
+void set_transmission_error(IdentifiedStructure& s, const PairResponse& response);
 
-// The structure of a joint: its identified cells' gains combined (cells == 0 and NaN values when
+// The structure of a joint: its identified cells' gains combined, and their transmission-error
+// responses at each cell's rms speed times the joint's phase rate (cells == 0 and NaN values when
 // none was identified or the model has none of these inputs).
 IdentifiedStructure identified_structure(const JointIdentification& joint,
-                                         std::span<const TableInput> inputs);
+                                         std::span<const TableInput> inputs, FitForm form = {});
 
 }  // namespace imscal::ident

@@ -22,7 +22,8 @@ IdentifiedStructure structure_beside_config(const JointIdentification& result,
   if (options.transmission_error_mode_pairs == GearModePairs::kBeside &&
       !(result.parameters.transmission_error_mode_rad_s > 0.0))  // fitted without them
     options.transmission_error_mode_pairs = GearModePairs::kNone;
-  IdentifiedStructure s = identified_structure(result, extra_inputs_of(options));
+  const FitForm form{options.form == ArxModelForm::kInverse, options.preview_cycles};
+  IdentifiedStructure s = identified_structure(result, extra_inputs_of(options), form);
   if (joint < config.gear_stiffness_nm_per_rad.size())
     s.nominal_compliance_rad_per_nm = 1.0 / config.gear_stiffness_nm_per_rad[joint];
   if (config.options.transmission_error_input)

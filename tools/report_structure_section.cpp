@@ -26,13 +26,15 @@ std::string structure_row(const std::string& joint, const ident::IdentifiedStruc
   constexpr double kMicro = 1e6, kKilo = 1e-3;
   return fmt::format(
       "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
-      "<td>{}</td><td>{}</td></tr>\n",
+      "<td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
       html_escape(joint), s.cells, with_sigma(s.compliance_rad_per_nm, kMicro),
       number(s.nominal_compliance_rad_per_nm * kMicro), with_sigma(s.stiffness_nm_per_rad, kKilo),
       with_sigma(s.direction_offset_rad, kArcsecPerRad),
       number(s.transmission_error_harmonic_per_motor_rev),
       with_sigma(s.transmission_error_amplitude_rad, kArcsecPerRad),
-      with_sigma(s.transmission_error_phase_rad, kDegPerRad));
+      with_sigma(s.transmission_error_phase_rad, kDegPerRad),
+      number(s.transmission_error_joint_speed_rad_s * kDegPerRad),
+      number(s.transmission_error_frequency_hz));
 }
 
 std::string vector_text(const std::array<double, 3>& v, double scale) {
@@ -103,17 +105,19 @@ std::string structure_table_html(const ident::IdentificationReport& report) {
   for (const ident::ReportedJoint& j : report.joints)
     if (j.structure) rows += structure_row(j.name, *j.structure);
   if (rows.empty()) return "";
-  return "<p>The drive structure the identified models imply, from their static gains "
-         "(ident/identified_structure.hpp), with 1&sigma; beside the values the identification "
-         "config gave: the compliance is the joint error per N m of model torque (the gear's and "
-         "the position loop's), the direction offset what the direction of motion adds as the "
-         "speed tends to zero, the transmission error the amplitude and phase of the config's "
-         "harmonic.</p>\n"
+  return "<p>The drive structure the identified models imply (ident/identified_structure.hpp), "
+         "with 1&sigma; beside the values the identification config gave: the compliance is the "
+         "joint error per N m of model torque (the gear's and the position loop's), the direction "
+         "offset what the direction of motion adds as the speed tends to zero (both static "
+         "gains), the transmission error the amplitude and phase at the link of the config's "
+         "harmonic at the frequency the data hold it: the models' response at the joint speed "
+         "and error frequency given (the cells' rms speeds, weighted as the cells are).</p>\n"
          "<table>\n<tr><th>joint</th><th>cells</th><th>compliance [&micro;rad/(N m)]</th>"
          "<th>config's 1/k [&micro;rad/(N m)]</th><th>stiffness [kN m/rad]</th>"
          "<th>direction offset [&Prime;]</th>"
          "<th>transmission error harmonic [per motor rev]</th><th>amplitude [&Prime;]</th>"
-         "<th>phase [&deg;]</th></tr>\n" +
+         "<th>phase [&deg;]</th><th>at joint speed [&deg;/s]</th><th>error frequency [Hz]</th>"
+         "</tr>\n" +
          rows + "</table>\n";
 }
 

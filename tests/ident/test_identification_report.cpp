@@ -69,6 +69,8 @@ JointOutcome sample_joint() {
   outcome.structure.compliance_rad_per_nm = {2.5e-6, 1e-7};
   outcome.structure.nominal_compliance_rad_per_nm = 2.2e-6;
   outcome.structure.transmission_error_phase_rad = {0.75, 0.125};
+  outcome.structure.transmission_error_joint_speed_rad_s = 0.625;
+  outcome.structure.transmission_error_frequency_hz = 15.5;
   return outcome;
 }
 
@@ -140,6 +142,8 @@ TEST_F(IdentificationReportTest, WhatIsWrittenIsReadBack) {
   EXPECT_EQ(j.structure->compliance_rad_per_nm.sigma, 1e-7);
   EXPECT_EQ(j.structure->nominal_compliance_rad_per_nm, 2.2e-6);
   EXPECT_EQ(j.structure->transmission_error_phase_rad.sigma, 0.125);
+  EXPECT_EQ(j.structure->transmission_error_joint_speed_rad_s, 0.625);
+  EXPECT_EQ(j.structure->transmission_error_frequency_hz, 15.5);
   EXPECT_FALSE(j.structure->stiffness_nm_per_rad.identified());  // NaN written as null, read as NaN
 }
 
@@ -165,6 +169,23 @@ TEST_F(IdentificationReportTest, RefusalsNameTheFileAndTheField) {
   refused("/joints"_json_pointer, json::object(), "joints");
   refused("/joints/0/table_validation_rows"_json_pointer, removed,
           "joints[0].table_validation_rows");
+  refused("/joints/0/structure/transmission_error_frequency_hz"_json_pointer, "15",
+          "joints[0].structure.transmission_error_frequency_hz");
+}
+
+// A report without the transmission error's speed and frequency (the pair's static gains, no
+// frequency) is read with them NaN, not refused.
+TEST_F(IdentificationReportTest, AStructureWithoutTheErrorsFrequencyReadsItAsNaN) {
+  const auto file = dir_ / "identification_report.json";
+  json older = identification_report_json(sample_header(), {sample_joint()});
+  older["joints"][0]["structure"].erase("transmission_error_joint_speed_rad_s");
+  older["joints"][0]["structure"].erase("transmission_error_frequency_hz");
+  std::ofstream(file) << older.dump();
+  const IdentificationReport read = read_identification_report(file);
+  ASSERT_TRUE(read.joints.at(0).structure.has_value());
+  EXPECT_TRUE(std::isnan(read.joints[0].structure->transmission_error_joint_speed_rad_s));
+  EXPECT_TRUE(std::isnan(read.joints[0].structure->transmission_error_frequency_hz));
+  EXPECT_EQ(read.joints[0].structure->transmission_error_phase_rad.value, 0.75);
 }
 
 // The report `imscal identify` wrote for the shipped campaign (the fuzz target's seed, its

@@ -1,10 +1,12 @@
 // The drive structure read from identified models (ident/identified_structure.hpp), against a
 // synthetic error-form system whose coefficients are known: the static gains are the closed form
-// C_e(1) / A(1), and their 1σ (delta method on the least-squares covariance) covers the truth as
-// often as a normal 1σ should over repeated noise.
+// C_e(1) / A(1), the transmission-error pair's response at a frequency is the closed form
+// (C_s + i C_c)(e^{-iΩT}) / A(e^{-iΩT}), and their 1σ (delta method on the least-squares
+// covariance) covers the truth as often as a normal 1σ should over repeated noise.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -80,22 +82,45 @@ SyntheticRecord synthetic_record(unsigned seed) {
   return r;
 }
 
-IdentifiedStructure structure_of_record(unsigned seed) {
-  const SyntheticRecord record = synthetic_record(seed);
-  const IoSegment segment = record.segment();
-  const ArxFitResult fit = fit_arx({&segment, 1}, synthetic_structure());
-  return structure_of_gains(static_gains(fit, kInputs), kInputs);
+// The transmission error's frequency the structure is read at [rad/s]: the record's sin(40 q) at
+// about its rms speed of 1 rad/s.
+constexpr double kErrorFrequencyRadS = 40.0;
+
+// The true pair's response at Ω, by hand: (C_s + i C_c)(u) / (1 + a_1 u), u = e^{-iΩT}.
+std::complex<double> true_pair_response(double frequency_rad_s) {
+  const std::complex<double> u = std::polar(1.0, -frequency_rad_s * 0.002);
+  const std::complex<double> c_s = kSinTaps[0] + kSinTaps[1] * u;
+  const std::complex<double> c_c = kCosTaps[0] + kCosTaps[1] * u;
+  return (c_s + std::complex<double>(0.0, 1.0) * c_c) / (1.0 + kA1 * u);
 }
 
-TEST(IdentifiedStructure, StaticGainsAreTheClosedFormOfTheCoefficients) {
+ArxFitResult fit_of_record(unsigned seed) {
+  const SyntheticRecord record = synthetic_record(seed);
+  const IoSegment segment = record.segment();
+  return fit_arx({&segment, 1}, synthetic_structure());
+}
+
+IdentifiedStructure structure_of_record(unsigned seed) {
+  const ArxFitResult fit = fit_of_record(seed);
+  IdentifiedStructure s = structure_of_gains(static_gains(fit, kInputs), kInputs);
+  set_transmission_error(s, transmission_error_response(fit, kInputs, kErrorFrequencyRadS));
+  return s;
+}
+
+TEST(IdentifiedStructure, GainsAndPairResponseAreTheClosedFormOfTheCoefficients) {
+  const ArxFitResult fit = fit_of_record(1);
+  const StaticGains g = static_gains(fit, kInputs);
+  EXPECT_NEAR(g.gain(2), kSinGain, 5 * std::sqrt(g.covariance(2, 2)));
+  EXPECT_NEAR(g.gain(3), kCosGain, 5 * std::sqrt(g.covariance(3, 3)));
   const IdentifiedStructure s = structure_of_record(1);
+  const std::complex<double> truth = true_pair_response(kErrorFrequencyRadS);
   // Tolerance 5σ of each estimate: the equation noise is the only error.
   EXPECT_NEAR(s.compliance_rad_per_nm.value, kCompliance, 5 * s.compliance_rad_per_nm.sigma);
   EXPECT_NEAR(s.stiffness_nm_per_rad.value, 1.0 / kCompliance, 5 * s.stiffness_nm_per_rad.sigma);
   EXPECT_NEAR(s.direction_offset_rad.value, kDirectionOffset, 5 * s.direction_offset_rad.sigma);
-  EXPECT_NEAR(s.transmission_error_amplitude_rad.value, std::hypot(kSinGain, kCosGain),
+  EXPECT_NEAR(s.transmission_error_amplitude_rad.value, std::abs(truth),
               5 * s.transmission_error_amplitude_rad.sigma);
-  EXPECT_NEAR(s.transmission_error_phase_rad.value, std::atan2(kCosGain, kSinGain),
+  EXPECT_NEAR(s.transmission_error_phase_rad.value, std::arg(truth),
               5 * s.transmission_error_phase_rad.sigma);
   // The σ are small against the values (a synthetic record rich in every input): under 2 %.
   EXPECT_LT(s.compliance_rad_per_nm.sigma, 0.02 * kCompliance);
@@ -116,9 +141,9 @@ TEST(IdentifiedStructure, OneSigmaCoversTheTruthAsANormalOneShould) {
     covered[0] += within_two_sigma(s.compliance_rad_per_nm, kCompliance);
     covered[1] += within_two_sigma(s.stiffness_nm_per_rad, 1.0 / kCompliance);
     covered[2] += within_two_sigma(s.direction_offset_rad, kDirectionOffset);
-    covered[3] +=
-        within_two_sigma(s.transmission_error_amplitude_rad, std::hypot(kSinGain, kCosGain));
-    covered[4] += within_two_sigma(s.transmission_error_phase_rad, std::atan2(kCosGain, kSinGain));
+    const std::complex<double> truth = true_pair_response(kErrorFrequencyRadS);
+    covered[3] += within_two_sigma(s.transmission_error_amplitude_rad, std::abs(truth));
+    covered[4] += within_two_sigma(s.transmission_error_phase_rad, std::arg(truth));
   }
   for (std::size_t q = 0; q < covered.size(); ++q) {
     const double share = double(covered[q]) / kDraws;
@@ -150,6 +175,31 @@ TEST(IdentifiedStructure, CellsCombineByInverseVariance) {
   EXPECT_NEAR(s.compliance_rad_per_nm.value, (w0 * g0.gain(0) + w1 * g1.gain(0)) / (w0 + w1),
               1e-12 * kCompliance);
   EXPECT_NEAR(s.compliance_rad_per_nm.sigma, 1.0 / std::sqrt(w0 + w1), 1e-12 * kCompliance);
+}
+
+TEST(IdentifiedStructure, TransmissionErrorCombinesCellsEachAtItsSpeed) {
+  JointIdentification joint;
+  joint.parameters.transmission_error_rad_per_rad = 40.0;
+  joint.cells = {identified_cell(0, 7), identified_cell(1, 8)};
+  joint.cells[0].rms_speed_rad_s = 0.5;
+  joint.cells[1].rms_speed_rad_s = 1.5;
+  const IdentifiedStructure s = identified_structure(joint, kInputs);
+  // Each cell's [Re, Im] at its own Ω = 40 v, weighted by its inverse variances; the speed by
+  // the inverse of each cell's total variance.
+  const PairResponse r0 = transmission_error_response(*joint.cells[0].fit, kInputs, 20.0);
+  const PairResponse r1 = transmission_error_response(*joint.cells[1].fit, kInputs, 60.0);
+  Eigen::Vector2d mean;
+  for (int c = 0; c < 2; ++c) {
+    const double w0 = 1.0 / r0.covariance(c, c), w1 = 1.0 / r1.covariance(c, c);
+    mean(c) = (w0 * r0.re_im_rad(c) + w1 * r1.re_im_rad(c)) / (w0 + w1);
+  }
+  const double v0 = 1.0 / r0.covariance.trace(), v1 = 1.0 / r1.covariance.trace();
+  const double speed = (0.5 * v0 + 1.5 * v1) / (v0 + v1);
+  // The same arithmetic in another order: 1e-12 relative.
+  EXPECT_NEAR(s.transmission_error_amplitude_rad.value, mean.norm(), 1e-12 * mean.norm());
+  EXPECT_NEAR(s.transmission_error_phase_rad.value, std::atan2(mean(1), mean(0)), 1e-12);
+  EXPECT_NEAR(s.transmission_error_joint_speed_rad_s, speed, 1e-12);
+  EXPECT_NEAR(s.transmission_error_frequency_hz, 40.0 * speed / (2.0 * std::numbers::pi), 1e-12);
 }
 
 TEST(IdentifiedStructure, ARigidDriveHasNoStiffness) {
