@@ -12,35 +12,18 @@
 #include "eval/gap_fold_fit.hpp"
 #include "eval/gap_normal_equations.hpp"
 #include "eval/gap_validation.hpp"
+#include "tests/eval/scaled_ls_problem.hpp"
 
 namespace imscal::eval {
 namespace {
 
 constexpr Eigen::Index kSamples = 600;
 
-struct Problem {
-  Eigen::MatrixXd x;
-  std::vector<double> y;
-};
+using Problem = test::ScaledLsProblem;
 
-// Four well-conditioned columns of different sizes; y = X theta + noise.
 Problem random_problem(std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  Problem p;
-  p.x.resize(kSamples, 4);
-  const double sizes[] = {1e-3, 1.0, 1e2, 1e-5};
-  for (Eigen::Index k = 0; k < kSamples; ++k) {
-    const double t = 0.01 * double(k);
-    p.x(k, 0) = sizes[0] * (std::sin(t) + 0.3 * normal(rng));
-    p.x(k, 1) = sizes[1] * (std::cos(0.7 * t) + 0.3 * normal(rng));
-    p.x(k, 2) = sizes[2] * normal(rng);
-    p.x(k, 3) = sizes[3] * (1.0 + 0.5 * normal(rng));
-  }
-  const Eigen::Vector4d theta(2e3, -0.5, 1e-3, 4e4);
-  const Eigen::VectorXd y = p.x * theta;
-  for (Eigen::Index k = 0; k < kSamples; ++k) p.y.push_back(y[k] + 0.3 * normal(rng));
-  return p;
+  return test::scaled_ls_problem(
+      seed, {kSamples, {1e-3, 1.0, 1e2, 1e-5}, 0.3, Eigen::Vector4d(2e3, -0.5, 1e-3, 4e4)});
 }
 
 std::vector<Eigen::Index> all_rows() {
