@@ -217,7 +217,7 @@ const SeedLineTruth& seed_line() {
 // After a stop, in windows of 0.5 s from settle_s (1 s) on while the truth is above 1e-7 m/s (1 %
 // of the creep updates' floor; below, the truth's differences are rounding): the term must
 // bound the truth, and by no more than 20 times. It leaves out the motor's inertia and the
-// output-side Coulomb friction's change, which takes up part of the controller's torque change
+// Coulomb friction's change, which takes up part of the controller's torque change
 // at creep speeds (docs/decisions/0081: ~5x); measured 5.4..13 here, 20 leaves ~50 % margin
 // above the worst and still says the term follows the truth's decay, not a constant.
 void expect_bounded(const SeedLineTruth& truth, const char* what, double stop_s, double end_s) {
