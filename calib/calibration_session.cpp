@@ -115,7 +115,6 @@ JointSpaceErrors session_joint_errors(const SessionInputs& in, const SessionResu
   js.log = &in.log;
   js.site = *in.imu.site;
   js.kinematics = in.robot.kinematics;
-  js.nominal_robot = &in.robot;
   js.frames = {result.T_R_W, result.T_S_H, result.biases, result.time_offset_s};
   js.first_rest = out.rests.rests.front();
   if (!result.joint_deviation_rad.empty())

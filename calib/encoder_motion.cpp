@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "calib/gear_torque_rate.hpp"
 #include "robot/forward_kinematics.hpp"
 #include "robot/jacobian.hpp"
 
@@ -55,40 +54,12 @@ JointVector fitted_rate(const RobotLog& log, const StandstillRun& run, std::size
   return (n * s_tq - s_t * s_q) / det;
 }
 
-// The sensor's speed [m/s] from the gears' deflection rates at sample k of a standstill run
-// (calib/gear_torque_rate.hpp): the readings' acceleration is the difference of the fitted rates
-// +-half samples apart; each joint's rate moves the sensor by its column of the sensor's velocity
-// Jacobian (r_R: the sensor's offset from the flange in R), the joints in quadrature (their
-// creep tails are not in phase).
-double torque_rate_sensor_speed_m_s(const RobotLog& log, const StandstillRun& run, std::size_t k,
-                                    std::size_t half, const JointVector& rate,
-                                    const RobotDescription& nominal_robot, const Jacobian& J,
-                                    const Eigen::Vector3d& r_R) {
-  const std::size_t hi = std::min(run.last, k + half);
-  const std::size_t lo = std::max(run.first, k - std::min(k, half));
-  const double span_s = log.samples[hi].t_s - log.samples[lo].t_s;
-  if (!(span_s > 0.0)) return 0.0;
-  const JointVector accel =
-      (fitted_rate(log, run, hi, half) - fitted_rate(log, run, lo, half)) / span_s;
-  const RobotLogSample& sample = log.samples[k];
-  const JointVector deflection_rate = gear_deflection_rate_rad_s(
-      nominal_robot, sample.q_desired_rad, sample.q_internal_rad, rate, accel);
-  double speed_sq = 0.0;
-  for (int i = 0; i < kJointCount; ++i) {
-    const Eigen::Vector3d column = J.block<3, 1>(0, i) + J.block<3, 1>(3, i).cross(r_R);
-    speed_sq += std::pow(deflection_rate[i] * column.norm(), 2);
-  }
-  return std::sqrt(speed_sq);
-}
-
 }  // namespace
 
 EncoderMotion encoder_motion(const RobotLog& log, const KinematicModel& kinematics,
                              const Eigen::Isometry3d& T_W_R, const Eigen::Vector3d& p_H_S,
-                             double time_offset_s, const EncoderMotionOptions& options,
-                             const RobotDescription* nominal_robot) {
+                             double time_offset_s, const EncoderMotionOptions& options) {
   EncoderMotion out;
-  const bool torque_rate = options.gear_torque_rate && nominal_robot != nullptr;
   const Eigen::Matrix3d R_W_R = T_W_R.linear();
   const double cycle = log.cycle_s > 0.0 ? log.cycle_s : 0.002;
   const auto half = static_cast<std::size_t>(std::max(1L, std::lround(options.fit_s / cycle)));
@@ -119,11 +90,8 @@ EncoderMotion encoder_motion(const RobotLog& log, const KinematicModel& kinemati
         close_still(k - 1);
       }
       if (sample.t_s - stop_s >= options.settle_s) {
-        double sigma = std::hypot(options.velocity_sigma_floor_m_s,
-                                  options.velocity_sigma_fraction * v_W.norm());
-        if (torque_rate)
-          sigma = std::hypot(sigma, torque_rate_sensor_speed_m_s(log, run, k, half, rate,
-                                                                 *nominal_robot, J, R_R_H * p_H_S));
+        const double sigma = std::hypot(options.velocity_sigma_floor_m_s,
+                                        options.velocity_sigma_fraction * v_W.norm());
         out.creep_velocity.push_back({sample.t_s + time_offset_s, v_W, sigma});
       }
     }

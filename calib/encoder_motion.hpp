@@ -17,11 +17,7 @@
 //    stay below still_velocity_m_s / still_rate_rad_s, for at least min_still_s (IMS clock);
 //  - creep_velocity: the sensor's velocity in W from the readings at every robot sample of a
 //    commanded standstill from settle_s after it began, with a 1-sigma of
-//    velocity_sigma_fraction of it (+) velocity_sigma_floor_m_s (+), where the nominal robot
-//    file is given and gear_torque_rate is on, the link's rate against its motor from the
-//    controller's torque rate (calib/gear_torque_rate.hpp) at the sensor. That term is large
-//    where the controller still works against a creep after a stop (the link's rate differs
-//    from the readings' there) and vanishes where the arm has settled.
+//    velocity_sigma_fraction of it (+) velocity_sigma_floor_m_s.
 #include <Eigen/Geometry>
 #include <vector>
 
@@ -41,9 +37,6 @@ struct EncoderMotionOptions {
   double settle_s = 1.0;
   double velocity_sigma_fraction = 0.02;
   double velocity_sigma_floor_m_s = 1e-5;
-  // Add the gears' deflection rate from the controller's torque rate to the sigma (only where
-  // encoder_motion is given the nominal robot file).
-  bool gear_torque_rate = true;
 };
 
 struct EncoderMotion {
@@ -52,11 +45,9 @@ struct EncoderMotion {
 };
 
 // T_W_R: the robot base in W; p_H_S: the sensor's origin in the flange frame; time_offset_s:
-// t_ims = t_robot + time_offset_s; nominal_robot: the robot file the chain believes (its gains and
-// gear stiffness, never the simulator's plant), null: no torque-rate term.
+// t_ims = t_robot + time_offset_s.
 EncoderMotion encoder_motion(const RobotLog& log, const KinematicModel& kinematics,
                              const Eigen::Isometry3d& T_W_R, const Eigen::Vector3d& p_H_S,
-                             double time_offset_s, const EncoderMotionOptions& options = {},
-                             const RobotDescription* nominal_robot = nullptr);
+                             double time_offset_s, const EncoderMotionOptions& options = {});
 
 }  // namespace imscal::calib

@@ -298,9 +298,9 @@ JointSpaceErrors joint_space_errors(const JointSpaceInput& input,
   const ims::EarthModel earth(input.site);
   ims::SmootherAids aids;
   if (options.encoder_stillness || options.creep_velocity_updates) {
-    const EncoderMotion motion = encoder_motion(
-        *input.log, input.kinematics, T_W_R, input.frames.T_S_H.inverse().translation(),
-        input.frames.time_offset_s, options.encoder, input.nominal_robot);
+    const EncoderMotion motion = encoder_motion(*input.log, input.kinematics, T_W_R,
+                                                input.frames.T_S_H.inverse().translation(),
+                                                input.frames.time_offset_s, options.encoder);
     if (options.encoder_stillness) aids.still = motion.still;
     if (options.creep_velocity_updates) aids.velocity = motion.creep_velocity;
   }

@@ -56,9 +56,6 @@ struct JointSpaceInput {
   const RobotLog* log = nullptr;  // robot clock
   ims::Site site;
   KinematicModel kinematics;
-  // The nominal robot file (its controller gains and gear stiffness give the creep velocities'
-  // torque-rate term, calib/encoder_motion.hpp); never the simulator's plant. Null: no term.
-  const RobotDescription* nominal_robot = nullptr;
   CalibratedFrames frames;
   // The first rest pose: the smoothing starts at its begin (the IMS record is cut there) from
   // the attitude and position of the forward kinematics of its link-side angles (for a

@@ -51,7 +51,6 @@ ImsJointMeasurement measure_joints_with_ims(const sim::Scenario& scenario,
   input.log = &log;
   input.site = scenario.site;
   input.kinematics = nominal.description.kinematics;
-  input.nominal_robot = &nominal.description;
   input.frames.T_R_W = T_W_R.inverse();
   input.frames.T_S_H = T_H_S.inverse();
   // The biases as the record carries them at its start (turn-on plus in-run part: what a
