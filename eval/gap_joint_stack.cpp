@@ -33,14 +33,4 @@ std::vector<Eigen::Index> stacked_rows(const std::vector<Eigen::Index>& fold, st
   return rows;
 }
 
-std::optional<std::size_t> only_joint(const std::vector<Eigen::MatrixXd>& columns) {
-  std::optional<std::size_t> found;
-  for (std::size_t j = 0; j < columns.size(); ++j) {
-    if (columns[j].size() == 0) continue;
-    if (found) return std::nullopt;
-    found = j;
-  }
-  return found;
-}
-
 }  // namespace imscal::eval

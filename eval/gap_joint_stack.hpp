@@ -5,7 +5,6 @@
 // each joint's Gram matrix instead.
 #include <Eigen/Core>
 #include <cstddef>
-#include <optional>
 #include <vector>
 
 namespace imscal::eval {
@@ -21,9 +20,6 @@ StackedJoints stack_joints(const std::vector<Eigen::MatrixXd>& columns,
 // The rows of `fold` (sample indices) on every one of `joints` stacked joints of `samples` rows.
 std::vector<Eigen::Index> stacked_rows(const std::vector<Eigen::Index>& fold, std::size_t joints,
                                        Eigen::Index samples);
-
-// The joint whose columns are the only ones, if one joint has columns.
-std::optional<std::size_t> only_joint(const std::vector<Eigen::MatrixXd>& columns);
 
 // The joints that have columns, ascending.
 std::vector<std::size_t> joints_with_columns(const std::vector<Eigen::MatrixXd>& columns);

@@ -26,13 +26,6 @@ TrainingFolds training_folds(const GapSignals& s, const std::vector<bool>& train
   std::size_t count = 0;
   for (std::size_t k = 0; k < training.size(); ++k)
     if (training[k]) f.folds[(count++ / chunk) % kFoldCount].push_back(Eigen::Index(k));
-  for (std::size_t i = 0; i < f.folds.size(); ++i) {
-    std::vector<Eigen::Index> rest;
-    for (std::size_t j = 0; j < f.folds.size(); ++j)
-      if (j != i) rest.insert(rest.end(), f.folds[j].begin(), f.folds[j].end());
-    std::sort(rest.begin(), rest.end());
-    f.complements.push_back(std::move(rest));
-  }
   return f;
 }
 

@@ -14,8 +14,6 @@ namespace imscal::eval {
 
 struct TrainingFolds {
   std::vector<std::vector<Eigen::Index>> folds;  // sample indices per fold
-  // The rows of all folds but fold i.
-  std::vector<std::vector<Eigen::Index>> complements;
   bool usable() const { return folds.size() > 1 && !folds.back().empty(); }
 };
 TrainingFolds training_folds(const GapSignals& signals, const std::vector<bool>& training);

@@ -94,7 +94,6 @@ TEST(GapFoldFit, ColumnZeroOnTheFitRowsPredictsNothingOnTheCheckRows) {
     if (k < kSamples / 2) p.x(k, 3) = 0.0;
     folds.folds[k < kSamples / 2 ? 0 : 1].push_back(k);
   }
-  folds.complements = {folds.folds[1], folds.folds[0]};
   const auto sse_of = [&](const std::vector<Eigen::Index>& fit,
                           const std::vector<Eigen::Index>& check, Eigen::Index columns) {
     const Eigen::MatrixXd x = p.x(fit, Eigen::seqN(0, columns));

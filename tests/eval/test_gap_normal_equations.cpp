@@ -59,7 +59,6 @@ double direct_sse(const Eigen::MatrixXd& x, const std::vector<double>& y,
 TrainingFolds two_folds(Eigen::Index chunk, Eigen::Index step) {
   TrainingFolds folds;
   folds.folds = {chunked_rows(0, chunk, step), chunked_rows(chunk, chunk, step)};
-  folds.complements = {folds.folds[1], folds.folds[0]};
   return folds;
 }
 
@@ -67,7 +66,7 @@ TrainingFolds two_folds(Eigen::Index chunk, Eigen::Index step) {
 double qr_cross_validation_sse(const Problem& p, const TrainingFolds& folds) {
   double sse = 0.0;
   for (std::size_t i = 0; i < 2; ++i)
-    sse += direct_sse(p.x, p.y, folds.folds[i], qr_theta(p.x, p.y, folds.complements[i]));
+    sse += direct_sse(p.x, p.y, folds.folds[i], qr_theta(p.x, p.y, folds.folds[1 - i]));
   return sse;
 }
 
@@ -147,8 +146,8 @@ TEST(GapNormalEquations, CrossValidationMatchesFoldFitsByQr) {
   const double truth = qr_cross_validation_sse(p, folds);
   // As above: relative error ~eps y'y / sse.
   EXPECT_NEAR(cross_validation_sse(p.x, p.y, folds), truth, 1e-7 * truth);
-  EXPECT_NEAR(validation_sse(p.x, p.y, folds.complements[0], folds.folds[0]),
-              direct_sse(p.x, p.y, folds.folds[0], qr_theta(p.x, p.y, folds.complements[0])),
+  EXPECT_NEAR(validation_sse(p.x, p.y, folds.folds[1], folds.folds[0]),
+              direct_sse(p.x, p.y, folds.folds[0], qr_theta(p.x, p.y, folds.folds[1])),
               1e-7 * truth);
 
   // The same parameters on two joints: the stack of their rows.
@@ -165,7 +164,7 @@ TEST(GapNormalEquations, CrossValidationMatchesFoldFitsByQr) {
   double stacked_truth = 0.0;
   for (std::size_t i = 0; i < 2; ++i)
     stacked_truth += direct_sse(stacked, y, both(folds.folds[i]),
-                                qr_theta(stacked, y, both(folds.complements[i])));
+                                qr_theta(stacked, y, both(folds.folds[1 - i])));
   const std::vector<Eigen::MatrixXd> columns = {Eigen::MatrixXd(), p.x, q.x};
   const std::vector<std::vector<double>> gap = {{}, p.y, q.y};
   EXPECT_NEAR(cross_validation_sse(columns, gap, folds), stacked_truth, 1e-7 * stacked_truth);

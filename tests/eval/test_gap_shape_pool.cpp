@@ -48,7 +48,7 @@ ShapePool pool_of(std::size_t joints, Eigen::Index width, std::vector<std::vecto
 }
 
 // The 2-fold validation error of the stacked columns ([joint], empty: none) by a
-// column-pivoted QR of each fold's complement.
+// column-pivoted QR of the other fold.
 double validation_by_qr(const std::vector<Eigen::MatrixXd>& columns,
                         const std::vector<std::vector<double>>& y, const TrainingFolds& folds) {
   double sse = 0.0;
@@ -57,7 +57,7 @@ double validation_by_qr(const std::vector<Eigen::MatrixXd>& columns,
     std::vector<Eigen::VectorXd> rows_fit, rows_check;
     for (std::size_t j = 0; j < columns.size(); ++j) {
       if (columns[j].size() == 0) continue;
-      for (Eigen::Index k : folds.complements[i])
+      for (Eigen::Index k : folds.folds[1 - i])  // two folds: the other is the fit
         rows_fit.push_back(columns[j].row(k).transpose()), fit_y.push_back(y[j][std::size_t(k)]);
       for (Eigen::Index k : folds.folds[i])
         rows_check.push_back(columns[j].row(k).transpose()),
