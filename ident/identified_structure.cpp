@@ -69,6 +69,14 @@ std::pair<int, int> transmission_error_pair(std::span<const TableInput> inputs) 
                                  : TableInput::kTransmissionErrorModeCos)};
 }
 
+// Throws std::invalid_argument unless the model has one further input per entry of `inputs`.
+void require_table_inputs(const ArxStructure& s, std::span<const TableInput> inputs,
+                          const std::string& caller) {
+  if (std::size_t(s.extra_inputs) != inputs.size())
+    throw std::invalid_argument(caller + ": the model has " + std::to_string(s.extra_inputs) +
+                                " further inputs, the table " + std::to_string(inputs.size()));
+}
+
 // A cell's weight in the speed the combined pair is given at: the inverse of its variance.
 double pair_weight(const PairResponse& r) {
   return 1.0 / r.covariance.trace();
@@ -78,9 +86,7 @@ double pair_weight(const PairResponse& r) {
 
 StaticGains static_gains(const ArxFitResult& fit, std::span<const TableInput> inputs) {
   const ArxStructure& s = fit.model.structure();
-  if (std::size_t(s.extra_inputs) != inputs.size())
-    throw std::invalid_argument("static_gains: the model has " + std::to_string(s.extra_inputs) +
-                                " further inputs, the table " + std::to_string(inputs.size()));
+  require_table_inputs(s, inputs, "static_gains");
   const Eigen::VectorXd& a = fit.model.a();
   const double a_at_one = 1.0 + a.sum();
   const Eigen::Index n = Eigen::Index(inputs.size());
@@ -101,10 +107,7 @@ PairResponse transmission_error_response(const ArxFitResult& fit,
                                          std::span<const TableInput> inputs, double frequency_rad_s,
                                          FitForm form) {
   const ArxStructure& s = fit.model.structure();
-  if (std::size_t(s.extra_inputs) != inputs.size())
-    throw std::invalid_argument("transmission_error_response: the model has " +
-                                std::to_string(s.extra_inputs) + " further inputs, the table " +
-                                std::to_string(inputs.size()));
+  require_table_inputs(s, inputs, "transmission_error_response");
   const auto [sin_input, cos_input] = transmission_error_pair(inputs);
   if (sin_input < 0 || cos_input < 0)
     throw std::invalid_argument("transmission_error_response: no transmission-error pair");
