@@ -9,8 +9,9 @@
 // The normal equations square the columns' condition number (the error of theta grows as
 // eps kappa², against eps kappa for a QR, Higham 2002 ch. 20). A solution is only given when the
 // condition number of the scaled Gram matrix is at most kMaxGramCondition (kappa(X) <= 1e4: theta
-// within ~1e-8 of the QR's, relative); otherwise the caller falls back to its column-pivoted QR,
-// which also handles a rank-deficient set of columns.
+// within ~1e-8 of the QR's, relative); otherwise the final fits (eval/gap_candidates.hpp) fall back
+// to their column-pivoted QR, which also handles a rank-deficient set of columns, and the
+// validation's fold fits are truncated (eval/gap_fold_fit.hpp).
 //
 // References (docs/references.md): [Higham2002], [Bjorck1996].
 #include <Eigen/Core>
