@@ -75,4 +75,42 @@ std::string summarize_figure(const PopulationTable& table, const std::string& fi
   return text + "\n";
 }
 
+std::string summarize_scatter_ceiling(const PopulationTable& table, const std::string& prefix,
+                                      double goal_percent) {
+  const auto has = [&table](const std::string& name) {
+    return std::find(table.columns.begin(), table.columns.end(), name) != table.columns.end();
+  };
+  const std::string before = prefix + "_before_mm", floor = prefix + "_scatter_floor_mm",
+                    reached = prefix + "_reduction_percent";
+  if (!has(before) || !has(floor) || !has(reached)) return "";
+  const std::size_t i_before = column_index(table, before), i_floor = column_index(table, floor),
+                    i_reached = column_index(table, reached);
+  std::vector<double> ceilings, seeds, reductions;
+  for (const auto& row : table.rows) {
+    const double ceiling = 100.0 * (1.0 - row.at(i_floor) / row.at(i_before));
+    if (!std::isfinite(ceiling)) continue;
+    ceilings.push_back(ceiling);
+    seeds.push_back(row.front());
+    reductions.push_back(row.at(i_reached));
+  }
+  if (ceilings.empty()) return "";
+  const auto worst = std::min_element(ceilings.begin(), ceilings.end()) - ceilings.begin();
+  std::string text = fmt::format(
+      "{} scatter ceiling (100 (1 - scatter floor / before), the most a precontrol the same in "
+      "every cycle can reach): {} plants, median {:.1f}, 10th percentile {:.1f}, worst {:.1f} "
+      "(seed {:.0f})\n",
+      prefix, ceilings.size(), percentile(ceilings, 50.0), percentile(ceilings, 10.0),
+      ceilings[worst], seeds[static_cast<std::size_t>(worst)]);
+  std::string below;
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < ceilings.size(); ++k) {
+    if (ceilings[k] >= goal_percent) continue;
+    ++count;
+    below += fmt::format(" {:.0f} (ceiling {:.1f}, reached {:.1f});", seeds[k], ceilings[k],
+                         reductions[k]);
+  }
+  return text + fmt::format("  ceiling below {:.0f}: {} of {} plants:{}\n", goal_percent, count,
+                            ceilings.size(), count == 0 ? " none" : below);
+}
+
 }  // namespace imscal::eval

@@ -35,4 +35,15 @@ std::vector<DrawCorrelation> strongest_correlations(const PopulationTable& table
 std::string summarize_figure(const PopulationTable& table, const std::string& figure,
                              const std::vector<std::string>& figures);
 
+// What a precontrol the same in every cycle can reach at most on one verification (`prefix`:
+// seed_line or iso100), from its columns <prefix>_before_mm, _scatter_floor_mm and
+// _reduction_percent: per plant the ceiling 100 (1 - scatter floor / before) [%] (the floor is
+// half the widest distance between two compensated cycles: docs/decisions/0082). Text: its
+// median, 10th percentile and worst, and the plants whose ceiling lies below `goal_percent`,
+// each with the reduction it reached (no table can bring them to the goal, whatever its
+// structure). Plants without the columns' values (NaN) are left out; "" when the table has no
+// such columns.
+std::string summarize_scatter_ceiling(const PopulationTable& table, const std::string& prefix,
+                                      double goal_percent);
+
 }  // namespace imscal::eval

@@ -2,6 +2,8 @@
 // of a few values by hand, the correlation of exactly linear and of unrelated series.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "eval/population_summary.hpp"
 
 namespace imscal::eval {
@@ -38,6 +40,28 @@ TEST(PopulationSummary, StrongestDrawsAndTheSummaryLine) {
             std::string::npos)
       << text;
   EXPECT_NE(text.find("stiffness +1.00"), std::string::npos) << text;
+}
+
+// The ceiling by hand: 100 (1 - floor / before) = 96, 90, 95 % for the three plants with both
+// values (the fourth has no floor and is left out); their median 95, 10th percentile
+// 90 + 0.2 (95 - 90) = 91 (position 0.2 of the sorted 90, 95, 96), worst 90 (seed 2). Printed
+// to one decimal, so the strings are exact.
+TEST(PopulationSummary, ScatterCeilingNamesThePlantsNoTableBringsToTheGoal) {
+  PopulationTable t;
+  t.columns = {"seed", "seed_line_before_mm", "seed_line_scatter_floor_mm",
+               "seed_line_reduction_percent"};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  t.rows = {{1, 10.0, 0.4, 94.0}, {2, 5.0, 0.5, 85.5}, {3, 8.0, 0.4, 91.0}, {4, 6.0, nan, 80.0}};
+  const std::string text = summarize_scatter_ceiling(t, "seed_line", 93.0);
+  EXPECT_NE(text.find("3 plants, median 95.0, 10th percentile 91.0, worst 90.0 (seed 2)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("ceiling below 93: 1 of 3 plants: 2 (ceiling 90.0, reached 85.5);"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(summarize_scatter_ceiling(t, "seed_line", 80.0).find("below 80: 0 of 3 plants: none"),
+            std::string::npos);
+  EXPECT_EQ(summarize_scatter_ceiling(t, "iso100", 90.0), "");  // no such columns
 }
 
 }  // namespace
