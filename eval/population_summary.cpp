@@ -87,8 +87,9 @@ std::string summarize_scatter_ceiling(const PopulationTable& table, const std::s
                     i_reached = column_index(table, reached);
   std::vector<double> ceilings, seeds, reductions;
   for (const auto& row : table.rows) {
+    // One cycle has no scatter to measure (floor 0): such a plant has no ceiling to report.
+    if (!(row.at(i_floor) > 0.0 && row.at(i_before) > 0.0)) continue;
     const double ceiling = 100.0 * (1.0 - row.at(i_floor) / row.at(i_before));
-    if (!std::isfinite(ceiling)) continue;
     ceilings.push_back(ceiling);
     seeds.push_back(row.front());
     reductions.push_back(row.at(i_reached));

@@ -41,8 +41,8 @@ std::string summarize_figure(const PopulationTable& table, const std::string& fi
 // half the widest distance between two compensated cycles: docs/decisions/0082). Text: its
 // median, 10th percentile and worst, and the plants whose ceiling lies below `goal_percent`,
 // each with the reduction it reached (no table can bring them to the goal, whatever its
-// structure). Plants without the columns' values (NaN) are left out; "" when the table has no
-// such columns.
+// structure). Plants without a measured floor (NaN, or 0 from a single cycle) are left out; ""
+// when no plant is left or the table has no such columns.
 std::string summarize_scatter_ceiling(const PopulationTable& table, const std::string& prefix,
                                       double goal_percent);
 

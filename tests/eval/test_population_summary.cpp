@@ -43,15 +43,19 @@ TEST(PopulationSummary, StrongestDrawsAndTheSummaryLine) {
 }
 
 // The ceiling by hand: 100 (1 - floor / before) = 96, 90, 95 % for the three plants with both
-// values (the fourth has no floor and is left out); their median 95, 10th percentile
-// 90 + 0.2 (95 - 90) = 91 (position 0.2 of the sorted 90, 95, 96), worst 90 (seed 2). Printed
-// to one decimal, so the strings are exact.
+// values (the fourth has no floor, the fifth a floor of 0 from one cycle: both left out); their
+// median 95, 10th percentile 90 + 0.2 (95 - 90) = 91 (position 0.2 of the sorted 90, 95, 96), worst
+// 90 (seed 2). Printed to one decimal, so the strings are exact.
 TEST(PopulationSummary, ScatterCeilingNamesThePlantsNoTableBringsToTheGoal) {
   PopulationTable t;
   t.columns = {"seed", "seed_line_before_mm", "seed_line_scatter_floor_mm",
                "seed_line_reduction_percent"};
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  t.rows = {{1, 10.0, 0.4, 94.0}, {2, 5.0, 0.5, 85.5}, {3, 8.0, 0.4, 91.0}, {4, 6.0, nan, 80.0}};
+  t.rows = {{1, 10.0, 0.4, 94.0},
+            {2, 5.0, 0.5, 85.5},
+            {3, 8.0, 0.4, 91.0},
+            {4, 6.0, nan, 80.0},
+            {5, 6.0, 0.0, 70.0}};
   const std::string text = summarize_scatter_ceiling(t, "seed_line", 93.0);
   EXPECT_NE(text.find("3 plants, median 95.0, 10th percentile 91.0, worst 90.0 (seed 2)"),
             std::string::npos)
@@ -62,6 +66,8 @@ TEST(PopulationSummary, ScatterCeilingNamesThePlantsNoTableBringsToTheGoal) {
   EXPECT_NE(summarize_scatter_ceiling(t, "seed_line", 80.0).find("below 80: 0 of 3 plants: none"),
             std::string::npos);
   EXPECT_EQ(summarize_scatter_ceiling(t, "iso100", 90.0), "");  // no such columns
+  t.rows = {{5, 6.0, 0.0, 70.0}};
+  EXPECT_EQ(summarize_scatter_ceiling(t, "seed_line", 93.0), "");  // no plant with a floor
 }
 
 }  // namespace
