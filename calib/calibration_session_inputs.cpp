@@ -65,13 +65,16 @@ void read_imu_record(const SessionFiles& files, LoadedSession& s) {
   ims::ImuReadOptions read_options;
   if (spec.gyro.range > 0.0) read_options.gyro_range_rad_s = spec.gyro.range;
   if (spec.acc.range > 0.0) read_options.acc_range_m_s2 = spec.acc.range;
+  // The stages read the record by interval: in a temporary file it does not stay resident.
+  read_options.samples_to_file = true;
   ims::ImuSeries& imu = s.inputs.imu;
   imu = ims::read_imu_file(files.imu, read_options);
-  if (imu.quantity == ims::ImuQuantity::kRates) imu = ims::rates_to_increments(imu);
+  if (imu.quantity == ims::ImuQuantity::kRates) imu = ims::rates_to_increments(std::move(imu));
   s.unit_calibration_file = s.options.config.unit_calibration_file;
   if (!files.unit_calibration.empty()) s.unit_calibration_file = fs::path(files.unit_calibration);
   if (s.unit_calibration_file) {
-    imu = ims::correct(imu, ims::load_sensor_error_model(*s.unit_calibration_file));
+    const ims::SensorErrorModel unit = ims::load_sensor_error_model(*s.unit_calibration_file);
+    imu = ims::correct(std::move(imu), unit);
     spdlog::info("calibrate: corrected {} with the unit calibration {}", files.imu,
                  s.unit_calibration_file->string());
   }
@@ -85,7 +88,8 @@ void read_imu_record(const SessionFiles& files, LoadedSession& s) {
 void read_robot_log(const SessionFiles& files, LoadedSession& s) {
   const RobotDescription& robot = s.inputs.robot;
   RobotLog& log = s.inputs.log;
-  log = read_robot_log_csv(files.robot_log, robot.name);
+  log = read_robot_log_csv(files.robot_log, robot.name, "the robot description",
+                           /*samples_to_file=*/true);
   check_robot_log_joint_limits(log, files.robot_log, robot);
   std::vector<double> payload_kg, t_s;
   for (const RobotLogSample& sample : log.samples) {

@@ -16,7 +16,7 @@ struct StandstillRun {
 
 std::vector<StandstillRun> standstill_runs(const RobotLog& log) {
   std::vector<StandstillRun> runs;
-  const std::vector<RobotLogSample>& s = log.samples;
+  const auto& s = log.samples;
   for (std::size_t i = 0; i + 1 < s.size();) {
     if (s[i + 1].q_desired_rad != s[i].q_desired_rad) {
       ++i;
@@ -35,7 +35,7 @@ std::vector<StandstillRun> standstill_runs(const RobotLog& log) {
 // curvature of the creep (~1e-3 of it per missing 2 ms sample for a 0.3 s decay).
 JointVector fitted_rate(const RobotLog& log, const StandstillRun& run, std::size_t k,
                         std::size_t half) {
-  const std::vector<RobotLogSample>& s = log.samples;
+  const auto& s = log.samples;
   const std::size_t reach = std::min({half, k - run.first, run.last - k});
   double s_t = 0.0, s_tt = 0.0;
   JointVector s_q = JointVector::Zero(), s_tq = JointVector::Zero();

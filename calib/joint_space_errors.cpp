@@ -223,7 +223,7 @@ JointSpaceErrors joint_errors_in_blocks(ims::SmoothedStateStream& stream,
                                         const JointSpaceOptions& options) {
   JointErrorRows rows(*input.log, input.kinematics, input.frames, options.min_wrist_sin,
                       options.row_sink);
-  const std::vector<RobotLogSample>& samples = input.log->samples;
+  const auto& samples = input.log->samples;
   const double offset_s = input.frames.time_offset_s;
   std::vector<ims::SmoothedState> trajectory;
   std::size_t next = 0;

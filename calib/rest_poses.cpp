@@ -33,7 +33,7 @@ std::string seconds(double t) {
   return fmt::format("{:.3f} s", t);
 }
 
-using SampleIterator = std::vector<RobotLogSample>::const_iterator;
+using SampleIterator = const RobotLogSample*;
 
 // The first sample of [from, to) at or after t, and the first after t [s, robot clock].
 SampleIterator first_at_or_after(SampleIterator from, SampleIterator to, double t) {
@@ -60,7 +60,7 @@ RestPoseResult find_rest_poses(const RestPoseInput& input, const RestPoseOptions
   if (input.imu == nullptr || input.log == nullptr || input.robot == nullptr) {
     throw InputError(source, 0, "", "the IMS record, the robot log and the robot are required");
   }
-  const std::vector<RobotLogSample>& samples = input.log->samples;
+  const auto& samples = input.log->samples;
   if (samples.size() < 2) throw InputError(source, 0, "robot log", "fewer than 2 samples");
 
   RestPoseResult result;
@@ -275,9 +275,11 @@ TimeOffsetResult estimate_initial_time_offset(const ims::ImuSeries& imu, const R
     }
     earth_rate_S /= static_cast<double>(initial_rest.last_sample - initial_rest.first_sample + 1);
   }
-  const RobotJointSeries joints = robot_joint_series(log);
-  const RateMagnitudeSeries robot_rate =
-      flange_rate_magnitude(kinematics, joints.t_robot_s, joints.q_rad, "robot log");
+  // The joint series only while the flange rate is computed (both grow with the log).
+  const RateMagnitudeSeries robot_rate = [&] {
+    const RobotJointSeries joints = robot_joint_series(log);
+    return flange_rate_magnitude(kinematics, joints.t_robot_s, joints.q_rad, "robot log");
+  }();
   const RateMagnitudeSeries ims_rate = ims_rate_magnitude(imu, earth_rate_S);
   return estimate_time_offset(robot_rate, ims_rate, options);
 }

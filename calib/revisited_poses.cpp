@@ -22,7 +22,7 @@ struct SettledStandstill {
 
 std::vector<StandstillWindow> settled_standstill_windows(const RobotLog& log,
                                                          const RevisitedPoseOptions& options) {
-  const std::vector<RobotLogSample>& s = log.samples;
+  const auto& s = log.samples;
   std::vector<StandstillWindow> windows;
   for (std::size_t i = 0; i < s.size();) {
     std::size_t last = i;
@@ -44,7 +44,7 @@ std::vector<PositionErrorSample> position_errors_at_revisited_poses(
     const std::vector<ims::SmoothedState>& trajectory, const RobotLog& log,
     const KinematicModel& kinematics, const Eigen::Isometry3d& T_W_R, const Eigen::Vector3d& p_H_S,
     double time_offset_s, const RevisitedPoseOptions& options) {
-  const std::vector<RobotLogSample>& s = log.samples;
+  const auto& s = log.samples;
   // The mean of p_IMS - p_FK over samples [first, last]; nullopt outside the trajectory.
   const auto mean_difference = [&](std::size_t first,
                                    std::size_t last) -> std::optional<Eigen::Vector3d> {

@@ -118,6 +118,10 @@ RateMagnitudeSeries flange_rate_magnitude(const KinematicModel& model,
   }
   RateMagnitudeSeries out;
   out.source = source;
+  if (t_s.size() > 2) {
+    out.t_s.reserve(t_s.size() - 2);
+    out.rate_rad_s.reserve(t_s.size() - 2);
+  }
   for (std::size_t k = 1; k + 1 < t_s.size(); ++k) {
     const double span = t_s[k + 1] - t_s[k - 1];
     if (!(t_s[k] > t_s[k - 1]) || !(t_s[k + 1] > t_s[k])) {
@@ -135,6 +139,8 @@ RateMagnitudeSeries ims_rate_magnitude(const ims::ImuSeries& imu,
                                        const std::function<Eigen::Vector3d(double)>& earth_rate_S) {
   RateMagnitudeSeries out;
   out.source = imu.source.empty() ? std::string("IMS samples") : imu.source;
+  out.t_s.reserve(imu.samples.size());
+  out.rate_rad_s.reserve(imu.samples.size());
   for (std::size_t k = 0; k < imu.samples.size(); ++k) {
     const ims::ImuSample& s = imu.samples[k];
     double t = s.t_s;

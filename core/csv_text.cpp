@@ -1,5 +1,7 @@
 #include "core/csv_text.hpp"
 
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <system_error>
 
@@ -42,6 +44,18 @@ std::string format_shortest(double value) {
   std::string text;
   append_shortest(text, value);
   return text;
+}
+
+std::size_t lines_left(std::istream& in) {
+  const std::istream::pos_type here = in.tellg();
+  if (here == std::istream::pos_type(-1)) return 0;
+  std::size_t lines = 1;
+  std::array<char, 1 << 16> buffer{};
+  while (in.read(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0)
+    lines += std::size_t(std::count(buffer.data(), buffer.data() + in.gcount(), '\n'));
+  in.clear();
+  in.seekg(here);
+  return lines;
 }
 
 }  // namespace imscal::csv

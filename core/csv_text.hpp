@@ -1,6 +1,8 @@
 #pragma once
 // Small text helpers shared by the CSV readers and writers: trimming, splitting, strict number
 // parsing (the whole field must be a number) and the shortest round-trip formatting of doubles.
+#include <cstddef>
+#include <istream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,5 +17,8 @@ bool parse_number(std::string_view field, double& value);
 // Shortest decimal text that reads back to the same double ("0.1", "1e-09").
 std::string format_shortest(double value);
 void append_shortest(std::string& out, double value);
+// How many lines are left in `in` at most (counted from where it stands, then `in` put back
+// there), to reserve a reader's rows; 0 when `in` cannot tell its position.
+std::size_t lines_left(std::istream& in);
 
 }  // namespace imscal::csv

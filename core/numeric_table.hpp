@@ -7,7 +7,9 @@
 // line number of every row, so that the format's own checks can name file, line and field.
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -39,5 +41,14 @@ struct NumericTable {
 // empty line among the rows. A UTF-8 byte-order mark before the first line is skipped with a
 // warning.
 NumericTable read_numeric_table(const std::filesystem::path& file);
+
+// The same reading and checks, the rows handed over one at a time instead of kept (a reader
+// that converts them holds no second copy of a long file): `header` once, after the header line,
+// with the metadata and columns (no rows) and how many lines are left at most (to reserve);
+// then `row` with each data row's values, in column order, and its 1-based line.
+using NumericHeaderUse = std::function<void(const NumericTable& header, std::size_t lines_left)>;
+using NumericRowUse = std::function<void(std::span<const double> values, std::size_t line)>;
+void read_numeric_rows(const std::filesystem::path& file, const NumericHeaderUse& header,
+                       const NumericRowUse& row);
 
 }  // namespace imscal

@@ -131,7 +131,9 @@ class SpillableVector {
       return begin() + at;
     }
     to_memory();
-    return &*memory_.insert(memory_.begin() + at, first, last);
+    // By position, not by dereferencing: an empty range inserted at the end returns end().
+    const auto inserted = memory_.insert(memory_.begin() + at, first, last);
+    return memory_.data() + (inserted - memory_.begin());
   }
   T* insert(const T* position, const T& value) { return insert(position, &value, &value + 1); }
   T* erase(const T* first, const T* last) {

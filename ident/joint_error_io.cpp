@@ -82,14 +82,8 @@ std::vector<std::string> joints_from_header(const std::string& file, std::size_t
 // Reserves the columns for the lines left in `in` (counted, then `in` put back): each column
 // then takes what it holds, not up to twice as its vector grows.
 void reserve_rows(std::istream& in, JointErrorLog& log, bool with_internal) {
-  const std::istream::pos_type here = in.tellg();
-  if (here == std::istream::pos_type(-1)) return;
-  std::size_t lines = 1;
-  std::array<char, 1 << 16> buffer{};
-  while (in.read(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0)
-    lines += std::size_t(std::count(buffer.data(), buffer.data() + in.gcount(), '\n'));
-  in.clear();
-  in.seekg(here);
+  const std::size_t lines = csv::lines_left(in);
+  if (lines == 0) return;
   log.time_s.reserve(lines);
   log.payload_kg.reserve(lines);
   log.sample_lines.reserve(lines);

@@ -175,6 +175,7 @@ ImuSeries read_imu_binary(const fs::path& path, const ImuReadOptions& options,
   ImuSourceInfo info;
   info.record_count = static_cast<std::size_t>(n_records);
   ImuValidator validator(series, options, report, info);
+  if (options.samples_to_file) series.samples.spill_to_file();
   series.samples.reserve(n_records);
   advise_huge_pages(series.samples.data(), n_records * sizeof(ImuSample));
   constexpr std::size_t kChunkRecords = 4096;

@@ -1,6 +1,7 @@
 #include "ims/imu_conversion.hpp"
 
 #include <fmt/format.h>
+#include <utility>
 
 #include <cmath>
 #include <stdexcept>
@@ -34,6 +35,20 @@ ImuSeries rates_to_increments(const ImuSeries& rates) {
     out.samples[i].acc = rates.samples[i].acc * dt;
   }
   return out;
+}
+
+ImuSeries rates_to_increments(ImuSeries&& rates) {
+  if (rates.quantity != ImuQuantity::kRates) {
+    throw std::invalid_argument("rates_to_increments: the series holds increments already");
+  }
+  // Sample i's interval reads the time stamps only, which the conversion keeps.
+  for (std::size_t i = 0; i < rates.samples.size(); ++i) {
+    const double dt = interval_before(rates, i);
+    rates.samples[i].gyro *= dt;
+    rates.samples[i].acc *= dt;
+  }
+  rates.quantity = ImuQuantity::kIncrements;
+  return std::move(rates);
 }
 
 ImuSeries increments_to_rates(const ImuSeries& increments) {

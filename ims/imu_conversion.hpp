@@ -23,6 +23,9 @@ namespace imscal::ims {
 // Throws std::invalid_argument if the series holds increments already, or if its time stamps
 // do not increase strictly (validate it first: ims/imu_validation.hpp).
 ImuSeries rates_to_increments(const ImuSeries& rates);
+// The same, sample by sample in place (no second copy of a long record; the same values); on
+// an exception the series is left part converted.
+ImuSeries rates_to_increments(ImuSeries&& rates);
 
 // Throws std::invalid_argument if the series holds rates already, or if its time stamps do not
 // increase strictly.

@@ -22,6 +22,7 @@
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
 #include "core/input_file.hpp"
+#include "core/spill_mapping.hpp"
 #include "core/units.hpp"
 #include "ims/huge_pages.hpp"
 
@@ -138,7 +139,9 @@ void check_first_byte(int fd, const fs::path& path) {
 
 class MappedFile {
  public:
-  explicit MappedFile(const fs::path& path) : fd_(open_regular_file(path)) {
+  // `released`: the pages leave resident memory behind a reader of one pass
+  // (core/spill_mapping.hpp) instead of being mapped all at once.
+  MappedFile(const fs::path& path, bool released) : fd_(open_regular_file(path)) {
     struct stat status {};
     if (::fstat(fd_, &status) != 0) {
       const int error = errno;
@@ -154,7 +157,8 @@ class MappedFile {
       ::close(fd_);
       throw;
     }
-    void* mapped = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd_, 0);
+    void* mapped =
+        ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | (released ? 0 : MAP_POPULATE), fd_, 0);
     if (mapped == MAP_FAILED) {
       const int error = errno;
       ::close(fd_);
@@ -163,10 +167,13 @@ class MappedFile {
     }
     data_ = static_cast<const char*>(mapped);
     ::madvise(mapped, size_, MADV_SEQUENTIAL);
+    if (released) watch_resident_pages(data_, size_);
+    released_ = released;
   }
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;
   ~MappedFile() {
+    if (data_ != nullptr && released_) unwatch_resident_pages(data_);
     if (data_ != nullptr) ::munmap(const_cast<char*>(data_), size_);
     ::close(fd_);
   }
@@ -177,6 +184,7 @@ class MappedFile {
   int fd_ = -1;
   const char* data_ = nullptr;
   std::size_t size_ = 0;
+  bool released_ = false;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -357,7 +365,7 @@ void format_csv(const ImuSeries& series, std::string& out, Flush flush) {
 ImuSeries read_imu_csv(const fs::path& path, const ImuReadOptions& options, ImuReadReport* report) {
   if (report != nullptr) *report = ImuReadReport{};
   const std::string file = path.string();
-  const MappedFile mapped(path);
+  const MappedFile mapped(path, options.samples_to_file);
   const std::string_view whole(mapped.data(), mapped.size());
   const std::size_t mark = whole.starts_with(kUtf8ByteOrderMark) ? kUtf8ByteOrderMark.size() : 0;
   if (mark > 0) {
@@ -498,6 +506,7 @@ ImuSeries read_imu_csv(const fs::path& path, const ImuReadOptions& options, ImuR
 
   // Room for the samples, from the mean line length of the first megabyte.
   {
+    if (options.samples_to_file) series.samples.spill_to_file();
     const std::size_t probe = std::min<std::size_t>(static_cast<std::size_t>(end - p), 1u << 20);
     const auto lines = static_cast<std::size_t>(std::count(p, p + probe, '\n')) + 1;
     const double per_line = static_cast<double>(probe) / static_cast<double>(lines);

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/spillable_vector.hpp"
 #include "ims/earth_model.hpp"
 
 namespace imscal::ims {
@@ -30,7 +31,8 @@ struct ImuSample {
 struct ImuSeries {
   ImuQuantity quantity = ImuQuantity::kIncrements;
   double nominal_dt_s = 0.0;  // nominal sample interval
-  std::vector<ImuSample> samples;
+  // In memory, or in a temporary file for a long record (core/spillable_vector.hpp).
+  SpillableVector<ImuSample> samples;
   std::string source;  // file the data came from (for messages); empty if synthesised
   // Line of the file that holds samples[0] (1-based), so that sample i is on line
   // first_data_line + i in text files; 0 for binary files and synthesised data.

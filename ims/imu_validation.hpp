@@ -21,6 +21,10 @@
 namespace imscal::ims {
 
 struct ImuReadOptions {
+  // The samples go to a temporary file as they are read and the file's text leaves resident
+  // memory behind the parser (core/spillable_vector.hpp): for a command that holds a long
+  // record whole (calibrate), whose resident memory then does not grow with it.
+  bool samples_to_file = false;
   // A time step longer than gap_factor nominal intervals is a gap (missing samples).
   double gap_factor = 1.5;
   bool allow_gaps = false;  // gaps become a warning with their count instead of an error

@@ -1,6 +1,7 @@
 #include "ims/sensor_error_model.hpp"
 
 #include <fmt/format.h>
+#include <utility>
 
 #include <Eigen/LU>
 
@@ -59,6 +60,13 @@ ImuSeries apply(const ImuSeries& truth, const SensorErrorModel& errors) {
 ImuSeries correct(const ImuSeries& raw, const SensorErrorModel& errors) {
   return map_samples(
       raw, [&](const ImuSample& s, ImuQuantity q, double dt) { return errors.correct(s, q, dt); });
+}
+
+ImuSeries correct(ImuSeries&& raw, const SensorErrorModel& errors) {
+  // A corrected sample keeps its time stamp, so the intervals after it read as before.
+  for (std::size_t i = 0; i < raw.samples.size(); ++i)
+    raw.samples[i] = errors.correct(raw.samples[i], raw.quantity, sample_interval(raw, i));
+  return std::move(raw);
 }
 
 namespace {

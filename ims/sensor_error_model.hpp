@@ -64,6 +64,8 @@ struct SensorErrorModel {
 // sample is series.nominal_dt_s (ims/imu_data.hpp). Everything but the samples is copied.
 ImuSeries apply(const ImuSeries& truth, const SensorErrorModel& errors);
 ImuSeries correct(const ImuSeries& raw, const SensorErrorModel& errors);
+// The same, sample by sample in place (no second copy of a long record; the same values).
+ImuSeries correct(ImuSeries&& raw, const SensorErrorModel& errors);
 // The interval of sample i as used above [s].
 double sample_interval(const ImuSeries& series, std::size_t i);
 

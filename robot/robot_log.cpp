@@ -4,6 +4,8 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <exception>
+#include <span>
 
 #include "core/csv_text.hpp"
 #include "core/input_error.hpp"
@@ -59,14 +61,22 @@ void write_robot_log_csv(const std::filesystem::path& file, const RobotLog& log,
   write_file_atomically(file, format_robot_log_csv(log), overwrite);
 }
 
-RobotLog read_robot_log_csv(const std::filesystem::path& file, const std::string& expected_robot,
-                            const std::string& expected_by) {
-  const NumericTable table = read_numeric_table(file);
+namespace {
+
+// Where the log's values are in a row: column and factor to rad of each angle.
+struct LogColumns {
+  std::size_t time = 0, payload = 0;
+  std::array<std::pair<std::size_t, double>, kJointCount> desired{}, internal{};
+  bool used_degrees = false;
+};
+
+// The header's checks (version, robot, cycle, columns); the log's name, cycle and joints.
+LogColumns read_log_header(const NumericTable& table, const std::string& expected_robot,
+                           const std::string& expected_by, RobotLog& log) {
   if (table.meta("imscal-robot-log") != "1") {
     throw InputError(table.file, table.meta_line("imscal-robot-log"), "imscal-robot-log",
                      "unknown version '" + table.meta("imscal-robot-log") + "' (this reader: 1)");
   }
-  RobotLog log;
   log.robot_name = table.meta("robot");
   if (!expected_robot.empty() && log.robot_name != expected_robot) {
     throw InputError(table.file, table.meta_line("robot"), "robot",
@@ -96,13 +106,13 @@ RobotLog read_robot_log_csv(const std::filesystem::path& file, const std::string
     throw InputError(table.file, table.header_line, "q_desired_*",
                      fmt::format("{} q_desired columns, expected {}", found, kJointCount));
   }
-  const std::size_t time_column = table.column("t_s");
-  const std::size_t payload_column = table.column("payload_kg");
-  bool used_degrees = false;
-  std::array<std::pair<std::size_t, double>, kJointCount> desired{}, internal{};
+  LogColumns columns;
+  columns.time = table.column("t_s");
+  columns.payload = table.column("payload_kg");
   for (int j = 0; j < kJointCount; ++j) {
-    desired[j] = angle_column(table, "q_desired", log.joint_names[j], used_degrees);
-    internal[j] = angle_column(table, "q_internal", log.joint_names[j], used_degrees);
+    columns.desired[j] = angle_column(table, "q_desired", log.joint_names[j], columns.used_degrees);
+    columns.internal[j] =
+        angle_column(table, "q_internal", log.joint_names[j], columns.used_degrees);
   }
   const std::size_t expected_columns = 2 + 2 * kJointCount;
   if (table.columns.size() != expected_columns) {
@@ -111,40 +121,75 @@ RobotLog read_robot_log_csv(const std::filesystem::path& file, const std::string
                                  "internal joint angles)",
                                  table.columns.size(), expected_columns));
   }
-  log.samples.resize(table.rows());
-  log.sample_lines.assign(table.lines.begin(), table.lines.end());
-  for (std::size_t r = 0; r < table.rows(); ++r) {
-    RobotLogSample& s = log.samples[r];
-    s.t_s = table.at(r, time_column);
-    s.payload_kg = table.at(r, payload_column);
-    if (s.payload_kg < 0.0) {
-      throw InputError(table.file, table.lines[r], "payload_kg", "negative payload");
-    }
-    for (int j = 0; j < kJointCount; ++j) {
-      s.q_desired_rad[j] = table.at(r, desired[j].first) * desired[j].second;
-      s.q_internal_rad[j] = table.at(r, internal[j].first) * internal[j].second;
-    }
-    if (r == 0) continue;
-    const double step = s.t_s - log.samples[r - 1].t_s;
-    if (!(step > 0.0)) {
-      throw InputError(table.file, table.lines[r], "t_s",
-                       fmt::format("time {} s does not increase (previous line: {} s)", s.t_s,
-                                   log.samples[r - 1].t_s));
-    }
-    if (step > 1.5 * log.cycle_s) {
-      throw InputError(table.file, table.lines[r], "t_s",
-                       fmt::format("gap of {:.6g} s before this line ({:.1f} cycles of {} s)", step,
-                                   step / log.cycle_s, log.cycle_s));
-    }
-    if (step < 0.5 * log.cycle_s) {
-      throw InputError(table.file, table.lines[r], "t_s",
-                       fmt::format("step of {:.6g} s is less than half the cycle of {} s "
-                                   "(time stamps jitter or the cycle_s header is wrong)",
-                                   step, log.cycle_s));
-    }
+  return columns;
+}
+
+// One data row into the log, with its checks (payload, time step against the cycle).
+void add_log_row(std::span<const double> values, std::size_t line, const LogColumns& columns,
+                 const std::string& file, RobotLog& log) {
+  RobotLogSample& s = log.samples.emplace_back();
+  log.sample_lines.push_back(line);
+  s.t_s = values[columns.time];
+  s.payload_kg = values[columns.payload];
+  if (s.payload_kg < 0.0) throw InputError(file, line, "payload_kg", "negative payload");
+  for (int j = 0; j < kJointCount; ++j) {
+    s.q_desired_rad[j] = values[columns.desired[j].first] * columns.desired[j].second;
+    s.q_internal_rad[j] = values[columns.internal[j].first] * columns.internal[j].second;
   }
-  if (used_degrees) {
-    spdlog::warn("{}: joint angles given in degrees; converted to rad", table.file);
+  if (log.samples.size() == 1) return;
+  const double previous = log.samples[log.samples.size() - 2].t_s;
+  const double step = s.t_s - previous;
+  if (!(step > 0.0)) {
+    throw InputError(
+        file, line, "t_s",
+        fmt::format("time {} s does not increase (previous line: {} s)", s.t_s, previous));
+  }
+  if (step > 1.5 * log.cycle_s) {
+    throw InputError(file, line, "t_s",
+                     fmt::format("gap of {:.6g} s before this line ({:.1f} cycles of {} s)", step,
+                                 step / log.cycle_s, log.cycle_s));
+  }
+  if (step < 0.5 * log.cycle_s) {
+    throw InputError(file, line, "t_s",
+                     fmt::format("step of {:.6g} s is less than half the cycle of {} s "
+                                 "(time stamps jitter or the cycle_s header is wrong)",
+                                 step, log.cycle_s));
+  }
+}
+
+}  // namespace
+
+RobotLog read_robot_log_csv(const std::filesystem::path& file, const std::string& expected_robot,
+                            const std::string& expected_by, bool samples_to_file) {
+  // The rows go into the log as they are read, not through a whole table first. The file's
+  // structure (fields, numbers) is checked to its end before any of the log's own checks
+  // speaks, as when the table came first: the first of those waits in `refused`.
+  RobotLog log;
+  LogColumns columns;
+  std::exception_ptr refused;
+  const auto checked = [&](const auto& step) {
+    if (refused) return;
+    try {
+      step();
+    } catch (const InputError&) {
+      refused = std::current_exception();
+    }
+  };
+  const std::string name = file.string();
+  read_numeric_rows(
+      file,
+      [&](const NumericTable& header, std::size_t lines_left) {
+        checked([&] { columns = read_log_header(header, expected_robot, expected_by, log); });
+        if (samples_to_file) log.samples.spill_to_file();
+        log.samples.reserve(lines_left);
+        log.sample_lines.reserve(lines_left);
+      },
+      [&](std::span<const double> values, std::size_t line) {
+        checked([&] { add_log_row(values, line, columns, name, log); });
+      });
+  if (refused) std::rethrow_exception(refused);
+  if (columns.used_degrees) {
+    spdlog::warn("{}: joint angles given in degrees; converted to rad", name);
   }
   return log;
 }
@@ -160,25 +205,30 @@ std::vector<JointLimit> joint_limits_of(const RobotDescription& robot) {
 
 std::size_t check_robot_log_joint_limits(const RobotLog& log, const std::string& file,
                                          const RobotDescription& robot) {
-  std::vector<std::vector<double>> values(2 * kJointCount);
-  for (const RobotLogSample& s : log.samples)
-    for (int j = 0; j < kJointCount; ++j) {
-      values[std::size_t(j)].push_back(s.q_desired_rad[j]);
-      values[std::size_t(kJointCount + j)].push_back(s.q_internal_rad[j]);
-    }
-  std::vector<JointAngleColumn> columns;
+  const JointAngleSource source{file,
+                                [&log](std::size_t k) {
+                                  return k < log.sample_lines.size() ? log.sample_lines[k]
+                                                                     : std::size_t{0};
+                                },
+                                fmt::format("robot {} ({})", robot.name, robot.source)};
+  const std::vector<JointLimit> limits = joint_limits_of(robot);
+  // One column at a time (the order check_joint_limits takes them in), in one buffer: a copy of
+  // every column would grow with the log.
+  std::vector<double> values(log.samples.size());
+  std::size_t beyond = 0;
   for (std::size_t j = 0; j < std::size_t(kJointCount); ++j) {
-    columns.push_back({fmt::format("q_desired_{}_rad", log.joint_names[j]), j, values[j]});
-    columns.push_back(
-        {fmt::format("q_internal_{}_rad", log.joint_names[j]), j, values[kJointCount + j]});
+    for (const bool desired : {true, false}) {
+      for (std::size_t k = 0; k < log.samples.size(); ++k) {
+        const RobotLogSample& s = log.samples[k];
+        values[k] = desired ? s.q_desired_rad[int(j)] : s.q_internal_rad[int(j)];
+      }
+      const JointAngleColumn column{
+          fmt::format("{}_{}_rad", desired ? "q_desired" : "q_internal", log.joint_names[j]), j,
+          values};
+      beyond += check_joint_limits(std::span(&column, 1), limits, source);
+    }
   }
-  return check_joint_limits(columns, joint_limits_of(robot),
-                            {file,
-                             [&log](std::size_t k) {
-                               return k < log.sample_lines.size() ? log.sample_lines[k]
-                                                                  : std::size_t{0};
-                             },
-                             fmt::format("robot {} ({})", robot.name, robot.source)});
+  return beyond;
 }
 
 }  // namespace imscal::calib

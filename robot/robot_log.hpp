@@ -16,6 +16,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/joint_limit_plausibility.hpp"
+#include "core/spillable_vector.hpp"
 #include "robot/robot_description.hpp"
 
 namespace imscal::calib {
@@ -31,7 +32,8 @@ struct RobotLog {
   std::string robot_name;
   double cycle_s = 0.002;
   std::array<std::string, kJointCount> joint_names{"A1", "A2", "A3", "A4", "A5", "A6"};
-  std::vector<RobotLogSample> samples;
+  // In memory, or in a temporary file for a long log (core/spillable_vector.hpp).
+  SpillableVector<RobotLogSample> samples;
   std::vector<std::size_t> sample_lines;  // 1-based file line of each sample (empty: not read)
 };
 
@@ -44,9 +46,12 @@ std::string format_robot_log_csv(const RobotLog& log);
 // lost cycles, the log cannot be used as one run), steps shorter than 0.5 cycle (jitter beyond
 // what a real-time controller produces), a negative payload. `expected_robot`, when not empty,
 // must match the file's robot; `expected_by` names where it comes from, for the message.
+// `samples_to_file`: the samples go to a temporary file as they are read (core/
+// spillable_vector.hpp), for a command that holds a long log whole (calibrate).
 RobotLog read_robot_log_csv(const std::filesystem::path& file,
                             const std::string& expected_robot = "",
-                            const std::string& expected_by = "the robot description");
+                            const std::string& expected_by = "the robot description",
+                            bool samples_to_file = false);
 
 // The robot's joint limits by joint name (core/joint_limit_plausibility.hpp).
 std::vector<JointLimit> joint_limits_of(const RobotDescription& robot);

@@ -71,6 +71,15 @@ TEST(SpillableVector, FollowsAVectorInMemoryAndOnFile) {
   truth.erase(truth.begin() + 3, truth.begin() + 10);
   EXPECT_FALSE(array.on_file());
   EXPECT_TRUE(same_bits(array, truth));
+  // Inserting in memory returns the first inserted element's place, as std::vector's insert;
+  // an empty range at the end returns end() (never dereferenced).
+  const Sample extra[2] = {sample_of(7), sample_of(8)};
+  EXPECT_EQ(array.insert(array.begin() + 5, extra, extra + 2), array.begin() + 5);
+  truth.insert(truth.begin() + 5, extra, extra + 2);
+  EXPECT_EQ(array.insert(array.end(), extra, extra), array.end());
+  EXPECT_TRUE(same_bits(array, truth));
+  array.assign(extra, extra);  // clear, then an empty range at the end
+  EXPECT_TRUE(array.empty());
 }
 
 // An element of the array appended to it when the file is full: the copy is made before the

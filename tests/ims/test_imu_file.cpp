@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "core/input_error.hpp"
 #include "ims/imu_binary.hpp"
@@ -135,6 +136,16 @@ TEST(ImuConversion, RectangleRuleAgainstTheExactIntegralOfALinearRate) {
   }
   const ImuSeries increments = imscal::ims::rates_to_increments(rates);
   EXPECT_EQ(increments.quantity, ImuQuantity::kIncrements);
+  // In place: the same values bit for bit.
+  ImuSeries given = rates;
+  const ImuSeries in_place = imscal::ims::rates_to_increments(std::move(given));
+  EXPECT_EQ(in_place.quantity, ImuQuantity::kIncrements);
+  ASSERT_EQ(in_place.samples.size(), increments.samples.size());
+  for (std::size_t i = 0; i < increments.samples.size(); ++i) {
+    EXPECT_EQ(in_place.samples[i].t_s, increments.samples[i].t_s);
+    EXPECT_EQ(in_place.samples[i].gyro, increments.samples[i].gyro);
+    EXPECT_EQ(in_place.samples[i].acc, increments.samples[i].acc);
+  }
   for (std::size_t i = 0; i < increments.samples.size(); ++i) {
     const double t = rates.samples[i].t_s;
     const double step = i == 0 ? dt : t - rates.samples[i - 1].t_s;

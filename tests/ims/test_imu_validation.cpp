@@ -97,19 +97,24 @@ TEST_P(BadImuFile, RefusedWithFileLineAndField) {
   const Expected expected = load_expected(kBadDir / (std::string(GetParam()) + ".expected"));
   ASSERT_FALSE(expected.contains.empty());
   const std::string before = read_text(file);
-  try {
-    imscal::ims::read_imu_csv(file);
-    FAIL() << file << " was accepted";
-  } catch (const InputError& e) {
-    const std::string message = e.what();
-    EXPECT_EQ(e.file(), file.string());
-    EXPECT_EQ(e.line(), expected.line) << message;
-    EXPECT_EQ(e.field(), expected.field) << message;
-    EXPECT_NE(message.find(file.string() + ":" + std::to_string(expected.line) + ": field '" +
-                           expected.field + "'"),
-              std::string::npos)
-        << message;
-    EXPECT_NE(message.find(expected.contains), std::string::npos) << message;
+  // The same refusal with the samples read into a temporary file (as calibrate reads).
+  for (const bool samples_to_file : {false, true}) {
+    ImuReadOptions options;
+    options.samples_to_file = samples_to_file;
+    try {
+      imscal::ims::read_imu_csv(file, options);
+      FAIL() << file << " was accepted, samples_to_file " << samples_to_file;
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(e.file(), file.string());
+      EXPECT_EQ(e.line(), expected.line) << message;
+      EXPECT_EQ(e.field(), expected.field) << message;
+      EXPECT_NE(message.find(file.string() + ":" + std::to_string(expected.line) + ": field '" +
+                             expected.field + "'"),
+                std::string::npos)
+          << message;
+      EXPECT_NE(message.find(expected.contains), std::string::npos) << message;
+    }
   }
   // Readers never modify their input.
   EXPECT_EQ(read_text(file), before);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <utility>
 
 #include "core/input_error.hpp"
 #include "ims/sensor_error_model.hpp"
@@ -85,6 +86,25 @@ TEST(SensorErrorModel, CorrectInvertsApplyOnSeries) {
       const Eigen::Vector3d expected =
           errors.acc.sensitivity() * truth.samples[5].acc + errors.acc.bias;
       EXPECT_LT((raw.samples[5].acc - expected).norm(), 1e-14);
+    }
+  }
+}
+
+// In place (the overload for a series the caller gives up) gives the copy's values bit for bit,
+// also over uneven intervals, where each sample's interval reads the previous, corrected one.
+TEST(SensorErrorModel, CorrectInPlaceEqualsTheCopy) {
+  for (ImuQuantity q : {ImuQuantity::kIncrements, ImuQuantity::kRates}) {
+    const SensorErrorModel errors = poor_unit(5);
+    const ImuSeries raw = apply(random_series(q, 6), errors);
+    const ImuSeries copy = correct(raw, errors);
+    ImuSeries given = raw;
+    const ImuSeries in_place = correct(std::move(given), errors);
+    ASSERT_EQ(in_place.samples.size(), copy.samples.size());
+    EXPECT_EQ(in_place.quantity, copy.quantity);
+    for (std::size_t k = 0; k < copy.samples.size(); ++k) {
+      EXPECT_EQ(in_place.samples[k].t_s, copy.samples[k].t_s);
+      EXPECT_EQ(in_place.samples[k].gyro, copy.samples[k].gyro);
+      EXPECT_EQ(in_place.samples[k].acc, copy.samples[k].acc);
     }
   }
 }

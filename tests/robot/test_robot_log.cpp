@@ -43,16 +43,21 @@ RobotLog random_log(std::size_t rows) {
 TEST_F(RobotLogTest, RoundTripIsExact) {
   const RobotLog log = random_log(500);
   write_robot_log_csv(dir_ / "robot.csv", log, Overwrite::kRefuse);
-  const RobotLog back = read_robot_log_csv(dir_ / "robot.csv", "kr16");
-  ASSERT_EQ(back.samples.size(), log.samples.size());
-  EXPECT_EQ(back.robot_name, "kr16");
-  EXPECT_EQ(back.cycle_s, 0.002);
-  for (std::size_t k = 0; k < log.samples.size(); ++k) {
-    // Shortest round-trip formatting: bit-identical doubles.
-    EXPECT_EQ(back.samples[k].t_s, log.samples[k].t_s);
-    EXPECT_EQ(back.samples[k].payload_kg, log.samples[k].payload_kg);
-    EXPECT_EQ(back.samples[k].q_desired_rad, log.samples[k].q_desired_rad);
-    EXPECT_EQ(back.samples[k].q_internal_rad, log.samples[k].q_internal_rad);
+  // Read into memory and into a temporary file (as calibrate reads): the same samples.
+  for (const bool samples_to_file : {false, true}) {
+    const RobotLog back =
+        read_robot_log_csv(dir_ / "robot.csv", "kr16", "the robot description", samples_to_file);
+    EXPECT_EQ(back.samples.on_file(), samples_to_file);
+    ASSERT_EQ(back.samples.size(), log.samples.size());
+    EXPECT_EQ(back.robot_name, "kr16");
+    EXPECT_EQ(back.cycle_s, 0.002);
+    for (std::size_t k = 0; k < log.samples.size(); ++k) {
+      // Shortest round-trip formatting: bit-identical doubles.
+      EXPECT_EQ(back.samples[k].t_s, log.samples[k].t_s);
+      EXPECT_EQ(back.samples[k].payload_kg, log.samples[k].payload_kg);
+      EXPECT_EQ(back.samples[k].q_desired_rad, log.samples[k].q_desired_rad);
+      EXPECT_EQ(back.samples[k].q_internal_rad, log.samples[k].q_internal_rad);
+    }
   }
   // An existing log is not overwritten by accident.
   EXPECT_THROW(write_robot_log_csv(dir_ / "robot.csv", log, Overwrite::kRefuse), std::exception);
@@ -100,24 +105,27 @@ TEST(RobotLogBadInputs, EveryCaseIsRefusedWithFileLineAndField) {
     ++cases;
     const fs::path file = entry.path();
     const Expected expected = load_expected(fs::path(file).replace_extension(".expected"));
-    SCOPED_TRACE(file.filename().string());
-    try {
-      read_robot_log_csv(file, "kr16");
-      ADD_FAILURE() << "accepted";
-    } catch (const InputError& e) {
-      EXPECT_EQ(e.file(), file.string());
-      EXPECT_EQ(e.line(), expected.line) << e.what();
-      EXPECT_EQ(e.field(), expected.field) << e.what();
-      EXPECT_NE(std::string(e.what()).find(expected.contains), std::string::npos) << e.what();
+    // The same refusal with the samples read into a temporary file (as calibrate reads).
+    for (const bool samples_to_file : {false, true}) {
+      SCOPED_TRACE(file.filename().string() + (samples_to_file ? ", to a file" : ""));
+      try {
+        read_robot_log_csv(file, "kr16", "the robot description", samples_to_file);
+        ADD_FAILURE() << "accepted";
+      } catch (const InputError& e) {
+        EXPECT_EQ(e.file(), file.string());
+        EXPECT_EQ(e.line(), expected.line) << e.what();
+        EXPECT_EQ(e.field(), expected.field) << e.what();
+        EXPECT_NE(std::string(e.what()).find(expected.contains), std::string::npos) << e.what();
+      }
     }
   }
   EXPECT_EQ(cases, 23);  // make_cases.py writes 23: none may go missing silently
 }
 
-// Two faults in one file: the file's structure (fields, numbers) is checked to its end before
-// the log's own checks speak, and of those the header's and then the earlier row's come first.
-// The line and field of each are known from the file written here.
-TEST_F(RobotLogTest, TheFirstOfTwoFaultsIsTheStructureThenTheEarlierRow) {
+// Two faults in one file: the rows are read as they come, but the log's own checks speak only
+// once the file's structure is checked to its end, so the first error is the one a whole table
+// read first gave. The line and field of each are known from the file written here.
+TEST_F(RobotLogTest, TheFirstOfTwoFaultsIsTheOneTheTableGave) {
   const auto write = [&](const std::string& name, const std::string& robot,
                          const std::vector<std::string>& rows) {
     std::ofstream out(dir_ / name);
