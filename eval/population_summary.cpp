@@ -4,15 +4,32 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace imscal::eval {
 namespace {
 
-std::size_t column_index(const PopulationTable& table, const std::string& name) {
+std::optional<std::size_t> find_column(const PopulationTable& table, const std::string& name) {
   const auto it = std::find(table.columns.begin(), table.columns.end(), name);
-  if (it == table.columns.end()) throw std::invalid_argument("population: no column " + name);
+  if (it == table.columns.end()) return std::nullopt;
   return static_cast<std::size_t>(it - table.columns.begin());
+}
+
+std::size_t column_index(const PopulationTable& table, const std::string& name) {
+  const auto index = find_column(table, name);
+  if (!index) throw std::invalid_argument("population: no column " + name);
+  return *index;
+}
+
+// "N plants, median M, 10th percentile P, worst W (seed S)" of values (not empty), one per seed.
+std::string distribution_in_words(const std::vector<double>& values,
+                                  const std::vector<double>& seeds) {
+  const auto worst =
+      static_cast<std::size_t>(std::min_element(values.begin(), values.end()) - values.begin());
+  return fmt::format("{} plants, median {:.1f}, 10th percentile {:.1f}, worst {:.1f} (seed {:.0f})",
+                     values.size(), percentile(values, 50.0), percentile(values, 10.0),
+                     values[worst], seeds[worst]);
 }
 
 std::vector<double> column_values(const PopulationTable& table, std::size_t index) {
@@ -61,11 +78,8 @@ std::string summarize_figure(const PopulationTable& table, const std::string& fi
   const std::size_t index = column_index(table, figure);
   const std::vector<double> values = column_values(table, index);
   if (values.empty()) return figure + ": no plants\n";
-  const auto worst = std::min_element(values.begin(), values.end()) - values.begin();
-  std::string text = fmt::format(
-      "{}: {} plants, median {:.1f}, 10th percentile {:.1f}, worst {:.1f} (seed {:.0f})\n", figure,
-      values.size(), percentile(values, 50.0), percentile(values, 10.0), values[worst],
-      table.rows[static_cast<std::size_t>(worst)].front());
+  std::string text =
+      fmt::format("{}: {}\n", figure, distribution_in_words(values, column_values(table, 0)));
   if (values.size() < 3) return text;
   text +=
       "  draws correlated with it (Pearson r over the plants; a low figure goes with the\n"
@@ -77,31 +91,23 @@ std::string summarize_figure(const PopulationTable& table, const std::string& fi
 
 std::string summarize_scatter_ceiling(const PopulationTable& table, const std::string& prefix,
                                       double goal_percent) {
-  const auto has = [&table](const std::string& name) {
-    return std::find(table.columns.begin(), table.columns.end(), name) != table.columns.end();
-  };
-  const std::string before = prefix + "_before_mm", floor = prefix + "_scatter_floor_mm",
-                    reached = prefix + "_reduction_percent";
-  if (!has(before) || !has(floor) || !has(reached)) return "";
-  const std::size_t i_before = column_index(table, before), i_floor = column_index(table, floor),
-                    i_reached = column_index(table, reached);
+  const auto i_before = find_column(table, prefix + "_before_mm");
+  const auto i_floor = find_column(table, prefix + "_scatter_floor_mm");
+  const auto i_reached = find_column(table, prefix + "_reduction_percent");
+  if (!i_before || !i_floor || !i_reached) return "";
   std::vector<double> ceilings, seeds, reductions;
   for (const auto& row : table.rows) {
     // One cycle has no scatter to measure (floor 0): such a plant has no ceiling to report.
-    if (!(row.at(i_floor) > 0.0 && row.at(i_before) > 0.0)) continue;
-    const double ceiling = 100.0 * (1.0 - row.at(i_floor) / row.at(i_before));
-    ceilings.push_back(ceiling);
+    if (!(row.at(*i_floor) > 0.0 && row.at(*i_before) > 0.0)) continue;
+    ceilings.push_back(100.0 * (1.0 - row.at(*i_floor) / row.at(*i_before)));
     seeds.push_back(row.front());
-    reductions.push_back(row.at(i_reached));
+    reductions.push_back(row.at(*i_reached));
   }
   if (ceilings.empty()) return "";
-  const auto worst = std::min_element(ceilings.begin(), ceilings.end()) - ceilings.begin();
   std::string text = fmt::format(
       "{} scatter ceiling (100 (1 - scatter floor / before), the most a precontrol the same in "
-      "every cycle can reach): {} plants, median {:.1f}, 10th percentile {:.1f}, worst {:.1f} "
-      "(seed {:.0f})\n",
-      prefix, ceilings.size(), percentile(ceilings, 50.0), percentile(ceilings, 10.0),
-      ceilings[worst], seeds[static_cast<std::size_t>(worst)]);
+      "every cycle can reach): {}\n",
+      prefix, distribution_in_words(ceilings, seeds));
   std::string below;
   std::size_t count = 0;
   for (std::size_t k = 0; k < ceilings.size(); ++k) {

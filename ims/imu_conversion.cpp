@@ -24,17 +24,7 @@ double interval_before(const ImuSeries& series, std::size_t i) {
 }  // namespace
 
 ImuSeries rates_to_increments(const ImuSeries& rates) {
-  if (rates.quantity != ImuQuantity::kRates) {
-    throw std::invalid_argument("rates_to_increments: the series holds increments already");
-  }
-  ImuSeries out = rates;
-  out.quantity = ImuQuantity::kIncrements;
-  for (std::size_t i = 0; i < out.samples.size(); ++i) {
-    const double dt = interval_before(rates, i);
-    out.samples[i].gyro = rates.samples[i].gyro * dt;
-    out.samples[i].acc = rates.samples[i].acc * dt;
-  }
-  return out;
+  return rates_to_increments(ImuSeries(rates));
 }
 
 ImuSeries rates_to_increments(ImuSeries&& rates) {

@@ -58,8 +58,7 @@ ImuSeries apply(const ImuSeries& truth, const SensorErrorModel& errors) {
 }
 
 ImuSeries correct(const ImuSeries& raw, const SensorErrorModel& errors) {
-  return map_samples(
-      raw, [&](const ImuSample& s, ImuQuantity q, double dt) { return errors.correct(s, q, dt); });
+  return correct(ImuSeries(raw), errors);
 }
 
 ImuSeries correct(ImuSeries&& raw, const SensorErrorModel& errors) {
